@@ -1,0 +1,1 @@
+"""Drill models: the typed scene, the Exudyn multibody model and its results."""

@@ -1,0 +1,78 @@
+"""Energy account of a run, from the histories at every solver step.
+
+Balance (all terms cumulative from t = 0):
+    W_impact + W_feed = dE_kinetic + dE_elastic + D_damping + W_crushing
+with W_impact = int F_d v_shank dt, W_feed = sum_i F_i (x_i - x_i(0)) (+ (M_x - M_c) dphi),
+E_elastic including the rock spring (F_spring^2 / 2 k_n), D_damping = int of every damper's
+power (joints, shock absorber, the rock damper, c_x), W_crushing = F_th (x_n - x_n(0)).
+The powers are integrated by the trapezoidal rule over every stored solver step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import cumulative_trapezoid
+
+from models.results import SimulationResult
+
+
+def _cumulative(power: np.ndarray, time_s: np.ndarray) -> np.ndarray:
+    return cumulative_trapezoid(power, time_s, initial=0.0)
+
+
+@dataclass
+class EnergyAccount:
+    """Cumulative energies [J] at every stored step."""
+
+    time_s: np.ndarray
+    impact_work_j: np.ndarray
+    feed_work_j: np.ndarray
+    kinetic_j: np.ndarray
+    elastic_j: np.ndarray
+    damping_j: np.ndarray
+    crushing_work_j: np.ndarray
+
+    @property
+    def residual_j(self) -> np.ndarray:
+        """Work in minus energy accounted for; zero for an exact solution."""
+        stored = (self.kinetic_j - self.kinetic_j[0]) + (self.elastic_j - self.elastic_j[0])
+        return self.impact_work_j + self.feed_work_j - stored - self.damping_j - self.crushing_work_j
+
+    def relative_residual(self) -> float:
+        """Largest |residual| over the run divided by the total impact work."""
+        return float(np.max(np.abs(self.residual_j)) / max(self.impact_work_j[-1], 1e-300))
+
+
+def energy_account(result: SimulationResult) -> EnergyAccount:
+    chain, scene, t = result.chain, result.scene, result.time_s
+    x, v = result.position_m, result.velocity_m_per_s
+    rock = scene.rock.law()
+    masses = np.array([b.mass_kg for b in chain.bodies])
+    stiffness = np.array([link.stiffness_n_per_m for link in chain.links])
+    damping = np.array([link.damping_n_s_per_m for link in chain.links])
+
+    kinetic = 0.5 * (v**2) @ masses
+    spring_force = rock.spring_force(result.bit_position_m - result.bottom_m)
+    elastic = 0.5 * (chain.link_stretch(x) ** 2) @ stiffness + 0.5 * spring_force**2 / rock.stiffness_n_per_m
+    damping_power = (chain.link_stretch(v) ** 2) @ damping
+    # what the rock force does beyond its spring-slider part is dissipated in the rock damper
+    damping_power = damping_power + (result.rock_force_n - spring_force) * result.bit_velocity_m_per_s
+    feed = (x - x[0]) @ chain.constant_forces()
+    if result.torsion_angle_rad is not None:
+        tor = scene.torsion
+        phi, omega = result.torsion_angle_rad, result.torsion_rate_rad_per_s
+        kinetic = kinetic + 0.5 * tor.inertia_kg_m2 * omega**2
+        elastic = elastic + 0.5 * tor.stiffness_n_m_per_rad * phi**2
+        damping_power = damping_power + tor.damping_n_m_s_per_rad * omega**2
+        feed = feed + (tor.drive_torque_n_m - tor.resisting_torque_n_m) * (phi - phi[0])
+    return EnergyAccount(
+        time_s=t,
+        impact_work_j=_cumulative(result.impact_force_n * v[:, chain.impact_body], t),
+        feed_work_j=feed,
+        kinetic_j=kinetic,
+        elastic_j=elastic,
+        damping_j=_cumulative(damping_power, t),
+        crushing_work_j=rock.threshold_n * (result.bottom_m - result.bottom_m[0]),
+    )

@@ -1,0 +1,225 @@
+"""The drill as an Exudyn multibody system (the project's main formulation).
+
+Every axial body is a ``Node1D`` + ``ObjectMass1D``; every link of the chain an
+``ObjectConnectorCoordinateSpringDamper``; the feed a constant ``LoadCoordinate`` per body; the
+piston a ``LoadCoordinate`` with a symbolic load function (models.pulse); the rock the
+:class:`rocklaw.exudyn_element.ExudynRockContact` on the bit. Torsion, when enabled, is a
+``Node1D`` + ``ObjectRotationalMass1D`` with its own spring-damper to ground and a constant torque.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import exudyn as exu
+import numpy as np
+from exudyn.advancedUtilities import CreateSymbolicUserFunction
+from exudyn.itemInterface import (
+    LoadCoordinate,
+    MarkerNodeCoordinate,
+    Node1D,
+    NodePointGround,
+    ObjectConnectorCoordinateSpringDamper,
+    ObjectMass1D,
+    ObjectRotationalMass1D,
+    SensorLoad,
+    SensorNode,
+    SensorObject,
+)
+
+from models.chain import AxialChain, paper_chain
+from models.pulse import impact_force
+from models.results import SimulationResult
+from models.scene import AUTOMATIC_STEP_SOLVERS, Scene
+from models.stability import check_finite
+from rocklaw.backends import SymbolicBackend
+from rocklaw.exudyn_element import ExudynRockContact
+
+SOLVER_TYPES = {
+    "rk44": exu.DynamicSolverType.RK44,
+    "rk33": exu.DynamicSolverType.RK33,
+    "explicit_midpoint": exu.DynamicSolverType.ExplicitMidpoint,
+    "explicit_euler": exu.DynamicSolverType.ExplicitEuler,
+    "generalized_alpha": exu.DynamicSolverType.GeneralizedAlpha,
+    "trapezoidal_index2": exu.DynamicSolverType.TrapezoidalIndex2,
+    "dopri5": exu.DynamicSolverType.DOPRI5,
+    "ode23": exu.DynamicSolverType.ODE23,
+}
+COORDINATE = exu.OutputVariableType.Coordinates
+RATE = exu.OutputVariableType.Coordinates_t
+
+
+@dataclass
+class ExudynDrill:
+    """A built, assembled system and the handles needed to run and read it."""
+
+    scene: Scene
+    chain: AxialChain
+    system_container: Any
+    mbs: Any
+    rock: ExudynRockContact
+    sensors: dict[str, Any]
+    settings: Any
+    symbolic_functions: list[Any] = field(default_factory=list)  # kept alive with the system
+
+    @property
+    def coordinate_count(self) -> int:
+        return len(self.mbs.systemData.GetODE2Coordinates())
+
+
+def _add_coordinate_body(mbs: Any, make_object: Callable[[Any], Any]) -> tuple[Any, Any]:
+    node = mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[0.0], initialVelocities=[0.0]))
+    make_object(node)
+    return node, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0))
+
+
+def _store(mbs: Any, sensor: Any) -> Any:
+    return mbs.AddSensor(sensor)
+
+
+def _simulation_settings(scene: Scene) -> Any:
+    solver = scene.solver
+    settings = exu.SimulationSettings()
+    integration = settings.timeIntegration
+    integration.endTime = solver.end_time_s
+    integration.numberOfSteps = int(round(solver.end_time_s / solver.step_s))
+    integration.verboseMode = 0
+    integration.generalizedAlpha.spectralRadius = solver.spectral_radius
+    integration.newton.useModifiedNewton = True
+    if solver.type in AUTOMATIC_STEP_SOLVERS:
+        integration.automaticStepSize = True
+        integration.relativeTolerance = solver.relative_tolerance
+        integration.absoluteTolerance = solver.absolute_tolerance
+        integration.initialStepSize = solver.step_s / 10
+    else:
+        integration.automaticStepSize = False
+        integration.adaptiveStep = False
+    settings.show.statistics = False
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = 0.0  # every step: energies are integrated step by step
+    return settings
+
+
+def build_exudyn(scene: Scene) -> ExudynDrill:
+    """Build and assemble the Exudyn system of ``scene``."""
+    chain = paper_chain(scene)
+    container = exu.SystemContainer()
+    mbs = container.AddSystem()
+    ground = mbs.AddNode(NodePointGround())
+    ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+
+    nodes, markers = [], []
+    for body in chain.bodies:
+        node, marker = _add_coordinate_body(mbs, lambda n, m=body.mass_kg: mbs.AddObject(ObjectMass1D(nodeNumber=n, mass=m)))
+        nodes.append(node)
+        markers.append(marker)
+        if body.constant_force_n:
+            mbs.AddLoad(LoadCoordinate(markerNumber=marker, load=body.constant_force_n))
+    for link in chain.links:
+        base = ground_marker if link.body_a is None else markers[link.body_a]
+        mbs.AddObject(
+            ObjectConnectorCoordinateSpringDamper(
+                markerNumbers=[base, markers[link.body_b]],
+                stiffness=link.stiffness_n_per_m,
+                damping=link.damping_n_s_per_m,
+            )
+        )
+
+    impact_load = mbs.AddLoad(LoadCoordinate(markerNumber=markers[chain.impact_body], load=0.0))
+    backend = SymbolicBackend()
+
+    def piston_force(mbs, t, load):
+        return impact_force(scene.impact, t, backend)
+
+    symbolic_impact = CreateSymbolicUserFunction(mbs, piston_force, "loadUserFunction", impact_load)
+    mbs.SetLoadParameter(impact_load, "loadUserFunction", symbolic_impact)
+
+    rock = ExudynRockContact(mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], scene.rock.law())
+
+    sensors: dict[str, Any] = {}
+    for i, node in enumerate(nodes):
+        sensors[f"x{i}"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=COORDINATE))
+        sensors[f"v{i}"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=RATE))
+    sensors["rock"] = _store(
+        mbs, SensorObject(objectNumber=rock.object, storeInternal=True, outputVariableType=exu.OutputVariableType.Force)
+    )
+    sensors["impact"] = _store(mbs, SensorLoad(loadNumber=impact_load, storeInternal=True))
+
+    if scene.torsion.enabled:
+        tor = scene.torsion
+        node, marker = _add_coordinate_body(
+            mbs, lambda n: mbs.AddObject(ObjectRotationalMass1D(nodeNumber=n, inertia=tor.inertia_kg_m2))
+        )
+        mbs.AddObject(
+            ObjectConnectorCoordinateSpringDamper(
+                markerNumbers=[ground_marker, marker],
+                stiffness=tor.stiffness_n_m_per_rad,
+                damping=tor.damping_n_m_s_per_rad,
+            )
+        )
+        mbs.AddLoad(LoadCoordinate(markerNumber=marker, load=tor.drive_torque_n_m - tor.resisting_torque_n_m))
+        sensors["phi"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=COORDINATE))
+        sensors["omega"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=RATE))
+
+    mbs.Assemble()
+    return ExudynDrill(scene, chain, container, mbs, rock, sensors, _simulation_settings(scene), [symbolic_impact])
+
+
+def _pre_step(drill: ExudynDrill, progress: Callable[[float], None] | None) -> Callable[[Any, float], bool]:
+    update = drill.rock.update_bottom
+    if progress is None:
+        def pre_step(mbs: Any, t: float) -> bool:
+            update(mbs, t)
+            return True
+        return pre_step
+    report_every = drill.scene.solver.end_time_s / 100
+    next_report = [report_every]
+
+    def pre_step_with_progress(mbs: Any, t: float) -> bool:
+        update(mbs, t)
+        if t >= next_report[0]:
+            next_report[0] += report_every
+            progress(t)
+        return True
+    return pre_step_with_progress
+
+
+def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
+    return mbs.GetSensorStoredData(sensor)
+
+
+def simulate_exudyn(scene: Scene, progress: Callable[[float], None] | None = None) -> SimulationResult:
+    """Build and run the Exudyn model; ``progress(t)`` is called about 100 times during the run."""
+    drill = build_exudyn(scene)
+    mbs = drill.mbs
+    mbs.SetPreStepUserFunction(_pre_step(drill, progress))
+    start = time.process_time()
+    ok = mbs.SolveDynamic(drill.settings, solverType=SOLVER_TYPES[scene.solver.type])
+    cpu = time.process_time() - start
+    data = {name: _sensor(mbs, sensor) for name, sensor in drill.sensors.items()}
+    time_s = data["x0"][:, 0]
+    n = drill.chain.size
+    position = np.column_stack([data[f"x{i}"][:, 1] for i in range(n)])
+    velocity = np.column_stack([data[f"v{i}"][:, 1] for i in range(n)])
+    history = np.array(drill.rock.bottom_history)
+    bottom = history[np.clip(np.searchsorted(history[:, 0], time_s, side="right") - 1, 0, None), 1]
+    result = SimulationResult(
+        scene=scene,
+        chain=drill.chain,
+        formulation="exudyn",
+        time_s=time_s,
+        position_m=position,
+        velocity_m_per_s=velocity,
+        bottom_m=bottom,
+        rock_force_n=data["rock"][:, 1],
+        impact_force_n=data["impact"][:, 1],
+        torsion_angle_rad=data["phi"][:, 1] if "phi" in data else None,
+        torsion_rate_rad_per_s=data["omega"][:, 1] if "omega" in data else None,
+        cpu_time_s=cpu,
+        info={"solver_success": bool(ok), "coordinates": drill.coordinate_count, "steps": len(time_s) - 1},
+    )
+    check_finite(result, solver_ok=bool(ok))
+    return result

@@ -1,0 +1,69 @@
+"""What a simulation returns, whichever formulation produced it: histories at every solver step."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from models.chain import AxialChain
+from models.scene import Scene
+
+
+@dataclass
+class SimulationResult:
+    """State histories at the stored solver steps (rows) of one run.
+
+    Positions and velocities are along the drilling axis, positive into the rock, one column
+    per body of ``chain``. ``bottom_m`` is the borehole bottom x_n.
+    """
+
+    scene: Scene
+    chain: AxialChain
+    formulation: str
+    time_s: np.ndarray
+    position_m: np.ndarray
+    velocity_m_per_s: np.ndarray
+    bottom_m: np.ndarray
+    rock_force_n: np.ndarray
+    impact_force_n: np.ndarray
+    torsion_angle_rad: np.ndarray | None = None
+    torsion_rate_rad_per_s: np.ndarray | None = None
+    cpu_time_s: float = float("nan")
+    info: dict = field(default_factory=dict)
+
+    @property
+    def bit_position_m(self) -> np.ndarray:
+        return self.position_m[:, self.chain.bit_body]
+
+    @property
+    def bit_velocity_m_per_s(self) -> np.ndarray:
+        return self.velocity_m_per_s[:, self.chain.bit_body]
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """Named histories, header names carrying units."""
+        out = {"time_s": self.time_s}
+        for i, body in enumerate(self.chain.bodies):
+            out[f"{body.name}_position_m"] = self.position_m[:, i]
+            out[f"{body.name}_velocity_m_per_s"] = self.velocity_m_per_s[:, i]
+        out["borehole_bottom_m"] = self.bottom_m
+        out["rock_force_n"] = self.rock_force_n
+        out["impact_force_n"] = self.impact_force_n
+        if self.torsion_angle_rad is not None:
+            out["torsion_angle_rad"] = self.torsion_angle_rad
+            out["torsion_rate_rad_per_s"] = self.torsion_rate_rad_per_s
+        return out
+
+    def resampled(self, interval_s: float) -> dict[str, np.ndarray]:
+        """Histories on a uniform grid of ``interval_s`` (x_n held, the rest interpolated)."""
+        grid = np.arange(0.0, self.time_s[-1] + 0.5 * interval_s, interval_s)
+        grid = grid[grid <= self.time_s[-1] + 1e-12]
+        out = {}
+        for name, values in self.columns().items():
+            if name == "borehole_bottom_m":
+                index = np.searchsorted(self.time_s, grid, side="right") - 1
+                out[name] = values[np.clip(index, 0, len(values) - 1)]
+            else:
+                out[name] = np.interp(grid, self.time_s, values)
+        out["time_s"] = grid
+        return out

@@ -1,0 +1,185 @@
+"""The typed scene: everything one simulation needs, SI units in every name.
+
+Symbols refer to the paper (Eq. 4, Table 1). The scene knows nothing of files: build it from a
+plain dictionary with :func:`Scene.model_validate`; errors are pydantic ``ValidationError``s
+whose locations are the key paths.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from rocklaw.catalog import TABLE_1
+from rocklaw.jenkins import JenkinsRock
+
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+class Strict(BaseModel):
+    """Unknown keys are errors (a unit typo such as ``force_kn`` must not pass silently)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Bodies(Strict):
+    """Masses of the paper's three axial bodies."""
+
+    shank_mass_kg: Positive = Field(description="m1, hammer shank")
+    collar_mass_kg: Positive = Field(description="m2, drill collar (lumped string and rig mass)")
+    bit_mass_kg: Positive = Field(description="m3, drill bit")
+
+
+class SpringDamper(Strict):
+    """A linear spring k [N/m] in parallel with a viscous damper c [N s/m]."""
+
+    stiffness_n_per_m: Positive
+    damping_n_s_per_m: NonNegative = 0.0
+
+
+class Connectors(Strict):
+    """k1/c1 shock absorber, k2/c2 and k3/c3 threaded joints."""
+
+    shock_absorber: SpringDamper
+    shank_collar_joint: SpringDamper
+    collar_bit_joint: SpringDamper
+
+
+class Torsion(Strict):
+    """Fourth line of Eq. 4: J phi'' + c_x phi' + k_x phi = M_x - M_c (decoupled from the axial chain)."""
+
+    enabled: bool = True
+    inertia_kg_m2: Positive = Field(description="J_x of collar and bit")
+    stiffness_n_m_per_rad: NonNegative = Field(description="k_x")
+    damping_n_m_s_per_rad: NonNegative = Field(description="c_x")
+    drive_torque_n_m: Finite = Field(description="M_x")
+    resisting_torque_n_m: Finite = Field(description="M_c")
+
+
+class Feed(Strict):
+    """How the feed force reaches the string.
+
+    ``per_body``: the paper's Eq. 4, the shock absorber k1/c1 anchored to ground and ``force_n``
+    (F_dt) applied to every body. ``carriage``: a carriage of ``carriage_mass_kg`` pushed by
+    ``force_n`` carries the shock absorber and follows the hole, as a rig's feed does.
+    """
+
+    arrangement: Literal["per_body", "carriage"] = "carriage"
+    force_n: NonNegative
+    carriage_mass_kg: Positive | None = None
+
+    @model_validator(mode="after")
+    def _carriage_needs_mass(self) -> Feed:
+        if self.arrangement == "carriage" and self.carriage_mass_kg is None:
+            raise ValueError("arrangement 'carriage' needs carriage_mass_kg (a positive mass in kg)")
+        return self
+
+
+class Impact(Strict):
+    """Periodic piston force on the shank: one pulse of ``duration_s`` at the start of every period."""
+
+    amplitude_n: Positive = Field(description="I, the paper's impact 'impulse' (a force amplitude, N)")
+    frequency_hz: Positive = Field(description="f, blows per second")
+    shape: Literal["half_sine", "rectangular", "triangular"] = "half_sine"
+    duration_s: Positive = Field(description="tau, piston-shank contact time")
+
+    @property
+    def period_s(self) -> float:
+        return 1.0 / self.frequency_hz
+
+    @model_validator(mode="after")
+    def _pulse_fits_period(self) -> Impact:
+        if self.duration_s >= self.period_s:
+            raise ValueError(
+                f"duration_s {self.duration_s} must be shorter than the impact period "
+                f"1/frequency_hz = {self.period_s:.6g} s"
+            )
+        return self
+
+
+class Rock(Strict):
+    """The rock of Eq. 1, 2: a Table 1 ``name``, explicit values, or a name with overrides."""
+
+    name: Literal[tuple(TABLE_1)] | None = None  # type: ignore[valid-type]
+    stiffness_n_per_m: Positive | None = None
+    damping_n_s_per_m: NonNegative | None = None
+    threshold_n: Positive | None = None
+    damping_mode: Literal["contact", "always"] = "contact"
+
+    @model_validator(mode="after")
+    def _complete(self) -> Rock:
+        if self.name is None:
+            missing = [k for k in ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n") if getattr(self, k) is None]
+            if missing:
+                raise ValueError(f"give a Table 1 name ({', '.join(TABLE_1)}) or all of: {', '.join(missing)}")
+            return self
+        row = TABLE_1[self.name]
+        for key in ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n"):
+            if getattr(self, key) is None:
+                object.__setattr__(self, key, getattr(row, key))
+        return self
+
+    def law(self) -> JenkinsRock:
+        return JenkinsRock(self.stiffness_n_per_m, self.damping_n_s_per_m, self.threshold_n, self.damping_mode)
+
+
+EXUDYN_SOLVERS = (
+    "rk44", "rk33", "explicit_midpoint", "explicit_euler", "generalized_alpha",
+    "trapezoidal_index2", "dopri5", "ode23",
+)
+AUTOMATIC_STEP_SOLVERS = ("dopri5", "ode23")
+
+
+class Solver(Strict):
+    """Time integration. ``step_s`` is the fixed step (the largest step for dopri5/ode23)."""
+
+    type: Literal[EXUDYN_SOLVERS] = "rk44"  # type: ignore[valid-type]
+    step_s: Positive = 2e-5
+    spectral_radius: Annotated[float, Field(ge=0, le=1)] = 1.0
+    relative_tolerance: Positive = 1e-8
+    absolute_tolerance: Positive = 1e-12
+    end_time_s: Positive = 0.5
+    output_interval_s: Positive = 1e-4
+
+
+class Metrics(Strict):
+    """Averaging window: skip ``transient_blows`` blows, then whole blocks of ``block_blows`` blows."""
+
+    transient_blows: Annotated[int, Field(ge=0)] = 10
+    block_blows: Annotated[int, Field(ge=1)] = 5
+
+
+class Scene(Strict):
+    """One drill on one rock with one solver setting."""
+
+    name: str
+    description: str = ""
+    bodies: Bodies
+    connectors: Connectors
+    torsion: Torsion
+    feed: Feed
+    impact: Impact
+    rock: Rock
+    solver: Solver = Solver()
+    metrics: Metrics = Metrics()
+
+    @model_validator(mode="after")
+    def _long_enough(self) -> Scene:
+        period = self.impact.period_s
+        if self.solver.end_time_s < period:
+            raise ValueError(
+                f"solver.end_time_s {self.solver.end_time_s} is shorter than one impact period ({period:.6g} s)"
+            )
+        needed = (self.metrics.transient_blows + self.metrics.block_blows) * period
+        if self.solver.end_time_s < needed * (1 - 1e-12):
+            raise ValueError(
+                f"solver.end_time_s {self.solver.end_time_s} covers {self.solver.end_time_s / period:.3g} blows; "
+                f"the metrics need transient_blows + block_blows = "
+                f"{self.metrics.transient_blows + self.metrics.block_blows} blows ({needed:.6g} s)"
+            )
+        if self.solver.step_s > period / 20:
+            raise ValueError(f"solver.step_s {self.solver.step_s} must resolve the impact period: at most {period / 20:.3g} s")
+        return self

@@ -1,0 +1,1 @@
+"""YAML scenes and studies, and the ``rpdrill`` command line."""

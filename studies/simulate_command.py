@@ -1,0 +1,47 @@
+"""Run one scene: time histories, summary figures and a plot.
+
+Writes DIR/timeseries.csv, DIR/summary.json, DIR/scene.resolved.yaml and DIR/timeseries.png.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from models.exudyn_model import simulate_exudyn
+from models.metrics import summary_metrics
+from models.stability import SimulationFailed
+from studies.loading import load_scene
+from studies.outputs import staged_directory, write_columns_csv, write_json, write_resolved
+from studies.plots import plot_timeseries
+from studies.progress import time_progress
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="scene YAML file")
+    parser.add_argument("--out", required=True, help="output directory")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args: argparse.Namespace) -> int:
+    scene = load_scene(args.scene)
+    try:
+        with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
+            result = simulate_exudyn(scene, progress)
+    except SimulationFailed as err:
+        print(f"rpdrill: {err}", file=sys.stderr)
+        return 1
+    summary = summary_metrics(result)
+    columns = result.resampled(scene.solver.output_interval_s)
+    with staged_directory(args.out) as stage:
+        write_columns_csv(stage / "timeseries.csv", columns)
+        write_json(stage / "summary.json", {"scene": scene.name, "formulation": result.formulation,
+                                            "metrics": summary, "run": result.info})
+        write_resolved(stage / "scene.resolved.yaml", scene)
+        plot_timeseries(columns, f"{scene.name}: {scene.impact.frequency_hz:g} Hz, "
+                        f"{scene.impact.amplitude_n / 1e3:g} kN", stage / "timeseries.png")
+    rate = summary["penetration_rate_m_per_s"] * 1e3
+    print(f"{scene.name}: penetration rate {rate:.4g} mm/s, advance per blow "
+          f"{summary['advance_per_blow_m'] * 1e6:.4g} um, efficiency {summary['energy_transfer_efficiency']:.3g}, "
+          f"energy balance error {summary['energy_balance_relative_error']:.2e}; wrote {args.out}")
+    return 0
