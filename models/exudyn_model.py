@@ -16,7 +16,6 @@ from typing import Any
 
 import exudyn as exu
 import numpy as np
-from exudyn.advancedUtilities import CreateSymbolicUserFunction
 from exudyn.itemInterface import (
     LoadCoordinate,
     MarkerNodeCoordinate,
@@ -35,8 +34,8 @@ from models.pulse import impact_force
 from models.results import SimulationResult
 from models.scene import AUTOMATIC_STEP_SOLVERS, Scene
 from models.stability import check_finite
-from rocklaw.backends import SymbolicBackend
-from rocklaw.exudyn_element import ExudynRockContact
+from rocklaw.backends import NUMERIC, SymbolicBackend
+from rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 
 SOLVER_TYPES = {
     "rk44": exu.DynamicSolverType.RK44,
@@ -85,7 +84,7 @@ def _simulation_settings(scene: Scene) -> Any:
     settings = exu.SimulationSettings()
     integration = settings.timeIntegration
     integration.endTime = solver.end_time_s
-    integration.numberOfSteps = int(round(solver.end_time_s / solver.step_s))
+    integration.numberOfSteps = round(solver.end_time_s / solver.step_s)
     integration.verboseMode = 0
     integration.generalizedAlpha.spectralRadius = solver.spectral_radius
     integration.newton.useModifiedNewton = True
@@ -103,8 +102,12 @@ def _simulation_settings(scene: Scene) -> Any:
     return settings
 
 
-def build_exudyn(scene: Scene) -> ExudynDrill:
-    """Build and assemble the Exudyn system of ``scene``."""
+def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
+    """Build and assemble the Exudyn system of ``scene``.
+
+    ``symbolic=False`` uses Python callbacks for the impact and rock forces (same law, slower:
+    kept for the benchmark that measures what the symbolic functions save).
+    """
     chain = paper_chain(scene)
     container = exu.SystemContainer()
     mbs = container.AddSystem()
@@ -129,15 +132,15 @@ def build_exudyn(scene: Scene) -> ExudynDrill:
         )
 
     impact_load = mbs.AddLoad(LoadCoordinate(markerNumber=markers[chain.impact_body], load=0.0))
-    backend = SymbolicBackend()
+    backend = SymbolicBackend() if symbolic else NUMERIC
 
     def piston_force(mbs, t, load):
         return impact_force(scene.impact, t, backend)
 
-    symbolic_impact = CreateSymbolicUserFunction(mbs, piston_force, "loadUserFunction", impact_load)
-    mbs.SetLoadParameter(impact_load, "loadUserFunction", symbolic_impact)
-
-    rock = ExudynRockContact(mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], scene.rock.law())
+    impact_function = attach_user_function(mbs, impact_load, "loadUserFunction", piston_force, symbolic)
+    rock = ExudynRockContact(
+        mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], scene.rock.law(), symbolic=symbolic
+    )
 
     sensors: dict[str, Any] = {}
     for i, node in enumerate(nodes):
@@ -165,7 +168,7 @@ def build_exudyn(scene: Scene) -> ExudynDrill:
         sensors["omega"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=RATE))
 
     mbs.Assemble()
-    return ExudynDrill(scene, chain, container, mbs, rock, sensors, _simulation_settings(scene), [symbolic_impact])
+    return ExudynDrill(scene, chain, container, mbs, rock, sensors, _simulation_settings(scene), [impact_function])
 
 
 def _pre_step(drill: ExudynDrill, progress: Callable[[float], None] | None) -> Callable[[Any, float], bool]:
@@ -191,9 +194,11 @@ def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
     return mbs.GetSensorStoredData(sensor)
 
 
-def simulate_exudyn(scene: Scene, progress: Callable[[float], None] | None = None) -> SimulationResult:
+def simulate_exudyn(
+    scene: Scene, progress: Callable[[float], None] | None = None, symbolic: bool = True
+) -> SimulationResult:
     """Build and run the Exudyn model; ``progress(t)`` is called about 100 times during the run."""
-    drill = build_exudyn(scene)
+    drill = build_exudyn(scene, symbolic)
     mbs = drill.mbs
     mbs.SetPreStepUserFunction(_pre_step(drill, progress))
     start = time.process_time()

@@ -33,7 +33,7 @@ def impact_force(impact: Impact, t: Any, backend: Backend = NUMERIC) -> Any:
 def pulse_switch_times(impact: Impact, end_time_s: float) -> list[float]:
     """Times at which F_d switches on or off in [0, end_time_s] (for event-located solvers)."""
     times = []
-    for blow in range(int(math.floor(end_time_s * impact.frequency_hz)) + 1):
+    for blow in range(math.floor(end_time_s * impact.frequency_hz) + 1):
         start = blow * impact.period_s
         times += [t for t in (start, start + impact.duration_s) if t <= end_time_s]
     return times

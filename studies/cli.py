@@ -11,10 +11,11 @@ import sys
 
 from studies.loading import InputError
 
+# name: (module, one-line help); a module is imported only when its command runs
 COMMANDS = {
-    "simulate": "studies.simulate_command",
-    "crosscheck": "studies.crosscheck",
-    "study": "studies.study_command",
+    "simulate": ("studies.simulate_command", "run one scene: time histories, summary, plot"),
+    "crosscheck": ("studies.crosscheck", "run the Exudyn model and the ODE of Eq. 4 and compare them"),
+    "study": ("studies.study_command", "run a YAML study (scan) on all cores or a Dask cluster"),
 }
 
 
@@ -26,21 +27,18 @@ class _Parser(argparse.ArgumentParser):
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     parser = _Parser(prog="rpdrill", description="Rotary-percussive drilling simulator on Exudyn")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    modules = {}
-    for name, module_name in COMMANDS.items():
-        try:
+    module = None
+    for name, (module_name, help_text) in COMMANDS.items():
+        command_parser = sub.add_parser(name, help=help_text, description=help_text)
+        if argv[:1] == [name]:
             module = importlib.import_module(module_name)
-        except ModuleNotFoundError as err:
-            if err.name != module_name:
-                raise
-            continue
-        modules[name] = module
-        module.add_arguments(sub.add_parser(name, help=module.__doc__.strip().splitlines()[0]))
+            module.add_arguments(command_parser)
     args = parser.parse_args(argv)
     try:
-        return int(modules[args.command].run(args))
+        return int(module.run(args))
     except InputError as err:
         print(str(err), file=sys.stderr)
         return 2

@@ -1,0 +1,59 @@
+"""Cost of the core Exudyn model: CPU s per simulated second, symbolic vs Python user functions,
+and the accuracy of x_n(0.3 s) against step size.
+
+Usage: python benchmarks/bench_core.py [SCENE.yaml] [--repeats N]
+Prints medians over N repeats and ratios measured in this one run (the machine is shared).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+from pathlib import Path
+
+from models.exudyn_model import simulate_exudyn
+from models.scene import Scene
+from studies.loading import load_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def with_solver(scene: Scene, **solver: float | str) -> Scene:
+    data = scene.model_dump()
+    data["solver"].update(solver)
+    data["metrics"] = {"transient_blows": 0, "block_blows": 1}
+    return Scene.model_validate(data)
+
+
+def cpu_per_simulated_second(scene: Scene, repeats: int, symbolic: bool = True) -> float:
+    runs = [simulate_exudyn(scene, symbolic=symbolic).cpu_time_s for _ in range(repeats)]
+    return statistics.median(runs) / scene.solver.end_time_s
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scene", nargs="?", default=ROOT / "studies" / "scenes" / "paper_base.yaml")
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args()
+    scene = load_scene(args.scene)
+    step = scene.solver.step_s
+    timing = with_solver(scene, end_time_s=1.0)
+    symbolic = cpu_per_simulated_second(timing, args.repeats, symbolic=True)
+    python = cpu_per_simulated_second(timing, max(1, args.repeats // 2), symbolic=False)
+    print(f"scene {scene.name}, solver {scene.solver.type}, step {step:g} s, 1 s simulated")
+    print(f"symbolic user functions: {symbolic:.3f} CPU s per simulated s (median of {args.repeats})")
+    print(f"python user functions:   {python:.3f} CPU s per simulated s")
+    print(f"ratio python / symbolic: {python / symbolic:.2f}")
+
+    reference_step = step / 32
+    reference = simulate_exudyn(with_solver(scene, end_time_s=0.3, step_s=reference_step)).bottom_m[-1]
+    print(f"\nx_n(0.3 s) against {scene.solver.type} at step {reference_step:g} s: {reference * 1e3:.6f} mm")
+    print("step_s      x_n(0.3 s) [mm]   relative error   CPU s per simulated s")
+    for factor in (4, 2, 1, 0.5, 0.25):
+        run = simulate_exudyn(with_solver(scene, end_time_s=0.3, step_s=step * factor))
+        error = abs(run.bottom_m[-1] - reference) / abs(reference) if reference else float("nan")
+        print(f"{step * factor:<10.3g}  {run.bottom_m[-1] * 1e3:<16.6f}  {error:<15.2e}  {run.cpu_time_s / 0.3:.3f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,41 @@
+"""Scenes for tests: the shipped paper_base scene with overrides by dotted key path."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from models.scene import Scene
+
+SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
+PAPER_BASE = SCENES / "paper_base.yaml"
+
+# Overrides that make paper_base crush on every blow (used where a test needs crushing).
+CRUSHING = {"impact.amplitude_n": 400e3, "impact.frequency_hz": 45.0}
+
+
+def scene_dict(path: Path = PAPER_BASE, **overrides: Any) -> dict:
+    """The scene file as a dict with ``{"a.b.c": value}`` overrides (use ``None`` to delete a key)."""
+    data = copy.deepcopy(yaml.safe_load(path.read_text()))
+    for dotted, value in overrides.items():
+        *parents, key = dotted.split(".")
+        node = data
+        for part in parents:
+            node = node.setdefault(part, {})
+        if value is None:
+            node.pop(key, None)
+        else:
+            node[key] = value
+    return data
+
+
+def scene(**overrides: Any) -> Scene:
+    """``scene_dict`` validated; keyword names use ``__`` for dots (``impact__frequency_hz=50``)."""
+    return Scene.model_validate(scene_dict(**{k.replace("__", "."): v for k, v in overrides.items()}))
+
+
+def crushing_scene(**overrides: Any) -> Scene:
+    return scene(**({k.replace(".", "__"): v for k, v in CRUSHING.items()} | overrides))

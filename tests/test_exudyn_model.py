@@ -1,0 +1,113 @@
+"""The Exudyn model end to end: structure, the rock element in the system, feeds, energy."""
+
+import warnings
+
+import numpy as np
+import pytest
+from scenes import crushing_scene, scene
+
+from models.energy import energy_account
+from models.exudyn_model import build_exudyn, simulate_exudyn
+from models.metrics import summary_metrics
+
+SHORT = {"solver__end_time_s": 0.3, "metrics__transient_blows": 4, "metrics__block_blows": 3}
+
+
+@pytest.fixture(scope="module")
+def crushing_run():
+    return simulate_exudyn(crushing_scene(**SHORT))
+
+
+@pytest.mark.parametrize(
+    "overrides, coordinates",
+    [
+        ({}, 5),  # shank, collar, bit, carriage, torsion
+        ({"torsion__enabled": False}, 4),
+        ({"feed__arrangement": "per_body", "feed__carriage_mass_kg": None}, 4),
+        ({"feed__arrangement": "per_body", "torsion__enabled": False}, 3),
+    ],
+)
+def test_coordinate_count(overrides, coordinates):
+    assert build_exudyn(scene(**overrides)).coordinate_count == coordinates
+
+
+def test_no_deprecation_warnings():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)
+        simulate_exudyn(scene(solver__end_time_s=0.2, metrics__transient_blows=2, metrics__block_blows=2))
+
+
+def test_bottom_is_return_mapping_of_bit_path(crushing_run):
+    """x_n at every step is the running max of x_bit - F_th/k_n (Eq. 2 with per-step return mapping)."""
+    r = crushing_run
+    law = r.scene.rock.law()
+    expected = np.maximum.accumulate(np.maximum(r.bit_position_m - law.crushing_penetration_m, 0.0))
+    np.testing.assert_allclose(r.bottom_m, expected, rtol=0, atol=1e-15)
+    advancing_blows = np.unique(np.floor(r.time_s[np.diff(r.bottom_m, prepend=0.0) > 0] * r.scene.impact.frequency_hz))
+    assert len(advancing_blows) >= 10  # it crushed on many blows
+
+
+def test_rock_force_never_pulls_and_is_capped(crushing_run):
+    r = crushing_run
+    law = r.scene.rock.law()
+    assert r.rock_force_n.min() >= 0.0
+    # spring part capped at F_th; the rest is the rock damper c_n v
+    cap = law.threshold_n + law.damping_n_s_per_m * np.maximum(r.bit_velocity_m_per_s, 0.0)
+    assert np.all(r.rock_force_n <= cap * (1 + 1e-9))
+    off = r.bit_position_m < r.bottom_m
+    assert off.any() and np.all(r.rock_force_n[off] == 0.0)
+
+
+def test_symbolic_and_python_user_functions_agree():
+    s = crushing_scene(solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2)
+    symbolic, python = simulate_exudyn(s), simulate_exudyn(s, symbolic=False)
+    np.testing.assert_allclose(symbolic.position_m, python.position_m, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(symbolic.bottom_m, python.bottom_m, rtol=1e-12, atol=1e-15)
+
+
+def test_energy_balance_within_one_percent_and_shrinking_with_step():
+    errors = []
+    for step in (2e-5, 1e-5, 5e-6):
+        account = energy_account(simulate_exudyn(crushing_scene(solver__step_s=step, **SHORT)))
+        assert account.crushing_work_j[-1] > 0.1 * account.impact_work_j[-1]
+        errors.append(account.relative_residual())
+    assert errors[0] < 0.01
+    assert errors[1] < errors[0] and errors[2] < errors[1]
+
+
+def test_carriage_carries_the_feed_and_anchored_absorber_takes_it_up():
+    """Carriage: the shock absorber passes the feed force on (mean over the last blows ~ F_feed).
+    Anchored to ground: k1 x_shank grows with depth and takes over the feed of the bodies."""
+    carriage = simulate_exudyn(crushing_scene(**SHORT))
+    anchored = simulate_exudyn(crushing_scene(feed__arrangement="per_body", feed__force_n=10e3,
+                                              feed__carriage_mass_kg=None, **SHORT))
+    for r in (carriage, anchored):
+        assert r.bottom_m[-1] > 2 * r.scene.rock.law().crushing_penetration_m  # both crushed
+    k1 = carriage.scene.connectors.shock_absorber.stiffness_n_per_m
+    last = carriage.time_s > carriage.time_s[-1] - 3 * carriage.scene.impact.period_s
+    absorber = k1 * (carriage.position_m[:, 3] - carriage.position_m[:, 0])  # compression
+    assert np.mean(absorber[last]) == pytest.approx(carriage.scene.feed.force_n, rel=0.1)
+    held_by_k1 = k1 * anchored.position_m[:, 0]  # anchored at x = 0
+    quarter = len(held_by_k1) // 4
+    deepening = anchored.bottom_m[-1] - anchored.bottom_m[quarter]
+    assert deepening > 0
+    assert held_by_k1[-1] - held_by_k1[quarter] == pytest.approx(k1 * deepening, rel=0.3)
+
+
+def test_metrics_are_consistent(crushing_run):
+    m = summary_metrics(crushing_run)
+    period = crushing_run.scene.impact.period_s
+    assert m["advance_per_blow_m"] == pytest.approx(m["penetration_rate_m_per_s"] * period)
+    assert m["penetration_rate_block_min_m_per_s"] <= m["penetration_rate_m_per_s"] <= \
+        m["penetration_rate_block_max_m_per_s"]
+    assert 0 < m["energy_transfer_efficiency"] < 1
+    assert m["window_blows"] == 9  # 0.3 s at 45 Hz = 13 whole blows: skip 4, three blocks of 3
+    assert m["rock_force_max_n"] >= crushing_run.scene.rock.threshold_n
+
+
+def test_resampled_output_grid(crushing_run):
+    columns = crushing_run.resampled(1e-3)
+    assert np.allclose(np.diff(columns["time_s"]), 1e-3)
+    assert set(columns) >= {"bit_velocity_m_per_s", "borehole_bottom_m", "rock_force_n", "impact_force_n",
+                            "torsion_angle_rad", "carriage_position_m"}
+    assert np.all(np.diff(columns["borehole_bottom_m"]) >= 0)
