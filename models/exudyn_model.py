@@ -10,6 +10,7 @@ piston a ``LoadCoordinate`` with a symbolic load function (models.pulse); the ro
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -33,7 +34,7 @@ from models.chain import AxialChain, paper_chain
 from models.pulse import impact_force
 from models.results import SimulationResult
 from models.scene import AUTOMATIC_STEP_SOLVERS, Scene
-from models.stability import check_finite
+from models.stability import StepLimitWarning, check_result, step_warning
 from rocklaw.backends import NUMERIC, SymbolicBackend
 from rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 
@@ -198,6 +199,9 @@ def simulate_exudyn(
     scene: Scene, progress: Callable[[float], None] | None = None, symbolic: bool = True
 ) -> SimulationResult:
     """Build and run the Exudyn model; ``progress(t)`` is called about 100 times during the run."""
+    warning = step_warning(scene)
+    if warning:
+        warnings.warn(warning, StepLimitWarning, stacklevel=2)
     drill = build_exudyn(scene, symbolic)
     mbs = drill.mbs
     mbs.SetPreStepUserFunction(_pre_step(drill, progress))
@@ -226,5 +230,5 @@ def simulate_exudyn(
         cpu_time_s=cpu,
         info={"solver_success": bool(ok), "coordinates": drill.coordinate_count, "steps": len(time_s) - 1},
     )
-    check_finite(result, solver_ok=bool(ok))
+    check_result(result, solver_ok=bool(ok))
     return result

@@ -1,33 +1,114 @@
-"""Detection of runs whose numbers must not be reported (diverged or stopped early)."""
+"""Detection of runs whose numbers must not be reported, and the step limits of explicit solvers.
+
+A run is rejected when its states are non-finite or explode, when the energy stored in the
+drill grows beyond the work put in (impossible for this dissipative model), or when the solver
+stopped before the end time. Explicit solvers have a largest stable step h_max = factor /
+omega_max, with omega_max the highest natural frequency of the chain in contact with the rock
+(generalized eigenvalues of K + k_n e_bit e_bit^T and M); the factors were measured on the
+hard scenes (docs/stability.md).
+"""
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import eigh
 
+from models.chain import AxialChain, paper_chain
+from models.energy import energy_account
+from models.pulse import impulse_per_blow_n_s
 from models.results import SimulationResult
+from models.scene import Scene
 
 # Positions beyond this are not drilling: the solver has blown up (states near 1e300 seen with
 # explicit solvers at too large a step, reported as success by the solver).
 POSITION_LIMIT_M = 1e3
+
+# Largest stable h * omega_max measured on the hard scenes (docs/stability.md); None: no step
+# is stable on the undamped modes (explicit Euler amplifies every oscillation).
+STABLE_STEP_FACTOR: dict[str, float | None] = {
+    "rk44": 2.8,
+    "rk33": 1.6,
+    "explicit_midpoint": 0.2,
+    "explicit_euler": None,
+}
+SUGGESTED = "rk44"
 
 
 class SimulationFailed(RuntimeError):
     """A run that diverged or did not reach its end time."""
 
 
-def check_finite(result: SimulationResult, solver_ok: bool) -> None:
+class StepLimitWarning(UserWarning):
+    """A fixed explicit step beyond the measured stability limit of the scene's stiffest mode."""
+
+
+def highest_frequency_rad_per_s(chain: AxialChain, rock_stiffness_n_per_m: float) -> float:
+    """omega_max = sqrt(max eig(K_contact, M)), the stiffest mode with the bit on the rock."""
+    stiffness = chain.stiffness_matrix()
+    stiffness[chain.bit_body, chain.bit_body] += rock_stiffness_n_per_m
+    return float(np.sqrt(eigh(stiffness, chain.mass_matrix(), eigvals_only=True).max()))
+
+
+def largest_stable_step_s(scene: Scene) -> float | None:
+    """h_max of the scene's fixed-step explicit solver; None for implicit or adaptive solvers."""
+    if scene.solver.type not in STABLE_STEP_FACTOR:
+        return None
+    factor = STABLE_STEP_FACTOR[scene.solver.type]
+    omega = highest_frequency_rad_per_s(paper_chain(scene), scene.rock.stiffness_n_per_m)
+    return 0.0 if factor is None else factor / omega
+
+
+def step_warning(scene: Scene) -> str | None:
+    """A warning when a fixed explicit step exceeds the measured stability limit."""
+    limit = largest_stable_step_s(scene)
+    if limit is None or scene.solver.step_s <= limit:
+        return None
+    if limit == 0.0:
+        return (f"scene '{scene.name}': solver {scene.solver.type} is unstable at any step on the undamped "
+                f"modes of this drill; use {SUGGESTED} with step_s <= {_rk44_limit(scene):.3g}")
+    return (f"scene '{scene.name}': solver.step_s {scene.solver.step_s:g} exceeds the stability limit "
+            f"{limit:.3g} s of {scene.solver.type} for the stiffest mode of this drill")
+
+
+def _rk44_limit(scene: Scene) -> float:
+    return STABLE_STEP_FACTOR[SUGGESTED] / highest_frequency_rad_per_s(paper_chain(scene), scene.rock.stiffness_n_per_m)
+
+
+def _remedy(scene: Scene) -> str:
+    solver = scene.solver
+    if solver.type in STABLE_STEP_FACTOR:
+        limit = largest_stable_step_s(scene) or 0.0
+        if limit > 0 and solver.step_s > limit:
+            return f"try solver.step_s {0.5 * limit:.3g} (stability limit {limit:.3g} s)"
+        return f"try solver.type {SUGGESTED} with solver.step_s {0.5 * _rk44_limit(scene):.3g}"
+    return f"try solver.step_s {solver.step_s / 4:g} or solver.type {SUGGESTED}"
+
+
+def _energy_blow_up_index(result: SimulationResult) -> int | None:
+    """First step at which the stored energy exceeds twice the work put in (plus one blow's scale)."""
+    account = energy_account(result)
+    stored = account.kinetic_j - account.kinetic_j[0] + account.elastic_j - account.elastic_j[0]
+    work_in = np.maximum.accumulate(np.abs(account.impact_work_j) + np.abs(account.feed_work_j))
+    scene = result.scene
+    blow_scale_j = impulse_per_blow_n_s(scene.impact) ** 2 / (2 * scene.bodies.shank_mass_kg)
+    bad = stored > 2.0 * work_in + blow_scale_j
+    return int(np.argmax(bad)) if bad.any() else None
+
+
+def check_result(result: SimulationResult, solver_ok: bool) -> None:
     """Raise :class:`SimulationFailed` naming scene, solver, time and a remedy if the run is unusable."""
     scene, solver = result.scene, result.scene.solver
+    setting = f"solver {solver.type} with step_s {solver.step_s:g}"
     states = np.column_stack([result.position_m, result.velocity_m_per_s])
     bad = ~np.isfinite(states).all(axis=1) | (np.abs(result.position_m) > POSITION_LIMIT_M).any(axis=1)
-    setting = f"solver {solver.type} with step_s {solver.step_s:g}"
-    remedy = f"try solver.step_s {solver.step_s / 4:g} or solver.type generalized_alpha"
-    if bad.any():
-        when = result.time_s[np.argmax(bad)]
-        raise SimulationFailed(f"scene '{scene.name}': {setting} diverged at t = {when:.6g} s; {remedy}")
+    index = int(np.argmax(bad)) if bad.any() else _energy_blow_up_index(result)
+    if index is not None:
+        raise SimulationFailed(
+            f"scene '{scene.name}': {setting} diverged at t = {result.time_s[index]:.6g} s; {_remedy(scene)}"
+        )
     reached = result.time_s[-1] if len(result.time_s) else 0.0
     if not solver_ok or reached < solver.end_time_s * (1 - 1e-9):
         raise SimulationFailed(
             f"scene '{scene.name}': {setting} stopped at t = {reached:.6g} s before end_time_s "
-            f"{solver.end_time_s:g}; {remedy}"
+            f"{solver.end_time_s:g}; {_remedy(scene)}"
         )

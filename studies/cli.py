@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+import warnings
 
 from studies.loading import InputError
 
@@ -26,7 +27,12 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(2)
 
 
+def _one_line_warning(message, category, filename, lineno, line=None) -> str:  # noqa: ANN001
+    return f"rpdrill: warning: {message}\n"
+
+
 def main(argv: list[str] | None = None) -> int:
+    warnings.formatwarning = _one_line_warning
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = _Parser(prog="rpdrill", description="Rotary-percussive drilling simulator on Exudyn")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
