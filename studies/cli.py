@@ -27,7 +27,7 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(2)
 
 
-def _one_line_warning(message, category, filename, lineno, line=None) -> str:  # noqa: ANN001
+def _one_line_warning(message, category, filename, lineno, line=None) -> str:
     return f"rpdrill: warning: {message}\n"
 
 

@@ -1,0 +1,93 @@
+"""Hard scenes stay numerically stable with every preset and with the fixed-step explicit
+solvers at the largest step the docs allow; a too-large step is reported, never returned."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pytest
+
+from stability.hard_scenes import HARD_SCENES, LONG_RUN, SHORT
+from models.exudyn_model import simulate_exudyn
+from models.metrics import summary_metrics
+from models.results import SimulationResult
+from models.scene import SOLVER_PRESETS, Scene
+from models.stability import STABLE_STEP_FACTOR, SimulationFailed, StepLimitWarning, largest_stable_step_s
+from scenes import scene_dict
+
+
+def make(overrides: dict, solver: dict) -> Scene:
+    data = scene_dict(**(SHORT | overrides))
+    data["solver"] = {"end_time_s": data["solver"]["end_time_s"]} | solver
+    return Scene.model_validate(data)
+
+
+@functools.cache
+def run(name: str, preset: str) -> tuple[SimulationResult, dict]:
+    result = simulate_exudyn(make(HARD_SCENES[name], {"preset": preset}))
+    return result, summary_metrics(result)
+
+
+def assert_physical(result: SimulationResult) -> None:
+    assert np.isfinite(result.position_m).all() and np.isfinite(result.velocity_m_per_s).all()
+    assert np.all(np.diff(result.bottom_m) >= 0.0)  # the borehole never closes
+    assert result.rock_force_n.min() >= 0.0  # the rock never pulls (damping_mode contact)
+
+
+def rate_error(metrics: dict, reference: dict) -> float:
+    ref = reference["penetration_rate_m_per_s"]
+    return abs(metrics["penetration_rate_m_per_s"] - ref) / max(abs(ref), 1e-9)
+
+
+@pytest.mark.parametrize("preset", list(SOLVER_PRESETS))
+@pytest.mark.parametrize("name", list(HARD_SCENES))
+def test_preset_is_stable_and_within_its_stated_errors(name, preset):
+    result, metrics = run(name, preset)
+    assert_physical(result)
+    stated = SOLVER_PRESETS[preset]
+    assert metrics["energy_balance_relative_error"] <= stated["energy_balance_error"]
+    if preset != "reference":
+        assert rate_error(metrics, run(name, "reference")[1]) <= stated["penetration_rate_error"]
+
+
+@pytest.mark.parametrize("solver", [s for s, f in STABLE_STEP_FACTOR.items() if f is not None])
+@pytest.mark.parametrize("name", list(HARD_SCENES))
+def test_fixed_step_at_documented_limit_stays_stable(name, solver):
+    base = make(HARD_SCENES[name], {"preset": "standard"})
+    step = min(largest_stable_step_s(base, solver), base.impact.duration_s / 5, base.impact.period_s / 20)
+    result = simulate_exudyn(make(HARD_SCENES[name], {"type": solver, "step_s": step}))
+    assert_physical(result)
+
+
+def test_the_chattering_scene_chatters():
+    result, _ = run("chattering_bit", "standard")
+    made = np.flatnonzero(np.diff((result.bit_position_m > result.bottom_m).astype(int)) == 1)
+    _, per_blow = np.unique(np.floor(result.time_s[made] * result.scene.impact.frequency_hz), return_counts=True)
+    assert per_blow.max() >= 2  # re-contact within one blow
+
+
+@pytest.mark.parametrize("name", ["stiffest_rock_stiff_joints", "crushes_on_every_contact", "no_damping"])
+def test_crushing_scenes_do_crush(name):
+    assert run(name, "standard")[0].bottom_m[-1] > 0
+
+
+@pytest.mark.slow
+def test_long_run_650_blows():
+    results = {p: simulate_exudyn(make(LONG_RUN, {"preset": p})) for p in ("fast", "standard")}
+    for result in results.values():
+        assert_physical(result)
+        assert result.time_s[-1] * result.scene.impact.frequency_hz >= 650
+    fast, standard = (summary_metrics(results[p]) for p in ("fast", "standard"))
+    assert standard["energy_balance_relative_error"] <= SOLVER_PRESETS["standard"]["energy_balance_error"]
+    assert rate_error(fast, standard) <= SOLVER_PRESETS["fast"]["penetration_rate_error"]
+
+
+def test_unstable_step_is_reported_with_time_and_remedy():
+    limit = largest_stable_step_s(make(HARD_SCENES["no_damping"], {"preset": "standard"}), "rk44")
+    scene = make(HARD_SCENES["no_damping"], {"type": "rk44", "step_s": 1.5 * limit})
+    with pytest.warns(StepLimitWarning, match="exceeds the stability limit"), \
+            pytest.raises(SimulationFailed) as failure:
+        simulate_exudyn(scene)
+    message = str(failure.value)
+    assert "diverged at t =" in message and "rk44" in message and "try solver.step_s" in message
