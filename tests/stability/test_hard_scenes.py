@@ -7,14 +7,14 @@ import functools
 
 import numpy as np
 import pytest
+from scenes import scene_dict
 
-from stability.hard_scenes import HARD_SCENES, LONG_RUN, SHORT
 from models.exudyn_model import simulate_exudyn
 from models.metrics import summary_metrics
 from models.results import SimulationResult
 from models.scene import SOLVER_PRESETS, Scene
 from models.stability import STABLE_STEP_FACTOR, SimulationFailed, StepLimitWarning, largest_stable_step_s
-from scenes import scene_dict
+from stability.hard_scenes import HARD_SCENES, LONG_RUN, SHORT
 
 
 def make(overrides: dict, solver: dict) -> Scene:
