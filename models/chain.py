@@ -79,7 +79,10 @@ class AxialChain:
 
 
 def paper_chain(scene: Scene) -> AxialChain:
-    """Shank, collar, bit (indices 0, 1, 2) and, with a feed carriage, the carriage (index 3)."""
+    """Shank, collar, bit (indices 0, 1, 2) and, with a feed carriage, the carriage (index 3).
+
+    Joint damping (c1, c2, c3) is zero when the scene's ``joint_damping`` effect is off.
+    """
     per_body = scene.feed.arrangement == "per_body"
     body_force = scene.feed.force_n if per_body else 0.0
     bodies = [
@@ -91,11 +94,12 @@ def paper_chain(scene: Scene) -> AxialChain:
     if not per_body:
         bodies.append(Body("carriage", scene.feed.carriage_mass_kg, scene.feed.force_n))
         anchor = CARRIAGE
-    c = scene.connectors
-    links = (
-        Link("shock_absorber", anchor, SHANK, c.shock_absorber.stiffness_n_per_m, c.shock_absorber.damping_n_s_per_m),
-        Link("shank_collar_joint", SHANK, COLLAR, c.shank_collar_joint.stiffness_n_per_m,
-             c.shank_collar_joint.damping_n_s_per_m),
-        Link("collar_bit_joint", COLLAR, BIT, c.collar_bit_joint.stiffness_n_per_m, c.collar_bit_joint.damping_n_s_per_m),
+    joint_damping = scene.effects.joint_damping
+    links = tuple(
+        Link(name, anchor if name == "shock_absorber" else a, b, pair.stiffness_n_per_m,
+             pair.damping_n_s_per_m if joint_damping else 0.0)
+        for name, a, b in (("shock_absorber", None, SHANK), ("shank_collar_joint", SHANK, COLLAR),
+                           ("collar_bit_joint", COLLAR, BIT))
+        for pair in (getattr(scene.connectors, name),)
     )
     return AxialChain(tuple(bodies), links, impact_body=SHANK, bit_body=BIT)

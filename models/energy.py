@@ -48,7 +48,7 @@ class EnergyAccount:
 def energy_account(result: SimulationResult) -> EnergyAccount:
     chain, scene, t = result.chain, result.scene, result.time_s
     x, v = result.position_m, result.velocity_m_per_s
-    rock = scene.rock.law()
+    rock = scene.rock_law()
     masses = np.array([b.mass_kg for b in chain.bodies])
     stiffness = np.array([link.stiffness_n_per_m for link in chain.links])
     damping = np.array([link.damping_n_s_per_m for link in chain.links])
@@ -74,5 +74,5 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
         kinetic_j=kinetic,
         elastic_j=elastic,
         damping_j=_cumulative(damping_power, t),
-        crushing_work_j=rock.threshold_n * (result.bottom_m - result.bottom_m[0]),
+        crushing_work_j=(rock.threshold_n if rock.crushes else 0.0) * (result.bottom_m - result.bottom_m[0]),
     )

@@ -3,8 +3,11 @@
 Every axial body is a ``Node1D`` + ``ObjectMass1D``; every link of the chain an
 ``ObjectConnectorCoordinateSpringDamper``; the feed a constant ``LoadCoordinate`` per body; the
 piston a ``LoadCoordinate`` with a symbolic load function (models.pulse); the rock the
-:class:`rocklaw.exudyn_element.ExudynRockContact` on the bit. Torsion, when enabled, is a
-``Node1D`` + ``ObjectRotationalMass1D`` with its own spring-damper to ground and a constant torque.
+:class:`rocklaw.exudyn_element.ExudynRockContact` on the bit. Torsion, when its effect is on, is
+a ``Node1D`` + ``ObjectRotationalMass1D`` with its own spring-damper to ground and a constant
+torque. Only what the scene's effects and outputs need is built: no torsion node, no rock
+damping term, no per-step hook for an elastic rock, no force sensors and no per-step storage
+unless an output asks for them.
 """
 
 from __future__ import annotations
@@ -99,7 +102,8 @@ def _simulation_settings(scene: Scene) -> Any:
         integration.adaptiveStep = False
     settings.show.statistics = False
     settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = 0.0  # every step: energies are integrated step by step
+    # energies are integrated over every step; otherwise store only at the output interval
+    settings.solution.sensors.writePeriod = 0.0 if "energy" in scene.needed_data() else solver.output_interval_s
     return settings
 
 
@@ -140,19 +144,19 @@ def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
 
     impact_function = attach_user_function(mbs, impact_load, "loadUserFunction", piston_force, symbolic)
     rock = ExudynRockContact(
-        mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], scene.rock.law(), symbolic=symbolic
+        mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], scene.rock_law(), symbolic=symbolic
     )
 
     sensors: dict[str, Any] = {}
     for i, node in enumerate(nodes):
         sensors[f"x{i}"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=COORDINATE))
         sensors[f"v{i}"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=RATE))
-    sensors["rock"] = _store(
-        mbs, SensorObject(objectNumber=rock.object, storeInternal=True, outputVariableType=exu.OutputVariableType.Force)
-    )
-    sensors["impact"] = _store(mbs, SensorLoad(loadNumber=impact_load, storeInternal=True))
+    if "forces" in scene.needed_data():
+        sensors["rock"] = _store(mbs, SensorObject(objectNumber=rock.object, storeInternal=True,
+                                                   outputVariableType=exu.OutputVariableType.Force))
+        sensors["impact"] = _store(mbs, SensorLoad(loadNumber=impact_load, storeInternal=True))
 
-    if scene.torsion.enabled:
+    if scene.effects.torsion:
         tor = scene.torsion
         node, marker = _add_coordinate_body(
             mbs, lambda n: mbs.AddObject(ObjectRotationalMass1D(nodeNumber=n, inertia=tor.inertia_kg_m2))
@@ -172,9 +176,13 @@ def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
     return ExudynDrill(scene, chain, container, mbs, rock, sensors, _simulation_settings(scene), [impact_function])
 
 
-def _pre_step(drill: ExudynDrill, progress: Callable[[float], None] | None) -> Callable[[Any, float], bool]:
-    update = drill.rock.update_bottom
+def _pre_step(drill: ExudynDrill, progress: Callable[[float], None] | None) -> Callable[[Any, float], bool] | None:
+    """The per-step Python hook: the rock's return mapping (if it crushes) and progress reports."""
+    update = drill.rock.update_bottom if drill.rock.rock.crushes else None
     if progress is None:
+        if update is None:
+            return None
+
         def pre_step(mbs: Any, t: float) -> bool:
             update(mbs, t)
             return True
@@ -183,7 +191,8 @@ def _pre_step(drill: ExudynDrill, progress: Callable[[float], None] | None) -> C
     next_report = [report_every]
 
     def pre_step_with_progress(mbs: Any, t: float) -> bool:
-        update(mbs, t)
+        if update is not None:
+            update(mbs, t)
         if t >= next_report[0]:
             next_report[0] += report_every
             progress(t)
@@ -204,10 +213,13 @@ def simulate_exudyn(
         warnings.warn(warning, StepLimitWarning, stacklevel=2)
     drill = build_exudyn(scene, symbolic)
     mbs = drill.mbs
-    mbs.SetPreStepUserFunction(_pre_step(drill, progress))
+    pre_step = _pre_step(drill, progress)
+    if pre_step is not None:
+        mbs.SetPreStepUserFunction(pre_step)
     start = time.process_time()
     ok = mbs.SolveDynamic(drill.settings, solverType=SOLVER_TYPES[scene.solver.type])
     cpu = time.process_time() - start
+    reached_s = mbs.systemData.GetTime()
     data = {name: _sensor(mbs, sensor) for name, sensor in drill.sensors.items()}
     time_s = data["x0"][:, 0]
     n = drill.chain.size
@@ -223,12 +235,13 @@ def simulate_exudyn(
         position_m=position,
         velocity_m_per_s=velocity,
         bottom_m=bottom,
-        rock_force_n=data["rock"][:, 1],
-        impact_force_n=data["impact"][:, 1],
+        rock_force_n=data["rock"][:, 1] if "rock" in data else None,
+        impact_force_n=data["impact"][:, 1] if "impact" in data else None,
         torsion_angle_rad=data["phi"][:, 1] if "phi" in data else None,
         torsion_rate_rad_per_s=data["omega"][:, 1] if "omega" in data else None,
         cpu_time_s=cpu,
-        info={"solver_success": bool(ok), "coordinates": drill.coordinate_count, "steps": len(time_s) - 1},
+        info={"solver_success": bool(ok), "coordinates": drill.coordinate_count},
+        bottom_events=(history[:, 0], history[:, 1]),
     )
-    check_result(result, solver_ok=bool(ok))
+    check_result(result, solver_ok=bool(ok), reached_s=reached_s)
     return result

@@ -3,12 +3,14 @@
 Window: blows ``transient_blows`` .. N of the run (N whole periods that fit), cut into
 blocks of ``block_blows`` blows (a trailing partial block is dropped).
 Penetration rate = (x_n(end) - x_n(start)) / window length; its spread is the standard
-deviation of the block rates.
+deviation of the block rates. Only the metrics the scene's outputs ask for are computed.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from functools import cached_property
 
 import numpy as np
 from scipy.integrate import trapezoid
@@ -17,59 +19,80 @@ from models.energy import EnergyAccount, energy_account
 from models.results import SimulationResult
 
 
-def _held(time_s: np.ndarray, values: np.ndarray, at: np.ndarray) -> np.ndarray:
-    """Value of a step-held history at the given times (last stored value at or before)."""
-    index = np.searchsorted(time_s, at + 1e-12, side="right") - 1
-    return values[np.clip(index, 0, len(values) - 1)]
+class _Window:
+    """The averaging window of a run and the quantities several metrics share (computed once)."""
+
+    def __init__(self, result: SimulationResult, energy: EnergyAccount | None) -> None:
+        self.result, self._energy = result, energy
+        scene, t = result.scene, result.time_s
+        self.period = scene.impact.period_s
+        blows_run = math.floor(t[-1] / self.period + 1e-9)
+        self.first = scene.metrics.transient_blows
+        self.n_blocks = (blows_run - self.first) // scene.metrics.block_blows
+        self.blows = self.n_blocks * scene.metrics.block_blows
+        self.boundaries = np.arange(self.first, self.first + self.blows + 1) * self.period
+        self.duration = self.boundaries[-1] - self.boundaries[0]
+        self.mask = (t >= self.boundaries[0] - 1e-12) & (t <= self.boundaries[-1] + 1e-12)
+
+    @cached_property
+    def per_blow(self) -> np.ndarray:
+        return np.diff(self.result.bottom_at(self.boundaries))
+
+    @cached_property
+    def block_rates(self) -> np.ndarray:
+        blocks = self.per_blow.reshape(self.n_blocks, -1).sum(axis=1)
+        return blocks / (self.result.scene.metrics.block_blows * self.period)
+
+    @cached_property
+    def energy(self) -> EnergyAccount:
+        return self._energy or energy_account(self.result)
+
+    def work(self, cumulative: np.ndarray) -> float:
+        """Increase of a cumulative energy over the window."""
+        t = self.result.time_s
+        return float(np.interp(self.boundaries[-1], t, cumulative) - np.interp(self.boundaries[0], t, cumulative))
+
+    def peak(self, values: np.ndarray) -> float:
+        return float(np.max(np.abs(values[self.mask])))
+
+    def rms(self, values: np.ndarray) -> float:
+        return float(math.sqrt(trapezoid(values[self.mask] ** 2, self.result.time_s[self.mask]) / self.duration))
+
+    def efficiency(self) -> float:
+        impact = self.work(self.energy.impact_work_j)
+        return self.work(self.energy.crushing_work_j) / impact if impact > 0 else float("nan")
 
 
-def _interp(energy: np.ndarray, time_s: np.ndarray, at: float) -> float:
-    return float(np.interp(at, time_s, energy))
+def _spread(values: np.ndarray) -> float:
+    return float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
+
+
+METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
+    "penetration_rate_m_per_s": lambda w: float(w.per_blow.sum() / w.duration),
+    "penetration_rate_block_std_m_per_s": lambda w: _spread(w.block_rates),
+    "penetration_rate_block_min_m_per_s": lambda w: float(w.block_rates.min()),
+    "penetration_rate_block_max_m_per_s": lambda w: float(w.block_rates.max()),
+    "advance_per_blow_m": lambda w: float(w.per_blow.mean()),
+    "advance_per_blow_std_m": lambda w: _spread(w.per_blow),
+    "borehole_bottom_final_m": lambda w: float(w.result.bottom_m[-1]),
+    "bit_velocity_peak_m_per_s": lambda w: w.peak(w.result.bit_velocity_m_per_s),
+    "bit_velocity_rms_m_per_s": lambda w: w.rms(w.result.bit_velocity_m_per_s),
+    "collar_velocity_peak_m_per_s": lambda w: w.peak(w.result.velocity_m_per_s[:, 1]),
+    "collar_velocity_rms_m_per_s": lambda w: w.rms(w.result.velocity_m_per_s[:, 1]),
+    "rock_force_max_n": lambda w: float(np.max(w.result.rock_force_n[w.mask])),
+    "impact_energy_j": lambda w: w.work(w.energy.impact_work_j),
+    "feed_energy_j": lambda w: w.work(w.energy.feed_work_j),
+    "crushing_work_j": lambda w: w.work(w.energy.crushing_work_j),
+    "energy_transfer_efficiency": lambda w: w.efficiency(),
+    "energy_balance_relative_error": lambda w: w.energy.relative_residual(),
+    "window_start_s": lambda w: float(w.boundaries[0]),
+    "window_end_s": lambda w: float(w.boundaries[-1]),
+    "window_blows": lambda w: w.blows,
+    "cpu_time_s": lambda w: float(w.result.cpu_time_s),
+}
 
 
 def summary_metrics(result: SimulationResult, energy: EnergyAccount | None = None) -> dict[str, float]:
-    """Penetration, velocity, force and energy figures of one run (SI units in the keys)."""
-    scene, t = result.scene, result.time_s
-    energy = energy or energy_account(result)
-    period = scene.impact.period_s
-    blows_run = math.floor(t[-1] / period + 1e-9)
-    first = scene.metrics.transient_blows
-    n_blocks = (blows_run - first) // scene.metrics.block_blows
-    last = first + n_blocks * scene.metrics.block_blows
-    boundaries = np.arange(first, last + 1) * period
-    bottom_at = _held(t, result.bottom_m, boundaries)
-    per_blow = np.diff(bottom_at)
-    block_rates = per_blow.reshape(n_blocks, -1).sum(axis=1) / (scene.metrics.block_blows * period)
-    window = (t >= boundaries[0] - 1e-12) & (t <= boundaries[-1] + 1e-12)
-    tw, v_bit = t[window], result.bit_velocity_m_per_s[window]
-    v_collar = result.velocity_m_per_s[window, 1]
-    duration = boundaries[-1] - boundaries[0]
-
-    def window_work(cumulative: np.ndarray) -> float:
-        return _interp(cumulative, t, boundaries[-1]) - _interp(cumulative, t, boundaries[0])
-
-    impact_work = window_work(energy.impact_work_j)
-    crushing_work = window_work(energy.crushing_work_j)
-    return {
-        "penetration_rate_m_per_s": float((bottom_at[-1] - bottom_at[0]) / duration),
-        "penetration_rate_block_std_m_per_s": float(np.std(block_rates, ddof=1)) if n_blocks > 1 else 0.0,
-        "penetration_rate_block_min_m_per_s": float(block_rates.min()),
-        "penetration_rate_block_max_m_per_s": float(block_rates.max()),
-        "advance_per_blow_m": float(per_blow.mean()),
-        "advance_per_blow_std_m": float(per_blow.std(ddof=1)) if len(per_blow) > 1 else 0.0,
-        "borehole_bottom_final_m": float(result.bottom_m[-1]),
-        "bit_velocity_peak_m_per_s": float(np.max(np.abs(v_bit))),
-        "bit_velocity_rms_m_per_s": float(math.sqrt(trapezoid(v_bit**2, tw) / duration)),
-        "collar_velocity_peak_m_per_s": float(np.max(np.abs(v_collar))),
-        "collar_velocity_rms_m_per_s": float(math.sqrt(trapezoid(v_collar**2, tw) / duration)),
-        "rock_force_max_n": float(np.max(result.rock_force_n[window])),
-        "impact_energy_j": impact_work,
-        "feed_energy_j": window_work(energy.feed_work_j),
-        "crushing_work_j": crushing_work,
-        "energy_transfer_efficiency": crushing_work / impact_work if impact_work > 0 else float("nan"),
-        "energy_balance_relative_error": energy.relative_residual(),
-        "window_start_s": float(boundaries[0]),
-        "window_end_s": float(boundaries[-1]),
-        "window_blows": int(last - first),
-        "cpu_time_s": float(result.cpu_time_s),
-    }
+    """The metrics the scene's outputs ask for (SI units in the keys), in their order."""
+    window = _Window(result, energy)
+    return {name: METRIC_FUNCTIONS[name](window) for name in result.scene.outputs.metrics}

@@ -25,12 +25,21 @@ class SimulationResult:
     position_m: np.ndarray
     velocity_m_per_s: np.ndarray
     bottom_m: np.ndarray
-    rock_force_n: np.ndarray
-    impact_force_n: np.ndarray
+    rock_force_n: np.ndarray | None = None  # None when no output needs forces
+    impact_force_n: np.ndarray | None = None
     torsion_angle_rad: np.ndarray | None = None
     torsion_rate_rad_per_s: np.ndarray | None = None
     cpu_time_s: float = float("nan")
     info: dict = field(default_factory=dict)
+    # (time, x_n) at every change of the bottom, when the formulation records it (exact x_n
+    # between stored samples); None: bottom_m is stored at every solver step
+    bottom_events: tuple[np.ndarray, np.ndarray] | None = None
+
+    def bottom_at(self, times_s: np.ndarray) -> np.ndarray:
+        """Borehole bottom x_n at the given times (held between its changes)."""
+        event_t, event_x = self.bottom_events or (self.time_s, self.bottom_m)
+        index = np.searchsorted(event_t, np.asarray(times_s) + 1e-12, side="right") - 1
+        return event_x[np.clip(index, 0, len(event_x) - 1)]
 
     @property
     def bit_position_m(self) -> np.ndarray:
@@ -41,17 +50,20 @@ class SimulationResult:
         return self.velocity_m_per_s[:, self.chain.bit_body]
 
     def columns(self) -> dict[str, np.ndarray]:
-        """Named histories, header names carrying units."""
+        """Named histories the scene asked for (time, positions, velocities always), units in the names."""
         out = {"time_s": self.time_s}
         for i, body in enumerate(self.chain.bodies):
             out[f"{body.name}_position_m"] = self.position_m[:, i]
             out[f"{body.name}_velocity_m_per_s"] = self.velocity_m_per_s[:, i]
-        out["borehole_bottom_m"] = self.bottom_m
-        out["rock_force_n"] = self.rock_force_n
-        out["impact_force_n"] = self.impact_force_n
-        if self.torsion_angle_rad is not None:
-            out["torsion_angle_rad"] = self.torsion_angle_rad
-            out["torsion_rate_rad_per_s"] = self.torsion_rate_rad_per_s
+        optional = {
+            "borehole_bottom_m": self.bottom_m,
+            "rock_force_n": self.rock_force_n,
+            "impact_force_n": self.impact_force_n,
+            "torsion_angle_rad": self.torsion_angle_rad,
+            "torsion_rate_rad_per_s": self.torsion_rate_rad_per_s,
+        }
+        wanted = self.scene.outputs.timeseries
+        out.update({name: values for name, values in optional.items() if name in wanted and values is not None})
         return out
 
     def resampled(self, interval_s: float) -> dict[str, np.ndarray]:
@@ -60,10 +72,6 @@ class SimulationResult:
         grid = grid[grid <= self.time_s[-1] + 1e-12]
         out = {}
         for name, values in self.columns().items():
-            if name == "borehole_bottom_m":
-                index = np.searchsorted(self.time_s, grid, side="right") - 1
-                out[name] = values[np.clip(index, 0, len(values) - 1)]
-            else:
-                out[name] = np.interp(grid, self.time_s, values)
+            out[name] = self.bottom_at(grid) if name == "borehole_bottom_m" else np.interp(grid, self.time_s, values)
         out["time_s"] = grid
         return out

@@ -7,10 +7,12 @@ whose locations are the key paths.
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from models.outputs import METRICS, SERIES, needs
 from rocklaw.catalog import TABLE_1
 from rocklaw.jenkins import JenkinsRock
 
@@ -51,7 +53,6 @@ class Connectors(Strict):
 class Torsion(Strict):
     """Fourth line of Eq. 4: J phi'' + c_x phi' + k_x phi = M_x - M_c (decoupled from the axial chain)."""
 
-    enabled: bool = True
     inertia_kg_m2: Positive = Field(description="J_x of collar and bit")
     stiffness_n_m_per_rad: NonNegative = Field(description="k_x")
     damping_n_m_s_per_rad: NonNegative = Field(description="c_x")
@@ -180,6 +181,36 @@ class Solver(Strict):
         return data
 
 
+EFFECTS = ("torsion", "rock_damping", "rock_plasticity", "joint_damping")
+
+
+class Effects(Strict):
+    """Which parts of the model are built (the axial impact chain always is).
+
+    In a scene: ``true`` builds an effect, ``false`` leaves it out, a key absent leaves it out
+    unless a requested output needs it; no ``effects`` section at all builds every effect the
+    scene gives parameters for (the full model). After validation every key is true or false and
+    ``reasons`` says why. ``rock_plasticity`` off gives an elastic rock that never crushes.
+    """
+
+    torsion: bool | None = None
+    rock_damping: bool | None = None
+    rock_plasticity: bool | None = None
+    joint_damping: bool | None = None
+    reasons: dict[str, str] = Field(default_factory=dict)
+
+
+class Outputs(Strict):
+    """Requested metrics and time histories (time, positions and velocities always come).
+
+    No ``outputs`` section: every metric and history of the effects that are built. A list left
+    out of a given section is empty.
+    """
+
+    metrics: list[Literal[tuple(METRICS)]] = Field(default_factory=list)  # type: ignore[valid-type]
+    timeseries: list[Literal[tuple(SERIES)]] = Field(default_factory=list)  # type: ignore[valid-type]
+
+
 class Metrics(Strict):
     """Averaging window: skip ``transient_blows`` blows, then whole blocks of ``block_blows`` blows."""
 
@@ -194,12 +225,71 @@ class Scene(Strict):
     description: str = ""
     bodies: Bodies
     connectors: Connectors
-    torsion: Torsion
+    torsion: Torsion | None = None
     feed: Feed
     impact: Impact
     rock: Rock
     solver: Solver = Solver()
     metrics: Metrics = Metrics()
+    effects: Effects | None = None
+    outputs: Outputs | None = None
+
+    def _available(self, effect: str) -> bool:
+        """Whether the scene's parameters give the effect anything to do."""
+        c = self.connectors
+        return {
+            "torsion": self.torsion is not None,
+            "rock_damping": self.rock.damping_n_s_per_m > 0,
+            "rock_plasticity": True,
+            "joint_damping": any(link.damping_n_s_per_m > 0 for link in (
+                c.shock_absorber, c.shank_collar_joint, c.collar_bit_joint)),
+        }[effect]
+
+    @model_validator(mode="after")
+    def _resolve_effects_and_outputs(self) -> Scene:
+        outputs = self.outputs or Outputs()
+        need = needs(outputs.metrics, outputs.timeseries)
+        chosen, reasons = {}, {}
+        for effect in EFFECTS:
+            asked = None if self.effects is None else getattr(self.effects, effect)
+            users = [o for o in outputs.metrics + outputs.timeseries
+                     if effect in (METRICS.get(o) or SERIES[o]).effects]
+            if asked is False and users:
+                raise ValueError(f"effects.{effect} is false but outputs {', '.join(users)} need it")
+            if self.effects is None:
+                chosen[effect] = self._available(effect) or effect in need.effects
+                reasons[effect] = "no effects section: full model" if chosen[effect] else \
+                    "no effects section, and nothing for it to do in this scene"
+            elif asked:
+                chosen[effect], reasons[effect] = True, "asked for"
+            elif users:
+                chosen[effect], reasons[effect] = True, f"needed by outputs: {', '.join(users)}"
+            else:
+                chosen[effect], reasons[effect] = False, "not asked for" if asked is None else "switched off"
+        if chosen["torsion"] and self.torsion is None:
+            raise ValueError("the torsion effect needs a torsion section (inertia_kg_m2, stiffness_n_m_per_rad, "
+                             "damping_n_m_s_per_rad, drive_torque_n_m, resisting_torque_n_m)")
+        object.__setattr__(self, "effects", Effects(**chosen, reasons=reasons))
+        if self.outputs is None:
+            built = {e for e, on in chosen.items() if on}
+            object.__setattr__(self, "outputs", Outputs(
+                metrics=[m for m, n in METRICS.items() if n.effects <= built],
+                timeseries=[s for s, n in SERIES.items() if n.effects <= built]))
+        return self
+
+    def needed_data(self) -> frozenset[str]:
+        """What must be recorded for the requested outputs: ``forces``, ``energy``."""
+        return needs(self.outputs.metrics, self.outputs.timeseries).data
+
+    def rock_law(self) -> JenkinsRock:
+        """The rock law as built: without damping or plasticity when those effects are off."""
+        rock = self.rock
+        return JenkinsRock(
+            rock.stiffness_n_per_m,
+            rock.damping_n_s_per_m if self.effects.rock_damping else 0.0,
+            rock.threshold_n if self.effects.rock_plasticity else math.inf,
+            rock.damping_mode,
+        )
 
     @model_validator(mode="after")
     def _resolve_preset_and_check_length(self) -> Scene:

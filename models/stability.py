@@ -97,18 +97,23 @@ def _energy_blow_up_index(result: SimulationResult) -> int | None:
     return int(np.argmax(bad)) if bad.any() else None
 
 
-def check_result(result: SimulationResult, solver_ok: bool) -> None:
-    """Raise :class:`SimulationFailed` naming scene, solver, time and a remedy if the run is unusable."""
+def check_result(result: SimulationResult, solver_ok: bool, reached_s: float | None = None) -> None:
+    """Raise :class:`SimulationFailed` naming scene, solver, time and a remedy if the run is unusable.
+
+    ``reached_s`` is the solver's final time (default: the last stored sample)."""
     scene, solver = result.scene, result.scene.solver
     setting = f"solver {solver.type} with step_s {solver.step_s:g}"
     states = np.column_stack([result.position_m, result.velocity_m_per_s])
     bad = ~np.isfinite(states).all(axis=1) | (np.abs(result.position_m) > POSITION_LIMIT_M).any(axis=1)
-    index = int(np.argmax(bad)) if bad.any() else _energy_blow_up_index(result)
+    if bad.any():
+        index = int(np.argmax(bad))
+    else:  # the energy check needs the force histories at every step
+        index = _energy_blow_up_index(result) if "energy" in scene.needed_data() else None
     if index is not None:
         raise SimulationFailed(
             f"scene '{scene.name}': {setting} diverged at t = {result.time_s[index]:.6g} s; {_remedy(scene)}"
         )
-    reached = result.time_s[-1] if len(result.time_s) else 0.0
+    reached = reached_s if reached_s is not None else (result.time_s[-1] if len(result.time_s) else 0.0)
     if not solver_ok or reached < solver.end_time_s * (1 - 1e-9):
         raise SimulationFailed(
             f"scene '{scene.name}': {setting} stopped at t = {reached:.6g} s before end_time_s "

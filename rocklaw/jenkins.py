@@ -17,6 +17,7 @@ Rock damping c_n (the paper's Eq. 4 writes c_n x_bit' in the bit equation) is of
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -45,15 +46,26 @@ class JenkinsRock:
         """Penetration F_th / k_n at which the rock starts to crush."""
         return self.threshold_n / self.stiffness_n_per_m
 
+    @property
+    def crushes(self) -> bool:
+        """False for an elastic rock (F_th infinite): no slider, no return mapping."""
+        return math.isfinite(self.threshold_n)
+
     def spring_force(self, penetration_m: Any, backend: Backend = NUMERIC) -> Any:
         """Eq. 1: clip(k_n d, 0, F_th), the force carried by the spring-slider pair."""
         elastic = self.stiffness_n_per_m * penetration_m
-        return backend.where(elastic > 0, backend.minimum(elastic, self.threshold_n), 0.0)
+        capped = backend.minimum(elastic, self.threshold_n) if self.crushes else elastic
+        return backend.where(elastic > 0, capped, 0.0)
 
     def force(self, penetration_m: Any, bit_velocity_m_per_s: Any, backend: Backend = NUMERIC) -> Any:
-        """Total rock force on the bit [N], positive pushing the bit back out of the hole."""
+        """Total rock force on the bit [N], positive pushing the bit back out of the hole.
+
+        Terms of zero parameters (no damping, no crushing) are left out of the expression.
+        """
         elastic = self.stiffness_n_per_m * penetration_m
-        spring = backend.minimum(elastic, self.threshold_n)
+        spring = backend.minimum(elastic, self.threshold_n) if self.crushes else elastic
+        if self.damping_n_s_per_m == 0.0:
+            return backend.where(elastic > 0, spring, 0.0)
         damping = self.damping_n_s_per_m * bit_velocity_m_per_s
         if self.damping_mode == "always":
             return backend.where(elastic > 0, spring, 0.0) + damping

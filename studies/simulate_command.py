@@ -16,6 +16,9 @@ from studies.outputs import staged_directory, write_columns_csv, write_json, wri
 from studies.plots import plot_timeseries
 from studies.progress import time_progress
 
+HEADLINE = ("penetration_rate_m_per_s", "advance_per_blow_m", "energy_transfer_efficiency",
+            "energy_balance_relative_error")
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="scene YAML file")
@@ -40,8 +43,6 @@ def run(args: argparse.Namespace) -> int:
         write_resolved(stage / "scene.resolved.yaml", scene)
         plot_timeseries(columns, f"{scene.name}: {scene.impact.frequency_hz:g} Hz, "
                         f"{scene.impact.amplitude_n / 1e3:g} kN", stage / "timeseries.png")
-    rate = summary["penetration_rate_m_per_s"] * 1e3
-    print(f"{scene.name}: penetration rate {rate:.4g} mm/s, advance per blow "
-          f"{summary['advance_per_blow_m'] * 1e6:.4g} um, efficiency {summary['energy_transfer_efficiency']:.3g}, "
-          f"energy balance error {summary['energy_balance_relative_error']:.2e}; wrote {args.out}")
+    shown = ", ".join(f"{name} {value:.4g}" for name, value in summary.items() if name in HEADLINE)
+    print(f"{scene.name}: {shown}; wrote {args.out}")
     return 0

@@ -22,9 +22,9 @@ def crushing_run():
     "overrides, coordinates",
     [
         ({}, 5),  # shank, collar, bit, carriage, torsion
-        ({"torsion__enabled": False}, 4),
-        ({"feed__arrangement": "per_body", "feed__carriage_mass_kg": None}, 4),
-        ({"feed__arrangement": "per_body", "torsion__enabled": False}, 3),
+        ({"torsion": None}, 4),
+        ({"feed__arrangement": "per_body", "feed__carriage_mass_kg": None, "torsion": None}, 3),
+        ({"feed__arrangement": "per_body", "effects": {"torsion": True}}, 4),
     ],
 )
 def test_coordinate_count(overrides, coordinates):

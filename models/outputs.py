@@ -1,0 +1,66 @@
+"""The outputs a scene can ask for, and what each needs built.
+
+Each metric and time history names the effects it depends on (``torsion``, ``rock_plasticity``)
+and the data it needs recorded: ``forces`` (rock and impact force sensors) or ``energy``
+(every solver step stored and the energy account integrated). Asking for an output pulls in
+what it needs; asking for nothing more builds nothing more.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Need:
+    effects: frozenset[str] = frozenset()
+    data: frozenset[str] = frozenset()
+
+
+def _need(effects: tuple[str, ...] = (), data: tuple[str, ...] = ()) -> Need:
+    return Need(frozenset(effects), frozenset(data))
+
+
+PENETRATION = _need(("rock_plasticity",))
+PLAIN = _need()
+FORCES = _need(data=("forces",))
+ENERGY = _need(data=("forces", "energy"))
+
+METRICS: dict[str, Need] = {
+    "penetration_rate_m_per_s": PENETRATION,
+    "penetration_rate_block_std_m_per_s": PENETRATION,
+    "penetration_rate_block_min_m_per_s": PENETRATION,
+    "penetration_rate_block_max_m_per_s": PENETRATION,
+    "advance_per_blow_m": PENETRATION,
+    "advance_per_blow_std_m": PENETRATION,
+    "borehole_bottom_final_m": PENETRATION,
+    "bit_velocity_peak_m_per_s": PLAIN,
+    "bit_velocity_rms_m_per_s": PLAIN,
+    "collar_velocity_peak_m_per_s": PLAIN,
+    "collar_velocity_rms_m_per_s": PLAIN,
+    "rock_force_max_n": FORCES,
+    "impact_energy_j": ENERGY,
+    "feed_energy_j": ENERGY,
+    "crushing_work_j": _need(("rock_plasticity",), ("forces", "energy")),
+    "energy_transfer_efficiency": _need(("rock_plasticity",), ("forces", "energy")),
+    "energy_balance_relative_error": ENERGY,
+    "window_start_s": PLAIN,
+    "window_end_s": PLAIN,
+    "window_blows": PLAIN,
+    "cpu_time_s": PLAIN,
+}
+
+# Histories besides time and each body's position and velocity (always recorded).
+SERIES: dict[str, Need] = {
+    "borehole_bottom_m": PENETRATION,
+    "rock_force_n": FORCES,
+    "impact_force_n": FORCES,
+    "torsion_angle_rad": _need(("torsion",)),
+    "torsion_rate_rad_per_s": _need(("torsion",)),
+}
+
+
+def needs(metrics: list[str], series: list[str]) -> Need:
+    """Union of what the requested outputs need."""
+    wanted = [METRICS[m] for m in metrics] + [SERIES[s] for s in series]
+    return Need(frozenset().union(*(w.effects for w in wanted)), frozenset().union(*(w.data for w in wanted)))

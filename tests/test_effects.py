@@ -1,0 +1,88 @@
+"""Only the effects a scene calls for are built; outputs pull in what they need."""
+
+import numpy as np
+import pytest
+import yaml
+from scenes import CRUSHING, scene, scene_dict
+
+from models.exudyn_model import build_exudyn, simulate_exudyn
+from models.metrics import summary_metrics
+from studies.cli import main
+
+SHORT = {"solver__end_time_s": 0.25, "metrics__transient_blows": 3, "metrics__block_blows": 4}
+CRUSH = {k.replace(".", "__"): v for k, v in CRUSHING.items()}
+# what a penetration-rate scan needs: the same physics, no torsion, no forces, no energy
+RATE_ONLY = {"effects": {"rock_damping": True, "joint_damping": True},
+             "outputs": {"metrics": ["penetration_rate_m_per_s"]}}
+
+
+def test_full_model_when_no_effects_section():
+    s = scene()
+    assert s.effects.torsion and s.effects.rock_damping and s.effects.rock_plasticity and s.effects.joint_damping
+    assert "full model" in s.effects.reasons["torsion"]
+    assert "rock_force_n" in s.outputs.timeseries and "energy" in s.needed_data()
+
+
+def test_rate_only_scene_drops_torsion_sensors_and_storage():
+    full, lean = build_exudyn(scene(**CRUSH)), build_exudyn(scene(**CRUSH, **RATE_ONLY))
+    assert (full.coordinate_count, lean.coordinate_count) == (5, 4)
+    assert set(full.sensors) - set(lean.sensors) == {"rock", "impact", "phi", "omega"}
+    assert lean.settings.solution.sensors.writePeriod == lean.scene.solver.output_interval_s
+    assert full.settings.solution.sensors.writePeriod == 0.0  # energy needs every step
+    assert lean.scene.effects.rock_plasticity and "needed by outputs" in lean.scene.effects.reasons["rock_plasticity"]
+
+
+def test_dropping_decoupled_or_unused_parts_leaves_axial_results_unchanged():
+    full = simulate_exudyn(scene(**CRUSH, **SHORT))
+    lean = simulate_exudyn(scene(**CRUSH, **SHORT, **RATE_ONLY))
+    assert full.torsion_angle_rad is not None and lean.torsion_angle_rad is None
+    rate_full = summary_metrics(full)["penetration_rate_m_per_s"]
+    rate_lean = summary_metrics(lean)["penetration_rate_m_per_s"]
+    assert rate_full > 0 and rate_lean == pytest.approx(rate_full, rel=1e-12)
+    common = np.isin(np.round(full.time_s, 12), np.round(lean.time_s, 12))
+    np.testing.assert_allclose(full.position_m[common], lean.position_m, rtol=1e-12, atol=1e-15)
+
+
+def test_an_output_pulls_in_its_effect():
+    s = scene(effects={}, outputs={"timeseries": ["torsion_angle_rad"]})
+    assert s.effects.torsion and s.effects.reasons["torsion"] == "needed by outputs: torsion_angle_rad"
+    assert not s.effects.rock_damping and s.effects.reasons["rock_damping"] == "not asked for"
+    assert not s.effects.rock_plasticity  # nothing asked for the penetration
+
+
+def test_contradictory_request_is_a_clear_error(tmp_path, capsys):
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(scene_dict(effects={"torsion": False}, outputs={"timeseries": ["torsion_angle_rad"]})))
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "effects.torsion is false but outputs torsion_angle_rad need it" in err and str(path) in err
+
+
+def test_torsion_needs_its_section():
+    with pytest.raises(ValueError, match="needs a torsion section"):
+        scene(torsion=None, outputs={"timeseries": ["torsion_angle_rad"]})
+
+
+def test_elastic_rock_without_plasticity_never_crushes():
+    s = scene(**CRUSH, **SHORT, effects={"rock_damping": True, "joint_damping": True},
+              outputs={"timeseries": ["rock_force_n"]})
+    r = simulate_exudyn(s)
+    assert not s.effects.rock_plasticity and not s.rock_law().crushes
+    assert np.all(r.bottom_m == 0.0)
+    assert r.rock_force_n.max() > s.rock.threshold_n  # no cap without the slider
+
+
+def test_rock_damping_off_removes_the_term():
+    law = scene(effects={"rock_plasticity": True}).rock_law()
+    assert law.damping_n_s_per_m == 0.0 and law.force(1e-5, 3.0) == law.force(1e-5, 0.0)
+
+
+def test_resolved_scene_lists_effects_and_reasons(tmp_path):
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(scene_dict(**{"solver.end_time_s": 0.1, "metrics.transient_blows": 1,
+                                                 "metrics.block_blows": 2}, **RATE_ONLY)))
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    resolved = yaml.safe_load((tmp_path / "out" / "scene.resolved.yaml").read_text())
+    assert resolved["effects"]["torsion"] is False and resolved["effects"]["reasons"]["torsion"] == "not asked for"
+    header = (tmp_path / "out" / "timeseries.csv").read_text().splitlines()[0]
+    assert "torsion" not in header and "rock_force_n" not in header
