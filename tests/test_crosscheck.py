@@ -1,0 +1,89 @@
+"""Cross-check of the Exudyn model against the ODE of Eq. 4 (models.compare, rpdrill crosscheck).
+
+Every case runs 15 blows from rest (the shortest window the default metrics accept), Exudyn at
+the cross-check's default step, the ODE at its default tolerance.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from models.compare import compare_runs, verdict
+from models.exudyn_model import simulate_exudyn
+from models.ode_model import simulate_ode
+from models.scene import Scene
+from studies.cli import main
+from studies.crosscheck import DEFAULT_STEP_S
+
+BASE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
+BLOWS = 15
+LIFT_OFF_M = 1e-9  # a gap below this (round-off of the start from rest, ~1e-19 m) is no lift-off
+
+
+def scene_from_base(**changes: object) -> Scene:
+    """paper_base over BLOWS periods at the cross-check step, ``changes`` as 'section.key' -> value."""
+    data = copy.deepcopy(yaml.safe_load(BASE.read_text(encoding="utf-8")))
+    for path, value in changes.items():
+        section, key = path.split(".")
+        data[section][key] = value
+    data["solver"]["end_time_s"] = BLOWS / data["impact"]["frequency_hz"]
+    data["solver"].pop("preset", None)
+    data["solver"]["step_s"] = DEFAULT_STEP_S
+    return Scene.model_validate(data)
+
+
+def table_1(name: str) -> dict[str, object]:
+    """Changes selecting a Table 1 rock by name (its k_n, c_n, F_th, not paper_base's)."""
+    return {"rock.name": name, "rock.stiffness_n_per_m": None, "rock.damping_n_s_per_m": None,
+            "rock.threshold_n": None}
+
+
+# case: (changes, crushes, lifts off); crushing = x_n advanced in the window.
+CASES = {
+    "conglomerate_400kN": ({**table_1("conglomerate"), "impact.amplitude_n": 400e3}, False, True),
+    "sandstone_400kN": ({**table_1("sandstone"), "impact.amplitude_n": 400e3}, True, True),
+    "soft_limestone_220kN": (table_1("soft_limestone"), False, True),
+    "impulse_120kN": ({"impact.amplitude_n": 120e3}, False, True),
+    "impulse_280kN": ({"impact.amplitude_n": 280e3}, True, True),
+    "never_crushes": ({"rock.threshold_n": 1e7}, False, True),
+    "per_body_feed": ({"feed.arrangement": "per_body"}, True, False),
+    "carriage_contact_damping": ({"rock.threshold_n": 60e3}, True, True),
+    "carriage_always_damping": ({"rock.threshold_n": 60e3, "rock.damping_mode": "always"}, True, True),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_exudyn_agrees_with_ode(case: str) -> None:
+    changes, crushes, lifts_off = CASES[case]
+    scene = scene_from_base(**changes)
+    ode, exudyn = simulate_ode(scene), simulate_exudyn(scene)
+    report = compare_runs(ode, exudyn, scene.solver.end_time_s)
+    checks = verdict(report)
+    assert all(c["passed"] for c in checks.values()), checks
+    for r in (ode, exudyn):
+        assert bool(r.bottom_m[-1] > 1e-6) is crushes, r.bottom_m[-1]
+        assert bool(np.min(r.bit_position_m - r.bottom_m) < -LIFT_OFF_M) is lifts_off
+    if not crushes:
+        assert ode.bottom_m.max() == 0.0 and "crushing" not in ode.info["switches_into"]
+    np.testing.assert_allclose(exudyn.torsion_angle_rad[-1], ode.torsion_angle_rad[-1], rtol=1e-6)
+
+
+def test_cli_bad_input_exits_2(tmp_path: Path) -> None:
+    assert main(["crosscheck", str(tmp_path / "missing.yaml")]) == 2
+    assert main(["crosscheck", str(BASE), "--blows", "3"]) == 2  # fewer blows than the metrics need
+
+
+def test_cli_writes_report_and_passes(tmp_path: Path) -> None:
+    out = tmp_path / "cc"
+    assert main(["crosscheck", str(BASE), "--blows", str(BLOWS), "--out", str(out)]) == 0
+    report = json.loads((out / "crosscheck.json").read_text(encoding="utf-8"))
+    assert report["passed"] and report["blows"] == BLOWS
+    assert set(report["histories"]) == {"borehole_bottom_m", "bit_velocity_m_per_s", "rock_force_n"}
+    assert report["cpu_time_s"]["ode"] > 0 and report["cpu_time_s"]["exudyn"] > 0
+    assert (out / "crosscheck.png").stat().st_size > 0

@@ -1,0 +1,132 @@
+"""The plain ODE of Eq. 4 (models.ode_model): law, energy, events, methods, failures."""
+
+from __future__ import annotations
+
+import copy
+import functools
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from models import ode_model
+from models.energy import energy_account
+from models.ode_model import simulate_ode
+from models.scene import Scene
+from models.stability import SimulationFailed
+
+BASE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
+
+
+def scene_from_base(blows: float = 15, **changes: object) -> Scene:
+    """paper_base ending after ``blows`` periods, with ``changes`` given as 'section.key' -> value."""
+    data = copy.deepcopy(yaml.safe_load(BASE.read_text(encoding="utf-8")))
+    for path, value in changes.items():
+        section, key = path.split(".")
+        data.setdefault(section, {})[key] = value
+    data["solver"]["end_time_s"] = blows / data["impact"]["frequency_hz"]
+    return Scene.model_validate(data)
+
+
+CASES = {
+    "crushing_contact": {"rock.threshold_n": 60e3},
+    "crushing_always": {"rock.threshold_n": 60e3, "rock.damping_mode": "always"},
+    "lift_off_no_crushing": {"impact.amplitude_n": 120e3},
+}
+
+
+@functools.cache
+def result(case: str):
+    return simulate_ode(scene_from_base(**CASES[case]))
+
+
+def test_does_not_import_exudyn() -> None:
+    code = "import models.ode_model, sys; assert 'exudyn' not in sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_energy_balances(case: str) -> None:
+    assert energy_account(result(case)).relative_residual() < 1e-4
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_bottom_never_decreases_and_ends_at_window(case: str) -> None:
+    r = result(case)
+    assert np.all(np.diff(r.bottom_m) >= -1e-15)
+    assert np.all(np.diff(r.time_s) >= 0)
+    assert r.time_s[-1] == pytest.approx(r.scene.solver.end_time_s)
+
+
+def test_rock_force_never_negative_in_contact_mode() -> None:
+    assert result("crushing_contact").rock_force_n.min() >= 0.0
+
+
+def test_damping_always_pulls_off_the_bottom() -> None:
+    r = result("crushing_always")
+    off = r.bit_position_m < r.bottom_m
+    assert off.any()
+    rock = r.scene.rock
+    np.testing.assert_allclose(r.rock_force_n[off], rock.damping_n_s_per_m * r.bit_velocity_m_per_s[off], atol=1e-9)
+
+
+def test_crushing_runs_at_threshold_and_lift_off_without_crushing() -> None:
+    r = result("crushing_contact")
+    crushing = np.diff(r.bottom_m) > 0
+    assert r.bottom_m[-1] > 1e-4 and r.info["switches_into"]["crushing"] > 5
+    spring = r.scene.rock.law().spring_force(r.bit_position_m - r.bottom_m)
+    np.testing.assert_allclose(spring[1:][crushing], r.scene.rock.threshold_n, rtol=1e-9)
+    lift = result("lift_off_no_crushing")
+    assert lift.bottom_m.max() == 0.0 and "crushing" not in lift.info["switches_into"]
+    assert (lift.bit_position_m < lift.bottom_m).any()
+
+
+def test_torsion_line_matches_closed_form_static_angle() -> None:
+    r = result("crushing_contact")
+    tor = r.scene.torsion
+    static = (tor.drive_torque_n_m - tor.resisting_torque_n_m) / tor.stiffness_n_m_per_rad
+    assert 0.0 < r.torsion_angle_rad.max() <= 2.0 * static * (1 + 1e-9)  # step response overshoots at most 2x
+
+
+def _one_blow(**changes: object) -> Scene:
+    return scene_from_base(blows=1, **{"metrics.transient_blows": 0, "metrics.block_blows": 1, **changes})
+
+
+@pytest.mark.parametrize("method", ["Radau", "LSODA"])
+def test_methods_agree_with_dop853(method: str) -> None:
+    scene = _one_blow(**{"rock.threshold_n": 60e3})
+    reference = simulate_ode(scene)
+    other = simulate_ode(scene, method=method, rtol=1e-9, atol=1e-12)
+    assert other.info["mode_switches"] == reference.info["mode_switches"]
+    assert other.bottom_m[-1] == pytest.approx(reference.bottom_m[-1], rel=1e-5)
+    v = np.interp(reference.time_s, other.time_s, other.bit_velocity_m_per_s)
+    assert np.max(np.abs(v - reference.bit_velocity_m_per_s)) < 1e-4 * np.ptp(reference.bit_velocity_m_per_s)
+
+
+def test_rectangular_pulse_is_evaluated_on_each_side_of_its_switches() -> None:
+    scene = _one_blow(**{"impact.shape": "rectangular"})
+    r = simulate_ode(scene)
+    on = r.time_s < scene.impact.duration_s * (1 - 1e-9)
+    assert np.all(r.impact_force_n[on] == scene.impact.amplitude_n)
+    assert np.all(r.impact_force_n[r.time_s > scene.impact.duration_s * (1 + 1e-9)] == 0.0)
+
+
+def test_unknown_method_is_rejected() -> None:
+    with pytest.raises(ValueError, match="RK45"):
+        simulate_ode(_one_blow(), method="RK45")
+
+
+def test_solver_failure_raises_simulation_failed(monkeypatch: pytest.MonkeyPatch) -> None:
+    real = ode_model.solve_ivp
+
+    def failing(*args, **kwargs):
+        sol = real(*args, **kwargs)
+        sol.status, sol.message = -1, "Required step size is less than spacing between numbers."
+        return sol
+
+    monkeypatch.setattr(ode_model, "solve_ivp", failing)
+    with pytest.raises(SimulationFailed, match="ODE solver DOP853 failed"):
+        simulate_ode(_one_blow())
