@@ -1,0 +1,89 @@
+"""Runners: plug-ins that map a top-level function over arguments, yielding results as they complete.
+
+Each runner is ``runner(function, arguments) -> Iterator[result]`` (options bound with
+:func:`functools.partial`). Results come in completion order, so the function's result must say
+which argument it belongs to. Workers run one thread each (OMP/OpenBLAS/MKL set to 1).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from multiprocessing import get_context
+from typing import Any, TypeVar
+
+Arg = TypeVar("Arg")
+Result = TypeVar("Result")
+Runner = Callable[[Callable[[Arg], Result], Sequence[Arg]], Iterator[Result]]
+
+SINGLE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
+    """In this process, one after the other."""
+    for argument in arguments:
+        yield function(argument)
+
+
+@contextlib.contextmanager
+def _environment(values: dict[str, str]) -> Iterator[None]:
+    """Set environment variables for child processes started inside the block."""
+    saved = {key: os.environ.get(key) for key in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
+def processes(function: Callable[[Arg], Result], arguments: Sequence[Arg],
+              workers: int | None = None) -> Iterator[Result]:
+    """A pool of freshly spawned worker processes, all cores by default."""
+    workers = min(workers or os.cpu_count() or 1, max(len(arguments), 1))
+    with _environment(SINGLE_THREAD):
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+        try:
+            futures = [pool.submit(function, argument) for argument in arguments]
+            for future in as_completed(futures):
+                yield future.result()
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def dask(function: Callable[[Arg], Result], arguments: Sequence[Arg],
+         address: str | None = None, workers: int | None = None) -> Iterator[Result]:
+    """A Dask cluster at ``address`` (``tcp://host:8786``), or a LocalCluster of single-thread workers."""
+    from dask.distributed import Client, LocalCluster
+    from dask.distributed import as_completed as dask_completed
+
+    with contextlib.ExitStack() as stack:
+        if address:
+            client = stack.enter_context(Client(address))
+        else:
+            cluster = stack.enter_context(LocalCluster(
+                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                dashboard_address=":0", silence_logs=logging.ERROR, env=SINGLE_THREAD))
+            client = stack.enter_context(Client(cluster))
+        futures = client.map(function, list(arguments), pure=False)
+        try:
+            for future in dask_completed(futures):
+                yield future.result()
+        finally:
+            client.cancel(futures)
+
+
+def select(dask_address: str | None, workers: int | None) -> tuple[str, Runner[Any, Any]]:
+    """The runner for the command line options: its description and the bound callable."""
+    if dask_address is not None:
+        where = dask_address or "LocalCluster"
+        return f"dask ({where})", lambda f, a: dask(f, a, address=dask_address or None, workers=workers)
+    if workers == 1:
+        return "sequential", sequential
+    return f"processes ({workers or os.cpu_count()} workers)", lambda f, a: processes(f, a, workers=workers)

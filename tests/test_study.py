@@ -1,0 +1,193 @@
+"""YAML studies: expansion, end-to-end runs, resume after a kill, refusal of a changed study,
+Dask, and bad input."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from models.exudyn_model import simulate_exudyn
+from models.metrics import summary_metrics
+from models.scene import Scene
+from studies.cli import main
+from studies.study import METRIC_NAMES, load_study, run_point
+
+ROOT = Path(__file__).resolve().parents[1]
+BASE = ROOT / "studies" / "scenes" / "paper_base.yaml"
+SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}
+
+
+def write_study(path: Path, **changes) -> Path:
+    """A small study on the paper base scene (4 points, 0.15 s each), with ``changes`` applied."""
+    study = {
+        "name": "small",
+        "base_scene": str(BASE),
+        "base_overrides": SHORT,
+        "scan": {"impact.frequency_hz": [40, 60], "impact.amplitude_n": ["160.0e3", 220e3]},
+        "metrics": ["penetration_rate_m_per_s", "bit_velocity_peak_m_per_s"],
+        "plots": [
+            {"x": "impact.frequency_hz", "y": "bit_velocity_peak_m_per_s", "curves": "impact.amplitude_n"},
+            {"kind": "map", "x": "impact.frequency_hz", "y": "impact.amplitude_n", "z": "bit_velocity_peak_m_per_s"},
+        ],
+    }
+    study.update(changes)
+    path.write_text(yaml.safe_dump(study, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def rows(out: Path) -> list[dict[str, str]]:
+    with (out / "results.csv").open(newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory) -> tuple[Path, Path, int]:
+    base = tmp_path_factory.mktemp("small")
+    study, out = write_study(base / "small.yaml"), base / "out"
+    return study, out, main(["study", str(study), "--out", str(out), "--workers", "2", "--quiet"])
+
+
+def test_axes_expand_and_combine(tmp_path):
+    study = load_study(write_study(
+        tmp_path / "s.yaml",
+        scan={"impact.frequency_hz": {"from": 40, "to": 50, "step": 5},
+              "rock.stiffness_n_per_m": {"from": 1e8, "to": 1e9, "num": 3, "spacing": "log"},
+              "rock.damping_n_s_per_m": [1e3, 2e3, 3e3]},
+        combine=[["rock.stiffness_n_per_m", "rock.damping_n_s_per_m"]], plots=[]))
+    assert study.axes["impact.frequency_hz"] == [40.0, 45.0, 50.0]
+    assert study.axes["rock.stiffness_n_per_m"] == pytest.approx([1e8, 1e8 * 10**0.5, 1e9])
+    assert len(study.points) == 9
+    assert {(p.scene["rock"]["stiffness_n_per_m"], p.scene["rock"]["damping_n_s_per_m"]) for p in study.points} \
+        == set(zip(study.axes["rock.stiffness_n_per_m"], [1e3, 2e3, 3e3]))
+
+
+@pytest.mark.parametrize("name, count", [("frequency_scan", 23), ("impulse_scan", 92), ("stiffness_scan", 92),
+                                         ("rock_table", 69)])
+def test_paper_studies_expand(name, count):
+    study = load_study(ROOT / "studies" / "paper" / f"{name}.yaml")
+    assert len(study.points) == count
+    assert study.points[0].scene["impact"]["frequency_hz"] == 10.0
+
+
+def test_rock_name_axis_supplies_rock_values():
+    study = load_study(ROOT / "studies" / "paper" / "rock_table.yaml")
+    rocks = {p.resolved["rock"]["name"]: p.resolved["rock"]["stiffness_n_per_m"] for p in study.points}
+    assert rocks == {"conglomerate": 8.4e8, "sandstone": 5.1e8, "soft_limestone": 2.1e8}
+
+
+def test_points_run_on_a_base_scene_with_default_solver(tmp_path):
+    base = {key: value for key, value in yaml.safe_load(BASE.read_text()).items() if key != "solver"}
+    study = load_study(write_study(tmp_path / "s.yaml", base_scene=base, scan={"impact.frequency_hz": [40]},
+                                   base_overrides=SHORT, plots=[]))
+    outcome = run_point((0, study.points[0].scene, ["bit_velocity_peak_m_per_s"]))
+    assert outcome["status"] == "ok", outcome["error"]
+
+
+def test_metric_names_are_those_of_summary_metrics():
+    scene = Scene.model_validate({**yaml.safe_load(BASE.read_text()), "metrics": SHORT["metrics"],
+                                  "solver": {"end_time_s": 0.1}})
+    assert set(summary_metrics(simulate_exudyn(scene))) == set(METRIC_NAMES)
+
+
+def test_study_end_to_end(small_run):
+    study, out, status = small_run
+    assert status == 0
+    table = rows(out)
+    assert sorted(int(r["point"]) for r in table) == [0, 1, 2, 3]
+    assert all(r["status"] == "ok" and float(r["bit_velocity_peak_m_per_s"]) > 0 for r in table)
+    assert {(float(r["impact.frequency_hz"]), float(r["impact.amplitude_n"])) for r in table} \
+        == {(40, 160e3), (40, 220e3), (60, 160e3), (60, 220e3)}
+    provenance = json.loads((out / "study.json").read_text())
+    assert provenance["hash"] == load_study(study).hash
+    assert provenance["exudyn_version"] and provenance["rpdrill_version"]
+    assert provenance["resolved_study"]["base_scene"]["rock"]["threshold_n"] == 138e3
+    assert provenance["solver"]["end_time_s"] == 0.15
+    assert len(provenance["point_wall_time_s"]) == 4
+    assert len(list(out.glob("*.png"))) == 2
+
+
+def test_failed_point_is_recorded_and_the_study_goes_on(tmp_path):
+    study = write_study(tmp_path / "fail.yaml", scan={"solver.step_s": [2e-5, 1e-3]},
+                        base_overrides={**SHORT, "impact.frequency_hz": 40}, plots=[])
+    assert main(["study", str(study), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"]) == 1
+    by_step = {float(r["solver.step_s"]): r for r in rows(tmp_path / "out")}
+    assert by_step[2e-5]["status"] == "ok" and by_step[2e-5]["error"] == ""
+    assert by_step[1e-3]["status"] == "failed" and "SimulationFailed" in by_step[1e-3]["error"]
+    assert by_step[1e-3]["penetration_rate_m_per_s"] == ""
+
+
+def test_finished_study_rerun_skips_all(small_run, capsys):
+    study, out, _ = small_run
+    before = sorted(rows(out), key=lambda r: int(r["point"]))
+    assert main(["study", str(study), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    assert "4 finished earlier, running 0" in capsys.readouterr().err
+    assert rows(out) == before  # rewritten in point order, nothing run again
+
+
+def test_changed_study_is_refused(small_run, capsys):
+    study, out, _ = small_run
+    changed = write_study(study.with_name("changed.yaml"),
+                          scan={"impact.frequency_hz": [40, 65], "impact.amplitude_n": [160e3, 220e3]})
+    assert main(["study", str(changed), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "changed.yaml" in err and "differs" in err and str(out) in err
+
+
+def test_resume_after_kill(tmp_path, capsys):
+    study = write_study(tmp_path / "resume.yaml", base_overrides={"solver.end_time_s": 0.4},
+                        scan={"impact.frequency_hz": [40, 45, 50, 55, 60, 65]}, plots=[])
+    out = tmp_path / "out"
+    process = subprocess.Popen([sys.executable, "-m", "studies.cli", "study", str(study), "--out", str(out),
+                                "--workers", "1", "--quiet"], cwd=ROOT, start_new_session=True,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and process.poll() is None:
+        if (out / "results.csv").exists() and len(rows(out)) >= 2:
+            break
+        time.sleep(0.02)
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+    before = {r["point"]: r for r in rows(out)}
+    assert 2 <= len(before) < 6, "the kill should come mid-run"
+    assert main(["study", str(study), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    assert f"{len(before)} finished earlier, running {6 - len(before)}" in capsys.readouterr().err
+    after = rows(out)
+    assert sorted(int(r["point"]) for r in after) == list(range(6))
+    assert all(r == before[r["point"]] for r in after if r["point"] in before)
+
+
+def test_dask_local_cluster(tmp_path):
+    study = write_study(tmp_path / "dask.yaml", scan={"impact.frequency_hz": [40, 60]}, plots=[])
+    out = tmp_path / "out"
+    assert main(["study", str(study), "--out", str(out), "--dask", "--workers", "2", "--quiet"]) == 0
+    assert sorted(r["point"] for r in rows(out)) == ["0", "1"]
+    assert json.loads((out / "study.json").read_text())["sessions"][0]["runner"] == "dask (LocalCluster)"
+
+
+@pytest.mark.parametrize("changes, expected", [
+    ({"scna": {}}, "scna: {}: unknown key; allowed keys here: name, description, base_scene"),
+    ({"scan": {"impact.freq": [40]}, "plots": []}, "scan.impact.freq: unknown scene key path; allowed keys here: amplitude_n"),
+    ({"scan": {"impact.frequency_hz": [40, "fast"]}, "plots": []}, "scan.impact.frequency_hz: 'fast': Input should be a valid"),
+    ({"scan": {"impact.frequency_hz": [40, 2000]}, "plots": []}, "scan.impact.frequency_hz: 2000"),
+    ({"scan": {"impact.frequency_hz": {"from": 40, "to": 50}}, "plots": []}, "scan.impact.frequency_hz: give a list"),
+    ({"scan": {"rock.name": ["sandstone", "conglomerate"]}, "plots": []}, "scan.rock.name: the base rock sets stiffness_n_per_m"),
+    ({"base_scene": "missing.yaml"}, "base_scene: 'missing.yaml': no scene file"),
+    ({"metrics": ["penetration_rate"]}, "metrics.0: 'penetration_rate': Input should be"),
+    ({"plots": [{"x": "rock.threshold_n", "y": "penetration_rate_m_per_s"}]},
+     "plots.0.x: 'rock.threshold_n': not a scan axis"),
+])
+def test_bad_input_exits_2_naming_file_and_key(tmp_path, capsys, changes, expected):
+    study = write_study(tmp_path / "bad.yaml", **changes)
+    assert main(["study", str(study), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert str(study) in err and expected in err, err
+    assert not (tmp_path / "out").exists()
