@@ -37,7 +37,7 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
     return data
 
 
-def _allowed_keys(model: type[BaseModel], location: tuple[Any, ...]) -> list[str] | None:
+def allowed_keys(model: type[BaseModel], location: tuple[Any, ...]) -> list[str] | None:
     """Keys allowed at the parent of ``location`` inside ``model`` (None if not a model there)."""
     current: Any = model
     for part in location[:-1]:
@@ -67,7 +67,7 @@ def describe_validation_error(source: str, error: ValidationError, model: type[B
         location = tuple(part for part in item["loc"] if part not in ("function-after",))
         path = ".".join(str(p) for p in prefix + location) or "(top level)"
         if item["type"] == "extra_forbidden":
-            allowed = _allowed_keys(model, location)
+            allowed = allowed_keys(model, location)
             hint = f"unknown key; allowed keys here: {', '.join(allowed)}" if allowed else "unknown key"
             lines.append(f"{source}: {path}: {_short(item['input'])}: {hint}")
         elif item["type"] == "missing":

@@ -121,7 +121,9 @@ def test_failed_point_is_recorded_and_the_study_goes_on(tmp_path):
     assert main(["study", str(study), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"]) == 1
     by_step = {float(r["solver.step_s"]): r for r in rows(tmp_path / "out")}
     assert by_step[2e-5]["status"] == "ok" and by_step[2e-5]["error"] == ""
-    assert by_step[1e-3]["status"] == "failed" and "SimulationFailed" in by_step[1e-3]["error"]
+    error = by_step[1e-3]["error"]
+    assert by_step[1e-3]["status"] == "failed" and "SimulationFailed" in error
+    assert "diverged at t =" in error and "rk44" in error and "try solver.step_s" in error  # the run's message
     assert by_step[1e-3]["penetration_rate_m_per_s"] == ""
 
 
