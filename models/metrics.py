@@ -59,8 +59,9 @@ class _Window:
         return float(math.sqrt(trapezoid(values[self.mask] ** 2, self.result.time_s[self.mask]) / self.duration))
 
     def efficiency(self) -> float:
-        impact = self.work(self.energy.impact_work_j)
-        return self.work(self.energy.crushing_work_j) / impact if impact > 0 else float("nan")
+        """Crushing work / work put in by the impacts and the feed over the window."""
+        put_in = self.work(self.energy.impact_work_j) + self.work(self.energy.feed_work_j)
+        return self.work(self.energy.crushing_work_j) / put_in if put_in > 0 else float("nan")
 
 
 def _spread(values: np.ndarray) -> float:

@@ -152,10 +152,10 @@ ACCURACY_KEYS = ("type", "step_s", "spectral_radius", "relative_tolerance", "abs
 
 
 class Solver(Strict):
-    """Time integration: a ``preset`` (fast, standard, reference) or explicit settings.
+    """Time integration: a ``preset`` (fast, standard, reference) and/or explicit settings.
 
-    ``step_s`` is the fixed step (the largest step for dopri5/ode23). Without explicit settings
-    the ``standard`` preset applies; a preset and explicit accuracy settings exclude each other.
+    ``step_s`` is the fixed step (the largest step for dopri5/ode23). A preset sets ``type`` and
+    ``step_s``; explicit values given next to it win. Without either, the ``standard`` preset applies.
     """
 
     preset: Literal[tuple(SOLVER_PRESETS)] | None = None  # type: ignore[valid-type]
@@ -169,14 +169,8 @@ class Solver(Strict):
 
     @model_validator(mode="before")
     @classmethod
-    def _preset_or_explicit(cls, data: object) -> object:
-        if not isinstance(data, dict):
-            return data
-        explicit = [key for key in ACCURACY_KEYS if key in data]
-        if data.get("preset") is not None and explicit:
-            raise ValueError(f"give a preset or explicit settings, not both: preset {data['preset']!r} "
-                             f"with {', '.join(explicit)}")
-        if not explicit and data.get("preset") is None:
+    def _default_preset(cls, data: object) -> object:
+        if isinstance(data, dict) and data.get("preset") is None and not any(k in data for k in ACCURACY_KEYS):
             return {**data, "preset": DEFAULT_PRESET}
         return data
 
@@ -299,7 +293,9 @@ class Scene(Strict):
             preset = SOLVER_PRESETS[self.solver.preset]
             step = min(preset["step_s"], self.impact.duration_s / preset["steps_per_pulse"],
                        preset["step_times_radius"] / spectral_radius_per_s(self))
-            object.__setattr__(self, "solver", self.solver.model_copy(update={"type": "rk44", "step_s": step}))
+            given = self.solver.model_fields_set
+            update = {key: value for key, value in (("type", "rk44"), ("step_s", step)) if key not in given}
+            object.__setattr__(self, "solver", self.solver.model_copy(update=update))
         period = self.impact.period_s
         if self.solver.end_time_s < period:
             raise ValueError(

@@ -17,6 +17,8 @@ COMMANDS = {
     "simulate": ("studies.simulate_command", "run one scene: time histories, summary, plot"),
     "crosscheck": ("studies.crosscheck", "run the Exudyn model and the ODE of Eq. 4 and compare them"),
     "study": ("studies.study_command", "run a YAML study (scan) on all cores or a Dask cluster"),
+    "accuracy": ("studies.accuracy_command", "work-precision study: error against CPU time of solver settings"),
+    "calibrate": ("studies.calibrate_command", "fit scene parameters to target optimum frequencies"),
 }
 
 

@@ -43,18 +43,34 @@ def _environment(values: dict[str, str]) -> Iterator[None]:
                 os.environ[key] = value
 
 
+@contextlib.contextmanager
+def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
+    """A runner bound to one pool of spawned single-thread workers, kept for many calls
+    (calibration evaluates many scans; starting workers costs seconds)."""
+    workers = workers or os.cpu_count() or 1
+    with _environment(SINGLE_THREAD):  # workers start on demand: the setting lasts the pool's life
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+
+        def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
+            futures = [pool.submit(function, argument) for argument in arguments]
+            try:
+                for future in as_completed(futures):
+                    yield future.result()
+            finally:
+                for future in futures:
+                    future.cancel()
+
+        try:
+            yield run
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
 def processes(function: Callable[[Arg], Result], arguments: Sequence[Arg],
               workers: int | None = None) -> Iterator[Result]:
     """A pool of freshly spawned worker processes, all cores by default."""
-    workers = min(workers or os.cpu_count() or 1, max(len(arguments), 1))
-    with _environment(SINGLE_THREAD):
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
-        try:
-            futures = [pool.submit(function, argument) for argument in arguments]
-            for future in as_completed(futures):
-                yield future.result()
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+    with process_pool(min(workers or os.cpu_count() or 1, max(len(arguments), 1))) as run:
+        yield from run(function, arguments)
 
 
 def dask(function: Callable[[Arg], Result], arguments: Sequence[Arg],

@@ -54,11 +54,11 @@ NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 MetricName = Literal[METRIC_NAMES]  # type: ignore[valid-type]
 
 
-class _Strict(BaseModel):
+class StrictSpec(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
 
 
-class Axis(_Strict):
+class Axis(StrictSpec):
     """Values of one scan axis: a list ``[..]``, ``{from, to, step}`` or ``{from, to, num, spacing}``."""
 
     values: list[Any] | None = Field(None, min_length=1)
@@ -109,7 +109,7 @@ class Axis(_Strict):
         return [float(f"{v:.12g}") for v in raw]
 
 
-class Plot(_Strict):
+class Plot(StrictSpec):
     """``curves``: metric(s) ``y`` against axis ``x``, one curve per value of the other axes
     (labelled by axis ``curves``), maximum of each curve marked. ``map``: metric ``z`` over
     axes ``x`` and ``y`` with the ridge of maxima along ``x`` for each ``y``."""
@@ -137,7 +137,7 @@ class Plot(_Strict):
         return [self.x, self.y] if self.kind == "map" else [self.x] + ([self.curves] if self.curves else [])
 
 
-class StudySpec(_Strict):
+class StudySpec(StrictSpec):
     """The study file as written."""
 
     name: str
@@ -193,7 +193,7 @@ def set_path(data: dict[str, Any], path: str, value: Any) -> None:
     data[leaf] = copy.deepcopy(value)
 
 
-def _check_scene_path(source: str, key: str, path: str) -> None:
+def check_scene_path(source: str, key: str, path: str) -> None:
     parts = tuple(path.split("."))
     allowed = allowed_keys(Scene, parts)
     if allowed is None or parts[-1] not in allowed:
@@ -256,7 +256,7 @@ def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]
     return lines
 
 
-def _base_scene(spec: StudySpec, source: Path) -> dict[str, Any]:
+def base_scene_dict(spec: StudySpec, source: Path) -> dict[str, Any]:
     """The base scene as written, with the overrides set (not filled in: a scanned ``rock.name``
     must still supply the rock values)."""
     if isinstance(spec.base_scene, str):
@@ -269,7 +269,7 @@ def _base_scene(spec: StudySpec, source: Path) -> dict[str, Any]:
         data = copy.deepcopy(spec.base_scene)
         parse(Scene, data, str(source), ("base_scene",))
     for path, value in spec.base_overrides.items():
-        _check_scene_path(str(source), "base_overrides", path)
+        check_scene_path(str(source), "base_overrides", path)
         set_path(data, path, value)
     parse(Scene, data, f"{source} (base_scene with base_overrides)")
     return data
@@ -279,9 +279,9 @@ def load_study(path: str | Path) -> Study:
     """Read, validate and expand a study file; InputError naming the file and key path otherwise."""
     path = Path(path)
     spec = parse(StudySpec, read_yaml(path), str(path))
-    base = _base_scene(spec, path)
+    base = base_scene_dict(spec, path)
     for axis in spec.scan:
-        _check_scene_path(str(path), "scan", axis)
+        check_scene_path(str(path), "scan", axis)
     axes = {name: axis.expand() for name, axis in spec.scan.items()}
     _check_plots(spec, axes, str(path))
     _check_rock_name_axis(spec, base, str(path))

@@ -1,4 +1,4 @@
-"""Scenes for tests: the shipped paper_base scene with overrides by dotted key path."""
+"""Scenes for tests: the frozen test drill (tests/test_drill.yaml) with overrides by dotted key path."""
 
 from __future__ import annotations
 
@@ -10,10 +10,9 @@ import yaml
 
 from models.scene import Scene
 
-SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
-PAPER_BASE = SCENES / "paper_base.yaml"
+PAPER_BASE = Path(__file__).resolve().parent / "test_drill.yaml"
 
-# Overrides that make paper_base crush on every blow (used where a test needs crushing).
+# Overrides that make the test drill crush on every blow (used where a test needs crushing).
 CRUSHING = {"impact.amplitude_n": 400e3, "impact.frequency_hz": 45.0}
 
 

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from scenes import PAPER_BASE
 
 from models.compare import compare_runs, verdict
 from models.exudyn_model import simulate_exudyn
@@ -21,14 +22,13 @@ from models.scene import Scene
 from studies.cli import main
 from studies.crosscheck import DEFAULT_STEP_S
 
-BASE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
 BLOWS = 15
 LIFT_OFF_M = 1e-9  # a gap below this (round-off of the start from rest, ~1e-19 m) is no lift-off
 
 
 def scene_from_base(**changes: object) -> Scene:
-    """paper_base over BLOWS periods at the cross-check step, ``changes`` as 'section.key' -> value."""
-    data = copy.deepcopy(yaml.safe_load(BASE.read_text(encoding="utf-8")))
+    """The test drill over BLOWS periods at the cross-check step, ``changes`` as 'section.key' -> value."""
+    data = copy.deepcopy(yaml.safe_load(PAPER_BASE.read_text(encoding="utf-8")))
     for path, value in changes.items():
         section, key = path.split(".")
         data[section][key] = value
@@ -76,12 +76,12 @@ def test_exudyn_agrees_with_ode(case: str) -> None:
 
 def test_cli_bad_input_exits_2(tmp_path: Path) -> None:
     assert main(["crosscheck", str(tmp_path / "missing.yaml")]) == 2
-    assert main(["crosscheck", str(BASE), "--blows", "3"]) == 2  # fewer blows than the metrics need
+    assert main(["crosscheck", str(PAPER_BASE), "--blows", "3"]) == 2  # fewer blows than the metrics need
 
 
 def test_cli_writes_report_and_passes(tmp_path: Path) -> None:
     out = tmp_path / "cc"
-    assert main(["crosscheck", str(BASE), "--blows", str(BLOWS), "--out", str(out)]) == 0
+    assert main(["crosscheck", str(PAPER_BASE), "--blows", str(BLOWS), "--out", str(out)]) == 0
     report = json.loads((out / "crosscheck.json").read_text(encoding="utf-8"))
     assert report["passed"] and report["blows"] == BLOWS
     assert set(report["histories"]) == {"borehole_bottom_m", "bit_velocity_m_per_s", "rock_force_n"}

@@ -6,11 +6,11 @@ import copy
 import functools
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from scenes import PAPER_BASE
 
 from models import ode_model
 from models.energy import energy_account
@@ -18,12 +18,10 @@ from models.ode_model import simulate_ode
 from models.scene import Scene
 from models.stability import SimulationFailed
 
-BASE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
-
 
 def scene_from_base(blows: float = 15, **changes: object) -> Scene:
-    """paper_base ending after ``blows`` periods, with ``changes`` given as 'section.key' -> value."""
-    data = copy.deepcopy(yaml.safe_load(BASE.read_text(encoding="utf-8")))
+    """The test drill ending after ``blows`` periods, with ``changes`` given as 'section.key' -> value."""
+    data = copy.deepcopy(yaml.safe_load(PAPER_BASE.read_text(encoding="utf-8")))
     for path, value in changes.items():
         section, key = path.split(".")
         data.setdefault(section, {})[key] = value

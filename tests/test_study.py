@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from scenes import PAPER_BASE
 
 from models.exudyn_model import simulate_exudyn
 from models.metrics import summary_metrics
@@ -22,15 +23,14 @@ from studies.cli import main
 from studies.study import METRIC_NAMES, load_study, run_point
 
 ROOT = Path(__file__).resolve().parents[1]
-BASE = ROOT / "studies" / "scenes" / "paper_base.yaml"
 SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}
 
 
 def write_study(path: Path, **changes) -> Path:
-    """A small study on the paper base scene (4 points, 0.15 s each), with ``changes`` applied."""
+    """A small study on the test drill (4 points, 0.15 s each), with ``changes`` applied."""
     study = {
         "name": "small",
-        "base_scene": str(BASE),
+        "base_scene": str(PAPER_BASE),
         "base_overrides": SHORT,
         "scan": {"impact.frequency_hz": [40, 60], "impact.amplitude_n": ["160.0e3", 220e3]},
         "metrics": ["penetration_rate_m_per_s", "bit_velocity_peak_m_per_s"],
@@ -85,7 +85,7 @@ def test_rock_name_axis_supplies_rock_values():
 
 
 def test_points_run_on_a_base_scene_with_default_solver(tmp_path):
-    base = {key: value for key, value in yaml.safe_load(BASE.read_text()).items() if key != "solver"}
+    base = {key: value for key, value in yaml.safe_load(PAPER_BASE.read_text()).items() if key != "solver"}
     study = load_study(write_study(tmp_path / "s.yaml", base_scene=base, scan={"impact.frequency_hz": [40]},
                                    base_overrides=SHORT, plots=[]))
     outcome = run_point((0, study.points[0].scene, ["bit_velocity_peak_m_per_s"]))
@@ -93,7 +93,7 @@ def test_points_run_on_a_base_scene_with_default_solver(tmp_path):
 
 
 def test_metric_names_are_those_of_summary_metrics():
-    scene = Scene.model_validate({**yaml.safe_load(BASE.read_text()), "metrics": SHORT["metrics"],
+    scene = Scene.model_validate({**yaml.safe_load(PAPER_BASE.read_text()), "metrics": SHORT["metrics"],
                                   "solver": {"end_time_s": 0.1}})
     assert set(summary_metrics(simulate_exudyn(scene))) == set(METRIC_NAMES)
 
