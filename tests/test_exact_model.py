@@ -1,0 +1,175 @@
+"""The exact event-driven solution (models.exact_model) as the reference formulation.
+
+(a) agreement with the tight-tolerance ODE formulation on crushing scenes, both feed arrangements
+and both rock damping modes; (b) energy conserved to round-off without damping; (c) a switch just
+after a sub-grid point is found at the same time; (d) chattering contact runs to the end, and an
+exceeded switch limit is reported.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scenes import crushing_scene, scene
+
+from models.energy import energy_account
+from models.exact_model import simulate_exact
+from models.metrics import summary_metrics
+from models.ode_model import simulate_ode
+from models.results import SimulationResult
+from models.scene import Scene
+from models.stability import SimulationFailed
+
+BLOWS = 12
+SHORT_METRICS = {"metrics__transient_blows": 2, "metrics__block_blows": 2}
+FEEDS = {
+    "carriage": {},
+    "per_body": {"feed__arrangement": "per_body", "feed__carriage_mass_kg": None},
+}
+UNDAMPED = {
+    "connectors__shock_absorber__damping_n_s_per_m": 0.0,
+    "connectors__shank_collar_joint__damping_n_s_per_m": 0.0,
+    "connectors__collar_bit_joint__damping_n_s_per_m": 0.0,
+    "rock__damping_n_s_per_m": 0.0,
+    "torsion__damping_n_m_s_per_rad": 0.0,
+}
+ODE_RTOL, ODE_ATOL = 1e-12, 1e-15
+AGREEMENT = 1e-9
+
+
+def crushing(feed: str, damping_mode: str, blows: int = BLOWS, **changes: object) -> Scene:
+    """The test drill made to crush (400 kN at 45 Hz) for ``blows`` blows."""
+    return crushing_scene(rock__damping_mode=damping_mode, solver__end_time_s=blows / 45.0,
+                          **SHORT_METRICS, **FEEDS[feed], **changes)
+
+
+@functools.cache
+def exact(feed: str, damping_mode: str) -> SimulationResult:
+    return simulate_exact(crushing(feed, damping_mode))
+
+
+def held_at(result: SimulationResult, values: np.ndarray, times_s: np.ndarray) -> np.ndarray:
+    """Last stored value at or before each time (both formulations store every pulse switch)."""
+    index = np.searchsorted(result.time_s, times_s + 1e-12, side="right") - 1
+    return values[index]
+
+
+def pulse_switches(scene_: Scene) -> np.ndarray:
+    """Blow starts and pulse ends, where x_n is stored by both formulations."""
+    period, tau = scene_.impact.period_s, scene_.impact.duration_s
+    starts = np.arange(1, math.floor(scene_.solver.end_time_s / period + 1e-9)) * period
+    return np.sort(np.concatenate([starts, starts - period + tau]))
+
+
+def relative_error(result: SimulationResult, reference: SimulationResult, column: str) -> float:
+    times, exact_values = pulse_switches(reference.scene), getattr(reference, column)
+    difference = held_at(result, getattr(result, column), times) - held_at(reference, exact_values, times)
+    return float(np.max(np.abs(difference)) / np.max(np.abs(exact_values)))
+
+
+def test_does_not_import_exudyn() -> None:
+    code = "import models.exact_model, sys; assert 'exudyn' not in sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+@pytest.mark.parametrize("damping_mode", ["contact", "always"])
+@pytest.mark.parametrize("feed", list(FEEDS))
+def test_agrees_with_tight_ode(feed: str, damping_mode: str) -> None:
+    reference = exact(feed, damping_mode)
+    ode = simulate_ode(reference.scene, method="DOP853", rtol=ODE_RTOL, atol=ODE_ATOL)
+    assert reference.info["switches_into"].get("crushing", 0) >= 2
+    assert reference.bottom_m[-1] > 5e-4  # the bottom advanced by crushing
+    assert relative_error(ode, reference, "bottom_m") < AGREEMENT
+    assert relative_error(ode, reference, "bit_position_m") < AGREEMENT
+    end = (ode.torsion_angle_rad[-1], reference.torsion_angle_rad[-1])
+    assert abs(end[0] - end[1]) < AGREEMENT * abs(end[1])
+
+
+@pytest.mark.parametrize("shape", ["rectangular", "triangular"])
+def test_other_pulse_shapes_agree_with_tight_ode(shape: str) -> None:
+    """The rectangular pulse (constant state) and the triangular one (ramp state, two phases)."""
+    reference = simulate_exact(crushing("carriage", "contact", blows=6, impact__shape=shape))
+    ode = simulate_ode(reference.scene, method="DOP853", rtol=ODE_RTOL, atol=ODE_ATOL)
+    assert reference.info["switches_into"].get("crushing", 0) >= 4
+    assert relative_error(ode, reference, "bottom_m") < AGREEMENT
+    assert relative_error(ode, reference, "bit_position_m") < AGREEMENT
+
+
+def test_torsion_without_stiffness_matches_closed_form() -> None:
+    """k_x = 0 makes the torsion matrix defective (expm path): phi' = (M/c)(1 - exp(-c t / J))."""
+    result = simulate_exact(crushing("carriage", "contact", blows=6, torsion__stiffness_n_m_per_rad=0.0))
+    tor, t = result.scene.torsion, result.time_s
+    rate = tor.damping_n_m_s_per_rad / tor.inertia_kg_m2
+    terminal = (tor.drive_torque_n_m - tor.resisting_torque_n_m) / tor.damping_n_m_s_per_rad
+    expected_rate = terminal * (1 - np.exp(-rate * t))
+    expected_angle = terminal * (t - (1 - np.exp(-rate * t)) / rate)
+    assert np.max(np.abs(result.torsion_rate_rad_per_s - expected_rate)) < 1e-12 * terminal
+    assert np.max(np.abs(result.torsion_angle_rad - expected_angle)) < 1e-12 * expected_angle[-1]
+
+
+@pytest.mark.parametrize("feed", list(FEEDS))
+def test_result_feeds_energy_and_metrics(feed: str) -> None:
+    result = exact(feed, "contact")
+    assert np.all(np.diff(result.time_s) >= 0.0)
+    assert np.all(np.diff(result.bottom_m) >= -1e-15)
+    metrics = summary_metrics(result)
+    assert metrics["penetration_rate_m_per_s"] > 0
+    assert metrics["window_blows"] == BLOWS - 2
+    fine = simulate_exact(result.scene, sample_interval_s=2e-6)
+    assert energy_account(fine).relative_residual() < 1e-4  # trapezoidal rule on the samples
+
+
+@pytest.mark.parametrize("threshold_n", [1e9, None], ids=["no_crushing", "crushing"])
+def test_energy_conserved_to_round_off_without_damping(threshold_n: float | None) -> None:
+    """Without dampers, T + V + F_spring^2/2k_n - W_feed + F_th x_n is constant between pulses (to
+    round-off of its largest terms, thousands of J here against 160 J of impact work)."""
+    changes = UNDAMPED | ({"rock__threshold_n": threshold_n} if threshold_n else {})
+    result = simulate_exact(crushing("carriage", "contact", blows=8, **changes))
+    energy = energy_account(result)
+    total = energy.kinetic_j + energy.elastic_j - energy.feed_work_j + energy.crushing_work_j
+    impact = result.scene.impact
+    blow = np.floor(result.time_s / impact.period_s + 1e-12)
+    between = result.time_s - blow * impact.period_s >= impact.duration_s - 1e-15
+    spread = max(np.ptp(total[between & (blow == b)]) for b in np.unique(blow[between]))
+    assert (result.bottom_m[-1] > 0) == (threshold_n is None)
+    assert result.info["mode_switches"] > 8
+    largest_term = np.max(energy.kinetic_j + energy.elastic_j + np.abs(energy.feed_work_j))
+    assert spread < 1e-12 * largest_term
+
+
+def test_switch_just_after_a_grid_point_is_found() -> None:
+    """Shift the sub-grid so that a point lies 1e-6 sub-steps before a contact event."""
+    base = exact("carriage", "contact")
+    times, modes = base.info["switch_times_s"], base.info["switch_modes"]
+    contact_made = next(t for t, mode, before in zip(times[1:], modes[1:], modes) if mode == "contact" and before == "free")
+    step = base.info["sub_step_s"]
+    per_sample = round(base.info["sample_interval_s"] / step)
+    points = math.floor(contact_made / step)
+    shifted_step = (contact_made - 1e-6 * step) / points
+    shifted = simulate_exact(base.scene, sample_interval_s=shifted_step * per_sample)
+    assert shifted.info["sub_step_s"] == pytest.approx(shifted_step, rel=1e-14)
+    assert 0 < contact_made - points * shifted.info["sub_step_s"] < 2e-6 * step
+    assert shifted.info["switch_modes"] == modes
+    assert np.max(np.abs(shifted.info["switch_times_s"] - times)) < 1e-13
+    assert abs(shifted.bottom_m[-1] - base.bottom_m[-1]) < 1e-12 * base.bottom_m[-1]
+
+
+# a light bit loosely held by a light collar on a stiff rock, little feed: ~70 switches per blow
+CHATTER = {"bodies__bit_mass_kg": 0.5, "bodies__collar_mass_kg": 30.0, "rock__stiffness_n_per_m": 5e10,
+           "connectors__collar_bit_joint__stiffness_n_per_m": 1e7, "feed__force_n": 200.0}
+
+
+def test_chattering_contact_runs_to_the_end() -> None:
+    chatter = scene(solver__end_time_s=10 / 65, **SHORT_METRICS, **CHATTER)
+    result = simulate_exact(chatter)
+    assert result.time_s[-1] == pytest.approx(chatter.solver.end_time_s)
+    assert result.info["mode_switches"] > 30 * 10
+    assert np.min(np.diff(result.info["switch_times_s"])) >= result.info["min_switch_interval_s"]
+    assert result.cpu_time_s < 10.0
+    with pytest.raises(SimulationFailed, match="chattering"):
+        simulate_exact(chatter, max_switches_per_blow=5)
