@@ -70,7 +70,7 @@ from scipy.optimize import brentq
 from models.chain import AxialChain, paper_chain
 from models.results import SimulationResult
 from models.scene import Impact, Scene, Torsion
-from models.stability import POSITION_LIMIT_M, SimulationFailed
+from models.stability import SimulationFailed, diverged_index
 from rocklaw.jenkins import JenkinsRock
 
 FREE, CONTACT, CLIPPED, CRUSHING = "free", "contact", "clipped", "crushing"
@@ -528,8 +528,10 @@ def simulate_exact(scene: Scene, sample_interval_s: float | None = None, min_swi
     n = solver.layout.n
     torsion = torsion_history(scene.torsion, time_s) if scene.effects.torsion else (None, None)
     cpu = time.process_time() - start
-    if not np.isfinite(states).all() or (np.abs(states[:, :n]) > POSITION_LIMIT_M).any():
-        raise SimulationFailed(f"scene '{scene.name}': exact solution diverged (unstable chain?)")
+    bad = diverged_index(states[:, :n], states[:, n:2 * n])
+    if bad is not None:
+        raise SimulationFailed(f"scene '{scene.name}': exact solution diverged at t = {time_s[bad]:.6g} s "
+                               "(an unstable chain?)")
     return SimulationResult(
         scene=scene,
         chain=solver.chain,

@@ -46,7 +46,7 @@ from models.chain import AxialChain, paper_chain
 from models.pulse import impact_force, pulse_switch_times
 from models.results import SimulationResult
 from models.scene import Impact, Scene
-from models.stability import POSITION_LIMIT_M, SimulationFailed
+from models.stability import SimulationFailed, diverged_index
 from rocklaw.backends import NUMERIC
 from rocklaw.jenkins import JenkinsRock
 
@@ -317,9 +317,9 @@ def simulate_ode(scene: Scene, method: str = "DOP853", rtol: float = 1e-10, atol
     time_s = np.concatenate(record.time_s)
     states = np.concatenate(record.states, axis=1).T
     n = system.n
-    bad = ~np.isfinite(states).all(axis=1) | (np.abs(states[:, :n]) > POSITION_LIMIT_M).any(axis=1)
-    if bad.any():
-        raise _fail(scene, method, float(time_s[np.argmax(bad)]), "diverged")
+    bad = diverged_index(states[:, :n], states[:, n:2 * n])
+    if bad is not None:
+        raise _fail(scene, method, float(time_s[bad]), "diverged")
     torsion = system.torsion is not None
     return SimulationResult(
         scene=scene,

@@ -97,18 +97,22 @@ def _energy_blow_up_index(result: SimulationResult) -> int | None:
     return int(np.argmax(bad)) if bad.any() else None
 
 
+def diverged_index(position_m: np.ndarray, velocity_m_per_s: np.ndarray) -> int | None:
+    """First stored step with a non-finite state or a position beyond POSITION_LIMIT_M, if any."""
+    states = np.column_stack([position_m, velocity_m_per_s])
+    bad = ~np.isfinite(states).all(axis=1) | (np.abs(position_m) > POSITION_LIMIT_M).any(axis=1)
+    return int(np.argmax(bad)) if bad.any() else None
+
+
 def check_result(result: SimulationResult, solver_ok: bool, reached_s: float | None = None) -> None:
     """Raise :class:`SimulationFailed` naming scene, solver, time and a remedy if the run is unusable.
 
     ``reached_s`` is the solver's final time (default: the last stored sample)."""
     scene, solver = result.scene, result.scene.solver
     setting = f"solver {solver.type} with step_s {solver.step_s:g}"
-    states = np.column_stack([result.position_m, result.velocity_m_per_s])
-    bad = ~np.isfinite(states).all(axis=1) | (np.abs(result.position_m) > POSITION_LIMIT_M).any(axis=1)
-    if bad.any():
-        index = int(np.argmax(bad))
-    else:  # the energy check needs the force histories at every step
-        index = _energy_blow_up_index(result) if "energy" in scene.needed_data() else None
+    index = diverged_index(result.position_m, result.velocity_m_per_s)
+    if index is None and "energy" in scene.needed_data():  # needs the force histories at every step
+        index = _energy_blow_up_index(result)
     if index is not None:
         raise SimulationFailed(
             f"scene '{scene.name}': {setting} diverged at t = {result.time_s[index]:.6g} s; {_remedy(scene)}"

@@ -32,10 +32,12 @@ FREQUENCY = "impact.frequency_hz"
 
 
 class Target(StrictSpec):
-    """One scan: overrides on the base scene and where its optimum should be [Hz]."""
+    """One scan: overrides on the base scene, where its optimum should be [Hz], and the metric
+    whose maximum is that optimum (default: the calibration's ``metric``)."""
 
     overrides: dict[str, Any] = Field(default_factory=dict)
     optimum_hz: float = Field(gt=0)
+    metric: str | None = None
 
 
 class CalibrationSpec(StrictSpec):
@@ -78,8 +80,10 @@ class Calibration:
 def load_calibration(path: str | Path) -> Calibration:
     path = Path(path)
     spec = parse(CalibrationSpec, read_yaml(path), str(path))
-    if spec.metric not in METRICS:
-        raise InputError(f"{path}: metric: {spec.metric!r}: not a metric of models.outputs.METRICS")
+    for key, metric in [("metric", spec.metric)] + [(f"targets.{i}.metric", t.metric) for i, t in
+                                                     enumerate(spec.targets) if t.metric]:
+        if metric not in METRICS:
+            raise InputError(f"{path}: {key}: {metric!r}: not a metric; allowed: {', '.join(METRICS)}")
     for key in spec.parameters:
         check_scene_path(str(path), "parameters", key)
     for i, target in enumerate(spec.targets):
@@ -108,11 +112,13 @@ def optimum_hz(frequencies: list[float], values: list[float]) -> float | None:
 def evaluate(calibration: Calibration, values: dict[str, float], runner: Runner) -> dict[str, Any]:
     """Run every target's scan at these parameter values: optima and objective."""
     spec = calibration.spec
-    tasks = [((t, i), calibration.scene(values, target, f), [spec.metric])
+    metrics = [target.metric or spec.metric for target in spec.targets]
+    tasks = [((t, i), calibration.scene(values, target, f), [metrics[t]])
              for t, target in enumerate(spec.targets) for i, f in enumerate(calibration.frequencies)]
     metric = {}
     for outcome in runner(run_point, tasks):
-        metric[outcome["point"]] = outcome["metrics"].get(spec.metric, float("nan"))
+        (t, _) = outcome["point"]
+        metric[outcome["point"]] = outcome["metrics"].get(metrics[t], float("nan"))
     optima, objective = [], 0.0
     for t, target in enumerate(spec.targets):
         found = optimum_hz(calibration.frequencies, [metric[(t, i)] for i in range(len(calibration.frequencies))])

@@ -7,6 +7,7 @@ DIR/calibrated_scene.yaml (the base scene with the best parameters).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from pathlib import Path
 
@@ -15,7 +16,7 @@ from tqdm import tqdm
 
 from studies.calibrate import calibrate, load_calibration
 from studies.outputs import staged_directory, write_json
-from studies.runners import process_pool
+from studies.runners import process_pool, sequential
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -29,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
     calibration = load_calibration(args.calibration)
     spec = calibration.spec
     with tqdm(total=spec.max_evaluations, desc=spec.name, unit="eval", disable=args.quiet) as bar, \
-            process_pool(args.workers) as runner:
+            (contextlib.nullcontext(sequential) if args.workers == 1 else process_pool(args.workers)) as runner:
         def progress(record: dict) -> None:
             bar.update(1)
             bar.set_postfix(objective=f"{record['objective']:.3g}")
