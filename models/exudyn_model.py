@@ -38,7 +38,7 @@ from models.pulse import impact_force
 from models.results import SimulationResult
 from models.scene import AUTOMATIC_STEP_SOLVERS, Scene
 from models.stability import StepLimitWarning, check_result, step_warning
-from rocklaw.backends import NUMERIC, SymbolicBackend
+from rocklaw.backends import SCALAR, SymbolicBackend
 from rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 
 SOLVER_TYPES = {
@@ -137,7 +137,7 @@ def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
         )
 
     impact_load = mbs.AddLoad(LoadCoordinate(markerNumber=markers[chain.impact_body], load=0.0))
-    backend = SymbolicBackend() if symbolic else NUMERIC
+    backend = SymbolicBackend() if symbolic else SCALAR
 
     def piston_force(mbs, t, load):
         return impact_force(scene.impact, t, backend)

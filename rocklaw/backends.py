@@ -4,7 +4,7 @@ A law written against the small interface below (``where``, ``minimum``, ``maxim
 ``sin``, ``mod``) runs
 
 * numerically with :data:`NUMERIC` (NumPy: scalars or arrays), as used by the ODE formulation,
-  the tests and post-processing, and
+  the tests and post-processing, or :data:`SCALAR` (plain floats, for Python callbacks), and
 * symbolically with :data:`SYMBOLIC` (``exudyn.symbolic``), recorded once into an expression
   tree that Exudyn evaluates in C++ at every solver evaluation (no Python call per evaluation).
 
@@ -14,6 +14,7 @@ laws must branch with ``where`` only.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Protocol
 
 import numpy as np
@@ -52,6 +53,25 @@ class NumericBackend:
         return self._scalar(np.mod(x, y))
 
 
+class ScalarBackend:
+    """Plain Python floats (math module): the fastest way to evaluate a law in a Python callback."""
+
+    def where(self, condition: Any, if_true: Any, if_false: Any) -> Any:
+        return if_true if condition else if_false
+
+    def minimum(self, a: Any, b: Any) -> Any:
+        return min(b, a)
+
+    def maximum(self, a: Any, b: Any) -> Any:
+        return max(b, a)
+
+    def sin(self, x: Any) -> Any:
+        return math.sin(x)
+
+    def mod(self, x: Any, y: Any) -> Any:
+        return x % y
+
+
 class SymbolicBackend:
     """``exudyn.symbolic`` evaluation: every constant is wrapped as a symbolic ``Real``."""
 
@@ -80,3 +100,4 @@ class SymbolicBackend:
 
 
 NUMERIC: Backend = NumericBackend()
+SCALAR: Backend = ScalarBackend()

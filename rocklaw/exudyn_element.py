@@ -15,7 +15,7 @@ import exudyn as exu
 from exudyn.advancedUtilities import CreateSymbolicUserFunction
 from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
 
-from rocklaw.backends import NUMERIC, SymbolicBackend
+from rocklaw.backends import SCALAR, SymbolicBackend
 from rocklaw.jenkins import JenkinsRock
 
 
@@ -58,7 +58,7 @@ class ExudynRockContact:
                 offset=initial_bottom_m,
             )
         )
-        backend = SymbolicBackend() if symbolic else NUMERIC
+        backend = SymbolicBackend() if symbolic else SCALAR
 
         def rock_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
             return rock.force(displacement - offset, velocity, backend)
