@@ -23,6 +23,7 @@ import numpy as np
 from pydantic import Field, model_validator
 from scipy import optimize
 
+from models.formulations import FORMULATIONS
 from models.outputs import METRICS
 from studies.loading import InputError, parse, read_yaml
 from studies.runners import Runner
@@ -49,6 +50,7 @@ class CalibrationSpec(StrictSpec):
     metric: str = "penetration_rate_m_per_s"
     targets: list[Target] = Field(min_length=1)
     method: Literal["nelder-mead", "differential-evolution"] = "nelder-mead"
+    formulation: Literal[tuple(FORMULATIONS)] = "exudyn"  # type: ignore[valid-type]
     max_evaluations: int = Field(40, ge=1)
 
     @model_validator(mode="after")
@@ -113,7 +115,7 @@ def evaluate(calibration: Calibration, values: dict[str, float], runner: Runner)
     """Run every target's scan at these parameter values: optima and objective."""
     spec = calibration.spec
     metrics = [target.metric or spec.metric for target in spec.targets]
-    tasks = [((t, i), calibration.scene(values, target, f), [metrics[t]])
+    tasks = [((t, i), calibration.scene(values, target, f), [metrics[t]], spec.formulation)
              for t, target in enumerate(spec.targets) for i, f in enumerate(calibration.frequencies)]
     metric = {}
     for outcome in runner(run_point, tasks):

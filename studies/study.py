@@ -43,7 +43,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from models.exudyn_model import simulate_exudyn
+from models.formulations import FORMULATIONS
 from models.metrics import summary_metrics
 from models.outputs import METRICS
 from models.scene import Scene
@@ -147,6 +147,7 @@ class StudySpec(StrictSpec):
     scan: dict[str, Axis] = Field(min_length=1)
     combine: Literal["grid", "zip"] | list[list[str]] = "grid"
     metrics: list[MetricName] = Field(list(METRIC_NAMES), min_length=1)
+    formulation: Literal[tuple(FORMULATIONS)] = "exudyn"  # type: ignore[valid-type]
     plots: list[Plot] = []
     format: Literal["png", "svg", "pdf"] = "png"
 
@@ -181,7 +182,8 @@ class Study:
     @property
     def hash(self) -> str:
         """SHA-256 of what determines the results: the point scenes and the collected metrics."""
-        content = {"points": [p.resolved for p in self.points], "metrics": list(self.spec.metrics)}
+        content = {"points": [p.resolved for p in self.points], "metrics": list(self.spec.metrics),
+                   "formulation": self.spec.formulation}
         return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
 
 
@@ -310,12 +312,14 @@ def _check_rock_name_axis(spec: StudySpec, base: dict[str, Any], source: str) ->
                          "base_overrides: {rock: {name: sandstone}}")
 
 
-def run_point(task: tuple[int, dict[str, Any], list[str]]) -> dict[str, Any]:
-    """Worker: simulate one point ``(index, scene dict, metric names)``; a failure is returned, not raised."""
-    index, scene, names = task
+def run_point(task: tuple[int, dict[str, Any], list[str], str]) -> dict[str, Any]:
+    """Worker: simulate one point ``(index, scene dict, metric names, formulation)``; a failure is
+    returned, not raised."""
+    index, scene, names, formulation = task
     start = time.perf_counter()
     try:  # ask the model for the collected metrics only: it then records only what they need
-        metrics = summary_metrics(simulate_exudyn(Scene.model_validate({"outputs": {"metrics": names}} | scene)))
+        result = FORMULATIONS[formulation](Scene.model_validate({"outputs": {"metrics": names}} | scene))
+        metrics = summary_metrics(result)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
         return {"point": index, "status": "failed", "error": f"{type(err).__name__}: {err}",
                 "wall_time_s": time.perf_counter() - start, "metrics": {}}

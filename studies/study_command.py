@@ -106,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"{study.spec.name}: {len(study.points)} points, {len(done)} finished earlier, "
           f"running {len(todo)} on {label}", file=sys.stderr)
     start = time.perf_counter()
-    tasks = [(p.index, p.scene, list(study.spec.metrics)) for p in todo]
+    tasks = [(p.index, p.scene, list(study.spec.metrics), study.spec.formulation) for p in todo]
     with results.open("a", newline="", encoding="utf-8") as handle, \
             tqdm(total=len(study.points), initial=len(done), desc=study.spec.name, unit="point",
                  disable=args.quiet) as bar:

@@ -88,7 +88,7 @@ def test_points_run_on_a_base_scene_with_default_solver(tmp_path):
     base = {key: value for key, value in yaml.safe_load(PAPER_BASE.read_text()).items() if key != "solver"}
     study = load_study(write_study(tmp_path / "s.yaml", base_scene=base, scan={"impact.frequency_hz": [40]},
                                    base_overrides=SHORT, plots=[]))
-    outcome = run_point((0, study.points[0].scene, ["bit_velocity_peak_m_per_s"]))
+    outcome = run_point((0, study.points[0].scene, ["bit_velocity_peak_m_per_s"], "exudyn"))
     assert outcome["status"] == "ok", outcome["error"]
 
 
@@ -193,3 +193,18 @@ def test_bad_input_exits_2_naming_file_and_key(tmp_path, capsys, changes, expect
     err = capsys.readouterr().err
     assert str(study) in err and expected in err, err
     assert not (tmp_path / "out").exists()
+
+
+def test_exact_formulation_as_the_fast_path_agrees_with_exudyn(tmp_path):
+    """The same crushing points with formulation exact and exudyn (standard preset, 0.3 % stated)."""
+    rates = {}
+    for formulation in ("exudyn", "exact"):
+        study = write_study(tmp_path / f"{formulation}.yaml", formulation=formulation, plots=[],
+                            scan={"impact.frequency_hz": [45, 50]},
+                            base_overrides={"solver.end_time_s": 0.4, "impact.amplitude_n": 400e3,
+                                            "metrics": {"transient_blows": 5, "block_blows": 5}})
+        out = tmp_path / formulation
+        assert main(["study", str(study), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+        rates[formulation] = [float(r["penetration_rate_m_per_s"]) for r in sorted(rows(out), key=lambda r: r["point"])]
+    assert min(rates["exact"]) > 0
+    assert rates["exudyn"] == pytest.approx(rates["exact"], rel=3e-3)

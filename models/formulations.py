@@ -1,0 +1,23 @@
+"""The three formulations of the same model, by name.
+
+``exudyn``: the multibody model (default, any chain the builder makes). ``ode``: the paper's Eq. 4
+as an event-located SciPy ODE (independent cross-check). ``exact``: the piecewise-linear model
+propagated by matrix exponentials between located switches (the reference and the fast path for
+large sweeps; only for laws linear between switches, as the paper's).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from models.exact_model import simulate_exact
+from models.exudyn_model import simulate_exudyn
+from models.ode_model import simulate_ode
+from models.results import SimulationResult
+from models.scene import Scene
+
+FORMULATIONS: dict[str, Callable[[Scene], SimulationResult]] = {
+    "exudyn": simulate_exudyn,
+    "exact": simulate_exact,
+    "ode": simulate_ode,
+}
