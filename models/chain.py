@@ -103,3 +103,27 @@ def paper_chain(scene: Scene) -> AxialChain:
         for pair in (getattr(scene.connectors, name),)
     )
     return AxialChain(tuple(bodies), links, impact_body=SHANK, bit_body=BIT)
+
+
+def initial_positions_m(scene: Scene) -> np.ndarray:
+    """Positions at t = 0: zero from rest, or the static equilibrium under the feed forces with the
+    bit on the rock, (K + k_n e_bit e_bit^T) q0 = F_feed, for ``start: preloaded``."""
+    chain = paper_chain(scene)
+    if scene.start == "rest":
+        return np.zeros(chain.size)
+    stiffness = chain.stiffness_matrix()
+    stiffness[chain.bit_body, chain.bit_body] += scene.rock.stiffness_n_per_m
+    positions = np.linalg.solve(stiffness, chain.constant_forces())
+    if scene.rock.stiffness_n_per_m * positions[chain.bit_body] >= scene.rock.threshold_n:
+        raise ValueError(f"start: 'preloaded': the static feed alone crushes the rock (rock force "
+                         f"{scene.rock.stiffness_n_per_m * positions[chain.bit_body]:.4g} N >= rock.threshold_n "
+                         f"{scene.rock.threshold_n:.4g} N); lower feed.force_n or use start: rest")
+    return positions
+
+
+def initial_torsion_angle_rad(scene: Scene) -> float:
+    """phi at t = 0: zero from rest, (M_x - M_c) / k_x preloaded (zero without a torsion spring)."""
+    tor = scene.torsion
+    if scene.start == "rest" or tor is None or tor.stiffness_n_m_per_rad == 0:
+        return 0.0
+    return (tor.drive_torque_n_m - tor.resisting_torque_n_m) / tor.stiffness_n_m_per_rad

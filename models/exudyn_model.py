@@ -33,7 +33,7 @@ from exudyn.itemInterface import (
     SensorObject,
 )
 
-from models.chain import AxialChain, paper_chain
+from models.chain import AxialChain, initial_positions_m, initial_torsion_angle_rad, paper_chain
 from models.pulse import impact_force
 from models.results import SimulationResult
 from models.scene import AUTOMATIC_STEP_SOLVERS, Scene
@@ -73,8 +73,8 @@ class ExudynDrill:
         return len(self.mbs.systemData.GetODE2Coordinates())
 
 
-def _add_coordinate_body(mbs: Any, make_object: Callable[[Any], Any]) -> tuple[Any, Any]:
-    node = mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[0.0], initialVelocities=[0.0]))
+def _add_coordinate_body(mbs: Any, make_object: Callable[[Any], Any], initial: float = 0.0) -> tuple[Any, Any]:
+    node = mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[initial], initialVelocities=[0.0]))
     make_object(node)
     return node, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0))
 
@@ -120,8 +120,9 @@ def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
     ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
 
     nodes, markers = [], []
-    for body in chain.bodies:
-        node, marker = _add_coordinate_body(mbs, lambda n, m=body.mass_kg: mbs.AddObject(ObjectMass1D(nodeNumber=n, mass=m)))
+    for body, initial in zip(chain.bodies, initial_positions_m(scene), strict=True):
+        node, marker = _add_coordinate_body(
+            mbs, lambda n, m=body.mass_kg: mbs.AddObject(ObjectMass1D(nodeNumber=n, mass=m)), initial)
         nodes.append(node)
         markers.append(marker)
         if body.constant_force_n:
@@ -159,7 +160,8 @@ def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
     if scene.effects.torsion:
         tor = scene.torsion
         node, marker = _add_coordinate_body(
-            mbs, lambda n: mbs.AddObject(ObjectRotationalMass1D(nodeNumber=n, inertia=tor.inertia_kg_m2))
+            mbs, lambda n: mbs.AddObject(ObjectRotationalMass1D(nodeNumber=n, inertia=tor.inertia_kg_m2)),
+            initial_torsion_angle_rad(scene),
         )
         mbs.AddObject(
             ObjectConnectorCoordinateSpringDamper(

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from models.chain import AxialChain, paper_chain
+from models.chain import AxialChain, initial_positions_m, initial_torsion_angle_rad, paper_chain
 from models.pulse import impact_force, pulse_switch_times
 from models.results import SimulationResult
 from models.scene import Impact, Scene
@@ -305,6 +305,9 @@ def simulate_ode(scene: Scene, method: str = "DOP853", rtol: float = 1e-10, atol
         raise ValueError(f"method {method!r} not one of {', '.join(ODE_METHODS)}")
     system = _system(scene)
     y = np.zeros(system.state_size)
+    y[:system.n] = initial_positions_m(scene)
+    if system.torsion:
+        y[-2] = initial_torsion_angle_rad(scene)
     mode = system.initial_mode(y)
     record = _Record([], [], [], {})
     breakpoints = _breakpoints(scene)

@@ -227,6 +227,9 @@ class Scene(Strict):
     metrics: Metrics = Metrics()
     effects: Effects | None = None
     outputs: Outputs | None = None
+    start: Literal["rest", "preloaded"] = Field(
+        "rest", description="rest: every coordinate zero (Eq. 4 from rest); preloaded: the static "
+        "equilibrium under the feed (and torque) with the bit pressed on the rock")
 
     def _available(self, effect: str) -> bool:
         """Whether the scene's parameters give the effect anything to do."""
@@ -310,4 +313,12 @@ class Scene(Strict):
             )
         if self.solver.step_s > period / 20:
             raise ValueError(f"solver.step_s {self.solver.step_s} must resolve the impact period: at most {period / 20:.3g} s")
+        return self
+
+    @model_validator(mode="after")
+    def _preload_does_not_crush(self) -> Scene:
+        if self.start == "preloaded":
+            from models.chain import initial_positions_m  # needs a complete scene
+
+            initial_positions_m(self)  # raises when the static feed alone would crush the rock
         return self

@@ -111,3 +111,27 @@ def test_resampled_output_grid(crushing_run):
     assert set(columns) >= {"bit_velocity_m_per_s", "borehole_bottom_m", "rock_force_n", "impact_force_n",
                             "torsion_angle_rad", "carriage_position_m"}
     assert np.all(np.diff(columns["borehole_bottom_m"]) >= 0)
+
+
+def test_preloaded_start_is_the_static_equilibrium_and_all_formulations_use_it():
+    from models.chain import initial_positions_m, paper_chain
+    from models.exact_model import simulate_exact
+
+    s = crushing_scene(start="preloaded", solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2)
+    chain, q0 = paper_chain(s), initial_positions_m(s)
+    rock_force = s.rock.stiffness_n_per_m * q0[chain.bit_body]
+    assert 0 < rock_force < s.rock.threshold_n
+    residual = chain.stiffness_matrix() @ q0 - chain.constant_forces()
+    residual[chain.bit_body] += rock_force
+    np.testing.assert_allclose(residual, 0.0, atol=1e-6 * s.feed.force_n)  # K q0 + F_rock = F_feed
+    assert rock_force == pytest.approx(s.feed.force_n)  # the carriage's feed rests on the rock
+    exudyn, exact = simulate_exudyn(s), simulate_exact(s)
+    np.testing.assert_allclose(exudyn.position_m[0], q0)
+    np.testing.assert_allclose(exact.position_m[0], q0)
+    assert exudyn.bottom_m[-1] == pytest.approx(exact.bottom_m[-1], rel=1e-3)
+    assert energy_account(exudyn).relative_residual() < 0.01
+
+
+def test_preload_that_would_crush_is_refused():
+    with pytest.raises(ValueError, match="static feed alone crushes the rock"):
+        scene(start="preloaded", feed__force_n=200e3)

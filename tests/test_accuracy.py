@@ -1,0 +1,141 @@
+"""Work-precision harness: measured convergence orders on a linear case against its matrix
+exponential, the Pareto front, and the ``rpdrill accuracy`` study end to end and on bad input."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import warnings
+from pathlib import Path
+
+import pytest
+import yaml
+from scenes import PAPER_BASE, scene_dict
+
+from models.exudyn_model import simulate_exudyn
+from models.linear_reference import linear_reference
+from models.scene import Scene
+from models.workprecision import (
+    convergence_order,
+    cost_at_error,
+    errors,
+    pareto_front,
+    signature,
+    uniform_grid_s,
+)
+from studies.accuracy import TimeLimitExceeded, cpu_time_limit
+from studies.cli import main
+
+END_S = 0.04  # two blows at 50 Hz
+GRID = uniform_grid_s(END_S, 1e-4)
+
+
+def linear_scene(solver_type: str, step_s: float) -> Scene:
+    """paper_base made linear: elastic rock without damping, feed on every body (the bit never
+    lifts off: checked against the reference), 20 kN blows; the pulse (1 ms) and the period
+    (20 ms) are whole numbers of every step, so no step straddles a kink of the pulse."""
+    data = scene_dict(**{"feed.arrangement": "per_body", "feed.carriage_mass_kg": None,
+                         "impact.amplitude_n": 20e3, "impact.frequency_hz": 50.0, "impact.duration_s": 1e-3})
+    data["effects"] = {"rock_plasticity": False, "rock_damping": False, "torsion": False, "joint_damping": True}
+    data["outputs"] = {"metrics": [], "timeseries": []}
+    data["metrics"] = {"transient_blows": 0, "block_blows": 1}
+    data["solver"] = {"type": solver_type, "step_s": step_s, "end_time_s": END_S, "output_interval_s": 1e-4}
+    return Scene.model_validate(data)
+
+
+@pytest.fixture(scope="module")
+def reference():
+    result = linear_reference(linear_scene("rk44", 1e-5), GRID)
+    assert result.info["min_penetration_m"] > 0  # the bit stays on the rock: the model is linear
+    return signature(result, GRID)
+
+
+@pytest.mark.parametrize("solver_type, order, steps_s", [
+    ("rk44", 4, [2e-5, 1e-5, 5e-6]),
+    ("rk33", 3, [1e-5, 5e-6, 2.5e-6]),
+    ("explicit_midpoint", 2, [5e-6, 2.5e-6, 1.25e-6]),
+    ("generalized_alpha", 2, [2.5e-6, 1.25e-6, 6.25e-7]),
+])
+def test_measured_order_of_fixed_step_solvers(reference, solver_type, order, steps_s):
+    measured = []
+    for step in steps_s:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            run = simulate_exudyn(linear_scene(solver_type, step))
+        measured.append(errors(reference, signature(run, GRID))["bit_velocity_rms_error_rel"])
+    assert abs(convergence_order(steps_s, measured) - order) < 0.3, measured
+
+
+def test_pareto_front_and_cost_at_error():
+    cost = [1.0, 2.0, 3.0, 4.0, 0.5, math.nan]
+    error = [1e-2, 1e-3, 2e-3, 1e-5, 1e-1, 1e-9]
+    assert pareto_front(cost, error) == [4, 0, 1, 3]
+    assert cost_at_error(cost, error, 1e-4) == pytest.approx(math.exp(math.log(2) + math.log(2) * 0.5))
+    assert math.isnan(cost_at_error(cost, error, 1e-7))
+
+
+def test_cpu_time_limit_stops_a_run():
+    with pytest.raises(TimeLimitExceeded), cpu_time_limit(0.2):
+        while True:
+            pass
+
+
+def write_study(path: Path, **changes) -> Path:
+    study = {
+        "name": "small_accuracy",
+        "base_scene": str(PAPER_BASE),
+        "base_overrides": {"metrics": {"transient_blows": 1, "block_blows": 2}},
+        "blows": 3,
+        "repeats": 1,
+        "reference": {"formulation": "exact"},
+        "reference_check": {"formulation": "ode", "method": "DOP853", "rtol": 1e-11},
+        "families": [
+            {"label": "rk44", "formulation": "exudyn", "solver": {"type": "rk44"}, "sweep": {"step_s": [2e-5, 1e-5]}},
+            {"label": "midpoint", "formulation": "exudyn", "solver": {"type": "explicit_midpoint"},
+             "sweep": {"step_s": [1e-4]}},  # far beyond its stability limit: diverges
+            {"label": "DOP853", "formulation": "ode", "sweep": {"rtol": [1e-5]}},
+        ],
+    }
+    study.update(changes)
+    path.write_text(yaml.safe_dump(study))
+    return path
+
+
+def test_accuracy_study_end_to_end(tmp_path):
+    out = tmp_path / "out"
+    assert main(["accuracy", str(write_study(tmp_path / "s.yaml")), "--out", str(out), "--workers", "1",
+                 "--quiet"]) == 0
+    with (out / "workprecision.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert [r["family"] for r in rows] == ["rk44", "rk44", "midpoint", "DOP853"]
+    failed = [r for r in rows if r["status"] == "failed"]
+    assert [r["family"] for r in failed] == ["midpoint"] and "diverged" in failed[0]["error"]
+    ok = [r for r in rows if r["status"] == "ok"]
+    assert all(float(r["cpu_time_s"]) > 0 and float(r["penetration_rate_error_rel"]) >= 0 for r in ok)
+    assert float(ok[1]["bit_velocity_rms_error_rel"]) < float(ok[0]["bit_velocity_rms_error_rel"])
+    with (out / "pareto.csv").open() as handle:
+        front = list(csv.DictReader(handle))
+    assert {r["measure"] for r in front} == {"bottom_end_error_rel", "penetration_rate_error_rel",
+                                              "bit_velocity_rms_error_rel"}
+    report = json.loads((out / "reference.json").read_text())
+    assert all(report["agreement_below_smallest_error"].values())
+    assert (out / "workprecision.png").stat().st_size > 10_000
+    # a rerun finds every setting finished
+    assert main(["accuracy", str(tmp_path / "s.yaml"), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+
+
+@pytest.mark.parametrize("changes, expected", [
+    ({"blows": 0}, "blows"),
+    ({"families": [{"label": "x", "formulation": "ode", "solver": {"method": "RK45"}, "sweep": {"rtol": [1e-3]}}]},
+     "method: 'RK45'"),
+    ({"families": [{"label": "x", "formulation": "exudyn", "solver": {"type": "rk5"}, "sweep": {"step_s": [1e-5]}}]},
+     "solver.type"),
+    ({"families": [{"label": "x", "formulation": "exudyn", "sweep": {"step_s": [1e-5], "preset": ["fast"]}}]},
+     "families.0.sweep"),
+])
+def test_bad_input_exits_2(tmp_path, capsys, changes, expected):
+    study = write_study(tmp_path / "bad.yaml", **changes)
+    assert main(["accuracy", str(study), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    message = capsys.readouterr().err
+    assert str(study) in message and expected in message, message
