@@ -46,7 +46,7 @@ def _columns(study: Study) -> list[str]:
     return ["point", *study.axes, *STATUS_COLUMNS, *study.spec.metrics]
 
 
-def _provenance(study: Study, out: Path) -> dict[str, Any]:
+def study_provenance(study: Study, out: Path) -> dict[str, Any]:
     """study.json as found in ``out`` (refused if from another study) or a new one."""
     path = out / "study.json"
     if not path.exists():
@@ -65,7 +65,7 @@ def _provenance(study: Study, out: Path) -> dict[str, Any]:
     return provenance
 
 
-def _finished(path: Path, columns: list[str], count: int) -> dict[int, dict[str, str]]:
+def finished_rows(path: Path, columns: list[str], count: int) -> dict[int, dict[str, str]]:
     """Complete rows of earlier runs by point index; the file is rewritten with just those."""
     text = path.read_text(encoding="utf-8") if path.exists() else ""
     rows: dict[int, dict[str, str]] = {}
@@ -82,7 +82,7 @@ def _finished(path: Path, columns: list[str], count: int) -> dict[int, dict[str,
     return rows
 
 
-def _row(point: Point, outcome: dict[str, Any]) -> dict[str, Any]:
+def result_row(point: Point, outcome: dict[str, Any]) -> dict[str, Any]:
     return {"point": point.index, **point.parameters, "status": outcome["status"], "error": outcome["error"],
             "wall_time_s": f"{outcome['wall_time_s']:.4g}", **outcome["metrics"]}
 
@@ -96,11 +96,11 @@ def run(args: argparse.Namespace) -> int:
     study = load_study(args.study)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    provenance = _provenance(study, out)
+    provenance = study_provenance(study, out)
     write_json(out / "study.json", provenance)
     results = out / "results.csv"
     columns = _columns(study)
-    done = _finished(results, columns, len(study.points))
+    done = finished_rows(results, columns, len(study.points))
     todo = [p for p in study.points if p.index not in done]
     label, runner = select(args.dask, args.workers)
     print(f"{study.spec.name}: {len(study.points)} points, {len(done)} finished earlier, "
@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
                  disable=args.quiet) as bar:
         writer = csv.DictWriter(handle, columns)
         for outcome in runner(run_point, tasks) if tasks else ():
-            writer.writerow(_row(study.points[outcome["point"]], outcome))
+            writer.writerow(result_row(study.points[outcome["point"]], outcome))
             handle.flush()
             bar.update(1)
     rows = read_results(results)

@@ -1,0 +1,82 @@
+"""What accuracy costs: CPU seconds per simulated second of each accuracy preset (Exudyn), and the
+CPU-time ratio Exudyn model : ODE formulation at equal error.
+
+Usage: python benchmarks/bench_accuracy.py [STUDY.yaml] [--level 1e-4 1e-6 1e-8] [--repeats N] [--seconds S]
+
+Everything is measured in this one run (the machine is shared): each preset runs the study's
+base scene for ``--seconds`` simulated seconds; the ratio interpolates (log-log) the Pareto fronts
+of the study's Exudyn families (all fixed-step and automatic Exudyn solvers) and of its DOP853 ODE
+family at each penetration-rate error ``--level``, on the study's window against its reference.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import warnings
+from dataclasses import replace
+from pathlib import Path
+
+from models.exudyn_model import simulate_exudyn
+from models.scene import SOLVER_PRESETS, Scene
+from models.workprecision import cost_at_error, errors
+from studies.accuracy import load_accuracy_study, reference_signature, run_setting
+
+ROOT = Path(__file__).resolve().parents[1]
+MEASURE = "penetration_rate_error_rel"
+
+
+def preset_cost(base: dict, preset: str, seconds: float, repeats: int) -> tuple[float, float]:
+    """(CPU s per simulated s, step) of the base scene run with ``preset`` for ``seconds``."""
+    data = {**base, "solver": {"preset": preset, "end_time_s": seconds}}
+    data["outputs"] = {"metrics": ["penetration_rate_m_per_s"], "timeseries": ["borehole_bottom_m"]}
+    scene = Scene.model_validate(data)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        runs = [simulate_exudyn(scene).cpu_time_s for _ in range(repeats)]
+    return statistics.median(runs) / seconds, scene.solver.step_s
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("study", nargs="?", default=ROOT / "studies" / "accuracy" / "paper_base.yaml")
+    parser.add_argument("--level", type=float, nargs="+", default=[1e-4, 1e-6, 1e-8],
+                        help="penetration-rate errors at which the ratio is taken")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--seconds", type=float, default=1.0, help="simulated seconds per preset run")
+    args = parser.parse_args()
+    study = load_accuracy_study(args.study)
+    reference = reference_signature(study, study.reference)
+    print(f"study {study.spec.name}: {study.spec.blows} blows, reference {study.reference.formulation}")
+
+    print("\npreset     step [s]   CPU s / simulated s   penetration-rate error (window)")
+    presets = [(p, r) for p, r in zip(study.points, study.runs) if r.settings.get("preset")]
+    for point, run in presets:
+        outcome = run_setting((point.index, study.scene, replace(run, repeats=args.repeats), study.spec.grid_interval_s,
+                               study.spec.time_limit_s))
+        error = errors(reference, outcome["signature"])[MEASURE] if outcome["status"] == "ok" else float("nan")
+        per_second, step = preset_cost(study.base, run.settings["preset"], args.seconds, args.repeats)
+        print(f"{run.settings['preset']:<10} {step:<10.3g} {per_second:<21.4g} {error:.3g}")
+    missing = set(SOLVER_PRESETS) - {r.settings["preset"] for _, r in presets}
+    if missing:
+        print(f"(presets not in the study: {', '.join(sorted(missing))})")
+
+    groups = {"exudyn": [], "ode": []}
+    for point, run in zip(study.points, study.runs):
+        if run.settings.get("preset") or (run.formulation == "ode" and run.settings["method"] != "DOP853"):
+            continue
+        if run.formulation not in groups:
+            continue
+        outcome = run_setting((point.index, study.scene, replace(run, repeats=args.repeats), study.spec.grid_interval_s,
+                               study.spec.time_limit_s))
+        if outcome["status"] == "ok":
+            groups[run.formulation].append((outcome["metrics"]["cpu_time_s"], errors(reference, outcome["signature"])[MEASURE]))
+    print("\nCPU time of the window at equal penetration-rate error (Pareto fronts, log-log interpolated):")
+    print("error level   Exudyn model [s]   ODE DOP853 [s]   ratio Exudyn : ODE")
+    for level in args.level:
+        cost = {name: cost_at_error([c for c, _ in pairs], [e for _, e in pairs], level)
+                for name, pairs in groups.items()}
+        print(f"{level:<13g} {cost['exudyn']:<18.4g} {cost['ode']:<16.4g} {cost['exudyn'] / cost['ode']:.3g}")
+
+if __name__ == "__main__":
+    main()
