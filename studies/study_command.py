@@ -20,7 +20,6 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
-import exudyn
 from tqdm import tqdm
 
 from models.scene import Scene
@@ -53,7 +52,7 @@ def study_provenance(study: Study, out: Path) -> dict[str, Any]:
         if (out / "results.csv").exists():
             raise InputError(f"{out}: holds results.csv but no study.json; use a new --out directory")
         return {"study": study.spec.name, "study_file": str(study.source), "hash": study.hash,
-                "rpdrill_version": importlib.metadata.version("rpdrill"), "exudyn_version": exudyn.__version__,
+                "rpdrill_version": importlib.metadata.version("rpdrill"), "exudyn_version": importlib.metadata.version("exudyn"),
                 "points": len(study.points), "solver": Scene.model_validate(study.base).solver.model_dump(), "resolved_study": study.resolved(),
                 "sessions": [], "point_wall_time_s": {}}
     provenance = json.loads(path.read_text(encoding="utf-8"))
