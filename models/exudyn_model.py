@@ -37,7 +37,7 @@ from models.chain import AxialChain, initial_positions_m, initial_torsion_angle_
 from models.pulse import impact_force
 from models.results import SimulationResult
 from models.scene import AUTOMATIC_STEP_SOLVERS, Scene
-from models.stability import StepLimitWarning, check_result, step_warning
+from models.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
 from rocklaw.backends import SCALAR, SymbolicBackend
 from rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 
@@ -178,28 +178,41 @@ def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
     return ExudynDrill(scene, chain, container, mbs, rock, sensors, _simulation_settings(scene), [impact_function])
 
 
-def _pre_step(drill: ExudynDrill, progress: Callable[[float], None] | None) -> Callable[[Any, float], bool] | None:
-    """The per-step Python hook: the rock's return mapping (if it crushes) and progress reports."""
-    update = drill.rock.update_bottom if drill.rock.rock.crushes else None
-    if progress is None:
-        if update is None:
-            return None
+class _MinimumStepGuard:
+    """Stops an automatic-step run whose step fell to Exudyn's minimum (Exudyn would go on with
+    errors beyond the tolerance, or crawl for hours at that step) and remembers when. The step
+    is the solver's own (rejected attempts also call the pre-step function)."""
 
-        def pre_step(mbs: Any, t: float) -> bool:
-            update(mbs, t)
-            return True
-        return pre_step
-    report_every = drill.scene.solver.end_time_s / 100
-    next_report = [report_every]
+    def __init__(self, minimum_step_s: float) -> None:
+        self.minimum_step_s, self.reached_at_s = minimum_step_s, None
 
-    def pre_step_with_progress(mbs: Any, t: float) -> bool:
-        if update is not None:
-            update(mbs, t)
+    def __call__(self, mbs: Any, t: float) -> bool:
+        if mbs.sys["dynamicSolver"].it.currentStepSize <= self.minimum_step_s * (1 + 1e-6):
+            self.reached_at_s = t
+            return False
+        return True
+
+
+def _progress_reporter(end_time_s: float, progress: Callable[[float], None]) -> Callable[[Any, float], bool]:
+    every = end_time_s / 100
+    next_report = [every]
+
+    def report(mbs: Any, t: float) -> bool:
         if t >= next_report[0]:
-            next_report[0] += report_every
+            next_report[0] += every
             progress(t)
         return True
-    return pre_step_with_progress
+    return report
+
+
+def _pre_step(actions: list[Callable[[Any, float], bool]]) -> Callable[[Any, float], bool] | None:
+    """One Exudyn pre-step hook running ``actions`` in order; a False stops the run."""
+    if len(actions) <= 1:
+        return actions[0] if actions else None
+
+    def pre_step(mbs: Any, t: float) -> bool:
+        return all(action(mbs, t) for action in actions)
+    return pre_step
 
 
 def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
@@ -215,7 +228,14 @@ def simulate_exudyn(
         warnings.warn(warning, StepLimitWarning, stacklevel=2)
     drill = build_exudyn(scene, symbolic)
     mbs = drill.mbs
-    pre_step = _pre_step(drill, progress)
+    actions = [drill.rock.update_bottom] if drill.rock.rock.crushes else []
+    guard = None
+    if scene.solver.type in AUTOMATIC_STEP_SOLVERS:
+        guard = _MinimumStepGuard(drill.settings.timeIntegration.minimumStepSize)
+        actions.append(guard)
+    if progress is not None:
+        actions.append(_progress_reporter(scene.solver.end_time_s, progress))
+    pre_step = _pre_step(actions)
     if pre_step is not None:
         mbs.SetPreStepUserFunction(pre_step)
     start = time.process_time()
@@ -245,5 +265,11 @@ def simulate_exudyn(
         info={"solver_success": bool(ok), "coordinates": drill.coordinate_count},
         bottom_events=(history[:, 0], history[:, 1]),
     )
+    if guard is not None and guard.reached_at_s is not None:
+        raise SimulationFailed(
+            f"scene '{scene.name}': solver {scene.solver.type} with relative_tolerance "
+            f"{scene.solver.relative_tolerance:g} reached the minimum step "
+            f"{guard.minimum_step_s:g} s at t = {guard.reached_at_s:.6g} s; try relative_tolerance "
+            f"{scene.solver.relative_tolerance * 100:g} or a fixed-step preset (solver: {{preset: standard}})")
     check_result(result, solver_ok=bool(ok), reached_s=reached_s)
     return result

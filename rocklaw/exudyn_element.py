@@ -69,7 +69,7 @@ class ExudynRockContact:
         )
         self._coordinate = exu.OutputVariableType.Coordinates
 
-    def update_bottom(self, mbs: Any, t: float) -> None:
+    def update_bottom(self, mbs: Any, t: float) -> bool:
         """Return mapping x_n <- max(x_n, x_bit - F_th/k_n), called once before each step.
 
         Exudyn passes the pre-step function the time at the *end* of the coming step while the
@@ -81,3 +81,4 @@ class ExudynRockContact:
             mbs.SetObjectParameter(self.object, "offset", candidate)
             self.bottom_history.append((self._step_start_s, candidate))
         self._step_start_s = t
+        return True  # as an Exudyn pre-step function: go on

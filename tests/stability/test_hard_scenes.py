@@ -91,3 +91,13 @@ def test_unstable_step_is_reported_with_time_and_remedy():
         simulate_exudyn(scene)
     message = str(failure.value)
     assert "diverged at t =" in message and "rk44" in message and "try solver.step_s" in message
+
+
+def test_automatic_step_at_its_minimum_is_reported_not_returned():
+    """DOPRI5 at a tolerance the rock's kinks cannot meet: Exudyn would go on at its minimum step
+    (inaccurate, or for hours); the run is stopped and reported with a remedy."""
+    scene = make(HARD_SCENES["stiffest_rock_stiff_joints"],
+                 {"type": "dopri5", "step_s": 1e-4, "relative_tolerance": 1e-9, "absolute_tolerance": 1e-12})
+    with pytest.raises(SimulationFailed, match="reached the minimum step") as failure:
+        simulate_exudyn(scene)
+    assert "try relative_tolerance" in str(failure.value)
