@@ -48,6 +48,7 @@ from typing import Any, Literal
 
 from pydantic import Field
 
+from models.formulations import FORMULATIONS
 from models.ode_model import ODE_METHODS, simulate_ode
 from models.results import SimulationResult
 from models.scene import Scene
@@ -55,7 +56,7 @@ from models.workprecision import Signature, signature, uniform_grid_s
 from studies.loading import InputError, parse, read_yaml
 from studies.study import Axis, Point, StrictSpec, base_scene_dict
 
-Formulation = Literal["exudyn", "ode", "exact"]
+Formulation = Literal[tuple(FORMULATIONS)]  # type: ignore[valid-type]
 ODE_KEYS = ("method", "rtol", "atol", "atol_ratio", "sample_interval_s")
 ODE_DEFAULTS: dict[str, Any] = {"method": "DOP853", "atol_ratio": 1e-3, "sample_interval_s": 2e-7}
 # Exudyn runs store every step (a write period below any step): the error of a run includes the
