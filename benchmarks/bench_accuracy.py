@@ -17,10 +17,10 @@ import warnings
 from dataclasses import replace
 from pathlib import Path
 
-from models.exudyn_model import simulate_exudyn
-from models.scene import SOLVER_PRESETS, Scene
-from models.workprecision import cost_at_error, errors
-from studies.accuracy import load_accuracy_study, reference_signature, run_setting
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.scene import SOLVER_PRESETS, Scene
+from rpdrill.models.workprecision import cost_at_error, errors
+from rpdrill.studies.accuracy import load_accuracy_study, reference_signature, run_setting
 
 ROOT = Path(__file__).resolve().parents[1]
 MEASURE = "penetration_rate_error_rel"

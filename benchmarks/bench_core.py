@@ -11,9 +11,9 @@ import argparse
 import statistics
 from pathlib import Path
 
-from models.exudyn_model import simulate_exudyn
-from models.scene import Scene
-from studies.loading import load_scene
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.scene import Scene
+from rpdrill.studies.loading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 

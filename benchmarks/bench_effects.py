@@ -11,10 +11,10 @@ import argparse
 import statistics
 from pathlib import Path
 
-from models.exudyn_model import build_exudyn, simulate_exudyn
-from models.metrics import summary_metrics
-from models.scene import Scene
-from studies.loading import read_yaml
+from rpdrill.models.exudyn_model import build_exudyn, simulate_exudyn
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.scene import Scene
+from rpdrill.studies.loading import read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 RATE_ONLY = {"effects": {"rock_damping": True, "joint_damping": True},

@@ -33,12 +33,11 @@ from pathlib import Path
 
 import numpy as np
 import yaml
-
-from models.exact_model import simulate_exact
-from models.exudyn_model import simulate_exudyn
-from models.ode_model import simulate_ode
-from models.results import SimulationResult
-from models.scene import Scene
+from rpdrill.models.exact_model import simulate_exact
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.ode_model import simulate_ode
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = ROOT / "studies" / "scenes" / "paper_base.yaml"
@@ -50,7 +49,7 @@ import os, sys, time
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 sys.path.insert(0, {benchmarks!r})
 from bench_exact import scenes
-from models.exact_model import simulate_exact
+from rpdrill.models.exact_model import simulate_exact
 scene = scenes(0.5)["paper_base"]
 start = time.process_time()
 simulate_exact(scene)

@@ -22,13 +22,12 @@ import statistics
 from pathlib import Path
 
 import numpy as np
-
-from models.exudyn_model import simulate_exudyn
-from models.formulations import FORMULATIONS
-from models.metrics import summary_metrics
-from models.scene import Scene
-from models.waves import transmitted_pulse_n, travel_time_s
-from studies.loading import load_scene, read_yaml
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.formulations import FORMULATIONS
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.scene import Scene
+from rpdrill.models.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.studies.loading import load_scene, read_yaml
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 

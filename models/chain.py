@@ -12,10 +12,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from rpdrill.models.links import LINK_TYPES, Link
+from rpdrill.models.scene import EVERY_BODY, GROUND, Body, Connector, Scene
 from scipy.optimize import root
-
-from models.links import LINK_TYPES, Link
-from models.scene import EVERY_BODY, GROUND, Body, Connector, Scene
 
 
 @dataclass(frozen=True)

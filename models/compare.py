@@ -17,9 +17,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from models.metrics import summary_metrics
-from models.results import SimulationResult
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.results import SimulationResult
 
 HISTORIES = {
     "borehole_bottom_m": lambda r: r.bottom_m,

@@ -14,9 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from rpdrill.models.results import SimulationResult
 from scipy.integrate import cumulative_trapezoid
-
-from models.results import SimulationResult
 
 
 def _cumulative(power: np.ndarray, time_s: np.ndarray) -> np.ndarray:

@@ -72,16 +72,15 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+from rpdrill.models.chain import AxialChain, axial_chain, initial_positions_m, initial_torsion_angle_rad
+from rpdrill.models.exact_kernels import DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
+from rpdrill.models.exact_scope import exact_unsupported
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Impact, Scene, Torsion
+from rpdrill.models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
+from rpdrill.rocklaw.jenkins import JenkinsRock
 from scipy.linalg import expm
 from scipy.linalg.lapack import dgebal
-
-from models.chain import AxialChain, axial_chain, initial_positions_m, initial_torsion_angle_rad
-from models.exact_kernels import DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
-from models.exact_scope import exact_unsupported
-from models.results import SimulationResult
-from models.scene import Impact, Scene, Torsion
-from models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
-from rocklaw.jenkins import JenkinsRock
 
 FREE, CONTACT, CLIPPED, CRUSHING = MODES = "free", "contact", "clipped", "crushing"
 OFF, ON, RISING, FALLING = PHASES = "off", "on", "rising", "falling"

@@ -4,8 +4,8 @@ not a matrix exponential between switches; the Exudyn model and the ODE formulat
 
 from __future__ import annotations
 
-from models.chain import axial_chain
-from models.scene import Scene
+from rpdrill.models.chain import axial_chain
+from rpdrill.models.scene import Scene
 
 
 def exact_unsupported(scene: Scene) -> str | None:

@@ -32,14 +32,13 @@ from exudyn.itemInterface import (
     SensorNode,
     SensorObject,
 )
-
-from models.chain import AxialChain, Link, axial_chain, initial_positions_m, initial_torsion_angle_rad
-from models.pulse import impact_force
-from models.results import SimulationResult
-from models.scene import AUTOMATIC_STEP_SOLVERS, Scene
-from models.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
-from rocklaw.backends import SCALAR, SymbolicBackend
-from rocklaw.exudyn_element import ExudynRockContact, attach_user_function
+from rpdrill.models.chain import AxialChain, Link, axial_chain, initial_positions_m, initial_torsion_angle_rad
+from rpdrill.models.pulse import impact_force
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import AUTOMATIC_STEP_SOLVERS, Scene
+from rpdrill.models.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
+from rpdrill.rocklaw.backends import SCALAR, SymbolicBackend
+from rpdrill.rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 
 SOLVER_TYPES = {
     "rk44": exu.DynamicSolverType.RK44,

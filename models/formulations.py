@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from models.exact_model import simulate_exact
-from models.exact_scope import exact_unsupported
-from models.exudyn_model import simulate_exudyn
-from models.ode_model import simulate_ode
-from models.results import SimulationResult
-from models.scene import Scene
+from rpdrill.models.exact_model import simulate_exact
+from rpdrill.models.exact_scope import exact_unsupported
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.ode_model import simulate_ode
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Scene
 
 FORMULATIONS: dict[str, Callable[[Scene], SimulationResult]] = {
     "exudyn": simulate_exudyn,

@@ -19,12 +19,11 @@ import itertools
 import math
 
 import numpy as np
+from rpdrill.models.chain import axial_chain, initial_positions_m
+from rpdrill.models.pulse import pulse_switch_times
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Scene
 from scipy.linalg import expm
-
-from models.chain import axial_chain, initial_positions_m
-from models.pulse import pulse_switch_times
-from models.results import SimulationResult
-from models.scene import Scene
 
 
 def _matrix(scene: Scene, pulse_on: bool) -> np.ndarray:

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
-from rocklaw.backends import NUMERIC, Backend
+from rpdrill.rocklaw.backends import NUMERIC, Backend
 
 
 @dataclass(frozen=True)

@@ -13,10 +13,9 @@ from collections.abc import Callable
 from functools import cached_property
 
 import numpy as np
+from rpdrill.models.energy import EnergyAccount, energy_account
+from rpdrill.models.results import SimulationResult
 from scipy.integrate import trapezoid
-
-from models.energy import EnergyAccount, energy_account
-from models.results import SimulationResult
 
 
 class _Window:

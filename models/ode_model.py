@@ -26,17 +26,22 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from rpdrill.models.chain import (
+    AxialChain,
+    axial_chain,
+    initial_positions_m,
+    initial_torsion_angle_rad,
+    link_load_n,
+)
+from rpdrill.models.links import Link
+from rpdrill.models.pulse import impact_force, pulse_switch_times
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Impact, Scene
+from rpdrill.models.stability import SimulationFailed, diverged_index
+from rpdrill.rocklaw.backends import NUMERIC
+from rpdrill.rocklaw.base import EventFunction as RockEvent
+from rpdrill.rocklaw.base import RockLaw
 from scipy.integrate import solve_ivp
-
-from models.chain import AxialChain, axial_chain, initial_positions_m, initial_torsion_angle_rad, link_load_n
-from models.links import Link
-from models.pulse import impact_force, pulse_switch_times
-from models.results import SimulationResult
-from models.scene import Impact, Scene
-from models.stability import SimulationFailed, diverged_index
-from rocklaw.backends import NUMERIC
-from rocklaw.base import EventFunction as RockEvent
-from rocklaw.base import RockLaw
 
 ODE_METHODS = ("DOP853", "Radau", "LSODA")
 # Mode switches at one instant beyond this mean the law chatters: report instead of looping.

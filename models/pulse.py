@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from models.scene import Impact
-from rocklaw.backends import NUMERIC, Backend
+from rpdrill.models.scene import Impact
+from rpdrill.rocklaw.backends import NUMERIC, Backend
 
 
 def impact_force(impact: Impact, t: Any, backend: Backend = NUMERIC) -> Any:

@@ -5,9 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from models.chain import AxialChain
-from models.scene import Scene
+from rpdrill.models.chain import AxialChain
+from rpdrill.models.scene import Scene
 
 
 @dataclass

@@ -12,11 +12,10 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
-
-from models.links import LINK_TYPES
-from models.outputs import METRICS, SERIES, needs
-from rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
-from rocklaw.catalog import TABLE_1
+from rpdrill.models.links import LINK_TYPES
+from rpdrill.models.outputs import METRICS, SERIES, needs
+from rpdrill.rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
+from rpdrill.rocklaw.catalog import TABLE_1
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -456,7 +455,7 @@ class Scene(Strict):
     @model_validator(mode="after")
     def _resolve_preset_and_check_length(self) -> Scene:
         if self.solver.preset is not None:
-            from models.stability import spectral_radius_per_s  # needs a complete scene
+            from rpdrill.models.stability import spectral_radius_per_s  # needs a complete scene
 
             preset = SOLVER_PRESETS[self.solver.preset]
             step = min(preset["step_s"], self.impact.duration_s / preset["steps_per_pulse"],
@@ -483,7 +482,7 @@ class Scene(Strict):
     @model_validator(mode="after")
     def _preload_does_not_crush(self) -> Scene:
         if self.start == "preloaded":
-            from models.chain import initial_positions_m  # needs a complete scene
+            from rpdrill.models.chain import initial_positions_m  # needs a complete scene
 
             initial_positions_m(self)  # raises when the static feed alone would crush the rock
         return self

@@ -10,12 +10,11 @@ the factors were measured on the hard scenes (docs/stability.md).
 from __future__ import annotations
 
 import numpy as np
-
-from models.chain import axial_chain
-from models.energy import energy_account
-from models.pulse import impulse_per_blow_n_s
-from models.results import SimulationResult
-from models.scene import Scene
+from rpdrill.models.chain import axial_chain
+from rpdrill.models.energy import energy_account
+from rpdrill.models.pulse import impulse_per_blow_n_s
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Scene
 
 # Positions beyond this are not drilling: the solver has blown up (states near 1e300 seen with
 # explicit solvers at too large a step, reported as success by the solver).

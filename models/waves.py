@@ -10,8 +10,7 @@ their peaks.
 from __future__ import annotations
 
 import numpy as np
-
-from models.results import SimulationResult
+from rpdrill.models.results import SimulationResult
 
 
 def first_crossing_s(time_s: np.ndarray, values: np.ndarray, fraction: float = 0.5) -> float:

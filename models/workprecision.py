@@ -22,9 +22,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-
-from models.metrics import summary_metrics
-from models.results import SimulationResult
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.results import SimulationResult
 
 ERROR_MEASURES = ("bottom_end_error_rel", "penetration_rate_error_rel", "bit_velocity_rms_error_rel")
 ERROR_LABELS = {

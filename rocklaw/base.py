@@ -27,9 +27,8 @@ from collections.abc import Callable, Sequence
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
+from rpdrill.rocklaw.backends import NUMERIC, Backend
 from scipy.integrate import cumulative_trapezoid
-
-from rocklaw.backends import NUMERIC, Backend
 
 State = tuple[float, ...]
 # g(bit position [m], bit velocity [m/s], state) whose zero crossing ends a mode

@@ -44,9 +44,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-
-from rocklaw.backends import NUMERIC, Backend
-from rocklaw.base import State, Transition, trapezoidal_plastic_work_j
+from rpdrill.rocklaw.backends import NUMERIC, Backend
+from rpdrill.rocklaw.base import State, Transition, trapezoidal_plastic_work_j
 
 FREE, LOADING, UNLOADING = "free", "loading", "unloading"
 

@@ -16,9 +16,8 @@ import exudyn as exu
 import numpy as np
 from exudyn.advancedUtilities import CreateSymbolicUserFunction
 from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
-
-from rocklaw.backends import SCALAR, SymbolicBackend
-from rocklaw.base import RockLaw, State
+from rpdrill.rocklaw.backends import SCALAR, SymbolicBackend
+from rpdrill.rocklaw.base import RockLaw, State
 
 
 def attach_user_function(mbs: Any, item: Any, parameter: str, function: Any, symbolic: bool) -> Any:

@@ -41,9 +41,8 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
-
-from rocklaw.backends import NUMERIC, Backend
-from rocklaw.base import State, Transition
+from rpdrill.rocklaw.backends import NUMERIC, Backend
+from rpdrill.rocklaw.base import State, Transition
 
 DampingMode = Literal["contact", "always"]
 FREE, CONTACT, CLIPPED, CRUSHING = "free", "contact", "clipped", "crushing"

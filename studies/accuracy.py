@@ -47,14 +47,13 @@ from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import Field
-
-from models.formulations import FORMULATIONS
-from models.ode_model import ODE_METHODS, simulate_ode
-from models.results import SimulationResult
-from models.scene import Scene
-from models.workprecision import Signature, signature, uniform_grid_s
-from studies.loading import InputError, parse, read_yaml
-from studies.study import Axis, Point, StrictSpec, base_scene_dict, check_formulation
+from rpdrill.models.formulations import FORMULATIONS
+from rpdrill.models.ode_model import ODE_METHODS, simulate_ode
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Scene
+from rpdrill.models.workprecision import Signature, signature, uniform_grid_s
+from rpdrill.studies.loading import InputError, parse, read_yaml
+from rpdrill.studies.study import Axis, Point, StrictSpec, base_scene_dict, check_formulation
 
 Formulation = Literal[tuple(FORMULATIONS)]  # type: ignore[valid-type]
 ODE_KEYS = ("method", "rtol", "atol", "atol_ratio", "sample_interval_s")
@@ -229,8 +228,8 @@ def load_accuracy_study(path: str | Path) -> AccuracyStudy:
 def simulate_setting(scene: dict[str, Any], setting: Setting) -> SimulationResult:
     """One run of the windowed ``scene`` with ``setting`` (StepLimitWarnings silenced: a diverged
     run is reported as SimulationFailed by the formulation)."""
-    from models.exact_model import simulate_exact
-    from models.exudyn_model import simulate_exudyn
+    from rpdrill.models.exact_model import simulate_exact
+    from rpdrill.models.exudyn_model import simulate_exudyn
 
     if setting.formulation == "exudyn":
         with warnings.catch_warnings():

@@ -34,13 +34,18 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from rpdrill.models.workprecision import ERROR_LABELS, ERROR_MEASURES, Signature, errors, pareto_front
+from rpdrill.studies.accuracy import (
+    AccuracyStudy,
+    Setting,
+    load_accuracy_study,
+    reference_signature,
+    run_setting,
+)
+from rpdrill.studies.outputs import write_json
+from rpdrill.studies.runners import select
+from rpdrill.studies.study_command import finished_rows, read_results, result_row, study_provenance
 from tqdm import tqdm
-
-from models.workprecision import ERROR_LABELS, ERROR_MEASURES, Signature, errors, pareto_front
-from studies.accuracy import AccuracyStudy, Setting, load_accuracy_study, reference_signature, run_setting
-from studies.outputs import write_json
-from studies.runners import select
-from studies.study_command import finished_rows, read_results, result_row, study_provenance
 
 PARAMETERS = ("family", "formulation", "solver", "setting", "value")
 STATUS = ("status", "error", "wall_time_s")

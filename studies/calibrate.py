@@ -21,13 +21,11 @@ from typing import Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
-from scipy import optimize
-
-from models.formulations import FORMULATIONS
-from models.outputs import METRICS
-from studies.loading import InputError, parse, read_yaml
-from studies.runners import Runner
-from studies.study import (
+from rpdrill.models.formulations import FORMULATIONS
+from rpdrill.models.outputs import METRICS
+from rpdrill.studies.loading import InputError, parse, read_yaml
+from rpdrill.studies.runners import Runner
+from rpdrill.studies.study import (
     Axis,
     StrictSpec,
     base_scene_dict,
@@ -36,6 +34,7 @@ from studies.study import (
     run_point,
     set_path,
 )
+from scipy import optimize
 
 FREQUENCY = "impact.frequency_hz"
 

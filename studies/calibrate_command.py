@@ -12,11 +12,10 @@ import sys
 from pathlib import Path
 
 import yaml
+from rpdrill.studies.calibrate import calibrate, load_calibration
+from rpdrill.studies.outputs import staged_directory, write_json
+from rpdrill.studies.runners import process_pool, sequential
 from tqdm import tqdm
-
-from studies.calibrate import calibrate, load_calibration
-from studies.outputs import staged_directory, write_json
-from studies.runners import process_pool, sequential
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

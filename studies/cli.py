@@ -10,15 +10,15 @@ import importlib
 import sys
 import warnings
 
-from studies.loading import InputError
+from rpdrill.studies.loading import InputError
 
 # name: (module, one-line help); a module is imported only when its command runs
 COMMANDS = {
-    "simulate": ("studies.simulate_command", "run one scene: time histories, summary, plot"),
-    "crosscheck": ("studies.crosscheck", "run the Exudyn model and the ODE of Eq. 4 and compare them"),
-    "study": ("studies.study_command", "run a YAML study (scan) on all cores or a Dask cluster"),
-    "accuracy": ("studies.accuracy_command", "work-precision study: error against CPU time of solver settings"),
-    "calibrate": ("studies.calibrate_command", "fit scene parameters to target optimum frequencies"),
+    "simulate": ("rpdrill.studies.simulate_command", "run one scene: time histories, summary, plot"),
+    "crosscheck": ("rpdrill.studies.crosscheck", "run the Exudyn model and the ODE of Eq. 4 and compare them"),
+    "study": ("rpdrill.studies.study_command", "run a YAML study (scan) on all cores or a Dask cluster"),
+    "accuracy": ("rpdrill.studies.accuracy_command", "work-precision study: error against CPU time of solver settings"),
+    "calibrate": ("rpdrill.studies.calibrate_command", "fit scene parameters to target optimum frequencies"),
 }
 
 

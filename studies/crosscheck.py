@@ -21,14 +21,14 @@ import argparse
 import sys
 from pathlib import Path
 
-from models.compare import compare_runs, verdict
-from models.exudyn_model import simulate_exudyn
-from models.ode_model import ODE_METHODS, simulate_ode
-from models.results import SimulationResult
-from models.scene import Scene
-from models.stability import SimulationFailed
-from studies.loading import load_scene, parse
-from studies.outputs import staged_directory, write_json
+from rpdrill.models.compare import compare_runs, verdict
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.ode_model import ODE_METHODS, simulate_ode
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Scene
+from rpdrill.models.stability import SimulationFailed
+from rpdrill.studies.loading import load_scene, parse
+from rpdrill.studies.outputs import staged_directory, write_json
 
 DEFAULT_STEP_S = 5e-6
 

@@ -11,8 +11,7 @@ from typing import Any, TypeVar, get_args, get_origin
 
 import yaml
 from pydantic import BaseModel, ValidationError
-
-from models.scene import Scene
+from rpdrill.models.scene import Scene
 
 ModelT = TypeVar("ModelT", bound=BaseModel)
 

@@ -8,13 +8,13 @@ from __future__ import annotations
 import argparse
 import sys
 
-from models.exudyn_model import simulate_exudyn
-from models.metrics import summary_metrics
-from models.stability import SimulationFailed
-from studies.loading import load_scene
-from studies.outputs import staged_directory, write_columns_csv, write_json, write_resolved
-from studies.plots import plot_timeseries
-from studies.progress import time_progress
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.stability import SimulationFailed
+from rpdrill.studies.loading import load_scene
+from rpdrill.studies.outputs import staged_directory, write_columns_csv, write_json, write_resolved
+from rpdrill.studies.plots import plot_timeseries
+from rpdrill.studies.progress import time_progress
 
 HEADLINE = ("penetration_rate_m_per_s", "advance_per_blow_m", "energy_transfer_efficiency",
             "energy_balance_relative_error")

@@ -42,12 +42,11 @@ from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
-
-from models.formulations import FORMULATIONS, unsupported
-from models.metrics import summary_metrics
-from models.outputs import METRICS
-from models.scene import Scene
-from studies.loading import InputError, allowed_keys, parse, read_yaml
+from rpdrill.models.formulations import FORMULATIONS, unsupported
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.outputs import METRICS
+from rpdrill.models.scene import Scene
+from rpdrill.studies.loading import InputError, allowed_keys, parse, read_yaml
 
 METRIC_NAMES = tuple(METRICS)
 NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")

@@ -20,14 +20,13 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
+from rpdrill.models.scene import Scene
+from rpdrill.studies.loading import InputError
+from rpdrill.studies.outputs import write_json
+from rpdrill.studies.runners import select
+from rpdrill.studies.study import Point, Study, load_study, run_point
+from rpdrill.studies.study_plots import draw_plots
 from tqdm import tqdm
-
-from models.scene import Scene
-from studies.loading import InputError
-from studies.outputs import write_json
-from studies.runners import select
-from studies.study import Point, Study, load_study, run_point
-from studies.study_plots import draw_plots
 
 STATUS_COLUMNS = ("status", "error", "wall_time_s")
 

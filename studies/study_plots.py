@@ -15,8 +15,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-
-from studies.study import Plot, Study
+from rpdrill.studies.study import Plot, Study
 
 Row = dict[str, str]
 

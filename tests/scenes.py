@@ -7,8 +7,7 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-
-from models.scene import Scene
+from rpdrill.models.scene import Scene
 
 PAPER_BASE = Path(__file__).resolve().parent / "test_drill.yaml"
 

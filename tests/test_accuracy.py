@@ -11,12 +11,10 @@ from pathlib import Path
 
 import pytest
 import yaml
-from scenes import PAPER_BASE, PER_BODY, scene_dict
-
-from models.exudyn_model import simulate_exudyn
-from models.linear_reference import linear_reference
-from models.scene import Scene
-from models.workprecision import (
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.linear_reference import linear_reference
+from rpdrill.models.scene import Scene
+from rpdrill.models.workprecision import (
     convergence_order,
     cost_at_error,
     errors,
@@ -24,8 +22,9 @@ from models.workprecision import (
     signature,
     uniform_grid_s,
 )
-from studies.accuracy import TimeLimitExceeded, cpu_time_limit
-from studies.cli import main
+from rpdrill.studies.accuracy import TimeLimitExceeded, cpu_time_limit
+from rpdrill.studies.cli import main
+from scenes import PAPER_BASE, PER_BODY, scene_dict
 
 END_S = 0.04  # two blows at 50 Hz
 GRID = uniform_grid_s(END_S, 1e-4)

@@ -6,16 +6,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import yaml
+from rpdrill.models.compare import compare_runs, verdict
+from rpdrill.models.energy import energy_account
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.ode_model import simulate_ode
+from rpdrill.rocklaw import BilinearRock, force_and_state
+from rpdrill.studies.cli import main
+from rpdrill.studies.crosscheck import DEFAULT_STEP_S
 from scenes import scene, scene_dict
-
-from models.compare import compare_runs, verdict
-from models.energy import energy_account
-from models.exudyn_model import simulate_exudyn
-from models.metrics import summary_metrics
-from models.ode_model import simulate_ode
-from rocklaw import BilinearRock, force_and_state
-from studies.cli import main
-from studies.crosscheck import DEFAULT_STEP_S
 
 K_LOAD, K_UNLOAD = 2e8, 1e9
 LAW = BilinearRock(K_LOAD, K_UNLOAD)

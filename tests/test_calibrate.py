@@ -5,10 +5,9 @@ import json
 import numpy as np
 import pytest
 import yaml
+from rpdrill.studies.calibrate import load_calibration, optimum_hz
+from rpdrill.studies.cli import main
 from scenes import PAPER_BASE
-
-from studies.calibrate import load_calibration, optimum_hz
-from studies.cli import main
 
 
 def test_parabola_vertex_recovers_a_peak_between_scan_points():

@@ -6,9 +6,8 @@ import sys
 
 import pytest
 import yaml
+from rpdrill.studies.cli import main
 from scenes import scene_dict
-
-from studies.cli import main
 
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}
 
@@ -79,7 +78,7 @@ def test_unreadable_files(tmp_path, capsys, content, expected):
 
 def test_console_script_exit_status_and_no_traceback(tmp_path):
     path = write(tmp_path, scene_dict(**{"drill_string.bodies.shank.mass_kg": -1.0}))
-    done = subprocess.run([sys.executable, "-m", "studies.cli", "simulate", str(path), "--out", str(tmp_path / "o")],
+    done = subprocess.run([sys.executable, "-m", "rpdrill.studies.cli", "simulate", str(path), "--out", str(tmp_path / "o")],
                           capture_output=True, text=True, check=False)
     assert done.returncode == 2
     assert "drill_string.bodies.shank.mass_kg" in done.stderr and "Traceback" not in done.stderr

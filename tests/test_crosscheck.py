@@ -11,14 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from rpdrill.models.compare import compare_runs, verdict
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.ode_model import simulate_ode
+from rpdrill.models.scene import Scene
+from rpdrill.studies.cli import main
+from rpdrill.studies.crosscheck import DEFAULT_STEP_S
 from scenes import PAPER_BASE, PER_BODY, scene_dict
-
-from models.compare import compare_runs, verdict
-from models.exudyn_model import simulate_exudyn
-from models.ode_model import simulate_ode
-from models.scene import Scene
-from studies.cli import main
-from studies.crosscheck import DEFAULT_STEP_S
 
 BLOWS = 15
 LIFT_OFF_M = 1e-9  # a gap below this (round-off of the start from rest, ~1e-19 m) is no lift-off

@@ -10,17 +10,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 from pydantic import ValidationError
+from rpdrill.models.chain import axial_chain, initial_positions_m, link_load_n
+from rpdrill.models.energy import energy_account
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.links import Coupling
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.scene import Scene
+from rpdrill.models.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.studies.cli import main
+from rpdrill.studies.loading import load_scene, read_yaml
 from scenes import scene, scene_dict
-
-from models.chain import axial_chain, initial_positions_m, link_load_n
-from models.energy import energy_account
-from models.exudyn_model import simulate_exudyn
-from models.links import Coupling
-from models.metrics import summary_metrics
-from models.scene import Scene
-from models.waves import transmitted_pulse_n, travel_time_s
-from studies.cli import main
-from studies.loading import load_scene, read_yaml
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 ROD = {"length_m": 3.66, "diameter_m": 0.045, "bore_diameter_m": 0.012}

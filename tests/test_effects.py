@@ -3,11 +3,10 @@
 import numpy as np
 import pytest
 import yaml
+from rpdrill.models.exudyn_model import build_exudyn, simulate_exudyn
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.studies.cli import main
 from scenes import CRUSHING, scene, scene_dict
-
-from models.exudyn_model import build_exudyn, simulate_exudyn
-from models.metrics import summary_metrics
-from studies.cli import main
 
 SHORT = {"solver__end_time_s": 0.25, "metrics__transient_blows": 3, "metrics__block_blows": 4}
 CRUSH = {k.replace(".", "__"): v for k, v in CRUSHING.items()}
@@ -90,8 +89,8 @@ def test_resolved_scene_lists_effects_and_reasons(tmp_path):
 
 def test_ode_and_exact_formulations_follow_the_same_switches():
     """Like with like: without torsion, rock damping and plasticity, all three build the same model."""
-    from models.exact_model import simulate_exact
-    from models.ode_model import simulate_ode
+    from rpdrill.models.exact_model import simulate_exact
+    from rpdrill.models.ode_model import simulate_ode
 
     lean = scene(**CRUSH, solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2,
                  effects={"joint_damping": True}, outputs={"timeseries": ["rock_force_n"]})

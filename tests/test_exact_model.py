@@ -17,18 +17,17 @@ import sys
 
 import numpy as np
 import pytest
+import rpdrill.models.exact_model
+import rpdrill.models.stability
+from rpdrill.models.energy import energy_account
+from rpdrill.models.exact_kernels import run_events
+from rpdrill.models.exact_model import simulate_exact
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.ode_model import simulate_ode
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Scene
+from rpdrill.models.stability import SimulationFailed
 from scenes import PER_BODY, crushing_scene, scene
-
-import models.exact_model
-import models.stability
-from models.energy import energy_account
-from models.exact_kernels import run_events
-from models.exact_model import simulate_exact
-from models.metrics import summary_metrics
-from models.ode_model import simulate_ode
-from models.results import SimulationResult
-from models.scene import Scene
-from models.stability import SimulationFailed
 
 BLOWS = 12
 SHORT_METRICS = {"metrics__transient_blows": 2, "metrics__block_blows": 2}
@@ -78,7 +77,7 @@ def relative_error(result: SimulationResult, reference: SimulationResult, column
 
 
 def test_does_not_import_exudyn() -> None:
-    code = "import models.exact_model, sys; assert 'exudyn' not in sys.modules"
+    code = "import rpdrill.models.exact_model, sys; assert 'exudyn' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
@@ -200,7 +199,7 @@ def test_compiled_loop_matches_its_python_execution(monkeypatch: pytest.MonkeyPa
     """The same kernel run by the interpreter (numba's py_func) gives the same samples."""
     short = crushing("carriage", "contact", blows=4)
     compiled = simulate_exact(short, sample_interval_s=1e-4)
-    monkeypatch.setattr(models.exact_model, "run_events", run_events.py_func)
+    monkeypatch.setattr(rpdrill.models.exact_model, "run_events", run_events.py_func)
     interpreted = simulate_exact(short, sample_interval_s=1e-4)
     assert compiled.info["switch_modes"] == interpreted.info["switch_modes"]
     np.testing.assert_array_equal(compiled.time_s, interpreted.time_s)
@@ -215,7 +214,7 @@ def test_divergence_is_reported_at_the_first_bad_sample(monkeypatch: pytest.Monk
     short = crushing("carriage", "contact", blows=4)
     free = simulate_exact(short)
     first = np.argmax(np.any(np.abs(free.position_m) > limit, axis=1))
-    for module in (models.exact_model, models.stability):
+    for module in (rpdrill.models.exact_model, rpdrill.models.stability):
         monkeypatch.setattr(module, "POSITION_LIMIT_M", limit)
     with pytest.raises(SimulationFailed, match=f"diverged at t = {free.time_s[first]:.6g} s"):
         simulate_exact(short)

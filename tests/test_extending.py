@@ -7,14 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from rpdrill.models.compare import compare_bottom_at, compare_histories
+from rpdrill.models.energy import energy_account
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.links import LINK_TYPES
+from rpdrill.models.ode_model import simulate_ode
+from rpdrill.models.scene import Scene
 from scenes import scene_dict
-
-from models.compare import compare_bottom_at, compare_histories
-from models.energy import energy_account
-from models.exudyn_model import simulate_exudyn
-from models.links import LINK_TYPES
-from models.ode_model import simulate_ode
-from models.scene import Scene
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "extending.md"
 SHORT = {"solver.end_time_s": 0.2, "metrics.transient_blows": 3, "metrics.block_blows": 3,

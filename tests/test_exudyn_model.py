@@ -4,11 +4,10 @@ import warnings
 
 import numpy as np
 import pytest
+from rpdrill.models.energy import energy_account
+from rpdrill.models.exudyn_model import build_exudyn, simulate_exudyn
+from rpdrill.models.metrics import summary_metrics
 from scenes import PER_BODY, crushing_scene, scene
-
-from models.energy import energy_account
-from models.exudyn_model import build_exudyn, simulate_exudyn
-from models.metrics import summary_metrics
 
 SHORT = {"solver__end_time_s": 0.3, "metrics__transient_blows": 4, "metrics__block_blows": 3}
 PER_BODY_KW = {k.replace(".", "__"): v for k, v in PER_BODY.items()}
@@ -115,8 +114,8 @@ def test_resampled_output_grid(crushing_run):
 
 
 def test_preloaded_start_is_the_static_equilibrium_and_all_formulations_use_it():
-    from models.chain import axial_chain, initial_positions_m
-    from models.exact_model import simulate_exact
+    from rpdrill.models.chain import axial_chain, initial_positions_m
+    from rpdrill.models.exact_model import simulate_exact
 
     s = crushing_scene(start="preloaded", solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2)
     chain, q0 = axial_chain(s), initial_positions_m(s)

@@ -10,13 +10,12 @@ import sys
 import numpy as np
 import pytest
 import yaml
+from rpdrill.models import ode_model
+from rpdrill.models.energy import energy_account
+from rpdrill.models.ode_model import simulate_ode
+from rpdrill.models.scene import Scene
+from rpdrill.models.stability import SimulationFailed
 from scenes import PAPER_BASE
-
-from models import ode_model
-from models.energy import energy_account
-from models.ode_model import simulate_ode
-from models.scene import Scene
-from models.stability import SimulationFailed
 
 
 def scene_from_base(blows: float = 15, **changes: object) -> Scene:
@@ -42,7 +41,7 @@ def result(case: str):
 
 
 def test_does_not_import_exudyn() -> None:
-    code = "import models.ode_model, sys; assert 'exudyn' not in sys.modules"
+    code = "import rpdrill.models.ode_model, sys; assert 'exudyn' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
 
 

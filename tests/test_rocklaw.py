@@ -5,8 +5,7 @@ import math
 
 import numpy as np
 import pytest
-
-from rocklaw import LAWS, TABLE_1, BilinearRock, JenkinsRock, RockLaw, force_and_state
+from rpdrill.rocklaw import LAWS, TABLE_1, BilinearRock, JenkinsRock, RockLaw, force_and_state
 
 ROCK = JenkinsRock(stiffness_n_per_m=5e8, damping_n_s_per_m=0.0, threshold_n=138e3)
 CRUSH = ROCK.crushing_penetration_m  # 276 um
@@ -163,8 +162,7 @@ def test_symbolic_recording_matches_numeric_in_every_branch(name):
     set through the element (off, elastic, crushing; bilinear loading, unloading, reloading)."""
     import exudyn as exu
     from exudyn.itemInterface import MarkerNodeCoordinate, Node1D, NodePointGround, ObjectMass1D
-
-    from rocklaw.exudyn_element import ExudynRockContact
+    from rpdrill.rocklaw.exudyn_element import ExudynRockContact
 
     law = LAW_CASES[name]
     mbs = exu.SystemContainer().AddSystem()

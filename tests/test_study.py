@@ -14,13 +14,12 @@ from pathlib import Path
 
 import pytest
 import yaml
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.scene import Scene
+from rpdrill.studies.cli import main
+from rpdrill.studies.study import METRIC_NAMES, load_study, run_point
 from scenes import PAPER_BASE
-
-from models.exudyn_model import simulate_exudyn
-from models.metrics import summary_metrics
-from models.scene import Scene
-from studies.cli import main
-from studies.study import METRIC_NAMES, load_study, run_point
 
 ROOT = Path(__file__).resolve().parents[1]
 SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}
@@ -148,7 +147,7 @@ def test_resume_after_kill(tmp_path, capsys):
     study = write_study(tmp_path / "resume.yaml", base_overrides={"solver.end_time_s": 0.4},
                         scan={"impact.frequency_hz": [40, 45, 50, 55, 60, 65]}, plots=[])
     out = tmp_path / "out"
-    process = subprocess.Popen([sys.executable, "-m", "studies.cli", "study", str(study), "--out", str(out),
+    process = subprocess.Popen([sys.executable, "-m", "rpdrill.studies.cli", "study", str(study), "--out", str(out),
                                 "--workers", "1", "--quiet"], cwd=ROOT, start_new_session=True,
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60

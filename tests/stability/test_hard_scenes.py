@@ -7,13 +7,18 @@ import functools
 
 import numpy as np
 import pytest
+from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import SOLVER_PRESETS, Scene
+from rpdrill.models.stability import (
+    STABLE_STEP_FACTOR,
+    SimulationFailed,
+    StepLimitWarning,
+    largest_stable_step_s,
+)
 from scenes import scene_dict
 
-from models.exudyn_model import simulate_exudyn
-from models.metrics import summary_metrics
-from models.results import SimulationResult
-from models.scene import SOLVER_PRESETS, Scene
-from models.stability import STABLE_STEP_FACTOR, SimulationFailed, StepLimitWarning, largest_stable_step_s
 from stability.hard_scenes import HARD_SCENES, LONG_RUN, SHORT
 
 
