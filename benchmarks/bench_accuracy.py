@@ -17,8 +17,9 @@ import warnings
 from dataclasses import replace
 from pathlib import Path
 
-from rpdrill.models.exudyn_model import simulate_exudyn
-from rpdrill.models.scene import SOLVER_PRESETS, Scene
+from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import prepare
+from rpdrill.models.solver_settings import EXUDYN_PRESETS
 from rpdrill.models.workprecision import cost_at_error, errors
 from rpdrill.studies.accuracy import load_accuracy_study, reference_signature, run_setting
 
@@ -28,13 +29,13 @@ MEASURE = "penetration_rate_error_rel"
 
 def preset_cost(base: dict, preset: str, seconds: float, repeats: int) -> tuple[float, float]:
     """(CPU s per simulated s, step) of the base scene run with ``preset`` for ``seconds``."""
-    data = {**base, "solver": {"preset": preset, "end_time_s": seconds}}
+    data = {**base, "solver": {"formulation": "exudyn", "preset": preset, "end_time_s": seconds}}
     data["outputs"] = {"metrics": ["penetration_rate_m_per_s"], "timeseries": ["borehole_bottom_m"]}
-    scene = Scene.model_validate(data)
+    simulation = prepare(Scene.model_validate(data))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        runs = [simulate_exudyn(scene).cpu_time_s for _ in range(repeats)]
-    return statistics.median(runs) / seconds, scene.solver.step_s
+        runs = [simulation.run().cpu_time_s for _ in range(repeats)]
+    return statistics.median(runs) / seconds, simulation.settings.step_s
 
 
 def main() -> None:
@@ -47,23 +48,23 @@ def main() -> None:
     args = parser.parse_args()
     study = load_accuracy_study(args.study)
     reference = reference_signature(study, study.reference)
-    print(f"study {study.spec.name}: {study.spec.blows} blows, reference {study.reference.formulation}")
+    print(f"study {study.spec.name}: {study.spec.blows} blows, reference {study.reference.solver}")
 
     print("\npreset     step [s]   CPU s / simulated s   penetration-rate error (window)")
-    presets = [(p, r) for p, r in zip(study.points, study.runs) if r.settings.get("preset")]
+    presets = [(p, r) for p, r in zip(study.points, study.runs) if r.solver.get("preset")]
     for point, run in presets:
         outcome = run_setting((point.index, study.scene, replace(run, repeats=args.repeats), study.spec.grid_interval_s,
                                study.spec.time_limit_s))
         error = errors(reference, outcome["signature"])[MEASURE] if outcome["status"] == "ok" else float("nan")
-        per_second, step = preset_cost(study.base, run.settings["preset"], args.seconds, args.repeats)
-        print(f"{run.settings['preset']:<10} {step:<10.3g} {per_second:<21.4g} {error:.3g}")
-    missing = set(SOLVER_PRESETS) - {r.settings["preset"] for _, r in presets}
+        per_second, step = preset_cost(study.base, run.solver["preset"], args.seconds, args.repeats)
+        print(f"{run.solver['preset']:<10} {step:<10.3g} {per_second:<21.4g} {error:.3g}")
+    missing = set(EXUDYN_PRESETS) - {r.solver["preset"] for _, r in presets}
     if missing:
         print(f"(presets not in the study: {', '.join(sorted(missing))})")
 
     groups = {"exudyn": [], "ode": []}
     for point, run in zip(study.points, study.runs):
-        if run.settings.get("preset") or (run.formulation == "ode" and run.settings["method"] != "DOP853"):
+        if run.solver.get("preset") or (run.formulation == "ode" and run.solver.get("method") != "DOP853"):
             continue
         if run.formulation not in groups:
             continue

@@ -11,22 +11,23 @@ import argparse
 import statistics
 from pathlib import Path
 
-from rpdrill.models.exudyn_model import simulate_exudyn
+from rpdrill.models import exudyn_model
 from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import prepare
 from rpdrill.studies.loading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def with_solver(scene: Scene, **solver: float | str) -> Scene:
-    data = scene.model_dump()
-    data["solver"].update(solver)
-    data["metrics"] = {"transient_blows": 0, "block_blows": 1}
-    return Scene.model_validate(data)
+    """The scene with these Exudyn solver settings, metrics over every blow."""
+    return scene.model_copy(update={"metrics": scene.metrics.model_copy(
+        update={"transient_blows": 0, "block_blows": 1})}).with_solver("exudyn", **solver)
 
 
 def cpu_per_simulated_second(scene: Scene, repeats: int, symbolic: bool = True) -> float:
-    runs = [simulate_exudyn(scene, symbolic=symbolic).cpu_time_s for _ in range(repeats)]
+    simulation = prepare(scene)
+    runs = [exudyn_model.simulate(simulation, symbolic=symbolic).cpu_time_s for _ in range(repeats)]
     return statistics.median(runs) / scene.solver.end_time_s
 
 
@@ -36,21 +37,21 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
     scene = load_scene(args.scene)
-    step = scene.solver.step_s
+    step = prepare(scene).settings.step_s
     timing = with_solver(scene, end_time_s=1.0)
     symbolic = cpu_per_simulated_second(timing, args.repeats, symbolic=True)
     python = cpu_per_simulated_second(timing, max(1, args.repeats // 2), symbolic=False)
-    print(f"scene {scene.name}, solver {scene.solver.type}, step {step:g} s, 1 s simulated")
+    print(f"scene {scene.name}, solver {prepare(timing).settings.type}, step {step:g} s, 1 s simulated")
     print(f"symbolic user functions: {symbolic:.3f} CPU s per simulated s (median of {args.repeats})")
     print(f"python user functions:   {python:.3f} CPU s per simulated s")
     print(f"ratio python / symbolic: {python / symbolic:.2f}")
 
     reference_step = step / 32
-    reference = simulate_exudyn(with_solver(scene, end_time_s=0.3, step_s=reference_step)).bottom_m[-1]
-    print(f"\nx_n(0.3 s) against {scene.solver.type} at step {reference_step:g} s: {reference * 1e3:.6f} mm")
+    reference = prepare(with_solver(scene, end_time_s=0.3, step_s=reference_step)).run().bottom_m[-1]
+    print(f"\nx_n(0.3 s) against rk44 at step {reference_step:g} s: {reference * 1e3:.6f} mm")
     print("step_s      x_n(0.3 s) [mm]   relative error   CPU s per simulated s")
     for factor in (4, 2, 1, 0.5, 0.25):
-        run = simulate_exudyn(with_solver(scene, end_time_s=0.3, step_s=step * factor))
+        run = prepare(with_solver(scene, end_time_s=0.3, step_s=step * factor)).run()
         error = abs(run.bottom_m[-1] - reference) / abs(reference) if reference else float("nan")
         print(f"{step * factor:<10.3g}  {run.bottom_m[-1] * 1e3:<16.6f}  {error:<15.2e}  {run.cpu_time_s / 0.3:.3f}")
 

@@ -11,9 +11,10 @@ import argparse
 import statistics
 from pathlib import Path
 
-from rpdrill.models.exudyn_model import build_exudyn, simulate_exudyn
+from rpdrill.models.exudyn_model import build_exudyn
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import prepare
 from rpdrill.studies.loading import read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -22,10 +23,10 @@ RATE_ONLY = {"effects": {"rock_damping": True, "joint_damping": True},
 
 
 def measure(data: dict, repeats: int) -> tuple[int, float, float]:
-    scene = Scene.model_validate(data)
-    runs = [simulate_exudyn(scene) for _ in range(repeats)]
+    simulation = prepare(Scene.model_validate(data))
+    runs = [simulation.run() for _ in range(repeats)]
     rate = summary_metrics(runs[0])["penetration_rate_m_per_s"]
-    return build_exudyn(scene).coordinate_count, statistics.median(r.cpu_time_s for r in runs), rate
+    return build_exudyn(simulation).coordinate_count, statistics.median(r.cpu_time_s for r in runs), rate
 
 
 def main() -> None:

@@ -33,26 +33,25 @@ from pathlib import Path
 
 import numpy as np
 import yaml
-from rpdrill.models.exact_model import simulate_exact
-from rpdrill.models.exudyn_model import simulate_exudyn
-from rpdrill.models.ode_model import simulate_ode
+
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import prepare
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = ROOT / "studies" / "scenes" / "paper_base.yaml"
 CRUSHING = {"amplitude_n": 400e3, "frequency_hz": 45.0}
 RATE_ONLY = {"metrics": ["penetration_rate_m_per_s"]}
-# First call of simulate_exact in a fresh process: CPU seconds (compiling or loading the kernels).
+# First exact run in a fresh process: CPU seconds (compiling or loading the kernels).
 FIRST_CALL = """
 import os, sys, time
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 sys.path.insert(0, {benchmarks!r})
 from bench_exact import scenes
-from rpdrill.models.exact_model import simulate_exact
-scene = scenes(0.5)["paper_base"]
+from rpdrill.models.simulation import prepare
+simulation = prepare(scenes(0.5)["paper_base"].with_solver("exact"))
 start = time.process_time()
-simulate_exact(scene)
+simulation.run()
 print(time.process_time() - start)
 """
 
@@ -94,7 +93,7 @@ def timed(run: Callable[[], SimulationResult], repeats: int) -> tuple[Simulation
 
 
 def first_call_cpu_s(cache_dir: str | None) -> float:
-    """CPU seconds of the first simulate_exact call in a fresh process (``cache_dir``: an empty numba
+    """CPU seconds of the first exact run in a fresh process (``cache_dir``: an empty numba
     cache, so the kernels compile; None: the project's cache)."""
     env = os.environ | {"PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
     if cache_dir:
@@ -117,12 +116,14 @@ def main() -> None:
     print("scene                 formulation                  CPU s / sim s   x_n rel. error   abs. [m]   x_n(end) [mm]")
     lean = scenes(args.end_time_s, RATE_ONLY)
     for name, scene in scenes(args.end_time_s).items():
-        reference = simulate_exact(scene, sample_interval_s=scene.solver.output_interval_s / 100)
+        reference = prepare(scene.with_solver("exact", sample_interval_s=scene.solver.output_interval_s / 100)).run()
+        exudyn = prepare(scene)
         runs = {
-            "exact (default)": lambda scene=scene: simulate_exact(scene),
-            "exact (rate only)": lambda name=name: simulate_exact(lean[name]),
-            f"exudyn {scene.solver.type} {scene.solver.step_s:g} s": lambda scene=scene: simulate_exudyn(scene),
-            "ode DOP853 rtol 1e-8": lambda scene=scene: simulate_ode(scene, rtol=1e-8, atol=1e-11),
+            "exact (default)": prepare(scene.with_solver("exact")).run,
+            "exact (rate only)": prepare(lean[name].with_solver("exact")).run,
+            f"exudyn {exudyn.settings.type} {exudyn.settings.step_s:.3g} s": exudyn.run,
+            "ode DOP853 rtol 1e-8": prepare(scene.with_solver("ode", relative_tolerance=1e-8,
+                                                             absolute_tolerance=1e-11)).run,
         }
         for label, run in runs.items():
             exact = label.startswith("exact")

@@ -2,7 +2,8 @@
 
 Every formulation assembles from this one description (built from a scene's ``drill_string`` by
 :func:`axial_chain`), so the Exudyn model, the ODE (Eq. 4: M q'' + C q' + K q = F) and the exact
-solver cannot disagree on the topology. A rod of ``segments`` N becomes N lumped masses
+solver cannot disagree on the topology. The chain owns the first-order form of its linear part,
+:meth:`AxialChain.first_order_matrix`, which the ODE, the exact solver and the stability limits use. A rod of ``segments`` N becomes N lumped masses
 ``name[0]`` .. ``name[N-1]`` joined by springs E A N / L; connectors attach to a rod's first
 segment (``to``) and last segment (``from``).
 """
@@ -12,9 +13,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from rpdrill.models.links import LINK_TYPES, Link
-from rpdrill.models.scene import EVERY_BODY, GROUND, Body, Connector, Scene
 from scipy.optimize import root
+
+from rpdrill.models.links import LINK_TYPES, Link
+from rpdrill.models.scene import EVERY_BODY, GROUND, Body, Connector, Scene, Torsion
+from rpdrill.rocklaw import RockLaw
 
 
 @dataclass(frozen=True)
@@ -80,6 +83,27 @@ class AxialChain:
     def constant_forces(self) -> np.ndarray:
         return np.array([b.constant_force_n for b in self.bodies])
 
+    def first_order_matrix(self, links: tuple[Link, ...] | None = None, bit_stiffness_n_per_m: float = 0.0,
+                           bit_damping_n_s_per_m: float = 0.0) -> np.ndarray:
+        """A of z' = A (x, v, 1) for the linear part of Eq. 4 (2n x (2n + 1)):
+
+            x' = v,   v' = M^-1 (-K x - C v + F_feed),
+
+        K and C of ``links`` (default: the linear links; the others are added by each formulation
+        from their own laws) plus a spring and damper from the bit to ground (the rock in contact)."""
+        links = self.linear_links() if links is None else links
+        n = self.size
+        stiffness, damping = self._assemble("stiffness_n_per_m", links), self._assemble("damping_n_s_per_m", links)
+        stiffness[self.bit_body, self.bit_body] += bit_stiffness_n_per_m
+        damping[self.bit_body, self.bit_body] += bit_damping_n_s_per_m
+        inverse_mass = 1.0 / np.array([b.mass_kg for b in self.bodies])
+        matrix = np.zeros((2 * n, 2 * n + 1))
+        matrix[:n, n:2 * n] = np.eye(n)
+        matrix[n:, :n] = -inverse_mass[:, None] * stiffness
+        matrix[n:, n:2 * n] = -inverse_mass[:, None] * damping
+        matrix[n:, 2 * n] = inverse_mass * self.constant_forces()
+        return matrix
+
     def link_stretch(self, positions: np.ndarray, links: tuple[Link, ...] | None = None) -> np.ndarray:
         """delta = x_b - x_a of every link (or of ``links``), for (..., n_bodies) positions."""
         links = self.links if links is None else links
@@ -111,11 +135,11 @@ def _derived_stiffness_n_per_m(ends: list[Body]) -> float:
     return 1.0 / sum(body.half_segment_compliance_m_per_n() for body in ends)
 
 
-def axial_chain(scene: Scene) -> AxialChain:
+def axial_chain(scene: Scene, joint_damping: bool = True) -> AxialChain:
     """The chain of the scene's drill string, rods split into their segments.
 
     Feed: ``force_n`` on the body ``feed.acts_on`` or on every body (a rod's share split evenly
-    over its segments). Joint damping is zero when the scene's ``joint_damping`` effect is off.
+    over its segments). Without ``joint_damping`` (the effect off) every connector's damping is zero.
     """
     string, feed = scene.drill_string, scene.feed
     bodies: list[ChainBody] = []
@@ -128,9 +152,8 @@ def axial_chain(scene: Scene) -> AxialChain:
         groups[name] = (first, first + n - 1)
         links += [Link(f"{name}[{i}-{i + 1}]", first + i, first + i + 1,
                        _derived_stiffness_n_per_m([body, body]), 0.0) for i in range(n - 1)]
-    damped = scene.effects.joint_damping
     for name, connector in string.connectors.items():
-        links.append(_connector_link(scene, name, connector, groups, damped))
+        links.append(_connector_link(scene, name, connector, groups, joint_damping))
     return AxialChain(tuple(bodies), tuple(links), impact_body=groups[string.impact_body][0],
                       bit_body=groups[string.rock_body][1], groups=groups)
 
@@ -159,18 +182,24 @@ def link_load_n(chain: AxialChain, positions: np.ndarray, velocities: np.ndarray
     return load
 
 
-def initial_positions_m(scene: Scene) -> np.ndarray:
-    """Positions at t = 0: zero from rest, or for ``start: preloaded`` the static equilibrium under
-    the feed with the bit pressed on the rock (loading stiffness k_load):
-    F_feed + F_links(q0) - k_load q0_bit e_bit = 0, solved from the linear guess
-    (K + k_load e_bit e_bit^T) q = F_feed (exact when every link is linear)."""
-    chain = axial_chain(scene)
-    if scene.start == "rest":
-        return np.zeros(chain.size)
-    law = scene.rock_law()
+def torsion_first_order_matrix(torsion: Torsion) -> np.ndarray:
+    """The torsion line of Eq. 4, J phi'' + c_x phi' + k_x phi = M_x - M_c, as
+    (phi, omega)' = T (phi, omega, 1) (2 x 3)."""
+    inertia = torsion.inertia_kg_m2
+    return np.array([[0.0, 1.0, 0.0],
+                     [-torsion.stiffness_n_m_per_rad / inertia, -torsion.damping_n_m_s_per_rad / inertia,
+                      (torsion.drive_torque_n_m - torsion.resisting_torque_n_m) / inertia]])
+
+
+def static_preload_m(chain: AxialChain, law: RockLaw) -> np.ndarray:
+    """The static equilibrium under the feed with the bit pressed on the rock (loading stiffness
+    k_load): F_feed + F_links(q0) - k_load q0_bit e_bit = 0, solved from the linear guess
+    (K + k_load e_bit e_bit^T) q = F_feed (exact when every link is linear). ValueError when there
+    is none or when the feed alone would crush the rock."""
     stiffness = chain.stiffness_matrix()
     stiffness[chain.bit_body, chain.bit_body] += law.loading_stiffness_n_per_m
     positions = np.linalg.solve(stiffness, chain.constant_forces())
+    feed_n = float(np.sum(chain.constant_forces()))
     if not chain.is_linear:
         rest = np.zeros(chain.size)
 
@@ -180,21 +209,18 @@ def initial_positions_m(scene: Scene) -> np.ndarray:
             return chain.constant_forces() + link_load_n(chain, q, rest) - rock
 
         solution = root(residual, positions, method="hybr", options={"xtol": 1e-13})
-        if not solution.success or np.max(np.abs(residual(solution.x))) > 1e-8 * max(scene.feed.force_n, 1.0):
-            raise ValueError(f"start: 'preloaded': no static equilibrium under the feed ({solution.message}); "
-                             f"use start: rest")
+        if not solution.success or np.max(np.abs(residual(solution.x))) > 1e-8 * max(feed_n, 1.0):
+            raise ValueError(f"no static equilibrium under the feed ({solution.message}); use start: rest")
         positions = solution.x
     rock_force = law.loading_stiffness_n_per_m * positions[chain.bit_body]
     if rock_force >= law.threshold_n:
-        raise ValueError(f"start: 'preloaded': the static feed alone crushes the rock (rock force "
-                         f"{rock_force:.4g} N >= rock threshold {law.threshold_n:.4g} N); "
-                         f"lower feed.force_n or use start: rest")
+        raise ValueError(f"the static feed alone crushes the rock (rock force {rock_force:.4g} N >= rock "
+                         f"threshold {law.threshold_n:.4g} N); lower feed.force_n or use start: rest")
     return positions
 
 
-def initial_torsion_angle_rad(scene: Scene) -> float:
-    """phi at t = 0: zero from rest, (M_x - M_c) / k_x preloaded (zero without a torsion spring)."""
-    tor = scene.torsion
-    if scene.start == "rest" or tor is None or tor.stiffness_n_m_per_rad == 0:
+def static_torsion_angle_rad(torsion: Torsion) -> float:
+    """phi of the static equilibrium, (M_x - M_c) / k_x (zero without a torsion spring)."""
+    if torsion.stiffness_n_m_per_rad == 0:
         return 0.0
-    return (tor.drive_torque_n_m - tor.resisting_torque_n_m) / tor.stiffness_n_m_per_rad
+    return (torsion.drive_torque_n_m - torsion.resisting_torque_n_m) / torsion.stiffness_n_m_per_rad

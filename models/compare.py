@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 

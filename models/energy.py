@@ -14,8 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from rpdrill.models.results import SimulationResult
 from scipy.integrate import cumulative_trapezoid
+
+from rpdrill.models.results import SimulationResult
 
 
 def _cumulative(power: np.ndarray, time_s: np.ndarray) -> np.ndarray:
@@ -46,9 +47,9 @@ class EnergyAccount:
 
 
 def energy_account(result: SimulationResult) -> EnergyAccount:
-    chain, scene, t = result.chain, result.scene, result.time_s
+    simulation, t = result.simulation, result.time_s
+    chain, rock = simulation.chain, simulation.rock
     x, v = result.position_m, result.velocity_m_per_s
-    rock = scene.rock_law()
     masses = np.array([b.mass_kg for b in chain.bodies])
 
     kinetic = 0.5 * (v**2) @ masses
@@ -59,7 +60,7 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
     damping_power = damping_power + (result.rock_force_n - spring_force) * result.bit_velocity_m_per_s
     feed = (x - x[0]) @ chain.constant_forces()
     if result.torsion_angle_rad is not None:
-        tor = scene.torsion
+        tor = simulation.scene.torsion
         phi, omega = result.torsion_angle_rad, result.torsion_rate_rad_per_s
         kinetic = kinetic + 0.5 * tor.inertia_kg_m2 * omega**2
         elastic = elastic + 0.5 * tor.stiffness_n_m_per_rad * phi**2

@@ -155,17 +155,19 @@ def locate(terms: np.ndarray, exit_count: int, directions: np.ndarray, low: floa
 def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, readout: np.ndarray,
                exit_counts: np.ndarray, directions: np.ndarray, next_modes: np.ndarray, rock_rows: np.ndarray,
                impact_rows: np.ndarray, key_of: np.ndarray, phase_times_s: np.ndarray, phase_ids: np.ndarray,
-               phase_pulse_states: np.ndarray, step_s: float, per_anchor: int, per_sample: int,
-               min_switch_interval_s: float, max_switches: int, bodies: int, bit: int, bottom: int,
-               crushing_mode: int, crushing_penetration_m: float, position_limit_m: float, progress: np.ndarray,
-               clock: np.ndarray, w: np.ndarray, time_out: np.ndarray, rows: np.ndarray,
+               phase_pulse_states: np.ndarray, reset_counts: np.ndarray, reset_targets: np.ndarray,
+               reset_rows: np.ndarray, monotone: int, step_s: float, per_anchor: int, per_sample: int,
+               min_switch_interval_s: float, max_switches: int, bodies: int, position_limit_m: float,
+               progress: np.ndarray, clock: np.ndarray, w: np.ndarray, time_out: np.ndarray, rows: np.ndarray,
                switch_times_s: np.ndarray, switch_modes: np.ndarray) -> int:
     """The event loop of models.exact_model (its module doc), from pulse phase progress[0] on.
 
     Per key (rock mode, pulse phase), with R = (I_m, rock row, piston row, exit rows), r rows, and
     B = ``per_anchor``: ``taylor`` [(R A^k / k!)^T]_k, ``one_step`` expm(A h), ``anchors``
     [expm(A a B h)^T]_a (m x A m), ``readout``
-    [(R expm(A b h))^T]_b (m x B r). Fills ``time_out``, ``rows`` (w, F_r, F_d; both sides of every
+    [(R expm(A b h))^T]_b (m x B r); per exit e of a key the next mode id ``next_modes`` and the entry
+    resets w[reset_targets[j]] = reset_rows[j] . w (j < reset_counts; the ``monotone`` entry keeps the
+    larger of old and new value). Fills ``time_out``, ``rows`` (w, F_r, F_d; both sides of every
     switch) and the switch log. The run's state is progress = (phase, mode id, rows filled, switches,
     resume), clock = (t, mode start) and w: a key not built yet (key_of -1) returns MISSING_KEY with
     resume = 1, and the call after it is built goes on from there. Returns OK, TOO_MANY_SWITCHES,
@@ -290,8 +292,11 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
             mode, mode_start_s = next_modes[key, e], t
             for c in range(size):
                 w[c] = final[c]
-            if mode == crushing_mode:  # the return map of Eq. 2
-                w[bottom] = max(w[bottom], w[bit] - crushing_penetration_m)
+            for j in range(reset_counts[key, e]):  # entry values of the new mode, from the switch state
+                target, value = reset_targets[key, e, j], 0.0
+                for c in range(size):
+                    value += reset_rows[key, e, j, c] * final[c]
+                w[target] = max(final[target], value) if target == monotone else value
             switch_times_s[switches], switch_modes[switches] = t, mode
             switches += 1
             resume = 1  # the new mode goes on from (t, w) in this pulse phase

@@ -1,124 +1,88 @@
 """Exact event-driven solution of the piecewise-linear model (paper Eq. 1, 2, 4), no Exudyn.
 
 Between two switches the model is linear and autonomous in the augmented state
-w = (x (n bodies), v (n bodies), x_n, [phi, phi'], 1, u1, u2) (phi, phi' with the torsion effect):
+w = (x (n bodies), v (n bodies), rock states, [phi, phi'], 1, u1, u2) (phi, phi' with the torsion
+effect; u1, u2 the pulse generator of models.pulse, the constant 1 carrying the feed forces, the
+laws' constants and the net torque):
 
-    w' = A_(mode, phase) w
+    w' = A_(modes, phase) w
 
-The constant 1 carries the feed forces, F_th and the net torque; u1, u2 generate the piston pulse
-(s = time since the blow's start, tau = pulse duration, I = amplitude):
+``modes`` holds the mode of every piecewise element (models.piecewise: the rock law and each
+nonlinear connector), ``phase`` the pulse phase. A is generated, never written by hand: the chain's
+first-order matrix (models.chain, the linear links and the feed), the torsion line, the pulse
+phase's force row and generator (models.pulse), and for each element its mode's force row acting
+along the element's load and its state-rate rows (rocklaw.modes: the laws' own declarations).
+The mode is left at the first zero crossing, in its direction, of one of the current modes' exit
+rows; the next mode starts from the element's entry values (Jenkins: x_n = x_bit - F_th / k_n on
+entering crushing, the return map on the switching surface; the bottom never decreases).
 
-=============  ================================  ===============================
-pulse shape    generator                          F_d
-=============  ================================  ===============================
-half_sine      u1 = sin(pi s/tau), u2 = cos(..)   I u1
-rectangular    (none)                             I 1
-triangular     u1 = s (u1' = 1)                   (2I/tau) u1, then 2I - (2I/tau) u1
-=============  ================================  ===============================
-
-and F_d = 0 between pulses (phase ``off``); the triangular pulse has a ``rising`` and a
-``falling`` phase. The axial rows are Eq. 4, M x'' + C x' + K x = F_feed + F_d e_shank - F_r e_bit,
-with the rock force F_r linear in w in each rock mode (d = x_bit - x_n, v = x_bit'):
-
-=========  ====================================  ===========================================
-mode       F_r, x_n'                             left when (direction) -> next mode
-=========  ====================================  ===========================================
-free       0 (``always``: c_n v), 0              d rises through 0 -> contact
-contact    k_n d + c_n v, 0                      d falls through 0 -> free;
-                                                 k_n d - F_th rises through 0 -> crushing;
-                                                 k_n d + c_n v falls through 0 -> clipped
-                                                 (``contact`` damping with c_n > 0 only:
-                                                 F_r = max(k_n d + c_n v, 0))
-clipped    0, 0                                  k_n d + c_n v rises through 0 -> contact;
-                                                 d falls through 0 -> free
-crushing   F_th + c_n v, v                       v falls through 0 -> contact
-                                                 (no crushing mode for an elastic rock, F_th = inf)
-=========  ====================================  ===========================================
-
-In crushing x_n' = x_bit', so k_n (x_bit - x_n) = F_th is kept exactly; on entering crushing x_n is
-set by the law's return map max(x_n, x_bit - F_th / k_n), removing the root's round-off.
-
-Propagation. A global sub-grid of step h (an integer fraction of the output interval, with
-||A_bal|| h <= 1 for the balanced matrices of all modes, so h <= 1/(2 pi) of the shortest period)
+Propagation. A global sub-grid of step h (an integer fraction of the sample interval, with
+||A_bal|| h <= 1 for the balanced matrices of the modes, so h <= 1/(2 pi) of the shortest period)
 carries the solution, w(t_j + b h) = expm(A b h) w(t_j), in batches of J = A B sub-grid points
 from one state s0: anchors expm(A a B h) s0 (a < A), then every point a B + b from its anchor
-(b < B). SciPy computes expm(A h) once per (mode, phase) (on the balanced matrix); its powers, the
-readout rows R = (I, F_r row, F_d row, exit rows) and the Taylor matrices A^k / k! are cached, and
-a batch is two matrix products. A piece shorter than h (to the first grid point after a switch, to
-a pulse switch, to a located switch) uses the Taylor series sum_k (A s)^k / k! w truncated where its
-remainder is below 1e-20 of the state (s <= h): the exact solution to round-off, without an expm
-per switch. Each exit function g = c . w comes with every point; the first interval where g goes
-from its side to the crossed side brackets the switch, which Brent's method (as
+(b < B). SciPy computes expm(A h) once per (modes, phase) key (on the balanced matrix); its powers,
+the readout rows R = (I, F_r row, F_d row, exit rows) and the Taylor matrices A^k / k! are cached,
+and a batch is two matrix products. A piece shorter than h (to the first grid point after a switch,
+to a pulse switch, to a located switch) uses the Taylor series sum_k (A s)^k / k! w truncated where
+its remainder is below 1e-20 of the state (s <= h): the exact solution to round-off, without an
+expm per switch. Each exit function g = c . w comes with every point; the first interval where g
+goes from its side to the crossed side brackets the switch, which Brent's method (as
 ``scipy.optimize.brentq``) locates on the Taylor polynomial g(s) of the exact solution. The event
-loop runs compiled (models.exact_kernels); the operators of a (mode, phase) are built when the run
-first reaches it.
+loop runs compiled (models.exact_kernels); the operators of a key are built when the run first
+reaches it.
 
 Zero-length modes: a mode lasts at least ``min_switch_interval_s``. Its start is taken as not
 crossed for every exit function; if an exit function is on its crossed side already at
 t_start + min_switch_interval_s, the switch is placed there. More than ``max_switches_per_blow``
-rock switches per blow on average raise :class:`SimulationFailed`, and so does a diverged state
+switches per blow on average raise :class:`SimulationFailed`, and so does a diverged state
 (models.stability's criterion, checked at every switch, pulse switch and batch end; the message
 names the first diverged sample).
-
-Torsion (decoupled, with the torsion effect): J phi'' + c_x phi' + k_x phi = M_x - M_c, two more
-rows of A, propagated with the axial state.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
-from rpdrill.models.chain import AxialChain, axial_chain, initial_positions_m, initial_torsion_angle_rad
-from rpdrill.models.exact_kernels import DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
-from rpdrill.models.exact_scope import exact_unsupported
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Impact, Scene, Torsion
-from rpdrill.models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
-from rpdrill.rocklaw.jenkins import JenkinsRock
 from scipy.linalg import expm
 from scipy.linalg.lapack import dgebal
+from threadpoolctl import ThreadpoolController
 
-FREE, CONTACT, CLIPPED, CRUSHING = MODES = "free", "contact", "clipped", "crushing"
-OFF, ON, RISING, FALLING = PHASES = "off", "on", "rising", "falling"
-# Sample interval when energies are asked for: the trapezoidal energy integrals then close the
-# balance to ~1e-4 of the impact work (1e-4 s samples: ~1e-2).
-ENERGY_SAMPLE_S = 1e-5
+from rpdrill.models.chain import torsion_first_order_matrix
+from rpdrill.models.exact_kernels import DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
+from rpdrill.models.piecewise import Element, elements
+from rpdrill.models.pulse import PHASES, generator_states, phase_generator, phase_pieces, phase_row
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import Simulation, as_simulation
+from rpdrill.models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
+from rpdrill.rocklaw.modes import Affine
+
 ANCHORS, PER_ANCHOR = 16, 16  # A, B: a batch is J = A B sub-grid points from one state (module doc)
-MAX_EXITS = 3
 TAYLOR_REMAINDER = 1e-20  # relative truncation of the Taylor series on pieces shorter than h
-Key = tuple[str, str]  # (rock mode, pulse phase)
+MAX_ENUMERATED_MODES = 256  # mode combinations whose norms are all measured to choose h
+# The operators are small (m ~ 10-300): a multi-threaded BLAS spends more on its threads than on the
+# products (a 13 x 13 expm took 8 ms with two threads on a loaded 2-core machine, 0.1 ms with one).
+BLAS = ThreadpoolController()
+Modes = tuple[str, ...]
 
 
 @dataclass(frozen=True)
-class Exit:
-    """Exit function g = row . w of a mode, its crossing direction (+1 rising) and the next mode."""
-
-    row: np.ndarray
-    direction: int
-    next_mode: str
-
-
-@dataclass
 class Layout:
-    """Indices into w = (x, v, x_n, [phi, phi'], 1, u1, u2) for ``n`` bodies."""
+    """Indices into w = (x, v, rock states, [phi, phi'], 1, u1, u2) for ``n`` bodies."""
 
     n: int
-    bit: int
-    impact: int
+    rock_states: int
     torsion: bool
-
-    @property
-    def bottom(self) -> int:
-        return 2 * self.n
 
     @property
     def angle(self) -> int:
         """phi (phi' follows); only with torsion."""
-        return 2 * self.n + 1
+        return 2 * self.n + self.rock_states
 
     @property
     def one(self) -> int:
@@ -126,140 +90,7 @@ class Layout:
 
     @property
     def size(self) -> int:
-        return 2 * self.n + 4 + 2 * self.torsion
-
-    def unit(self, index: int) -> np.ndarray:
-        row = np.zeros(self.size)
-        row[index] = 1.0
-        return row
-
-    @cached_property
-    def penetration_row(self) -> np.ndarray:
-        """d = x_bit - x_n."""
-        return self.unit(self.bit) - self.unit(self.bottom)
-
-    @cached_property
-    def bit_velocity_row(self) -> np.ndarray:
-        return self.unit(self.n + self.bit)
-
-
-def pulse_phases(impact: Impact, end_time_s: float) -> tuple[np.ndarray, list[str]]:
-    """((start, end) rows, phase) of the pieces of F_d covering [0, end_time_s], split where F_d
-    changes formula."""
-    tau, period = impact.duration_s, impact.period_s
-    inner = ((0.0, 0.5 * tau, RISING), (0.5 * tau, tau, FALLING)) if impact.shape == "triangular" else \
-        ((0.0, tau, ON),)
-    pieces = (*inner, (tau, period, OFF))
-    starts = np.arange(math.ceil(end_time_s / period))[:, None] * period
-    times = np.stack([starts + [low for low, _, _ in pieces], starts + [high for _, high, _ in pieces]], axis=-1)
-    times = times.reshape(-1, 2)
-    keep = times[:, 0] < end_time_s
-    times[:, 1] = np.minimum(times[:, 1], end_time_s)
-    return times[keep], [phase for phase, kept in zip([p[2] for p in pieces] * len(starts), keep) if kept]
-
-
-def pulse_states(impact: Impact, local_s: np.ndarray) -> np.ndarray:
-    """Exact (u1, u2) at times ``local_s`` after the blow's start: rows (sin, cos)(pi s / tau) for the
-    half-sine, (s, 0) for the triangular pulse, zeros for the rectangular one."""
-    states = np.zeros((len(local_s), 2))
-    if impact.shape == "half_sine":
-        states[:, 0], states[:, 1] = np.sin(np.pi * local_s / impact.duration_s), np.cos(np.pi * local_s / impact.duration_s)
-    elif impact.shape == "triangular":
-        states[:, 0] = local_s
-    return states
-
-
-def pulse_row(impact: Impact, phase: str) -> np.ndarray:
-    """F_d = row . (1, u1, u2) in ``phase``."""
-    amplitude, slope = impact.amplitude_n, 2.0 * impact.amplitude_n / impact.duration_s
-    if phase == OFF:
-        return np.zeros(3)
-    if impact.shape == "half_sine":
-        return np.array([0.0, amplitude, 0.0])
-    if impact.shape == "rectangular":
-        return np.array([amplitude, 0.0, 0.0])
-    return np.array([0.0, slope, 0.0]) if phase == RISING else np.array([2.0 * amplitude, -slope, 0.0])
-
-
-def pulse_generator(impact: Impact, phase: str) -> np.ndarray:
-    """G with (1, u1, u2)' = G (1, u1, u2): the oscillator of the half-sine, the ramp s' = 1."""
-    generator = np.zeros((3, 3))
-    if phase == OFF:
-        return generator
-    if impact.shape == "half_sine":
-        omega = math.pi / impact.duration_s
-        generator[1, 2], generator[2, 1] = omega, -omega
-    elif impact.shape == "triangular":
-        generator[1, 0] = 1.0
-    return generator
-
-
-def rock_row(layout: Layout, rock: JenkinsRock, mode: str) -> np.ndarray:
-    """F_r = row . w in rock ``mode`` (table in the module doc)."""
-    k, c, damper = rock.stiffness_n_per_m, rock.damping_n_s_per_m, layout.bit_velocity_row
-    if mode == CONTACT:
-        return k * layout.penetration_row + c * damper
-    if mode == CRUSHING:
-        return rock.threshold_n * layout.unit(layout.one) + c * damper
-    if mode == FREE and rock.damping_mode == "always":
-        return c * damper
-    return np.zeros(layout.size)
-
-
-def exits(layout: Layout, rock: JenkinsRock, mode: str) -> list[Exit]:
-    """Exit functions of ``mode`` (table in the module doc); no crushing exit for an elastic rock
-    (F_th infinite) and no clipping without rock damping (k_n d + c_n v = 0 is then d = 0)."""
-    k, c = rock.stiffness_n_per_m, rock.damping_n_s_per_m
-    d = layout.penetration_row
-    total = k * d + c * layout.bit_velocity_row
-    crushing = [Exit(k * d - rock.threshold_n * layout.unit(layout.one), 1, CRUSHING)] if rock.crushes else []
-    clipping = [Exit(total, -1, CLIPPED)] if rock.damping_mode == "contact" and c > 0 else []
-    table = {
-        FREE: [Exit(d, 1, CONTACT)],
-        CONTACT: [Exit(d, -1, FREE), *crushing, *clipping],
-        CLIPPED: [Exit(total, 1, CONTACT), Exit(d, -1, FREE)],
-        CRUSHING: [Exit(layout.bit_velocity_row, -1, CONTACT)],
-    }
-    return table[mode]
-
-
-def base_matrix(chain: AxialChain, layout: Layout, torsion: Torsion | None) -> np.ndarray:
-    """A without rock force and pulse: x' = v, M v' = -K x - C v + F_feed 1, and with torsion
-    phi'' = (-k_x phi - c_x phi' + M_x - M_c) / J."""
-    n = layout.n
-    forces = np.zeros((n, layout.size))
-    forces[:, :n] = -chain.stiffness_matrix()
-    forces[:, n:2 * n] = -chain.damping_matrix()
-    forces[:, layout.one] = chain.constant_forces()
-    matrix = np.zeros((layout.size, layout.size))
-    matrix[:n, n:2 * n] = np.eye(n)
-    matrix[n:2 * n] = np.linalg.solve(chain.mass_matrix(), forces)
-    if layout.torsion:
-        phi, inertia = layout.angle, torsion.inertia_kg_m2
-        matrix[phi, phi + 1] = 1.0
-        matrix[phi + 1, phi] = -torsion.stiffness_n_m_per_rad / inertia
-        matrix[phi + 1, phi + 1] = -torsion.damping_n_m_s_per_rad / inertia
-        matrix[phi + 1, layout.one] = (torsion.drive_torque_n_m - torsion.resisting_torque_n_m) / inertia
-    return matrix
-
-
-def mode_part(layout: Layout, rock: JenkinsRock, inverse_mass: np.ndarray, mode: str) -> np.ndarray:
-    """What rock ``mode`` adds to A: the rows -M^-1 F_r e_bit, and in crushing x_n' = v_bit (Eq. 2)."""
-    n = layout.n
-    part = np.zeros((layout.size, layout.size))
-    part[n:2 * n] = -np.outer(inverse_mass[:, layout.bit], rock_row(layout, rock, mode))
-    if mode == CRUSHING:
-        part[layout.bottom] = layout.bit_velocity_row
-    return part
-
-
-def phase_part(layout: Layout, impact: Impact, inverse_mass: np.ndarray, phase: str) -> np.ndarray:
-    """What pulse ``phase`` adds to A: the rows M^-1 F_d e_impact and the pulse generator."""
-    n = layout.n
-    part = np.zeros((layout.size, layout.size))
-    part[n:2 * n, layout.one:] = np.outer(inverse_mass[:, layout.impact], pulse_row(impact, phase))
-    part[layout.one:, layout.one:] = pulse_generator(impact, phase)
-    return part
+        return 2 * self.n + self.rock_states + 2 * self.torsion + 3
 
 
 def taylor_order(norm_times_step: float) -> int:
@@ -281,153 +112,251 @@ def balance(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return balanced, scale
 
 
-class Operators:
-    """The per-key (rock mode, pulse phase) arrays of models.exact_kernels.run_events, stacked over the
-    keys and filled when the kernel first reaches a key (``add``); key_of[mode id, phase id] -> key
-    (-1: not built). R = (I, F_r row, F_d row, exit rows) gives a point's outputs."""
+class Model:
+    """The generated matrices, rows and resets of one simulation (module doc)."""
 
-    def __init__(self, matrices: dict[Key, np.ndarray], step_s: float, order: int, layout: Layout,
-                 rock: JenkinsRock, impact: Impact) -> None:
-        self.matrices, self.step_s = matrices, step_s
-        self.layout, self.rock, self.impact = layout, rock, impact
-        keys, size, width = len(matrices), layout.size, layout.size + 2 + MAX_EXITS
-        self.taylor = np.empty((keys, size, (order + 1) * width))  # [(R A^k / k!)^T]_k
-        self.one_step = np.empty((keys, size, size))  # expm(A h)
-        self.anchors = np.empty((keys, size, ANCHORS * size))  # [expm(A a B h)^T]_a
-        self.readout = np.empty((keys, size, PER_ANCHOR * width))  # [(R expm(A b h))^T]_b
-        self.exit_counts = np.zeros(keys, dtype=np.int64)
-        self.directions = np.zeros((keys, MAX_EXITS))
-        self.next_modes = np.zeros((keys, MAX_EXITS), dtype=np.int64)  # mode ids
-        self.rock_rows = np.zeros((keys, size))  # F_r = row . w
-        self.impact_rows = np.zeros((keys, 3))  # F_d = row . (1, u1, u2)
-        self.key_of = np.full((len(MODES), len(PHASES)), -1, dtype=np.int64)
+    def __init__(self, simulation: Simulation) -> None:
+        chain, rock = simulation.chain, simulation.rock
+        self.simulation, self.impact = simulation, simulation.impact
+        self.layout = layout = Layout(chain.size, len(rock.state_names), simulation.torsion is not None)
+        self.pieces: tuple[Element, ...] = elements(chain, rock, layout.size)
+        self.masses_kg = np.array([b.mass_kg for b in chain.bodies])
+        n, m, one = layout.n, layout.size, layout.one
+        base = np.zeros((m, m))
+        linear = chain.first_order_matrix()
+        base[:2 * n, :2 * n], base[:2 * n, one] = linear[:, :-1], linear[:, -1]
+        if simulation.torsion is not None:
+            torsion = torsion_first_order_matrix(simulation.torsion)
+            phi = layout.angle
+            base[phi:phi + 2, phi:phi + 2], base[phi:phi + 2, one] = torsion[:, :2], torsion[:, 2]
+        self.base = base
+        self.max_exits = sum(max(len(mode.exits) for mode in element.table.values()) for element in self.pieces)
+        self.max_resets = max((len(mode.entry) for e in self.pieces for mode in e.table.values()), default=0) or 1
+
+    def row(self, element: Element, affine: Affine) -> np.ndarray:
+        """An affine function of an element's local variables as a row over w (constant on ``one``)."""
+        row, constant = element.row(affine)
+        row[self.layout.one] += constant
+        return row
+
+    def rock_force_row(self, modes: Modes) -> np.ndarray:
+        rock = self.pieces[0]
+        return self.row(rock, rock.table[modes[0]].force)
+
+    def matrix(self, modes: Modes, phase: str) -> np.ndarray:
+        """A of (modes, phase): base + each element's force along its load and its state rates + the pulse."""
+        n, one = self.layout.n, self.layout.one
+        matrix = self.base.copy()
+        for element, mode in zip(self.pieces, modes, strict=True):
+            declared = element.table[mode]
+            matrix[n:2 * n] += np.outer(element.load / self.masses_kg, self.row(element, declared.force))
+            for state, affine in declared.rates.items():
+                matrix[element.states[state]] += self.row(element, affine)
+        matrix[n + self.simulation.chain.impact_body, one:] += phase_row(self.impact, phase) \
+            / self.masses_kg[self.simulation.chain.impact_body]
+        matrix[one:, one:] = phase_generator(self.impact, phase)
+        return matrix
+
+    def exits(self, modes: Modes) -> list[tuple[np.ndarray, int, Modes, list[tuple[int, np.ndarray]]]]:
+        """(row, direction, next modes, entry resets (target index, row)) of every exit of ``modes``."""
+        out = []
+        for index, (element, mode) in enumerate(zip(self.pieces, modes, strict=True)):
+            for switch in element.table[mode].exits:
+                following = modes[:index] + (switch.next_mode,) + modes[index + 1:]
+                resets = [(element.states[state], self.row(element, affine))
+                          for state, affine in element.table[switch.next_mode].entry.items()]
+                out.append((self.row(element, switch.surface), switch.direction, following, resets))
+        return out
+
+    def norm_candidates(self, phases: list[str]) -> list[np.ndarray]:
+        """The matrices whose balanced norms choose the sub-step: every mode combination when they are
+        few, else every mode of each element with the others in their first mode."""
+        tables = [list(element.table) for element in self.pieces]
+        if math.prod(len(t) for t in tables) <= MAX_ENUMERATED_MODES:
+            combinations = list(itertools.product(*tables))
+        else:
+            first = tuple(t[0] for t in tables)
+            combinations = [first[:i] + (mode,) + first[i + 1:] for i, t in enumerate(tables) for mode in t]
+        return [self.matrix(modes, phase) for modes in combinations for phase in dict.fromkeys(phases)]
+
+
+class Operators:
+    """The per-key (modes, phase) arrays of models.exact_kernels.run_events, stacked over the keys and
+    filled when the kernel first reaches a key (``add``); mode combinations get ids as they are
+    first named, key_of[mode id, phase id] -> key (-1: not built), arrays growing as needed.
+    R = (I, F_r row, F_d row, exit rows) gives a point's outputs."""
+
+    def __init__(self, model: Model, step_s: float, order: int, capacity: int) -> None:
+        self.model, self.step_s, self.order = model, step_s, order
+        self.modes: list[Modes] = []
+        self.mode_ids: dict[Modes, int] = {}
+        size, exits = model.layout.size, model.max_exits
+        self.width = size + 2 + exits
+        self.taylor = np.empty((capacity, size, (order + 1) * self.width))  # [(R A^k / k!)^T]_k
+        self.one_step = np.empty((capacity, size, size))  # expm(A h)
+        self.anchors = np.empty((capacity, size, ANCHORS * size))  # [expm(A a B h)^T]_a
+        self.readout = np.empty((capacity, size, PER_ANCHOR * self.width))  # [(R expm(A b h))^T]_b
+        self.exit_counts = np.zeros(capacity, dtype=np.int64)
+        self.directions = np.zeros((capacity, exits))
+        self.next_modes = np.zeros((capacity, exits), dtype=np.int64)  # mode ids
+        self.reset_counts = np.zeros((capacity, exits), dtype=np.int64)
+        self.reset_targets = np.zeros((capacity, exits, model.max_resets), dtype=np.int64)
+        self.reset_rows = np.zeros((capacity, exits, model.max_resets, size))
+        self.rock_rows = np.zeros((capacity, size))  # F_r = row . w
+        self.impact_rows = np.zeros((capacity, 3))  # F_d = row . (1, u1, u2)
+        self.key_of = np.full((capacity, len(PHASES)), -1, dtype=np.int64)
         self.built = 0
 
-    def add(self, key: Key) -> None:
-        """Build the arrays of ``key``: expm(A h) = D expm(D^-1 A D h) D^-1 (``scipy.linalg.expm`` on
-        the balanced matrix), its powers, R, R A^k / k!."""
-        (mode, phase), layout, i = key, self.layout, self.built
-        matrix, size = self.matrices[key], layout.size
+    def mode_id(self, modes: Modes) -> int:
+        """The id of a mode combination (assigned when first named)."""
+        if modes not in self.mode_ids:
+            self.mode_ids[modes] = len(self.modes)
+            self.modes.append(modes)
+            if len(self.modes) > self.key_of.shape[0]:
+                self.key_of = np.concatenate([self.key_of, np.full_like(self.key_of, -1)])
+        return self.mode_ids[modes]
+
+    def _grow(self) -> None:
+        """Double the capacity of the per-key arrays."""
+        for name in ("taylor", "one_step", "anchors", "readout", "exit_counts", "directions", "next_modes",
+                     "reset_counts", "reset_targets", "reset_rows", "rock_rows", "impact_rows"):
+            array = getattr(self, name)
+            setattr(self, name, np.concatenate([array, np.zeros_like(array)]))
+
+    def add(self, modes: Modes, phase: str) -> None:
+        """Build the arrays of (modes, phase): expm(A h) = D expm(D^-1 A D h) D^-1 (``scipy.linalg.expm``
+        on the balanced matrix), its powers, R, R A^k / k!, the exits and their resets."""
+        model, i = self.model, self.built
+        if i == self.one_step.shape[0]:
+            self._grow()
+        matrix, size = model.matrix(modes, phase), model.layout.size
         balanced, scale = balance(matrix)
+        if taylor_order(np.linalg.norm(balanced, 1) * self.step_s) > self.order:
+            raise SimulationFailed(f"scene '{model.simulation.name}': exact solver: mode {modes} is stiffer "
+                                   f"than the modes that chose its sub-step; please report this scene")
         self.one_step[i] = scale[:, None] * expm(balanced * self.step_s) / scale[None, :]
-        mode_exits = exits(layout, self.rock, mode)
-        count = len(mode_exits)
-        readout = np.zeros((size + 2 + MAX_EXITS, size))
+        exits = model.exits(modes)
+        readout = np.zeros((self.width, size))
         readout[:size] = np.eye(size)
-        readout[size] = self.rock_rows[i] = rock_row(layout, self.rock, mode)
-        readout[size + 1, layout.one:] = self.impact_rows[i] = pulse_row(self.impact, phase)
-        readout[size + 2:size + 2 + count] = [e.row for e in mode_exits]
-        self.exit_counts[i] = count
-        self.directions[i, :count] = [e.direction for e in mode_exits]
-        self.next_modes[i, :count] = [MODES.index(e.next_mode) for e in mode_exits]
+        readout[size] = self.rock_rows[i] = model.rock_force_row(modes)
+        readout[size + 1, model.layout.one:] = self.impact_rows[i] = phase_row(model.impact, phase)
+        for e, (row, direction, following, resets) in enumerate(exits):
+            readout[size + 2 + e] = row
+            self.directions[i, e] = direction
+            self.next_modes[i, e] = self.mode_id(following)
+            self.reset_counts[i, e] = len(resets)
+            for j, (target, reset) in enumerate(resets):
+                self.reset_targets[i, e, j], self.reset_rows[i, e, j] = target, reset
+        self.exit_counts[i] = len(exits)
         assemble(self.one_step[i], matrix, readout, ANCHORS, PER_ANCHOR, self.readout[i], self.anchors[i],
                  self.taylor[i])
-        self.key_of[MODES.index(mode), PHASES.index(phase)] = i
+        self.key_of[self.mode_id(modes), PHASES.index(phase)] = i
         self.built += 1
 
 
 class ExactSolver:
-    """The event-driven exact solution of one scene (module doc)."""
+    """The event-driven exact solution of one simulation (module doc)."""
 
-    def __init__(self, scene: Scene, sample_interval_s: float, min_switch_interval_s: float,
-                 max_switches_per_blow: int) -> None:
-        self.scene, self.impact, self.rock = scene, scene.impact, scene.rock_law()
-        self.chain = axial_chain(scene)
-        self.layout = Layout(self.chain.size, self.chain.bit_body, self.chain.impact_body, scene.effects.torsion)
-        self.min_switch_interval_s = min_switch_interval_s
-        self.max_switches = max_switches_per_blow * math.ceil(scene.solver.end_time_s * self.impact.frequency_hz)
-        self.phase_times, self.phases = pulse_phases(self.impact, scene.solver.end_time_s)
-        clips = self.rock.damping_mode == "contact" and self.rock.damping_n_s_per_m > 0
-        modes = (FREE, CONTACT) + ((CLIPPED,) if clips else ()) + ((CRUSHING,) if self.rock.crushes else ())
-        inverse_mass = np.linalg.inv(self.chain.mass_matrix())
-        base = base_matrix(self.chain, self.layout, scene.torsion)
-        mode_parts = {mode: base + mode_part(self.layout, self.rock, inverse_mass, mode) for mode in modes}
-        phase_parts = {phase: phase_part(self.layout, self.impact, inverse_mass, phase)
-                       for phase in dict.fromkeys(self.phases)}
-        matrices = {(mode, phase): with_mode + phase_parts[phase]  # A = base + mode part + phase part
-                    for mode, with_mode in mode_parts.items() for phase in phase_parts}
-        norm = max(np.linalg.norm(balance(matrix)[0], 1) for matrix in matrices.values())
-        self.per_sample = max(1, math.ceil(sample_interval_s * norm))
-        self.step_s = sample_interval_s / self.per_sample
-        self.operators = Operators(matrices, self.step_s, taylor_order(norm * self.step_s), self.layout, self.rock,
-                                   self.impact)
+    def __init__(self, simulation: Simulation) -> None:
+        settings = simulation.settings
+        self.simulation, self.impact = simulation, simulation.impact
+        self.model = Model(simulation)
+        self.layout = self.model.layout
+        self.min_switch_interval_s = settings.min_switch_interval_s
+        self.max_switches = settings.max_switches_per_blow * math.ceil(settings.end_time_s * self.impact.frequency_hz)
+        self.phase_times, self.phases = phase_pieces(self.impact, settings.end_time_s)
+        norm = max(np.linalg.norm(balance(matrix)[0], 1) for matrix in self.model.norm_candidates(self.phases))
+        self.per_sample = max(1, math.ceil(settings.sample_interval_s * norm))
+        self.step_s = settings.sample_interval_s / self.per_sample
+        self.operators = Operators(self.model, self.step_s, taylor_order(norm * self.step_s),
+                                   len(self.model.pieces[0].table) * len(set(self.phases)))
 
-    def run(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """From the scene's start (rest, off the bottom; or preloaded, in contact) through every pulse
-        phase to the end time: (sample times; rows w, F_r, F_d; switch times; mode ids entered). The
+    def run(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Modes]]:
+        """From the simulation's start (rest, off the bottom; or preloaded, in contact) through every
+        pulse phase to the end time: (sample times; rows w, F_r, F_d; switch times; modes entered). The
         kernel returns when it reaches a key not built yet, and resumes once it is built."""
-        layout, ops, period = self.layout, self.operators, self.impact.period_s
+        layout, ops, period, simulation = self.layout, self.operators, self.impact.period_s, self.simulation
+        n = layout.n
         w = np.zeros(layout.size)
         w[layout.one] = 1.0
-        w[:layout.n] = initial_positions_m(self.scene)
+        w[:n] = simulation.initial_positions_m
+        w[2 * n:2 * n + layout.rock_states] = simulation.initial_rock_state
         if layout.torsion:
-            w[layout.angle] = initial_torsion_angle_rad(self.scene)
+            w[layout.angle] = simulation.initial_torsion_angle_rad
         starts = self.phase_times[:, 0]
-        pulse = pulse_states(self.impact, starts - np.floor(starts / period + 1e-9) * period)
+        pulse = generator_states(self.impact, starts - np.floor(starts / period + 1e-9) * period)
         phase_ids = np.array([PHASES.index(p) for p in self.phases])
-        capacity = (math.floor(self.scene.solver.end_time_s / (self.step_s * self.per_sample)) + 4
+        capacity = (math.floor(simulation.settings.end_time_s / (self.step_s * self.per_sample)) + 4
                     + 2 * len(self.phases) + 2 * self.max_switches + ANCHORS * PER_ANCHOR)
-        time_s, rows = np.empty(capacity), np.empty((capacity, layout.size + 2 + MAX_EXITS))
+        time_s, rows = np.empty(capacity), np.empty((capacity, ops.width))
         switch_times = np.empty(self.max_switches + 1)
         switch_modes = np.empty(self.max_switches + 1, dtype=np.int64)
-        progress = np.array([0, MODES.index(CONTACT if layout.penetration_row @ w > 0 else FREE), 0, 0, 0])
+        initial = tuple(element.initial_mode(w) for element in self.model.pieces)
+        progress = np.array([0, ops.mode_id(initial), 0, 0, 0])
         clock = np.zeros(2)
         while True:
             status = run_events(
                 ops.taylor, ops.one_step, ops.anchors, ops.readout, ops.exit_counts, ops.directions, ops.next_modes,
-                ops.rock_rows, ops.impact_rows, ops.key_of, self.phase_times, phase_ids, pulse, self.step_s,
-                PER_ANCHOR, self.per_sample, self.min_switch_interval_s, self.max_switches, layout.n, layout.bit,
-                layout.bottom, MODES.index(CRUSHING), self.rock.crushing_penetration_m if self.rock.crushes else 0.0,
-                POSITION_LIMIT_M, progress, clock, w, time_s, rows, switch_times, switch_modes)
+                ops.rock_rows, ops.impact_rows, ops.key_of, self.phase_times, phase_ids, pulse, ops.reset_counts,
+                ops.reset_targets, ops.reset_rows, self.model.pieces[0].monotone, self.step_s, PER_ANCHOR,
+                self.per_sample, self.min_switch_interval_s, self.max_switches, n, POSITION_LIMIT_M, progress, clock,
+                w, time_s, rows, switch_times, switch_modes)
             if status != MISSING_KEY:
                 break
-            ops.add((MODES[progress[1]], self.phases[progress[0]]))
+            ops.add(ops.modes[progress[1]], self.phases[progress[0]])
         filled, switches = progress[2], progress[3]
         time_s, rows, switch_times = time_s[:filled], rows[:filled], switch_times[:switches]
         if status == TOO_MANY_SWITCHES:
             raise SimulationFailed(
-                f"scene '{self.scene.name}': exact solver exceeded {self.max_switches} rock-law switches "
-                f"at t = {switch_times[-1]:.6g} s (chattering contact); raise max_switches_per_blow or check the scene"
-            )
+                f"scene '{simulation.name}': exact solver exceeded {self.max_switches} switches "
+                f"at t = {switch_times[-1]:.6g} s (chattering contact); raise solver.max_switches_per_blow "
+                f"or check the scene")
         if status == DIVERGED:
-            first = diverged_index(rows[:, :layout.n], rows[:, layout.n:2 * layout.n])
-            raise SimulationFailed(f"scene '{self.scene.name}': exact solution diverged at "
+            first = diverged_index(rows[:, :n], rows[:, n:2 * n])
+            raise SimulationFailed(f"scene '{simulation.name}': exact solution diverged at "
                                    f"t = {time_s[-1 if first is None else first]:.6g} s (an unstable chain?)")
-        return time_s, rows, switch_times, switch_modes[:switches]
+        return time_s, rows, switch_times, [ops.modes[m] for m in switch_modes[:switches]]
 
 
-def simulate_exact(scene: Scene, sample_interval_s: float | None = None, min_switch_interval_s: float = 1e-12,
-                   max_switches_per_blow: int = 1000) -> SimulationResult:
-    """Exact solution of ``scene`` from its start to ``scene.solver.end_time_s`` (formulation "exact").
+def _switch_counts(model: Model, before: Modes, entered: list[Modes]) -> dict[str, int]:
+    """How often each element mode was entered (``mode`` for the rock, ``link:mode`` for a link)."""
+    counts: dict[str, int] = {}
+    for modes in entered:
+        for index, (old, new) in enumerate(zip(before, modes, strict=True)):
+            if old != new:
+                key = new if index == 0 else f"{model.pieces[index].name}:{new}"
+                counts[key] = counts.get(key, 0) + 1
+        before = modes
+    return counts
 
-    Samples: a uniform grid of ``sample_interval_s`` (default ``scene.solver.output_interval_s``, at most
-    ENERGY_SAMPLE_S when energy outputs are asked for) plus both sides of every rock-law switch and pulse
-    switch (repeated times, the rock and piston forces of each side). ``min_switch_interval_s`` and
-    ``max_switches_per_blow``: module doc. ValueError for a scene outside its scope
-    (models.exact_scope: another rock law than Jenkins, a nonlinear connector).
+
+def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
+    """Exact solution of the simulation from its start to its end time (formulation "exact").
+
+    Samples: a uniform grid of the settings' ``sample_interval_s`` (models.solver_settings) plus both
+    sides of every switch and pulse switch (repeated times, the rock and piston forces of each side).
+    ``min_switch_interval_s`` and ``max_switches_per_blow``: module doc. ``progress(t)`` is called once,
+    at the end (a run takes milliseconds).
     """
-    why = exact_unsupported(scene)
-    if why:
-        raise ValueError(f"scene '{scene.name}': the exact formulation cannot run {why}; use exudyn or ode")
+    simulation = as_simulation(run)
     start = time.process_time()
-    if sample_interval_s is None:  # energies are integrated by quadrature over the samples
-        energy = "energy" in scene.needed_data()
-        sample_interval_s = min(scene.solver.output_interval_s, ENERGY_SAMPLE_S) if energy else \
-            scene.solver.output_interval_s
-    solver = ExactSolver(scene, sample_interval_s, min_switch_interval_s, max_switches_per_blow)
-    time_s, rows, switch_times, switch_modes = solver.run()
+    with BLAS.limit(limits=1, user_api="blas"):
+        solver = ExactSolver(simulation)
+        time_s, rows, switch_times, entered = solver.run()
     layout = solver.layout
-    n, angle = layout.n, layout.angle
+    n, angle, states = layout.n, layout.angle, slice(2 * layout.n, 2 * layout.n + layout.rock_states)
     cpu = time.process_time() - start
-    entered = np.bincount(switch_modes, minlength=len(MODES))
+    if progress is not None:
+        progress(simulation.settings.end_time_s)
+    initial = tuple(element.initial_mode(rows[0, :layout.size]) for element in solver.model.pieces)
     return SimulationResult(
-        scene=scene,
-        chain=solver.chain,
+        simulation=simulation,
         formulation="exact",
         time_s=time_s,
         position_m=rows[:, :n],
         velocity_m_per_s=rows[:, n:2 * n],
-        bottom_m=rows[:, layout.bottom],
+        bottom_m=rows[:, states][:, simulation.rock.bottom_index],
+        rock_state_m=rows[:, states],
         rock_force_n=rows[:, layout.size],
         impact_force_n=rows[:, layout.size + 1],
         torsion_angle_rad=rows[:, angle] if layout.torsion else None,
@@ -439,9 +368,10 @@ def simulate_exact(scene: Scene, sample_interval_s: float | None = None, min_swi
             "sample_interval_s": solver.step_s * solver.per_sample,
             "samples": len(time_s),
             "mode_switches": len(switch_times),
-            "switches_into": {mode: int(count) for mode, count in zip(MODES, entered) if count},
+            "switches_into": _switch_counts(solver.model, initial, entered),
             "switch_times_s": switch_times,
-            "switch_modes": [MODES[m] for m in switch_modes],  # the mode entered at each switch time
-            "min_switch_interval_s": min_switch_interval_s,
+            "switch_modes": entered,  # the modes entered at each switch time
+            "operator_keys": solver.operators.built,
+            "min_switch_interval_s": solver.min_switch_interval_s,
         },
     )

@@ -32,10 +32,13 @@ from exudyn.itemInterface import (
     SensorNode,
     SensorObject,
 )
-from rpdrill.models.chain import AxialChain, Link, axial_chain, initial_positions_m, initial_torsion_angle_rad
+
+from rpdrill.models.chain import AxialChain, Link
+from rpdrill.models.formulations import AUTOMATIC_STEP_SOLVERS
 from rpdrill.models.pulse import impact_force
 from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import AUTOMATIC_STEP_SOLVERS, Scene
+from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import Simulation, as_simulation
 from rpdrill.models.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
 from rpdrill.rocklaw.backends import SCALAR, SymbolicBackend
 from rpdrill.rocklaw.exudyn_element import ExudynRockContact, attach_user_function
@@ -58,7 +61,7 @@ RATE = exu.OutputVariableType.Coordinates_t
 class ExudynDrill:
     """A built, assembled system and the handles needed to run and read it."""
 
-    scene: Scene
+    simulation: Simulation
     chain: AxialChain
     system_container: Any
     mbs: Any
@@ -82,8 +85,8 @@ def _store(mbs: Any, sensor: Any) -> Any:
     return mbs.AddSensor(sensor)
 
 
-def _simulation_settings(scene: Scene) -> Any:
-    solver = scene.solver
+def _simulation_settings(simulation: Simulation) -> Any:
+    solver = simulation.settings
     settings = exu.SimulationSettings()
     integration = settings.timeIntegration
     integration.endTime = solver.end_time_s
@@ -102,7 +105,7 @@ def _simulation_settings(scene: Scene) -> Any:
     settings.show.statistics = False
     settings.solution.file.write = False
     # energies are integrated over every step; otherwise store only at the output interval
-    settings.solution.sensors.writePeriod = 0.0 if "energy" in scene.needed_data() else solver.output_interval_s
+    settings.solution.sensors.writePeriod = 0.0 if "energy" in simulation.needed_data else solver.output_interval_s
     return settings
 
 
@@ -113,20 +116,20 @@ def _link_force_function(link: Link, backend: Any) -> Callable[..., Any]:
     return link_force
 
 
-def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
-    """Build and assemble the Exudyn system of ``scene``.
+def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
+    """Build and assemble the Exudyn system of a prepared simulation.
 
     ``symbolic=False`` uses Python callbacks for the impact and rock forces (same law, slower:
     kept for the benchmark that measures what the symbolic functions save).
     """
-    chain = axial_chain(scene)
+    chain, impact = simulation.chain, simulation.impact
     container = exu.SystemContainer()
     mbs = container.AddSystem()
     ground = mbs.AddNode(NodePointGround())
     ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
 
     nodes, markers = [], []
-    for body, initial in zip(chain.bodies, initial_positions_m(scene), strict=True):
+    for body, initial in zip(chain.bodies, simulation.initial_positions_m, strict=True):
         node, marker = _add_coordinate_body(
             mbs, lambda n, m=body.mass_kg: mbs.AddObject(ObjectMass1D(nodeNumber=n, mass=m)), initial)
         nodes.append(node)
@@ -151,27 +154,26 @@ def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
     impact_load = mbs.AddLoad(LoadCoordinate(markerNumber=markers[chain.impact_body], load=0.0))
 
     def piston_force(mbs, t, load):
-        return impact_force(scene.impact, t, backend)
+        return impact_force(impact, t, backend)
 
     impact_function = attach_user_function(mbs, impact_load, "loadUserFunction", piston_force, symbolic)
-    rock = ExudynRockContact(
-        mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], scene.rock_law(), symbolic=symbolic
-    )
+    rock = ExudynRockContact(mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], simulation.rock,
+                             symbolic=symbolic, initial_state=simulation.initial_rock_state)
 
     sensors: dict[str, Any] = {}
     for i, node in enumerate(nodes):
         sensors[f"x{i}"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=COORDINATE))
         sensors[f"v{i}"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=RATE))
-    if "forces" in scene.needed_data():
+    if "forces" in simulation.needed_data:
         sensors["rock"] = _store(mbs, SensorObject(objectNumber=rock.object, storeInternal=True,
                                                    outputVariableType=exu.OutputVariableType.Force))
         sensors["impact"] = _store(mbs, SensorLoad(loadNumber=impact_load, storeInternal=True))
 
-    if scene.effects.torsion:
-        tor = scene.torsion
+    tor = simulation.torsion
+    if tor is not None:
         node, marker = _add_coordinate_body(
             mbs, lambda n: mbs.AddObject(ObjectRotationalMass1D(nodeNumber=n, inertia=tor.inertia_kg_m2)),
-            initial_torsion_angle_rad(scene),
+            simulation.initial_torsion_angle_rad,
         )
         mbs.AddObject(
             ObjectConnectorCoordinateSpringDamper(
@@ -185,7 +187,7 @@ def build_exudyn(scene: Scene, symbolic: bool = True) -> ExudynDrill:
         sensors["omega"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=RATE))
 
     mbs.Assemble()
-    return ExudynDrill(scene, chain, container, mbs, rock, sensors, _simulation_settings(scene),
+    return ExudynDrill(simulation, chain, container, mbs, rock, sensors, _simulation_settings(simulation),
                        [impact_function, *user_functions])
 
 
@@ -230,27 +232,28 @@ def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
     return mbs.GetSensorStoredData(sensor)
 
 
-def simulate_exudyn(
-    scene: Scene, progress: Callable[[float], None] | None = None, symbolic: bool = True
-) -> SimulationResult:
+def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None,
+             symbolic: bool = True) -> SimulationResult:
     """Build and run the Exudyn model; ``progress(t)`` is called about 100 times during the run."""
-    warning = step_warning(scene)
+    simulation = as_simulation(run)
+    settings = simulation.settings
+    warning = step_warning(simulation)
     if warning:
         warnings.warn(warning, StepLimitWarning, stacklevel=2)
-    drill = build_exudyn(scene, symbolic)
+    drill = build_exudyn(simulation, symbolic)
     mbs = drill.mbs
     actions = [drill.rock.update_bottom] if drill.rock.rock.crushes else []
     guard = None
-    if scene.solver.type in AUTOMATIC_STEP_SOLVERS:
+    if settings.type in AUTOMATIC_STEP_SOLVERS:
         guard = _MinimumStepGuard(drill.settings.timeIntegration.minimumStepSize)
         actions.append(guard)
     if progress is not None:
-        actions.append(_progress_reporter(scene.solver.end_time_s, progress))
+        actions.append(_progress_reporter(settings.end_time_s, progress))
     pre_step = _pre_step(actions)
     if pre_step is not None:
         mbs.SetPreStepUserFunction(pre_step)
     start = time.process_time()
-    ok = mbs.SolveDynamic(drill.settings, solverType=SOLVER_TYPES[scene.solver.type])
+    ok = mbs.SolveDynamic(drill.settings, solverType=SOLVER_TYPES[settings.type])
     cpu = time.process_time() - start
     reached_s = mbs.systemData.GetTime()
     data = {name: _sensor(mbs, sensor) for name, sensor in drill.sensors.items()}
@@ -261,8 +264,7 @@ def simulate_exudyn(
     history = np.array(drill.rock.bottom_history)
     rock_state = drill.rock.state_at(time_s)
     result = SimulationResult(
-        scene=scene,
-        chain=drill.chain,
+        simulation=simulation,
         formulation="exudyn",
         time_s=time_s,
         position_m=position,
@@ -279,9 +281,9 @@ def simulate_exudyn(
     )
     if guard is not None and guard.reached_at_s is not None:
         raise SimulationFailed(
-            f"scene '{scene.name}': solver {scene.solver.type} with relative_tolerance "
-            f"{scene.solver.relative_tolerance:g} reached the minimum step "
+            f"scene '{simulation.name}': solver {settings.type} with relative_tolerance "
+            f"{settings.relative_tolerance:g} reached the minimum step "
             f"{guard.minimum_step_s:g} s at t = {guard.reached_at_s:.6g} s; try relative_tolerance "
-            f"{scene.solver.relative_tolerance * 100:g} or a fixed-step preset (solver: {{preset: standard}})")
+            f"{settings.relative_tolerance * 100:g} or a fixed-step preset (solver: {{preset: standard}})")
     check_result(result, solver_ok=bool(ok), reached_s=reached_s)
     return result

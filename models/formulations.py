@@ -1,33 +1,70 @@
-"""The three formulations of the same model, by name.
+"""The formulations of the same model, by name: one registry that every command dispatches through.
 
-``exudyn``: the multibody model (default, any chain the builder makes). ``ode``: the paper's Eq. 4
-as an event-located SciPy ODE (independent cross-check). ``exact``: the piecewise-linear model
-propagated by matrix exponentials between located switches (the reference and the fast path for
-large sweeps; only for laws linear between switches, as the paper's).
+``exudyn``: the multibody model (default). ``ode``: the paper's Eq. 4 as an event-located SciPy
+ODE (independent cross-check). ``exact``: the piecewise-linear model propagated by matrix
+exponentials between located switches (the reference and the fast path for large sweeps).
+
+A scene chooses one in ``solver.formulation`` and gives its options next to it (the keys listed
+here; a key of another formulation is an error). Each implementation module is imported on first
+use (the exact and ODE formulations never import Exudyn) and provides ``simulate(simulation,
+progress=None)`` (``progress(t)`` is called as simulated time advances) and, if it cannot run every
+scene, ``unsupported(simulation) -> str | None``.
 """
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable
+from dataclasses import dataclass
+from types import ModuleType
+from typing import TYPE_CHECKING
 
-from rpdrill.models.exact_model import simulate_exact
-from rpdrill.models.exact_scope import exact_unsupported
-from rpdrill.models.exudyn_model import simulate_exudyn
-from rpdrill.models.ode_model import simulate_ode
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Scene
+if TYPE_CHECKING:
+    from rpdrill.models.results import SimulationResult
+    from rpdrill.models.simulation import Simulation
 
-FORMULATIONS: dict[str, Callable[[Scene], SimulationResult]] = {
-    "exudyn": simulate_exudyn,
-    "exact": simulate_exact,
-    "ode": simulate_ode,
-}
-
-# Why a formulation cannot run a scene (None: it can); formulations not listed run every scene.
-LIMITS: dict[str, Callable[[Scene], str | None]] = {"exact": exact_unsupported}
+# accuracy tiers that every formulation resolves into its own settings (models.solver_settings)
+PRESETS = ("fast", "standard", "reference")
+DEFAULT_PRESET = "standard"
+EXUDYN_SOLVERS = ("rk44", "rk33", "explicit_midpoint", "explicit_euler", "generalized_alpha",
+                  "trapezoidal_index2", "dopri5", "ode23")
+AUTOMATIC_STEP_SOLVERS = ("dopri5", "ode23")
+ODE_METHODS = ("DOP853", "Radau", "LSODA")
 
 
-def unsupported(formulation: str, scene: Scene) -> str | None:
-    """Why ``formulation`` cannot run ``scene``, or None."""
-    limit = LIMITS.get(formulation)
-    return limit(scene) if limit else None
+@dataclass(frozen=True)
+class Formulation:
+    """A formulation: its implementation module and the ``solver`` keys it takes."""
+
+    name: str
+    module: str
+    option_keys: tuple[str, ...]
+    summary: str
+
+    def implementation(self) -> ModuleType:
+        return importlib.import_module(self.module)
+
+
+FORMULATIONS: dict[str, Formulation] = {f.name: f for f in (
+    Formulation("exudyn", "rpdrill.models.exudyn_model",
+                ("type", "step_s", "spectral_radius", "relative_tolerance", "absolute_tolerance"),
+                "the Exudyn multibody model"),
+    Formulation("exact", "rpdrill.models.exact_model",
+                ("sample_interval_s", "min_switch_interval_s", "max_switches_per_blow"),
+                "exact piecewise-linear propagation between located switches"),
+    Formulation("ode", "rpdrill.models.ode_model",
+                ("method", "relative_tolerance", "absolute_tolerance", "sample_interval_s"),
+                "the paper's Eq. 4 as an event-located SciPy ODE"),
+)}
+COMMON_SOLVER_KEYS = ("formulation", "preset", "end_time_s", "output_interval_s")
+
+
+def simulate(simulation: Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
+    """Run a prepared simulation with the formulation its scene names."""
+    return FORMULATIONS[simulation.settings.formulation].implementation().simulate(simulation, progress)
+
+
+def unsupported(name: str, simulation: Simulation) -> str | None:
+    """Why formulation ``name`` cannot run ``simulation``, or None if it can."""
+    check = getattr(FORMULATIONS[name].implementation(), "unsupported", None)
+    return check(simulation) if check else None

@@ -5,21 +5,26 @@ the stretch rate. Its force F > 0 pulls the two bodies together (on body_b it ac
 Each law is written once against the backends of :mod:`rocklaw.backends`: the Exudyn builder
 records it as a symbolic spring-force function, the ODE formulation and the energy account
 evaluate it with NumPy. A ``linear`` law is assembled into the matrices K and C instead; a
-nonlinear one lists its ``kinks`` (functions of delta whose zero crossings are where the law
-changes branch), at which the ODE formulation restarts its integrator.
+nonlinear one that is linear between switches declares its modes once (:mod:`rocklaw.modes`,
+local variables ``stretch``, ``rate`` and ``one``), from which the ODE formulation takes its
+events and the exact formulation its matrices and exit rows.
 
-A new connector type is a subclass with its own ``spring_force_n``, ``force_n`` and ``kinks``,
-registered in :data:`LINK_TYPES` (docs/extending.md); its extra dataclass fields are the
-parameters a scene's connector may give.
+A new connector type is a subclass with its own ``spring_force_n``, ``force_n``, ``modes`` and
+``initial_mode``, registered in :data:`LINK_TYPES` (docs/extending.md); its extra dataclass
+fields are the parameters a scene's connector may give.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
 from rpdrill.rocklaw.backends import NUMERIC, Backend
+from rpdrill.rocklaw.modes import ONE, Mode, ModeTable, Switch
+
+STRETCH, RATE = "stretch", "rate"  # a link's local variables in its mode table
+BONDED, OPEN, CLOSED, CLIPPED = "bonded", "open", "closed", "clipped"
 
 
 @dataclass(frozen=True)
@@ -45,8 +50,12 @@ class Link:
     def force_n(self, stretch_m: Any, rate_m_per_s: Any, backend: Backend = NUMERIC) -> Any:
         return self.stiffness_n_per_m * stretch_m + self.damping_n_s_per_m * rate_m_per_s
 
-    def kinks(self) -> tuple[Callable[[float], float], ...]:
-        return ()
+    def modes(self) -> ModeTable:
+        """One mode: F = k delta + c delta'."""
+        return {BONDED: Mode({STRETCH: self.stiffness_n_per_m, RATE: self.damping_n_s_per_m}, ())}
+
+    def initial_mode(self, values: Mapping[str, float]) -> str:
+        return BONDED
 
     @classmethod
     def parameters(cls) -> tuple[str, ...]:
@@ -72,8 +81,24 @@ class Coupling(Link):
         total = backend.minimum(self.stiffness_n_per_m * closure + self.damping_n_s_per_m * rate_m_per_s, 0.0)
         return backend.where(closure < 0, total, 0.0)
 
-    def kinks(self) -> tuple[Callable[[float], float], ...]:
-        return (lambda stretch_m: stretch_m + self.gap_m,)
+    def modes(self) -> ModeTable:
+        """open (F = 0) until the closure delta + g falls through 0; closed, F = k (delta + g) + c delta',
+        until it rises through 0 again or F rises through 0 (the damper would pull: clipped, F = 0)."""
+        k, c = self.stiffness_n_per_m, self.damping_n_s_per_m
+        closure = {STRETCH: 1.0, ONE: self.gap_m}
+        total = {STRETCH: k, RATE: c, ONE: k * self.gap_m}
+        closed_exits = [Switch(closure, 1, OPEN)] + ([Switch(total, 1, CLIPPED)] if c > 0 else [])
+        table = {OPEN: Mode({}, (Switch(closure, -1, CLOSED),)), CLOSED: Mode(total, tuple(closed_exits))}
+        if c > 0:
+            table[CLIPPED] = Mode({}, (Switch(total, -1, CLOSED), Switch(closure, 1, OPEN)))
+        return table
+
+    def initial_mode(self, values: Mapping[str, float]) -> str:
+        closure = values[STRETCH] + self.gap_m
+        if closure >= 0:
+            return OPEN
+        total = self.stiffness_n_per_m * closure + self.damping_n_s_per_m * values[RATE]
+        return CLIPPED if self.damping_n_s_per_m > 0 and total >= 0 else CLOSED
 
 
 LINK_TYPES: dict[str, type[Link]] = {"spring_damper": Link, "coupling": Coupling}

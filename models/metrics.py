@@ -13,9 +13,10 @@ from collections.abc import Callable
 from functools import cached_property
 
 import numpy as np
+from scipy.integrate import trapezoid
+
 from rpdrill.models.energy import EnergyAccount, energy_account
 from rpdrill.models.results import SimulationResult
-from scipy.integrate import trapezoid
 
 
 class _Window:
@@ -95,4 +96,4 @@ METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
 def summary_metrics(result: SimulationResult, energy: EnergyAccount | None = None) -> dict[str, float]:
     """The metrics the scene's outputs ask for (SI units in the keys), in their order."""
     window = _Window(result, energy)
-    return {name: METRIC_FUNCTIONS[name](window) for name in result.scene.outputs.metrics}
+    return {name: METRIC_FUNCTIONS[name](window) for name in result.simulation.outputs.metrics}

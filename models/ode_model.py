@@ -1,21 +1,22 @@
-"""The paper's Eq. 4 as a plain ODE with event-located rock-law switches (no Exudyn).
+"""The paper's Eq. 4 as a plain ODE with event-located switches (no Exudyn).
 
-State y = [x (n bodies), v (n bodies), rock law states (, phi, omega)] of
-:func:`models.chain.axial_chain` and the scene's rock law as built (``Scene.rock_law``, a
-:class:`rocklaw.base.RockLaw`):
+State y = [x (n bodies), v (n bodies), rock law states (, phi, omega)] of the prepared
+simulation's chain and rock law:
 
-    M x'' + C x' + K x = F_feed + F_d(t) e_shank - F_rock e_bit          (Eq. 4, axial lines)
-                         + sum over nonlinear links of F_link (e_a - e_b)   (couplings, models.links)
-    state' = law.state_rate(mode, x_bit')                   (Jenkins: Eq. 2, x_n' = x_bit' while crushing)
-    J phi'' + c_x phi' + k_x phi = M_x - M_c             (Eq. 4, torsion line, if its effect is on)
+    (x, v)' = A (x, v, 1) + (F_d(t) e_shank / m_shank) - F_rock e_bit / m_bit
+              + sum over nonlinear links of F_link (e_a - e_b) / m     (couplings, models.links)
+    state' = rates of the rock law's mode             (Jenkins: Eq. 2, x_n' = x_bit' while crushing)
+    (phi, omega)' = T (phi, omega, 1)                 (Eq. 4, torsion line, if its effect is on)
 
-F_rock is the law's ``force`` at (x_bit, x_bit', state) (Jenkins: Eq. 1 at d = x_bit - x_n).
-The law is piecewise; the integration never steps over a branch change. Each piece runs in one
-rock mode of the law's mode table (rocklaw.jenkins, rocklaw.bilinear) and stops at the first
-zero crossing of one of the mode's ``transitions``, then restarts in the next mode from the
-law's ``enter`` state. The piston pulse's on/off times (:func:`models.pulse.pulse_switch_times`)
-are breakpoints: the run is integrated segment by segment between them, and the pulse is
-evaluated on the segment's own side of each switch.
+with A the chain's first-order matrix (models.chain: x' = v, M v' = -K x - C v + F_feed over the
+linear links) and T its torsion matrix. F_rock is the law's closed-form ``force`` at (x_bit,
+x_bit', state) (Jenkins: Eq. 1 at d = x_bit - x_n), each nonlinear link's force its closed form.
+The laws are piecewise; the integration never steps over a switch. Each piece runs in one mode of
+every piecewise element (models.piecewise: the rock law and the nonlinear links, whose mode tables
+are the laws' own declarations) and stops at the first zero crossing of one of the current modes'
+exits; the next piece starts in the element's next mode from its entry state. The piston pulse's
+switch times (models.pulse.switch_times) are breakpoints: the run is integrated segment by segment
+between them, and the pulse is evaluated on the segment's own side of each switch.
 """
 
 from __future__ import annotations
@@ -26,117 +27,84 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from rpdrill.models.chain import (
-    AxialChain,
-    axial_chain,
-    initial_positions_m,
-    initial_torsion_angle_rad,
-    link_load_n,
-)
-from rpdrill.models.links import Link
-from rpdrill.models.pulse import impact_force, pulse_switch_times
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Impact, Scene
-from rpdrill.models.stability import SimulationFailed, diverged_index
-from rpdrill.rocklaw.backends import NUMERIC
-from rpdrill.rocklaw.base import EventFunction as RockEvent
-from rpdrill.rocklaw.base import RockLaw
 from scipy.integrate import solve_ivp
 
-ODE_METHODS = ("DOP853", "Radau", "LSODA")
-# Mode switches at one instant beyond this mean the law chatters: report instead of looping.
+from rpdrill.models.chain import link_load_n, torsion_first_order_matrix
+from rpdrill.models.piecewise import Element, elements
+from rpdrill.models.pulse import impact_force, switch_times
+from rpdrill.models.results import SimulationResult
+from rpdrill.models.scene import Impact
+from rpdrill.models.simulation import Scene, Simulation, as_simulation
+from rpdrill.models.stability import SimulationFailed, diverged_index
+from rpdrill.rocklaw.backends import NUMERIC
+
+# Mode switches at one instant beyond this mean a law chatters: report instead of looping.
 MAX_SWITCHES_AT_ONE_TIME = 20
 EventFunction = Callable[[float, np.ndarray], float]
+Modes = tuple[str, ...]  # the mode of every piecewise element
 
 
 @dataclass(frozen=True)
 class _System:
-    """Eq. 4 in first-order form, pre-multiplied by M^-1; ``n`` axial bodies, state layout in the module doc."""
+    """Eq. 4 in first-order form (module doc) with its piecewise elements."""
 
-    scene: Scene
-    chain: AxialChain
-    rock: RockLaw
-    stiffness_per_mass: np.ndarray  # M^-1 K [1/s^2]
-    damping_per_mass: np.ndarray  # M^-1 C [1/s]
-    feed_per_mass: np.ndarray  # M^-1 F_feed [m/s^2]
-    torsion: tuple[float, float, float] | None  # ((M_x - M_c)/J, k_x/J, c_x/J)
-    n: int  # axial bodies; the state is [x (n), v (n), rock states (, phi, omega)]
+    simulation: Simulation
+    linear: np.ndarray  # A of (x, v)' = A (x, v, 1)
+    torsion: np.ndarray | None  # T of (phi, omega)' = T (phi, omega, 1)
+    pieces: tuple[Element, ...]  # the rock first, then the nonlinear links
+    n: int
     bit: int
     impact: int
-    bit_mass_kg: float
-    impact_mass_kg: float
-    inverse_masses: np.ndarray  # 1 / m of every body [1/kg]
-    nonlinear_links: tuple[Link, ...]  # not in K and C: their forces are evaluated in the rhs
+    masses_kg: np.ndarray
 
     @property
     def rock_states(self) -> slice:
         """Where the rock law's states sit in y."""
-        return slice(2 * self.n, 2 * self.n + len(self.rock.state_names))
-
-    @property
-    def kink_event_count(self) -> int:
-        """Kink events at the end of every :meth:`transitions` list (two per kink)."""
-        return 2 * sum(len(link.kinks()) for link in self.nonlinear_links)
+        return slice(2 * self.n, 2 * self.n + len(self.simulation.rock.state_names))
 
     @property
     def state_size(self) -> int:
-        return self.rock_states.stop + (2 if self.torsion else 0)
-
-    def bit_position(self, y: np.ndarray) -> np.ndarray:
-        return y[self.bit]
-
-    def bit_velocity(self, y: np.ndarray) -> np.ndarray:
-        return y[self.n + self.bit]
+        return self.rock_states.stop + (2 if self.torsion is not None else 0)
 
     def rock_force_n(self, y: np.ndarray) -> np.ndarray:
-        return self.rock.force(self.bit_position(y), self.bit_velocity(y), y[self.rock_states], NUMERIC)
+        return self.simulation.rock.force(y[self.bit], y[self.n + self.bit], y[self.rock_states], NUMERIC)
 
-    def rhs(self, t_s: float, y: np.ndarray, pulse_n: _SegmentPulse, mode: str) -> np.ndarray:
+    def rhs(self, t_s: float, y: np.ndarray, pulse_n: _SegmentPulse, modes: Modes) -> np.ndarray:
         n = self.n
         x, v = y[:n], y[n:2 * n]
-        dy = np.empty_like(y)
-        dy[:n] = v
-        acceleration = self.feed_per_mass - self.stiffness_per_mass @ x - self.damping_per_mass @ v
-        acceleration[self.impact] += pulse_n(t_s) / self.impact_mass_kg
-        acceleration[self.bit] -= self.rock_force_n(y) / self.bit_mass_kg
-        if self.nonlinear_links:
-            acceleration += link_load_n(self.chain, x, v, self.nonlinear_links) * self.inverse_masses
-        dy[n:2 * n] = acceleration
-        dy[self.rock_states] = self.rock.state_rate(mode, v[self.bit])
-        if self.torsion:
-            torque, stiffness, damping = self.torsion
-            dy[-2] = y[-1]
-            dy[-1] = torque - stiffness * y[-2] - damping * y[-1]
+        dy = np.zeros_like(y)
+        dy[:2 * n] = self.linear[:, :-1] @ y[:2 * n] + self.linear[:, -1]
+        acceleration = dy[n:2 * n]
+        acceleration[self.impact] += pulse_n(t_s) / self.masses_kg[self.impact]
+        acceleration[self.bit] -= self.rock_force_n(y) / self.masses_kg[self.bit]
+        if len(self.pieces) > 1:
+            acceleration += link_load_n(self.simulation.chain, x, v, self.simulation.chain.nonlinear_links()) \
+                / self.masses_kg
+        rock = self.pieces[0]
+        for state, affine in rock.table[modes[0]].rates.items():
+            row, constant = rock.row(affine)
+            dy[rock.states[state]] = row @ y + constant
+        if self.torsion is not None:
+            dy[-2:] = self.torsion[:, :2] @ y[-2:] + self.torsion[:, 2]
         return dy
 
-    def transitions(self, mode: str) -> list[tuple[EventFunction, int, str]]:
-        """(event function of (t, y), crossing direction, next mode) leaving ``mode`` (the law's table),
-        and the kinks of the nonlinear links in both directions (the piece ends, the mode stays)."""
-        rock = [(_strict(self._on_state(function), direction), direction, following)
-                for function, direction, following in self.rock.transitions(mode)]
-        kinks = [(_strict(_on_stretch(link, kink), direction), direction, mode)
-                 for link in self.nonlinear_links for kink in link.kinks() for direction in (1, -1)]
-        return rock + kinks
-
-    def _on_state(self, function: RockEvent) -> EventFunction:
-        def event(t_s: float, y: np.ndarray) -> float:
-            return function(self.bit_position(y), self.bit_velocity(y), y[self.rock_states])
-        return event
-
-    def initial_mode(self, y: np.ndarray) -> str:
-        return self.rock.initial_mode(self.bit_position(y), self.bit_velocity(y), y[self.rock_states])
-
-    def enter(self, mode: str, y: np.ndarray) -> np.ndarray:
-        """State at the start of a piece in ``mode``: the law's ``enter`` (Jenkins: crushing starts from
-        the return map of Eq. 2, removing the event location's round-off in d)."""
-        y = y.copy()
-        y[self.rock_states] = self.rock.enter(mode, float(self.bit_position(y)), tuple(y[self.rock_states]))
-        return y
+    def transitions(self, modes: Modes) -> list[tuple[EventFunction, int, int, str]]:
+        """(event function of (t, y), direction, element index, next mode) of every exit of the current modes."""
+        events = []
+        for index, (element, mode) in enumerate(zip(self.pieces, modes, strict=True)):
+            for switch in element.table[mode].exits:
+                row, constant = element.row(switch.surface)
+                events.append((_strict(_affine(row, constant), switch.direction), switch.direction, index,
+                               switch.next_mode))
+        return events
 
 
-def _on_stretch(link: Link, kink: Callable[[float], float]) -> EventFunction:
+def _affine(row: np.ndarray, constant: float) -> EventFunction:
+    nonzero = np.flatnonzero(row)
+    weights = row[nonzero]
+
     def event(t_s: float, y: np.ndarray) -> float:
-        return kink(link.stretch(y))
+        return float(weights @ y[nonzero]) + constant
     return event
 
 
@@ -156,29 +124,20 @@ def _strict(function: EventFunction, direction: int) -> EventFunction:
     return event
 
 
-def _system(scene: Scene) -> _System:
-    chain = axial_chain(scene)
-    inverse_mass = np.linalg.inv(chain.mass_matrix())
-    tor = scene.torsion
-    torsion = None
-    if scene.effects.torsion:
-        torsion = ((tor.drive_torque_n_m - tor.resisting_torque_n_m) / tor.inertia_kg_m2,
-                   tor.stiffness_n_m_per_rad / tor.inertia_kg_m2, tor.damping_n_m_s_per_rad / tor.inertia_kg_m2)
+def _system(simulation: Simulation) -> _System:
+    chain = simulation.chain
+    n = chain.size
+    size = 2 * n + len(simulation.rock.state_names)
+    torsion = simulation.torsion
     return _System(
-        scene=scene,
-        chain=chain,
-        rock=scene.rock_law(),
-        stiffness_per_mass=inverse_mass @ chain.stiffness_matrix(linear_only=True),
-        damping_per_mass=inverse_mass @ chain.damping_matrix(linear_only=True),
-        feed_per_mass=inverse_mass @ chain.constant_forces(),
-        torsion=torsion,
-        n=chain.size,
+        simulation=simulation,
+        linear=chain.first_order_matrix(),
+        torsion=None if torsion is None else torsion_first_order_matrix(torsion),
+        pieces=elements(chain, simulation.rock, size + (2 if torsion is not None else 0)),
+        n=n,
         bit=chain.bit_body,
         impact=chain.impact_body,
-        bit_mass_kg=chain.bodies[chain.bit_body].mass_kg,
-        impact_mass_kg=chain.bodies[chain.impact_body].mass_kg,
-        inverse_masses=np.diag(inverse_mass).copy(),
-        nonlinear_links=chain.nonlinear_links(),
+        masses_kg=np.array([b.mass_kg for b in chain.bodies]),
     )
 
 
@@ -209,12 +168,6 @@ class _SegmentPulse:
         return np.asarray(impact_force(self.impact, local, NUMERIC)) + np.zeros_like(local)
 
 
-def _breakpoints(scene: Scene) -> np.ndarray:
-    end = scene.solver.end_time_s
-    times = np.unique([0.0, *pulse_switch_times(scene.impact, end), end])
-    return times[(times >= 0.0) & (times <= end)]
-
-
 @dataclass
 class _Record:
     """Samples of all pieces (restart points not duplicated) and solver counts."""
@@ -243,80 +196,72 @@ def _refined(steps_s: np.ndarray, interval_s: float) -> np.ndarray:
     return np.append(steps_s[step] + h[step] * j / parts[step], steps_s[-1])
 
 
-def _fail(scene: Scene, method: str, t_s: float, why: str) -> SimulationFailed:
+def _fail(simulation: Simulation, t_s: float, why: str) -> SimulationFailed:
     return SimulationFailed(
-        f"scene '{scene.name}': ODE solver {method} {why} at t = {t_s:.6g} s; "
-        f"try another method (Radau for stiff chains) or a looser rtol"
+        f"scene '{simulation.name}': ODE solver {simulation.settings.method} {why} at t = {t_s:.6g} s; "
+        f"try another method (Radau for stiff chains) or a looser relative_tolerance"
     )
 
 
-def _integrate_segment(system: _System, record: _Record, y: np.ndarray, mode: str, span: tuple[float, float],
-                       pulse_n: _SegmentPulse, method: str, rtol: float, atol: float,
-                       sample_interval_s: float) -> tuple[np.ndarray, str]:
-    """Integrate one pulse segment piece by piece across rock-mode switches; (end state, end mode)."""
+def _integrate_segment(system: _System, record: _Record, y: np.ndarray, modes: Modes, span: tuple[float, float],
+                       pulse_n: _SegmentPulse) -> tuple[np.ndarray, Modes]:
+    """Integrate one pulse segment piece by piece across mode switches; (end state, end modes)."""
+    settings = system.simulation.settings
     t, end = span
-    repeats, skip = 0, None
+    repeats = 0
     while t < end:
-        events = system.transitions(mode)
-        # a link kink that just fired starts the next piece on its old side by round-off: leave it out
-        # once (it can only fire again after its opposite crossing, which ends that piece)
-        active = [i for i in range(len(events)) if i != skip]
-        functions = [events[i][0] for i in active]
+        events = system.transitions(modes)
 
-        def rhs(t_s: float, y_: np.ndarray, mode: str = mode) -> np.ndarray:
-            return system.rhs(t_s, y_, pulse_n, mode)
+        def rhs(t_s: float, y_: np.ndarray, modes: Modes = modes) -> np.ndarray:
+            return system.rhs(t_s, y_, pulse_n, modes)
 
-        sol = solve_ivp(rhs, (t, end), y, method=method, rtol=rtol, atol=atol, events=functions,
-                        dense_output=True)
+        sol = solve_ivp(rhs, (t, end), y, method=settings.method, rtol=settings.relative_tolerance,
+                        atol=settings.absolute_tolerance, events=[e[0] for e in events], dense_output=True)
         record.pieces += 1
         record.solver_steps += len(sol.t) - 1
         record.rhs_evaluations += sol.nfev
         if sol.status == -1:
-            raise _fail(system.scene, method, float(sol.t[-1]), f"failed ({sol.message})")
-        samples = _refined(sol.t, sample_interval_s)
+            raise _fail(system.simulation, float(sol.t[-1]), f"failed ({sol.message})")
+        samples = _refined(sol.t, settings.sample_interval_s)
         record.add(samples, sol.sol(samples), pulse_n)
         if sol.status == 0:
-            return sol.y[:, -1], mode
+            return sol.y[:, -1], modes
         fired = next(i for i, te in enumerate(sol.t_events) if len(te))
         t_next, y = float(sol.t_events[fired][0]), sol.y_events[fired][0]
         repeats = repeats + 1 if t_next <= t else 0
         if repeats > MAX_SWITCHES_AT_ONE_TIME:
-            raise _fail(system.scene, method, t_next, "chattered between rock modes")
-        fired = active[fired]
-        kink = fired >= len(events) - system.kink_event_count
-        t, mode, skip = t_next, events[fired][2], fired if kink else None
-        into = "link_kink" if kink else mode
+            raise _fail(system.simulation, t_next, "chattered between modes")
+        _, _, index, next_mode = events[fired]
+        element = system.pieces[index]
+        modes = modes[:index] + (next_mode,) + modes[index + 1:]
+        into = next_mode if index == 0 else f"{element.name}:{next_mode}"
         record.switches[into] = record.switches.get(into, 0) + 1
-        y = y if kink else system.enter(mode, y)
+        t, y = t_next, element.enter(next_mode, y)
         record.time_s[-1][-1], record.states[-1][:, -1] = t, y  # the switch point, in the new mode
-    return y, mode
+    return y, modes
 
 
-def simulate_ode(scene: Scene, method: str = "DOP853", rtol: float = 1e-10, atol: float = 1e-13,
-                 sample_interval_s: float = 2e-6) -> SimulationResult:
-    """Integrate Eq. 4 of ``scene`` from its start (rest or preloaded; the rock state consistent
-    with it, return_map(x_bit(0), initial_state())) to ``scene.solver.end_time_s``.
-
-    ``method`` is a SciPy ``solve_ivp`` method (DOP853, Radau or LSODA); ``rtol``/``atol`` its
-    tolerances (atol in the state's SI units: m, m/s, rad, rad/s). Every accepted step is stored,
-    and the solver's dense output fills steps longer than ``sample_interval_s``, so that the
-    trapezoidal energy account (models.energy) of the stored samples balances.
-    """
-    if method not in ODE_METHODS:
-        raise ValueError(f"method {method!r} not one of {', '.join(ODE_METHODS)}")
-    system = _system(scene)
+def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
+    """Integrate Eq. 4 from the simulation's start (rest or preloaded; the rock state consistent with
+    it) to its end time, with the scene's ODE settings (models.solver_settings: ``method``, a SciPy
+    ``solve_ivp`` method, ``relative_tolerance``/``absolute_tolerance`` in the state's SI units). Every
+    accepted step is stored, and the solver's dense output fills steps longer than
+    ``sample_interval_s``, so that the trapezoidal energy account (models.energy) balances."""
+    simulation = as_simulation(run)
+    system = _system(simulation)
     y = np.zeros(system.state_size)
-    y[:system.n] = initial_positions_m(scene)
-    y[system.rock_states] = system.rock.return_map(float(y[system.bit]), system.rock.initial_state())
-    if system.torsion:
-        y[-2] = initial_torsion_angle_rad(scene)
-    mode = system.initial_mode(y)
+    y[:system.n] = simulation.initial_positions_m
+    y[system.rock_states] = simulation.initial_rock_state
+    if system.torsion is not None:
+        y[-2] = simulation.initial_torsion_angle_rad
+    modes = tuple(element.initial_mode(y) for element in system.pieces)
     record = _Record([], [], [], {})
-    breakpoints = _breakpoints(scene)
     start = time.process_time()
-    for span in itertools.pairwise(breakpoints):
-        y, mode = _integrate_segment(system, record, y, mode, span, _SegmentPulse(scene.impact, *span),
-                                     method, rtol, atol, sample_interval_s)
+    impact = simulation.impact
+    for span in itertools.pairwise(switch_times(impact, simulation.settings.end_time_s)):
+        y, modes = _integrate_segment(system, record, y, modes, span, _SegmentPulse(impact, *span))
+        if progress is not None:
+            progress(span[1])
     cpu = time.process_time() - start
 
     time_s = np.concatenate(record.time_s)
@@ -324,16 +269,16 @@ def simulate_ode(scene: Scene, method: str = "DOP853", rtol: float = 1e-10, atol
     n = system.n
     bad = diverged_index(states[:, :n], states[:, n:2 * n])
     if bad is not None:
-        raise _fail(scene, method, float(time_s[bad]), "diverged")
+        raise _fail(simulation, float(time_s[bad]), "diverged")
     torsion = system.torsion is not None
+    settings = simulation.settings
     return SimulationResult(
-        scene=scene,
-        chain=system.chain,
+        simulation=simulation,
         formulation="ode",
         time_s=time_s,
         position_m=states[:, :n],
         velocity_m_per_s=states[:, n:2 * n],
-        bottom_m=states[:, system.rock_states][:, system.rock.bottom_index],
+        bottom_m=states[:, system.rock_states][:, simulation.rock.bottom_index],
         rock_force_n=system.rock_force_n(states.T),
         rock_state_m=states[:, system.rock_states],
         impact_force_n=np.concatenate(record.impact_n),
@@ -342,12 +287,12 @@ def simulate_ode(scene: Scene, method: str = "DOP853", rtol: float = 1e-10, atol
         cpu_time_s=cpu,
         info={
             "solver_success": True,
-            "method": method,
-            "rtol": rtol,
-            "atol": atol,
+            "method": settings.method,
+            "rtol": settings.relative_tolerance,
+            "atol": settings.absolute_tolerance,
             "solver_steps": record.solver_steps,
             "samples": len(time_s),
-            "sample_interval_s": sample_interval_s,
+            "sample_interval_s": settings.sample_interval_s,
             "pieces": record.pieces,
             "rhs_evaluations": record.rhs_evaluations,
             "mode_switches": sum(record.switches.values()),

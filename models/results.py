@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+
 from rpdrill.models.chain import AxialChain
 from rpdrill.models.scene import Scene
+
+if TYPE_CHECKING:
+    from rpdrill.models.simulation import Simulation
 
 
 @dataclass
@@ -14,11 +19,10 @@ class SimulationResult:
     """State histories at the stored solver steps (rows) of one run.
 
     Positions and velocities are along the drilling axis, positive into the rock, one column
-    per body of ``chain``. ``bottom_m`` is the borehole bottom x_n.
+    per body of the simulation's chain. ``bottom_m`` is the borehole bottom x_n.
     """
 
-    scene: Scene
-    chain: AxialChain
+    simulation: Simulation
     formulation: str
     time_s: np.ndarray
     position_m: np.ndarray
@@ -37,11 +41,19 @@ class SimulationResult:
     # steps; None: the formulation stored only the bottom (enough for a one-state law, Jenkins)
     rock_state_m: np.ndarray | None = None
 
+    @property
+    def scene(self) -> Scene:
+        return self.simulation.scene
+
+    @property
+    def chain(self) -> AxialChain:
+        return self.simulation.chain
+
     def rock_states(self) -> tuple[np.ndarray, ...]:
         """The rock law's states as one sample array per state (the bottom alone for a one-state law)."""
         if self.rock_state_m is not None:
             return tuple(self.rock_state_m.T)
-        if len(self.scene.rock_law().state_names) != 1:
+        if len(self.simulation.rock.state_names) != 1:
             raise ValueError(f"{self.formulation} result has no rock_state_m for the {self.scene.rock.law} law")
         return (self.bottom_m,)
 
@@ -76,7 +88,7 @@ class SimulationResult:
             "torsion_angle_rad": self.torsion_angle_rad,
             "torsion_rate_rad_per_s": self.torsion_rate_rad_per_s,
         }
-        wanted = self.scene.outputs.timeseries
+        wanted = self.simulation.outputs.timeseries
         out.update({name: values for name, values in optional.items() if name in wanted and values is not None})
         return out
 

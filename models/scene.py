@@ -1,19 +1,31 @@
-"""The typed scene: everything one simulation needs, SI units in every name.
+"""The typed scene: everything one simulation needs, SI units in every name; data only.
 
 Symbols refer to the paper (Eq. 4, Table 1). The scene knows nothing of files: build it from a
 plain dictionary with :func:`Scene.model_validate`; errors are pydantic ``ValidationError``s
-whose locations are the key paths.
+whose locations are the key paths. Validation checks the data for consistency and runs no
+physics; what a run derives from it (the effects built, the solver step of a preset, the chain,
+the rock law, the initial state) is resolved once per run by :mod:`rpdrill.models.simulation`.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
+
+from rpdrill.models.formulations import (
+    COMMON_SOLVER_KEYS,
+    EXUDYN_SOLVERS,
+    FORMULATIONS,
+    ODE_METHODS,
+    PRESETS,
+)
 from rpdrill.models.links import LINK_TYPES
-from rpdrill.models.outputs import METRICS, SERIES, needs
+from rpdrill.models.outputs import METRICS, SERIES, Need, needs
 from rpdrill.rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
 from rpdrill.rocklaw.catalog import TABLE_1
 
@@ -35,39 +47,46 @@ EVERY_BODY = "every_body"
 
 
 class Body(Strict):
-    """One body of the drill string: a rigid ``mass_kg``, or a rod given by its geometry.
+    """One body of the drill string: a rigid ``mass_kg``, a rod given by its geometry, or a pipe
+    given by its length and weight per metre.
 
-    A rod (``length_m``, ``diameter_m``, optional ``bore_diameter_m``) has the mass rho A L and
-    carries its own axial elasticity: a connector without ``stiffness_n_per_m`` joining it gets the
-    series stiffness of the two half-rods it joins, 1/k = sum L_i / (2 E_i A_i) (two identical rods:
-    k = E A / L). ``segments`` > 1 splits the rod into that many equal lumped masses joined by
-    springs E A N / L (a discrete wave-guide, docs/extending.md).
+    A rod (``length_m``, ``diameter_m``, optional ``bore_diameter_m``) has the mass rho A L, or
+    ``mass_per_length_kg_per_m`` x L when given (a drill pipe's nominal weight per metre, tool joints
+    included), and carries its own axial elasticity: a connector without ``stiffness_n_per_m``
+    joining it gets the series stiffness of the two half-rods it joins, 1/k = sum L_i / (2 E_i A_i)
+    (two identical rods: k = E A / L). ``segments`` > 1 splits the rod into that many equal lumped
+    masses joined by springs E A N / L (a discrete wave-guide, docs/extending.md). A pipe given by
+    ``length_m`` and ``mass_per_length_kg_per_m`` alone is a rigid body of that mass (no E A).
     """
 
     mass_kg: Positive | None = Field(None, description="rigid body mass; not with a rod geometry")
     length_m: Positive | None = None
     diameter_m: Positive | None = None
     bore_diameter_m: NonNegative = Field(0.0, description="flushing hole, m")
+    mass_per_length_kg_per_m: Positive | None = Field(None, description="weight per metre of a pipe, kg/m")
     youngs_modulus_pa: Positive = STEEL_YOUNGS_MODULUS_PA
     density_kg_per_m3: Positive = STEEL_DENSITY_KG_PER_M3
     segments: Annotated[int, Field(ge=1)] = 1
 
     @model_validator(mode="after")
     def _mass_or_geometry(self) -> Body:
-        geometry = self.length_m is not None or self.diameter_m is not None
-        if self.mass_kg is not None and geometry:
-            raise ValueError("give mass_kg (a rigid body) or length_m and diameter_m (a steel rod), not both")
-        if self.mass_kg is None and (self.length_m is None or self.diameter_m is None):
-            raise ValueError("give mass_kg, or both length_m and diameter_m")
-        if geometry and self.bore_diameter_m >= self.diameter_m:
+        sized = [key for key in ("length_m", "diameter_m", "mass_per_length_kg_per_m") if getattr(self, key) is not None]
+        if self.mass_kg is not None and sized:
+            raise ValueError(f"give mass_kg (a rigid body) or a length with a diameter or a mass per length, "
+                             f"not both (mass_kg with {', '.join(sized)})")
+        if self.mass_kg is None and (self.length_m is None or len(sized) < 2):
+            raise ValueError("give mass_kg, or length_m with diameter_m (a steel rod) and/or "
+                             "mass_per_length_kg_per_m (a pipe)")
+        if self.is_rod and self.bore_diameter_m >= self.diameter_m:
             raise ValueError(f"bore_diameter_m {self.bore_diameter_m} must be smaller than diameter_m {self.diameter_m}")
-        if self.segments > 1 and not geometry:
+        if self.segments > 1 and not self.is_rod:
             raise ValueError("segments > 1 needs a rod geometry (length_m, diameter_m)")
         return self
 
     @property
     def is_rod(self) -> bool:
-        return self.length_m is not None
+        """Whether the body carries an axial elasticity E A / L (a length and a diameter)."""
+        return self.length_m is not None and self.diameter_m is not None
 
     @property
     def area_m2(self) -> float:
@@ -76,8 +95,12 @@ class Body(Strict):
 
     @property
     def total_mass_kg(self) -> float:
-        """mass_kg, or rho A L for a rod."""
-        return self.mass_kg if self.mass_kg is not None else self.density_kg_per_m3 * self.area_m2 * self.length_m
+        """mass_kg, the weight per metre x L, or rho A L for a rod."""
+        if self.mass_kg is not None:
+            return self.mass_kg
+        if self.mass_per_length_kg_per_m is not None:
+            return self.mass_per_length_kg_per_m * self.length_m
+        return self.density_kg_per_m3 * self.area_m2 * self.length_m
 
     @property
     def wave_speed_m_per_s(self) -> float:
@@ -203,7 +226,7 @@ class Impact(Strict):
 
 def _problem(location: tuple[str, ...], value: object, message: str, **context: object) -> InitErrorDetails:
     """One problem at the key path ``location`` (pydantic prefixes the enclosing path)."""
-    return InitErrorDetails(type=PydanticCustomError("rock_law", message, context), loc=location, input=value)
+    return InitErrorDetails(type=PydanticCustomError("invalid_key", message, context), loc=location, input=value)
 
 
 def _key_error(model: str, location: tuple[str, ...], value: object, message: str, **context: object) -> ValidationError:
@@ -211,6 +234,7 @@ def _key_error(model: str, location: tuple[str, ...], value: object, message: st
     return ValidationError.from_exception_data(model, [_problem(location, value, message, **context)])
 
 
+JENKINS_VALUES = ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n")
 # the keys of each rock law (``law`` itself is common)
 ROCK_LAW_KEYS = {
     "jenkins": ("name", "stiffness_n_per_m", "damping_n_s_per_m", "threshold_n", "damping_mode"),
@@ -237,30 +261,17 @@ class Rock(Strict):
 
     @model_validator(mode="after")
     def _complete(self) -> Rock:
-        allowed = ", ".join(("law", *ROCK_LAW_KEYS[self.law]))
-        foreign = [_problem((key,), getattr(self, key), "a key of rock law '{other}', not of law '{law}'; "
-                            "allowed keys: {allowed}", other=law, law=self.law, allowed=allowed)
-                   for law, keys in ROCK_LAW_KEYS.items() if law != self.law
-                   for key in keys if getattr(self, key) is not None]
-        if foreign:
-            raise ValidationError.from_exception_data("Rock", foreign)
-        return self._complete_bilinear() if self.law == "bilinear" else self._complete_jenkins()
-
-    def _complete_jenkins(self) -> Rock:
-        if self.damping_mode is None:
-            object.__setattr__(self, "damping_mode", "contact")
+        _refuse_foreign_keys(self, "rock law", self.law, {law: ("law", *keys) for law, keys in ROCK_LAW_KEYS.items()},
+                             "Rock")
+        if self.law == "bilinear":
+            return self._check_bilinear()
         if self.name is None:
-            missing = [k for k in ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n") if getattr(self, k) is None]
+            missing = [k for k in JENKINS_VALUES if getattr(self, k) is None]
             if missing:
                 raise ValueError(f"give a Table 1 name ({', '.join(TABLE_1)}) or all of: {', '.join(missing)}")
-            return self
-        row = TABLE_1[self.name]
-        for key in ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n"):
-            if getattr(self, key) is None:
-                object.__setattr__(self, key, getattr(row, key))
         return self
 
-    def _complete_bilinear(self) -> Rock:
+    def _check_bilinear(self) -> Rock:
         for key in ROCK_LAW_KEYS["bilinear"]:
             if getattr(self, key) is None:
                 raise _key_error("Rock", (key,), None, "missing: rock law 'bilinear' needs {key}", key=key)
@@ -270,62 +281,72 @@ class Rock(Strict):
                              loading=f"{self.loading_stiffness_n_per_m:g}")
         return self
 
+    def completed(self) -> Rock:
+        """This rock with every value of its law filled in: a Jenkins rock's Table 1 values where a
+        named rock gives none, and damping_mode ``contact`` (a new object; the scene is not changed)."""
+        if self.law != "jenkins":
+            return self
+        row = TABLE_1[self.name] if self.name else None
+        filled = {key: getattr(row, key) for key in JENKINS_VALUES if getattr(self, key) is None}
+        return self.model_copy(update={**filled, "damping_mode": self.damping_mode or "contact"})
+
     def build(self, damping: bool = True, plasticity: bool = True) -> RockLaw:
         """The law; without ``damping`` no rock damper, without ``plasticity`` an elastic rock at the
         loading stiffness (Jenkins: F_th infinite; bilinear: k_u = k_l)."""
-        if self.law == "bilinear":
-            loading = self.loading_stiffness_n_per_m
-            return BilinearRock(loading, self.unloading_stiffness_n_per_m if plasticity else loading)
-        return JenkinsRock(self.stiffness_n_per_m, self.damping_n_s_per_m if damping else 0.0,
-                           self.threshold_n if plasticity else math.inf, self.damping_mode)
+        rock = self.completed()
+        if rock.law == "bilinear":
+            loading = rock.loading_stiffness_n_per_m
+            return BilinearRock(loading, rock.unloading_stiffness_n_per_m if plasticity else loading)
+        return JenkinsRock(rock.stiffness_n_per_m, rock.damping_n_s_per_m if damping else 0.0,
+                           rock.threshold_n if plasticity else math.inf, rock.damping_mode)
 
 
-EXUDYN_SOLVERS = (
-    "rk44", "rk33", "explicit_midpoint", "explicit_euler", "generalized_alpha",
-    "trapezoidal_index2", "dopri5", "ode23",
-)
-AUTOMATIC_STEP_SOLVERS = ("dopri5", "ode23")
-
-
-# Accuracy presets: RK44 at a fixed step, the smallest of a cap, a fraction of the pulse duration
-# (a step must resolve the pulse) and a multiple of 1/|lambda|_max (the stiffest or fastest
-# mode, models.stability.spectral_radius_per_s). The stated errors (relative to the reference
-# preset, and of the energy balance relative to the impact work) are the largest measured on the
-# hard scenes of tests/stability, rounded up (docs/stability.md); the suite checks them.
-SOLVER_PRESETS: dict[str, dict[str, float]] = {
-    "fast": {"step_s": 1e-4, "steps_per_pulse": 10, "step_times_radius": 0.8,
-             "penetration_rate_error": 0.03, "energy_balance_error": 0.03},
-    "standard": {"step_s": 4e-5, "steps_per_pulse": 25, "step_times_radius": 0.4,
-                 "penetration_rate_error": 0.003, "energy_balance_error": 0.003},
-    "reference": {"step_s": 5e-6, "steps_per_pulse": 200, "step_times_radius": 0.05,
-                  "penetration_rate_error": 1e-4, "energy_balance_error": 1e-4},
-}
-DEFAULT_PRESET = "standard"
-ACCURACY_KEYS = ("type", "step_s", "spectral_radius", "relative_tolerance", "absolute_tolerance")
+def _refuse_foreign_keys(model: BaseModel, what: str, chosen: str, keys: dict[str, tuple[str, ...]],
+                         title: str) -> None:
+    """A ValidationError for every key of another ``what`` (rock law, formulation) than ``chosen``
+    that ``model`` gives, naming the keys ``chosen`` allows."""
+    allowed = ", ".join(keys[chosen])
+    foreign = [_problem((key,), getattr(model, key), "a key of {what} '{other}', not of '{chosen}'; "
+                        "allowed keys here: {allowed}", what=what, other=other, chosen=chosen, allowed=allowed)
+               for other, other_keys in keys.items() if other != chosen
+               for key in other_keys if key not in keys[chosen] and getattr(model, key) is not None]
+    if foreign:
+        raise ValidationError.from_exception_data(title, foreign)
 
 
 class Solver(Strict):
-    """Time integration: a ``preset`` (fast, standard, reference) and/or explicit settings.
+    """How the scene is integrated: the ``formulation`` (models.formulations), an accuracy
+    ``preset`` (fast, standard, reference) and/or that formulation's explicit options, the end time
+    and the output interval.
 
-    ``step_s`` is the fixed step (the largest step for dopri5/ode23). A preset sets ``type`` and
-    ``step_s``; explicit values given next to it win. Without either, the ``standard`` preset applies.
+    Options (a key of another formulation is an error): exudyn ``type``, ``step_s`` (the fixed step;
+    the largest step for dopri5/ode23), ``spectral_radius``, ``relative_tolerance``,
+    ``absolute_tolerance``; ode ``method``, ``relative_tolerance``, ``absolute_tolerance`` (SI units
+    of the state), ``sample_interval_s`` (dense-output sampling); exact ``sample_interval_s``,
+    ``min_switch_interval_s``, ``max_switches_per_blow``. A preset fills the options not given;
+    without a preset and without explicit accuracy options the ``standard`` preset applies
+    (models.solver_settings resolves them once per run).
     """
 
-    preset: Literal[tuple(SOLVER_PRESETS)] | None = None  # type: ignore[valid-type]
-    type: Literal[EXUDYN_SOLVERS] = "rk44"  # type: ignore[valid-type]
-    step_s: Positive = SOLVER_PRESETS[DEFAULT_PRESET]["step_s"]
-    spectral_radius: Annotated[float, Field(ge=0, le=1)] = 1.0
-    relative_tolerance: Positive = 1e-8
-    absolute_tolerance: Positive = 1e-12
+    formulation: Literal[tuple(FORMULATIONS)] = "exudyn"  # type: ignore[valid-type]
+    preset: Literal[PRESETS] | None = None  # type: ignore[valid-type]
     end_time_s: Positive = 0.5
     output_interval_s: Positive = 1e-4
+    type: Literal[EXUDYN_SOLVERS] | None = None  # type: ignore[valid-type]
+    step_s: Positive | None = None
+    spectral_radius: Annotated[float, Field(ge=0, le=1)] | None = None
+    relative_tolerance: Positive | None = None
+    absolute_tolerance: Positive | None = None
+    method: Literal[ODE_METHODS] | None = None  # type: ignore[valid-type]
+    sample_interval_s: Positive | None = None
+    min_switch_interval_s: Positive | None = None
+    max_switches_per_blow: Annotated[int, Field(ge=1)] | None = None
 
-    @model_validator(mode="before")
-    @classmethod
-    def _default_preset(cls, data: object) -> object:
-        if isinstance(data, dict) and data.get("preset") is None and not any(k in data for k in ACCURACY_KEYS):
-            return {**data, "preset": DEFAULT_PRESET}
-        return data
+    @model_validator(mode="after")
+    def _options_of_the_formulation(self) -> Solver:
+        keys = {name: (*COMMON_SOLVER_KEYS, *f.option_keys) for name, f in FORMULATIONS.items()}
+        _refuse_foreign_keys(self, "formulation", self.formulation, keys, "Solver")
+        return self
 
 
 EFFECTS = ("torsion", "rock_damping", "rock_plasticity", "joint_damping")
@@ -336,8 +357,9 @@ class Effects(Strict):
 
     In a scene: ``true`` builds an effect, ``false`` leaves it out, a key absent leaves it out
     unless a requested output needs it; no ``effects`` section at all builds every effect the
-    scene gives parameters for (the full model). After validation every key is true or false and
-    ``reasons`` says why. ``rock_plasticity`` off gives an elastic rock that never crushes.
+    scene gives parameters for (the full model); :func:`built_effects` resolves them for a run.
+    ``reasons`` is informational (a resolved scene file says there why each effect was built).
+    ``rock_plasticity`` off gives an elastic rock that never crushes.
     """
 
     torsion: bool | None = None
@@ -366,7 +388,7 @@ class Metrics(Strict):
 
 
 class Scene(Strict):
-    """One drill on one rock with one solver setting."""
+    """One drill on one rock with one solver setting (data only: module doc)."""
 
     name: str
     description: str = ""
@@ -383,14 +405,15 @@ class Scene(Strict):
         "rest", description="rest: every coordinate zero (Eq. 4 from rest); preloaded: the static "
         "equilibrium under the feed (and torque) with the bit pressed on the rock")
 
-    def _available(self, effect: str) -> bool:
-        """Whether the scene's parameters give the effect anything to do."""
-        return {
-            "torsion": self.torsion is not None,
-            "rock_damping": self.rock.law == "jenkins" and self.rock.damping_n_s_per_m > 0,
-            "rock_plasticity": True,
-            "joint_damping": any(c.damping_n_s_per_m > 0 for c in self.drill_string.connectors.values()),
-        }[effect]
+    def with_solver(self, formulation: str | None = None, **options: object) -> Scene:
+        """This scene with another formulation (the options of the old one dropped, the common ones
+        kept) and/or other solver options (a new, validated scene)."""
+        solver = self.solver.model_dump(exclude_none=True)
+        if formulation is not None and formulation != solver["formulation"]:
+            solver = {key: value for key, value in solver.items() if key in COMMON_SOLVER_KEYS}
+            solver["formulation"] = formulation
+        data = self.model_dump(by_alias=True, exclude_none=True)
+        return Scene.model_validate({**data, "solver": {**solver, **options}})
 
     @model_validator(mode="after")
     def _feed_body_exists(self) -> Scene:
@@ -400,69 +423,25 @@ class Scene(Strict):
         return self
 
     @model_validator(mode="after")
-    def _resolve_effects_and_outputs(self) -> Scene:
-        outputs = self.outputs or Outputs()
-        need = needs(outputs.metrics, outputs.timeseries)
-        chosen, reasons = {}, {}
-        for effect in EFFECTS:
-            asked = None if self.effects is None else getattr(self.effects, effect)
-            users = [o for o in outputs.metrics + outputs.timeseries
-                     if effect in (METRICS.get(o) or SERIES[o]).effects]
-            if asked is False and users:
-                raise ValueError(f"effects.{effect} is false but outputs {', '.join(users)} need it")
-            if self.effects is None:
-                chosen[effect] = self._available(effect) or effect in need.effects
-                reasons[effect] = "no effects section: full model" if chosen[effect] else \
-                    "no effects section, and nothing for it to do in this scene"
-            elif asked:
-                chosen[effect], reasons[effect] = True, "asked for"
-            elif users:
-                chosen[effect], reasons[effect] = True, f"needed by outputs: {', '.join(users)}"
-            else:
-                chosen[effect], reasons[effect] = False, "not asked for" if asked is None else "switched off"
-        if chosen["torsion"] and self.torsion is None:
+    def _effects_and_outputs_consistent(self) -> Scene:
+        effects = built_effects(self)  # raises where the effects contradict the outputs
+        if effects.torsion and self.torsion is None:
             raise ValueError("the torsion effect needs a torsion section (inertia_kg_m2, stiffness_n_m_per_rad, "
                              "damping_n_m_s_per_rad, drive_torque_n_m, resisting_torque_n_m)")
-        object.__setattr__(self, "effects", Effects(**chosen, reasons=reasons))
-        bodies = set(self.drill_string.bodies)
-        missing = [o for o in outputs.metrics + outputs.timeseries
-                   if not (METRICS.get(o) or SERIES[o]).bodies <= bodies]
-        if missing:
-            raise ValueError(f"outputs {', '.join(missing)} need a body named "
-                             f"{', '.join(sorted(need.bodies - bodies))} in drill_string.bodies")
-        if self.outputs is None:
-            built = {e for e, on in chosen.items() if on}
-            object.__setattr__(self, "outputs", Outputs(
-                metrics=[m for m, n in METRICS.items() if n.effects <= built and n.bodies <= bodies],
-                timeseries=[s for s, n in SERIES.items() if n.effects <= built and n.bodies <= bodies]))
-        return self
-
-    def needed_data(self) -> frozenset[str]:
-        """What must be recorded for the requested outputs: ``forces``, ``energy``."""
-        return needs(self.outputs.metrics, self.outputs.timeseries).data
-
-    def rock_law(self) -> RockLaw:
-        """The rock law as built: without damping or plasticity when those effects are off."""
-        return self.rock.build(damping=self.effects.rock_damping, plasticity=self.effects.rock_plasticity)
-
-    @model_validator(mode="after")
-    def _rock_damping_needs_a_damped_law(self) -> Scene:
-        if self.effects.rock_damping and self.rock.law == "bilinear":
+        if effects.rock_damping and self.rock.law == "bilinear":
             raise _key_error("Scene", ("effects", "rock_damping"), True,
                              "rock law 'bilinear' has no rock damping; set it false or use law: jenkins")
+        outputs = self.outputs or Outputs()
+        bodies = set(self.drill_string.bodies)
+        missing = [o for o in outputs.metrics + outputs.timeseries if not _need(o).bodies <= bodies]
+        if missing:
+            absent = set().union(*(_need(o).bodies for o in missing)) - bodies
+            raise ValueError(f"outputs {', '.join(missing)} need a body named {', '.join(sorted(absent))} "
+                             f"in drill_string.bodies")
         return self
 
     @model_validator(mode="after")
-    def _resolve_preset_and_check_length(self) -> Scene:
-        if self.solver.preset is not None:
-            from rpdrill.models.stability import spectral_radius_per_s  # needs a complete scene
-
-            preset = SOLVER_PRESETS[self.solver.preset]
-            step = min(preset["step_s"], self.impact.duration_s / preset["steps_per_pulse"],
-                       preset["step_times_radius"] / spectral_radius_per_s(self))
-            given = self.solver.model_fields_set
-            update = {key: value for key, value in (("type", "rk44"), ("step_s", step)) if key not in given}
-            object.__setattr__(self, "solver", self.solver.model_copy(update=update))
+    def _end_time_and_step_fit_the_blows(self) -> Scene:
         period = self.impact.period_s
         if self.solver.end_time_s < period:
             raise ValueError(
@@ -475,14 +454,70 @@ class Scene(Strict):
                 f"the metrics need transient_blows + block_blows = "
                 f"{self.metrics.transient_blows + self.metrics.block_blows} blows ({needed:.6g} s)"
             )
-        if self.solver.step_s > period / 20:
+        if self.solver.step_s is not None and self.solver.step_s > period / 20:
             raise ValueError(f"solver.step_s {self.solver.step_s} must resolve the impact period: at most {period / 20:.3g} s")
         return self
 
-    @model_validator(mode="after")
-    def _preload_does_not_crush(self) -> Scene:
-        if self.start == "preloaded":
-            from rpdrill.models.chain import initial_positions_m  # needs a complete scene
 
-            initial_positions_m(self)  # raises when the static feed alone would crush the rock
-        return self
+def _need(output: str) -> Need:
+    return METRICS.get(output) or SERIES[output]
+
+
+@dataclass(frozen=True)
+class BuiltEffects:
+    """Which effects a run builds (every one true or false) and why (``reasons``)."""
+
+    torsion: bool
+    rock_damping: bool
+    rock_plasticity: bool
+    joint_damping: bool
+    reasons: Mapping[str, str]
+
+    def as_dict(self) -> dict[str, bool]:
+        return {effect: getattr(self, effect) for effect in EFFECTS}
+
+
+def _available(scene: Scene, effect: str) -> bool:
+    """Whether the scene's parameters give the effect anything to do."""
+    return {
+        "torsion": scene.torsion is not None,
+        "rock_damping": scene.rock.law == "jenkins" and scene.rock.completed().damping_n_s_per_m > 0,
+        "rock_plasticity": True,
+        "joint_damping": any(c.damping_n_s_per_m > 0 for c in scene.drill_string.connectors.values()),
+    }[effect]
+
+
+def built_effects(scene: Scene) -> BuiltEffects:
+    """The effects a run of ``scene`` builds (Effects docstring): asked for, needed by an output, or,
+    without an effects section, every effect the scene gives parameters for. ValueError when an
+    effect switched off is needed by an output."""
+    outputs = scene.outputs or Outputs()
+    need = needs(outputs.metrics, outputs.timeseries)
+    chosen, reasons = {}, {}
+    for effect in EFFECTS:
+        asked = None if scene.effects is None else getattr(scene.effects, effect)
+        users = [o for o in outputs.metrics + outputs.timeseries if effect in _need(o).effects]
+        if asked is False and users:
+            raise ValueError(f"effects.{effect} is false but outputs {', '.join(users)} need it")
+        if scene.effects is None:
+            chosen[effect] = _available(scene, effect) or effect in need.effects
+            reasons[effect] = "no effects section: full model" if chosen[effect] else \
+                "no effects section, and nothing for it to do in this scene"
+        elif asked:
+            chosen[effect], reasons[effect] = True, "asked for"
+        elif users:
+            chosen[effect], reasons[effect] = True, f"needed by outputs: {', '.join(users)}"
+        else:
+            chosen[effect], reasons[effect] = False, "not asked for" if asked is None else "switched off"
+    return BuiltEffects(**chosen, reasons=reasons)
+
+
+def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
+    """The scene's outputs, or without an outputs section every metric and history of the effects
+    built and the bodies present."""
+    if scene.outputs is not None:
+        return scene.outputs
+    built = {effect for effect, on in effects.as_dict().items() if on}
+    bodies = set(scene.drill_string.bodies)
+    return Outputs(metrics=[m for m, n in METRICS.items() if n.effects <= built and n.bodies <= bodies],
+                   timeseries=[s for s, n in SERIES.items() if n.effects <= built and n.bodies <= bodies])

@@ -9,12 +9,18 @@ the factors were measured on the hard scenes (docs/stability.md).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from rpdrill.models.chain import axial_chain
+
+from rpdrill.models.chain import AxialChain
 from rpdrill.models.energy import energy_account
 from rpdrill.models.pulse import impulse_per_blow_n_s
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Scene
+from rpdrill.rocklaw import RockLaw
+
+if TYPE_CHECKING:
+    from rpdrill.models.results import SimulationResult
+    from rpdrill.models.simulation import Simulation
 
 # Positions beyond this are not drilling: the solver has blown up (states near 1e300 seen with
 # explicit solvers at too large a step, reported as success by the solver).
@@ -39,50 +45,50 @@ class StepLimitWarning(UserWarning):
     """A fixed explicit step beyond the measured stability limit of the scene's stiffest mode."""
 
 
-def spectral_radius_per_s(scene: Scene) -> float:
-    """|lambda|_max of the first-order system z' = A z, A = [[0, I], [-M^-1 K, -M^-1 C]], with the
-    bit on the rock (k_n, c_n added on the bit): what limits an explicit solver's step, the
-    stiffest mode for light damping and the fastest decay for heavy damping."""
-    chain = axial_chain(scene)
-    stiffness, damping = chain.stiffness_matrix(), chain.damping_matrix()
-    law = scene.rock_law()
-    stiffness[chain.bit_body, chain.bit_body] += max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m)
-    damping[chain.bit_body, chain.bit_body] += law.damping_n_s_per_m
-    inverse_mass = np.linalg.inv(chain.mass_matrix())
-    n = chain.size
-    system = np.block([[np.zeros((n, n)), np.eye(n)], [-inverse_mass @ stiffness, -inverse_mass @ damping]])
+def spectral_radius_per_s(chain: AxialChain, law: RockLaw) -> float:
+    """|lambda|_max of the first-order system z' = A z, A = [[0, I], [-M^-1 K, -M^-1 C]] of every link
+    at its full stiffness, with the bit on the rock (its stiffest slope and its damper added on the
+    bit): what limits an explicit solver's step, the stiffest mode for light damping and the fastest
+    decay for heavy damping."""
+    stiffest = max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m)
+    system = chain.first_order_matrix(chain.links, stiffest, law.damping_n_s_per_m)[:, :-1]
     return float(np.abs(np.linalg.eigvals(system)).max())
 
 
-def largest_stable_step_s(scene: Scene, solver_type: str | None = None) -> float | None:
-    """h_max of a fixed-step explicit solver (default: the scene's); None for implicit or adaptive ones."""
-    solver_type = solver_type or scene.solver.type
+def largest_stable_step_s(simulation: Simulation, solver_type: str | None = None) -> float | None:
+    """h_max of a fixed-step explicit solver (default: the simulation's); None for implicit or
+    adaptive ones."""
+    solver_type = solver_type or simulation.settings.type
     if solver_type not in STABLE_STEP_FACTOR:
         return None
     factor = STABLE_STEP_FACTOR[solver_type]
-    return 0.0 if factor is None else factor / spectral_radius_per_s(scene)
+    radius = simulation.spectral_radius_per_s or spectral_radius_per_s(simulation.chain, simulation.rock)
+    return 0.0 if factor is None else factor / radius
 
 
-def step_warning(scene: Scene) -> str | None:
+def step_warning(simulation: Simulation) -> str | None:
     """A warning when a fixed explicit step exceeds the measured stability limit."""
-    limit = largest_stable_step_s(scene)
-    if limit is None or scene.solver.step_s <= limit:
+    settings = simulation.settings
+    limit = largest_stable_step_s(simulation)
+    if limit is None or settings.step_s <= limit:
         return None
     if limit == 0.0:
-        return (f"scene '{scene.name}': solver {scene.solver.type} is unstable at any step on the undamped "
-                f"modes of this drill; use {SUGGESTED} with step_s <= {largest_stable_step_s(scene, SUGGESTED):.3g}")
-    return (f"scene '{scene.name}': solver.step_s {scene.solver.step_s:g} exceeds the stability limit "
-            f"{limit:.3g} s of {scene.solver.type} for the stiffest mode of this drill")
+        return (f"scene '{simulation.name}': solver {settings.type} is unstable at any step on the undamped "
+                f"modes of this drill; use {SUGGESTED} with step_s <= "
+                f"{largest_stable_step_s(simulation, SUGGESTED):.3g}")
+    return (f"scene '{simulation.name}': solver.step_s {settings.step_s:g} exceeds the stability limit "
+            f"{limit:.3g} s of {settings.type} for the stiffest mode of this drill")
 
 
-def _remedy(scene: Scene) -> str:
-    solver = scene.solver
-    if solver.type in STABLE_STEP_FACTOR:
-        limit = largest_stable_step_s(scene) or 0.0
-        if limit > 0 and solver.step_s > limit:
+def _remedy(simulation: Simulation) -> str:
+    settings = simulation.settings
+    if settings.type in STABLE_STEP_FACTOR:
+        limit = largest_stable_step_s(simulation) or 0.0
+        if limit > 0 and settings.step_s > limit:
             return f"try solver.step_s {0.5 * limit:.3g} (stability limit {limit:.3g} s)"
-        return f"try solver.type {SUGGESTED} with solver.step_s {0.5 * largest_stable_step_s(scene, SUGGESTED):.3g}"
-    return f"try solver.step_s {solver.step_s / 4:g} or solver.type {SUGGESTED}"
+        return (f"try solver.type {SUGGESTED} with solver.step_s "
+                f"{0.5 * largest_stable_step_s(simulation, SUGGESTED):.3g}")
+    return f"try solver.step_s {settings.step_s / 4:g} or solver.type {SUGGESTED}"
 
 
 def _energy_blow_up_index(result: SimulationResult) -> int | None:
@@ -91,8 +97,8 @@ def _energy_blow_up_index(result: SimulationResult) -> int | None:
     account = energy_account(result)
     work_in = np.maximum.accumulate(np.abs(account.impact_work_j) + np.abs(account.feed_work_j))
     created = -account.residual_j  # accounted - work in
-    scene = result.scene
-    blow_scale_j = impulse_per_blow_n_s(scene.impact) ** 2 / (2 * result.chain.bodies[result.chain.impact_body].mass_kg)
+    chain = result.chain
+    blow_scale_j = impulse_per_blow_n_s(result.scene.impact) ** 2 / (2 * chain.bodies[chain.impact_body].mass_kg)
     bad = created > 0.5 * work_in + blow_scale_j
     return int(np.argmax(bad)) if bad.any() else None
 
@@ -105,21 +111,20 @@ def diverged_index(position_m: np.ndarray, velocity_m_per_s: np.ndarray) -> int 
 
 
 def check_result(result: SimulationResult, solver_ok: bool, reached_s: float | None = None) -> None:
-    """Raise :class:`SimulationFailed` naming scene, solver, time and a remedy if the run is unusable.
-
-    ``reached_s`` is the solver's final time (default: the last stored sample)."""
-    scene, solver = result.scene, result.scene.solver
-    setting = f"solver {solver.type} with step_s {solver.step_s:g}"
+    """Raise :class:`SimulationFailed` naming scene, solver, time and a remedy if an Exudyn run is
+    unusable. ``reached_s`` is the solver's final time (default: the last stored sample)."""
+    simulation = result.simulation
+    settings = simulation.settings
+    setting = f"solver {settings.type} with step_s {settings.step_s:g}"
     index = diverged_index(result.position_m, result.velocity_m_per_s)
-    if index is None and "energy" in scene.needed_data():  # needs the force histories at every step
+    if index is None and "energy" in simulation.needed_data:  # needs the force histories at every step
         index = _energy_blow_up_index(result)
     if index is not None:
-        raise SimulationFailed(
-            f"scene '{scene.name}': {setting} diverged at t = {result.time_s[index]:.6g} s; {_remedy(scene)}"
-        )
+        raise SimulationFailed(f"scene '{simulation.name}': {setting} diverged at t = "
+                               f"{result.time_s[index]:.6g} s; {_remedy(simulation)}")
     reached = reached_s if reached_s is not None else (result.time_s[-1] if len(result.time_s) else 0.0)
-    if not solver_ok or reached < solver.end_time_s * (1 - 1e-9):
+    if not solver_ok or reached < settings.end_time_s * (1 - 1e-9):
         raise SimulationFailed(
-            f"scene '{scene.name}': {setting} stopped at t = {reached:.6g} s before end_time_s "
-            f"{solver.end_time_s:g}; {_remedy(scene)}"
+            f"scene '{simulation.name}': {setting} stopped at t = {reached:.6g} s before end_time_s "
+            f"{settings.end_time_s:g}; {_remedy(simulation)}"
         )

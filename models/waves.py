@@ -10,6 +10,7 @@ their peaks.
 from __future__ import annotations
 
 import numpy as np
+
 from rpdrill.models.results import SimulationResult
 
 

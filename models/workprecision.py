@@ -22,6 +22,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 
@@ -54,7 +55,7 @@ def uniform_grid_s(end_s: float, interval_s: float) -> np.ndarray:
 def signature(result: SimulationResult, grid_s: np.ndarray) -> Signature:
     """Reduce a run to its :class:`Signature` (the penetration rate only if the scene asks for it);
     x_n is taken at the scene's end time."""
-    metrics = summary_metrics(result) if "penetration_rate_m_per_s" in result.scene.outputs.metrics else {}
+    metrics = summary_metrics(result) if "penetration_rate_m_per_s" in result.simulation.outputs.metrics else {}
     return Signature(
         bottom_end_m=float(result.bottom_at(np.array([result.scene.solver.end_time_s]))[0]),
         penetration_rate_m_per_s=float(metrics.get("penetration_rate_m_per_s", math.nan)),

@@ -11,9 +11,10 @@ and the state:
 * the time-discrete state update of the Exudyn element, :meth:`RockLaw.return_map`, applied once
   per accepted step before the step; it also gives the state consistent with a static preload,
   ``return_map(x_bit0, initial_state())``;
-* the ODE side, a mode table: in each mode the states move at :meth:`RockLaw.state_rate`; a mode
-  is left at the first zero crossing of one of its :meth:`RockLaw.transitions`, and
-  :meth:`RockLaw.enter` gives the state at the start of the next mode;
+* the piecewise-linear declaration (:mod:`rocklaw.modes`) of a law that is linear between
+  switches: :meth:`RockLaw.modes` over the local variables ``position``, ``velocity``, the state
+  names and ``one``, and :meth:`RockLaw.initial_mode`. The ODE and the exact formulations
+  generate their events, state rates, resets and matrices from it;
 * energy: the rock stores F_spring^2 / (2 k_unload) and dissipates the plastic (crushing) work
   W_p = int F_spring d(x_n) (:meth:`RockLaw.plastic_work_j`).
 
@@ -23,18 +24,17 @@ Implementations: :class:`rocklaw.jenkins.JenkinsRock` (the paper's Eq. 1, 2) and
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
-from rpdrill.rocklaw.backends import NUMERIC, Backend
 from scipy.integrate import cumulative_trapezoid
 
+from rpdrill.rocklaw.backends import NUMERIC, Backend
+from rpdrill.rocklaw.modes import ModeTable
+
 State = tuple[float, ...]
-# g(bit position [m], bit velocity [m/s], state) whose zero crossing ends a mode
-EventFunction = Callable[[float, float, Sequence[float]], float]
-# (event function, crossing direction: +1 rising, -1 falling, next mode)
-Transition = tuple[EventFunction, int, str]
+POSITION, VELOCITY = "position", "velocity"  # the bit's local variables in a law's mode table
 
 
 @runtime_checkable
@@ -83,21 +83,19 @@ class RockLaw(Protocol):
         """Cumulative plastic work int F_spring d(x_n) [J] along sampled histories."""
         ...
 
-    def initial_mode(self, bit_position_m: float, bit_velocity_m_per_s: float, state: Sequence[float]) -> str:
-        """The ODE mode of a start in this state."""
+    def modes(self) -> ModeTable:
+        """The mode table (rocklaw.modes) over position, velocity, the states and one."""
         ...
 
-    def transitions(self, mode: str) -> list[Transition]:
-        """How ``mode`` is left: (event function, direction, next mode)."""
+    def initial_mode(self, values: Mapping[str, float]) -> str:
+        """The mode of a start at these values of position, velocity and the states."""
         ...
 
-    def state_rate(self, mode: str, bit_velocity_m_per_s: float) -> State:
-        """d(state)/dt in ``mode``."""
-        ...
 
-    def enter(self, mode: str, bit_position_m: float, state: State) -> State:
-        """The state at the start of a piece in ``mode`` (removes the event location's round-off)."""
-        ...
+def local_values(law: RockLaw, bit_position_m: float, bit_velocity_m_per_s: float,
+                 state: Sequence[float]) -> dict[str, float]:
+    """The law's local variables (position, velocity, states) as a mapping for its mode table."""
+    return {POSITION: bit_position_m, VELOCITY: bit_velocity_m_per_s, **dict(zip(law.state_names, state, strict=True))}
 
 
 def force_and_state(law: RockLaw, bit_position_m: float, bit_velocity_m_per_s: float,

@@ -20,7 +20,7 @@ rock stores F^2 / (2 k_u). k_u = k_l is an elastic rock (no indentation, ``crush
 This law has no rock damping: a viscous term would need its own rule for the contact and the
 clipping at zero force on each branch, and the bilinear studies model the losses by k_u > k_l.
 
-ODE modes:
+Modes (:meth:`BilinearRock.modes`):
 
 =========  ===================================================  ==========
 mode       leaves when                                           next mode
@@ -39,15 +39,18 @@ p' = (1 - k_l / k_u) v in ``loading``, 0 otherwise; s' = 0. An elastic rock (k_u
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
 from rpdrill.rocklaw.backends import NUMERIC, Backend
-from rpdrill.rocklaw.base import State, Transition, trapezoidal_plastic_work_j
+from rpdrill.rocklaw.base import POSITION, VELOCITY, State, trapezoidal_plastic_work_j
+from rpdrill.rocklaw.modes import Mode, ModeTable, Switch
 
 FREE, LOADING, UNLOADING = "free", "loading", "unloading"
+SURFACE, BOTTOM = "surface_m", "bottom_m"
 
 
 @dataclass(frozen=True)
@@ -58,7 +61,7 @@ class BilinearRock:
     unloading_stiffness_n_per_m: float
 
     name = "bilinear"
-    state_names = ("surface_m", "bottom_m")
+    state_names = (SURFACE, BOTTOM)
     bottom_index = 1
     threshold_n = math.inf
     damping_n_s_per_m = 0.0
@@ -109,41 +112,32 @@ class BilinearRock:
         """W_p = int F dp (trapezoidal; exact on the loading line, where F is linear in p)."""
         return trapezoidal_plastic_work_j(spring_force_n, bottom_m)
 
-    def initial_mode(self, bit_position_m: float, bit_velocity_m_per_s: float, state: Sequence[float]) -> str:
+    def modes(self) -> ModeTable:
+        """The mode table of the module docstring over position x, surface_m s, bottom_m p, velocity v
+        and one: F = k_l (x - s) while loading (p' = (1 - k_l / k_u) v; entered at p = s + (1 - k_l / k_u)
+        (x - s), the return map on the switching surface), k_u (x - p) while unloading, 0 free
+        (entered with s = p: the next blow loads afresh from the indentation)."""
+        k_l, k_u, ratio = self.loading_stiffness_n_per_m, self.unloading_stiffness_n_per_m, self.indentation_ratio
+        gap = {POSITION: 1.0, BOTTOM: -1.0}
+        loading_exit = Switch({VELOCITY: 1.0}, -1, UNLOADING) if self.crushes else Switch(gap, -1, FREE)
+        table = {
+            FREE: Mode({}, (Switch(gap, 1, LOADING),), entry={SURFACE: {BOTTOM: 1.0}}),
+            LOADING: Mode({POSITION: k_l, SURFACE: -k_l}, (loading_exit,),
+                          rates={BOTTOM: {VELOCITY: ratio}},
+                          entry={BOTTOM: {SURFACE: 1.0 - ratio, POSITION: ratio}}),
+        }
+        if self.crushes:
+            reload_margin = {POSITION: k_u - k_l, BOTTOM: -k_u, SURFACE: k_l}  # k_u (x - p) - k_l (x - s)
+            table[UNLOADING] = Mode({POSITION: k_u, BOTTOM: -k_u},
+                                    (Switch(reload_margin, 1, LOADING), Switch(gap, -1, FREE)))
+        return table
+
+    def initial_mode(self, values: Mapping[str, float]) -> str:
         """free off the rock; loading on the loading line (to round-off) unless moving out; else unloading."""
-        surface, bottom = state
-        if bit_position_m <= bottom:
+        x, surface, bottom = values[POSITION], values[SURFACE], values[BOTTOM]
+        if x <= bottom:
             return FREE
-        loading = self.loading_stiffness_n_per_m * (bit_position_m - surface)
-        unloading = self.unloading_stiffness_n_per_m * (bit_position_m - bottom)
+        loading = self.loading_stiffness_n_per_m * (x - surface)
+        unloading = self.unloading_stiffness_n_per_m * (x - bottom)
         on_loading_line = unloading >= loading * (1 - 1e-9)
-        return LOADING if not self.crushes or (on_loading_line and bit_velocity_m_per_s >= 0) else UNLOADING
-
-    def transitions(self, mode: str) -> list[Transition]:
-        """The mode table of the module docstring."""
-        k_l, k_u = self.loading_stiffness_n_per_m, self.unloading_stiffness_n_per_m
-
-        def gap(x: float, v: float, state: Sequence[float]) -> float:
-            return x - state[1]
-
-        def bit_velocity(x: float, v: float, state: Sequence[float]) -> float:
-            return v
-
-        def reload_margin(x: float, v: float, state: Sequence[float]) -> float:
-            return k_u * (x - state[1]) - k_l * (x - state[0])
-
-        return {
-            FREE: [(gap, 1, LOADING)],
-            LOADING: [(bit_velocity, -1, UNLOADING)] if self.crushes else [(gap, -1, FREE)],
-            UNLOADING: [(reload_margin, 1, LOADING), (gap, -1, FREE)],
-        }[mode]
-
-    def state_rate(self, mode: str, bit_velocity_m_per_s: float) -> State:
-        """(s', p') = (0, (1 - k_l / k_u) v) while loading, else (0, 0)."""
-        return (0.0, self.indentation_ratio * bit_velocity_m_per_s if mode == LOADING else 0.0)
-
-    def enter(self, mode: str, bit_position_m: float, state: State) -> State:
-        """free: s <- p (fully unloaded, whatever the event's round-off); otherwise the return map,
-        which puts p on the unloading line through the current point."""
-        bottom = state[1]
-        return (bottom, bottom) if mode == FREE else self.return_map(bit_position_m, state)
+        return LOADING if not self.crushes or (on_loading_line and values[VELOCITY] >= 0) else UNLOADING

@@ -16,6 +16,7 @@ import exudyn as exu
 import numpy as np
 from exudyn.advancedUtilities import CreateSymbolicUserFunction
 from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
+
 from rpdrill.rocklaw.backends import SCALAR, SymbolicBackend
 from rpdrill.rocklaw.base import RockLaw, State
 

@@ -14,7 +14,7 @@ Rock damping c_n (the paper's Eq. 4 writes c_n x_bit' in the bit equation) is of
 * ``always``: Eq. 4 taken literally, F = F_spring + c_n v at all times, also off the bottom
   and also pulling (for the cross-check against the paper's equations as printed).
 
-ODE modes (x_n' = x_bit' in ``crushing``, 0 otherwise):
+Modes (:meth:`JenkinsRock.modes`; x_n' = x_bit' in ``crushing``, 0 otherwise):
 
 =========  ==============================================  ==========
 mode       leaves when                                      next mode
@@ -29,23 +29,26 @@ clipped    d falls through 0                                free
 crushing   v falls through 0 (crushing ends)                contact
 =========  ==============================================  ==========
 
-With damping_mode ``always`` there is no ``clipped`` mode; an elastic rock (F_th infinite) has
-no ``crushing`` mode.
+With damping_mode ``always``, or without rock damping, there is no ``clipped`` mode (k_n d + c_n v
+= 0 is then d = 0); an elastic rock (F_th infinite) has no ``crushing`` mode.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+
 from rpdrill.rocklaw.backends import NUMERIC, Backend
-from rpdrill.rocklaw.base import State, Transition
+from rpdrill.rocklaw.base import POSITION, VELOCITY, State
+from rpdrill.rocklaw.modes import ONE, Mode, ModeTable, Switch
 
 DampingMode = Literal["contact", "always"]
 FREE, CONTACT, CLIPPED, CRUSHING = "free", "contact", "clipped", "crushing"
+BOTTOM = "bottom_m"
 
 
 @dataclass(frozen=True)
@@ -58,7 +61,7 @@ class JenkinsRock:
     damping_mode: DampingMode = "contact"
 
     name = "jenkins"
-    state_names = ("bottom_m",)
+    state_names = (BOTTOM,)
     bottom_index = 0
 
     def __post_init__(self) -> None:
@@ -115,49 +118,41 @@ class JenkinsRock:
         """W_p = F_th (x_n - x_n(0)): the bottom moves only while the spring carries F_th."""
         return (self.threshold_n if self.crushes else 0.0) * (bottom_m - bottom_m[0])
 
-    def initial_mode(self, bit_position_m: float, bit_velocity_m_per_s: float, state: Sequence[float]) -> str:
-        d, v = bit_position_m - state[0], bit_velocity_m_per_s
+    def modes(self) -> ModeTable:
+        """The mode table of the module docstring over position x, velocity v, bottom_m and one:
+        F_r rows k_n (x - x_n) + c_n v (contact), F_th + c_n v with x_n' = v (crushing; entered at
+        x_n = x - F_th / k_n, the return map on the switching surface), 0 (clipped; free unless the
+        damping acts ``always``)."""
+        k, c, threshold = self.stiffness_n_per_m, self.damping_n_s_per_m, self.threshold_n
+        penetration = {POSITION: 1.0, BOTTOM: -1.0}
+        total = {POSITION: k, BOTTOM: -k, VELOCITY: c}
+        contact_exits = [Switch(penetration, -1, FREE)]
+        if self.crushes:
+            contact_exits.append(Switch({POSITION: k, BOTTOM: -k, ONE: -threshold}, 1, CRUSHING))
+        if self._clips:
+            contact_exits.append(Switch(total, -1, CLIPPED))
+        table = {
+            FREE: Mode({VELOCITY: c} if self.damping_mode == "always" and c > 0 else {},
+                       (Switch(penetration, 1, CONTACT),)),
+            CONTACT: Mode(total, tuple(contact_exits)),
+        }
+        if self._clips:
+            table[CLIPPED] = Mode({}, (Switch(total, 1, CONTACT), Switch(penetration, -1, FREE)))
+        if self.crushes:
+            table[CRUSHING] = Mode({ONE: threshold, VELOCITY: c}, (Switch({VELOCITY: 1.0}, -1, CONTACT),),
+                                   rates={BOTTOM: {VELOCITY: 1.0}},
+                                   entry={BOTTOM: {POSITION: 1.0, ONE: -self.crushing_penetration_m}})
+        return table
+
+    def initial_mode(self, values: Mapping[str, float]) -> str:
+        d, v = values[POSITION] - values[BOTTOM], values[VELOCITY]
         if d <= 0:
             return FREE
-        if self.stiffness_n_per_m * d >= self.threshold_n and v > 0:
+        if self.crushes and self.stiffness_n_per_m * d >= self.threshold_n and v > 0:
             return CRUSHING
         return CLIPPED if self._clips and self.stiffness_n_per_m * d + self.damping_n_s_per_m * v <= 0 else CONTACT
 
     @property
     def _clips(self) -> bool:
-        return self.damping_mode == "contact"
-
-    def transitions(self, mode: str) -> list[Transition]:
-        """The mode table of the module docstring."""
-        k, c, threshold = self.stiffness_n_per_m, self.damping_n_s_per_m, self.threshold_n
-
-        def penetration(x: float, v: float, state: Sequence[float]) -> float:
-            return x - state[0]
-
-        def crushing_margin(x: float, v: float, state: Sequence[float]) -> float:
-            return k * (x - state[0]) - threshold
-
-        def total_force(x: float, v: float, state: Sequence[float]) -> float:
-            return k * (x - state[0]) + c * v
-
-        def bit_velocity(x: float, v: float, state: Sequence[float]) -> float:
-            return v
-
-        contact: list[Transition] = [(penetration, -1, FREE)]
-        contact += [(crushing_margin, 1, CRUSHING)] if self.crushes else []
-        contact += [(total_force, -1, CLIPPED)] if self._clips else []
-        return {
-            FREE: [(penetration, 1, CONTACT)],
-            CONTACT: contact,
-            CLIPPED: [(total_force, 1, CONTACT), (penetration, -1, FREE)],
-            CRUSHING: [(bit_velocity, -1, CONTACT)],
-        }[mode]
-
-    def state_rate(self, mode: str, bit_velocity_m_per_s: float) -> State:
-        """Eq. 2: x_n' = x_bit' while crushing, else 0."""
-        return (bit_velocity_m_per_s if mode == CRUSHING else 0.0,)
-
-    def enter(self, mode: str, bit_position_m: float, state: State) -> State:
-        """Crushing starts from the return map x_n <- max(x_n, x_bit - F_th / k_n), removing the event
-        location's round-off in d; other modes keep the state."""
-        return self.return_map(bit_position_m, state) if mode == CRUSHING else state
+        """Contact damping clips the total force at zero (only a damper can make it negative)."""
+        return self.damping_mode == "contact" and self.damping_n_s_per_m > 0

@@ -34,6 +34,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from tqdm import tqdm
+
 from rpdrill.models.workprecision import ERROR_LABELS, ERROR_MEASURES, Signature, errors, pareto_front
 from rpdrill.studies.accuracy import (
     AccuracyStudy,
@@ -45,7 +47,6 @@ from rpdrill.studies.accuracy import (
 from rpdrill.studies.outputs import write_json
 from rpdrill.studies.runners import select
 from rpdrill.studies.study_command import finished_rows, read_results, result_row, study_provenance
-from tqdm import tqdm
 
 PARAMETERS = ("family", "formulation", "solver", "setting", "value")
 STATUS = ("status", "error", "wall_time_s")
@@ -110,7 +111,7 @@ def reference_report(study: AccuracyStudy, reference: Signature, check: Signatur
                      rows: list[Row]) -> dict[str, Any]:
     """Both references, their agreement per measure and whether it is below the smallest plotted error."""
     report: dict[str, Any] = {
-        "reference": {"formulation": study.reference.formulation, **study.reference.settings,
+        "reference": {**study.reference.solver,
                       "cpu_time_s": reference.cpu_time_s, "bottom_end_m": reference.bottom_end_m,
                       "penetration_rate_m_per_s": reference.penetration_rate_m_per_s},
         "smallest_plotted_error": smallest_errors(rows),
@@ -118,8 +119,8 @@ def reference_report(study: AccuracyStudy, reference: Signature, check: Signatur
     if check is None or study.reference_check is None:
         return report
     agreement = errors(reference, check)
-    report["reference_check"] = {"formulation": study.reference_check.formulation,
-                                 **study.reference_check.settings, "cpu_time_s": check.cpu_time_s}
+    report["reference_check"] = {
+                                 **study.reference_check.solver, "cpu_time_s": check.cpu_time_s}
     report["agreement"] = agreement
     report["agreement_below_smallest_error"] = {
         m: bool(not math.isfinite(report["smallest_plotted_error"][m])
@@ -172,7 +173,7 @@ def _reference(study: AccuracyStudy, setting: Setting | None, what: str) -> Sign
         return None
     start = time.perf_counter()
     sig = reference_signature(study, setting)
-    print(f"{study.spec.name}: {what} {setting.formulation} {setting.settings or ''} "
+    print(f"{study.spec.name}: {what} {setting.solver} "
           f"({time.perf_counter() - start:.2f} s)", file=sys.stderr)
     return sig
 

@@ -21,7 +21,8 @@ from typing import Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
-from rpdrill.models.formulations import FORMULATIONS
+from scipy import optimize
+
 from rpdrill.models.outputs import METRICS
 from rpdrill.studies.loading import InputError, parse, read_yaml
 from rpdrill.studies.runners import Runner
@@ -29,12 +30,11 @@ from rpdrill.studies.study import (
     Axis,
     StrictSpec,
     base_scene_dict,
-    check_formulation,
     check_scene_path,
+    prepare_point,
     run_point,
     set_path,
 )
-from scipy import optimize
 
 FREQUENCY = "impact.frequency_hz"
 
@@ -57,7 +57,6 @@ class CalibrationSpec(StrictSpec):
     metric: str = "penetration_rate_m_per_s"
     targets: list[Target] = Field(min_length=1)
     method: Literal["nelder-mead", "differential-evolution"] = "nelder-mead"
-    formulation: Literal[tuple(FORMULATIONS)] = "exudyn"  # type: ignore[valid-type]
     max_evaluations: int = Field(40, ge=1)
 
     @model_validator(mode="after")
@@ -94,7 +93,6 @@ def load_calibration(path: str | Path) -> Calibration:
         if metric not in METRICS:
             raise InputError(f"{path}: {key}: {metric!r}: not a metric; allowed: {', '.join(METRICS)}")
     base = base_scene_dict(spec, path)
-    check_formulation(str(path), "formulation", spec.formulation, base)
     for key in spec.parameters:
         check_scene_path(str(path), "parameters", key, base)
     for i, target in enumerate(spec.targets):
@@ -124,7 +122,8 @@ def evaluate(calibration: Calibration, values: dict[str, float], runner: Runner)
     """Run every target's scan at these parameter values: optima and objective."""
     spec = calibration.spec
     metrics = [target.metric or spec.metric for target in spec.targets]
-    tasks = [((t, i), calibration.scene(values, target, f), [metrics[t]], spec.formulation)
+    tasks = [((t, i), prepare_point(str(calibration.source), {**calibration.scene(values, target, f),
+                                                               "outputs": {"metrics": [metrics[t]]}}, values))
              for t, target in enumerate(spec.targets) for i, f in enumerate(calibration.frequencies)]
     metric = {}
     for outcome in runner(run_point, tasks):

@@ -12,10 +12,11 @@ import sys
 from pathlib import Path
 
 import yaml
+from tqdm import tqdm
+
 from rpdrill.studies.calibrate import calibrate, load_calibration
 from rpdrill.studies.outputs import staged_directory, write_json
 from rpdrill.studies.runners import process_pool, sequential
-from tqdm import tqdm
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -22,12 +22,11 @@ import sys
 from pathlib import Path
 
 from rpdrill.models.compare import compare_runs, verdict
-from rpdrill.models.exudyn_model import simulate_exudyn
-from rpdrill.models.ode_model import ODE_METHODS, simulate_ode
+from rpdrill.models.formulations import ODE_METHODS
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.stability import SimulationFailed
-from rpdrill.studies.loading import load_scene, parse
+from rpdrill.studies.loading import load_scene, parse, prepare_scene
 from rpdrill.studies.outputs import staged_directory, write_json
 
 DEFAULT_STEP_S = 5e-6
@@ -50,13 +49,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--rtol", type=_positive, default=1e-10, help="ODE relative tolerance (default 1e-10)")
 
 
-def window_scene(scene: Scene, blows: int, step_s: float, source: str) -> Scene:
-    """The scene ending after ``blows`` periods, Exudyn at ``step_s``; InputError if that is invalid."""
-    data = scene.model_dump(by_alias=True)
+def window_scenes(scene: Scene, args: argparse.Namespace, source: str) -> tuple[Scene, Scene]:
+    """The scene ending after ``--blows`` periods as (Exudyn at ``--step`` with the scene's solver type,
+    the ODE with ``--method`` at ``--rtol``, absolute tolerance 1e-3 rtol); InputError if invalid."""
+    data = scene.model_dump(by_alias=True, exclude_none=True)
     data.pop("outputs", None)  # every output: the comparison needs forces and energies of every step
-    data["solver"].pop("preset", None)  # the resolved type and step are kept as explicit settings
-    data["solver"].update(end_time_s=blows * scene.impact.period_s, step_s=step_s)
-    return parse(Scene, data, f"{source} (cross-check: --blows {blows}, --step {step_s:g})")
+    window = {"end_time_s": args.blows * scene.impact.period_s, "output_interval_s": scene.solver.output_interval_s}
+    solvers = ({"formulation": "exudyn", "type": scene.solver.type or "rk44", "step_s": args.step},
+               {"formulation": "ode", "method": args.method, "relative_tolerance": args.rtol,
+                "absolute_tolerance": args.rtol * 1e-3})
+    where = f"{source} (cross-check: --blows {args.blows}, --step {args.step:g}, --rtol {args.rtol:g})"
+    return tuple(parse(Scene, {**data, "solver": {**window, **solver}}, where) for solver in solvers)
 
 
 def _table(report: dict, checks: dict) -> str:
@@ -99,23 +102,25 @@ def plot_overlay(ode: SimulationResult, exudyn: SimulationResult, title: str, pa
 
 
 def run(args: argparse.Namespace) -> int:
-    scene = window_scene(load_scene(args.scene), args.blows, args.step, args.scene)
+    exudyn_scene, ode_scene = window_scenes(load_scene(args.scene), args, args.scene)
+    scene = exudyn_scene
     try:
-        exudyn = simulate_exudyn(scene)
-        ode = simulate_ode(scene, method=args.method, rtol=args.rtol)
+        exudyn = prepare_scene(exudyn_scene, args.scene).run()
+        ode = prepare_scene(ode_scene, args.scene).run()
     except SimulationFailed as err:
         print(f"rpdrill: {err}", file=sys.stderr)
         return 1
     report = compare_runs(ode, exudyn, scene.solver.end_time_s)
     checks = verdict(report)
     passed = all(c["passed"] for c in checks.values())
-    print(f"{scene.name}: {args.blows} blows, exudyn {scene.solver.type} at {args.step:g} s, "
+    print(f"{scene.name}: {args.blows} blows, exudyn {exudyn.simulation.settings.type} at {args.step:g} s, "
           f"ode {args.method} at rtol {args.rtol:g} ({ode.info['mode_switches']} rock mode switches)")
     print(_table(report, checks))
     if args.out:
         with staged_directory(args.out) as stage:
             write_json(stage / "crosscheck.json", {"scene": scene.name, "blows": args.blows,
-                                                    "exudyn": {"solver": scene.solver.type, "step_s": args.step,
+                                                    "exudyn": {"solver": exudyn.simulation.settings.type,
+                                                               "step_s": args.step,
                                                                **exudyn.info},
                                                     "ode": ode.info, "checks": checks, "passed": passed, **report})
             plot_overlay(ode, exudyn, f"{scene.name}: first {args.blows} blows", stage / "crosscheck.png")

@@ -11,7 +11,9 @@ from typing import Any, TypeVar, get_args, get_origin
 
 import yaml
 from pydantic import BaseModel, ValidationError
+
 from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import SceneError, Simulation, prepare
 
 ModelT = TypeVar("ModelT", bound=BaseModel)
 
@@ -104,3 +106,12 @@ def parse(model: type[ModelT], data: Any, source: str, prefix: tuple[Any, ...] =
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file."""
     return parse(Scene, read_yaml(path), str(path))
+
+
+def prepare_scene(scene: Scene, source: str) -> Simulation:
+    """Prepare a validated scene for a run; InputError naming ``source``, the key path and the value
+    where it cannot run as given (models.simulation.SceneError)."""
+    try:
+        return prepare(scene)
+    except SceneError as err:
+        raise InputError(f"{source}: {'.'.join(err.location)}: {_short(err.value)}: {err}") from None

@@ -13,7 +13,6 @@ from typing import Any
 
 import numpy as np
 import yaml
-from pydantic import BaseModel
 
 
 @contextlib.contextmanager
@@ -41,6 +40,6 @@ def write_json(path: Path, data: Any) -> None:
     path.write_text(json.dumps(data, indent=2, sort_keys=False) + "\n", encoding="utf-8")
 
 
-def write_resolved(path: Path, model: BaseModel) -> None:
-    """Every key of a validated model, defaults filled in, as YAML."""
-    path.write_text(yaml.safe_dump(model.model_dump(mode="json", by_alias=True), sort_keys=False), encoding="utf-8")
+def write_resolved(path: Path, data: dict[str, Any]) -> None:
+    """A resolved scene (every value filled in) as YAML."""
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")

@@ -8,10 +8,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from rpdrill.models.exudyn_model import simulate_exudyn
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.stability import SimulationFailed
-from rpdrill.studies.loading import load_scene
+from rpdrill.studies.loading import load_scene, prepare_scene
 from rpdrill.studies.outputs import staged_directory, write_columns_csv, write_json, write_resolved
 from rpdrill.studies.plots import plot_timeseries
 from rpdrill.studies.progress import time_progress
@@ -28,9 +27,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
+    simulation = prepare_scene(scene, args.scene)
     try:
         with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
-            result = simulate_exudyn(scene, progress)
+            result = simulation.run(progress)
     except SimulationFailed as err:
         print(f"rpdrill: {err}", file=sys.stderr)
         return 1
@@ -40,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
         write_columns_csv(stage / "timeseries.csv", columns)
         write_json(stage / "summary.json", {"scene": scene.name, "formulation": result.formulation,
                                             "metrics": summary, "run": result.info})
-        write_resolved(stage / "scene.resolved.yaml", scene)
+        write_resolved(stage / "scene.resolved.yaml", simulation.resolved_scene())
         plot_timeseries(columns, f"{scene.name}: {scene.impact.frequency_hz:g} Hz, "
                         f"{scene.impact.amplitude_n / 1e3:g} kN", stage / "timeseries.png")
     shown = ", ".join(f"{name} {value:.4g}" for name, value in summary.items() if name in HEADLINE)

@@ -4,9 +4,12 @@ A study names a ``base_scene`` (a file relative to the study file, or an inline 
 optional ``base_overrides`` (dotted path -> value, each replacing what is at that path, e.g.
 ``solver.end_time_s: 1.5`` or ``rock: {name: sandstone}``), the ``scan`` axes, how they
 ``combine`` (``grid``, ``zip``, or a list of groups zipped inside and crossed with each
-other), the ``metrics`` to collect and the ``plots`` to draw. Every point is a plain scene dict
-(YAML types only) that validates as a :class:`~models.scene.Scene`; workers validate it and build
-the model themselves (Exudyn systems cannot be pickled). :func:`run_point` is the worker function.
+other), the ``metrics`` to collect and the ``plots`` to draw. Every point's scene is validated and
+prepared once, at load (models.simulation.prepare: the chain, the rock law, the solver settings,
+the initial state); workers receive the prepared simulation and build the formulation's model
+themselves (Exudyn systems cannot be pickled). The formulation is the scene's
+``solver.formulation`` (e.g. ``base_overrides: {solver.formulation: exact}``). :func:`run_point`
+is the worker function.
 
 Example (``studies/paper/stiffness_scan.yaml`` has the full file)::
 
@@ -42,10 +45,12 @@ from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
-from rpdrill.models.formulations import FORMULATIONS, unsupported
+
+from rpdrill.models.formulations import unsupported
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.outputs import METRICS
 from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import SceneError, Simulation, prepare
 from rpdrill.studies.loading import InputError, allowed_keys, parse, read_yaml
 
 METRIC_NAMES = tuple(METRICS)
@@ -146,20 +151,17 @@ class StudySpec(StrictSpec):
     scan: dict[str, Axis] = Field(min_length=1)
     combine: Literal["grid", "zip"] | list[list[str]] = "grid"
     metrics: list[MetricName] = Field(list(METRIC_NAMES), min_length=1)
-    formulation: Literal[tuple(FORMULATIONS)] = "exudyn"  # type: ignore[valid-type]
     plots: list[Plot] = []
     format: Literal["png", "svg", "pdf"] = "png"
 
 
 @dataclass(frozen=True)
 class Point:
-    """One scene of a study: its index, its scan parameters, the scene dict as written (base,
-    overrides, axis values: what workers validate) and as resolved (every value filled in)."""
+    """One scene of a study: its index, its scan parameters and the prepared simulation."""
 
     index: int
     parameters: dict[str, Any]
-    scene: dict[str, Any]
-    resolved: dict[str, Any]
+    simulation: Simulation
 
 
 @dataclass(frozen=True)
@@ -181,8 +183,7 @@ class Study:
     @property
     def hash(self) -> str:
         """SHA-256 of what determines the results: the point scenes and the collected metrics."""
-        content = {"points": [p.resolved for p in self.points], "metrics": list(self.spec.metrics),
-                   "formulation": self.spec.formulation}
+        content = {"points": [p.simulation.resolved_scene() for p in self.points], "metrics": list(self.spec.metrics)}
         return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
 
 
@@ -288,14 +289,21 @@ def base_scene_dict(spec: StudySpec, source: Path) -> dict[str, Any]:
     return data
 
 
-def check_formulation(source: str, key: str, formulation: str, scene_data: dict[str, Any]) -> None:
-    """InputError unless ``formulation`` can run the scene (the exact one: Jenkins law, linear links)."""
-    scene = Scene.model_validate(scene_data)
-    why = unsupported(formulation, scene)
+def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]) -> Simulation:
+    """Validate and prepare one point's scene; InputError naming the scan axis that made it invalid
+    (or the point), and when its formulation cannot run it."""
+    try:
+        simulation = prepare(Scene.model_validate(scene))
+    except ValidationError as error:
+        raise InputError("\n".join(_point_error(source, error, parameters))) from None
+    except SceneError as error:
+        where = ".".join(error.location)
+        raise InputError(f"{source}: scan point {parameters}: {where}: {error.value!r}: {error}") from None
+    formulation = simulation.settings.formulation
+    why = unsupported(formulation, simulation)
     if why:
-        others = ", ".join(f for f in FORMULATIONS if unsupported(f, scene) is None)
-        raise InputError(f"{source}: {key}: {formulation!r} cannot run the base scene: {why}; "
-                         f"allowed here: {others}")
+        raise InputError(f"{source}: solver.formulation: {formulation!r} cannot run scan point {parameters}: {why}")
+    return simulation
 
 
 def load_study(path: str | Path) -> Study:
@@ -303,7 +311,6 @@ def load_study(path: str | Path) -> Study:
     path = Path(path)
     spec = parse(StudySpec, read_yaml(path), str(path))
     base = base_scene_dict(spec, path)
-    check_formulation(str(path), "formulation", spec.formulation, base)
     for axis in spec.scan:
         check_scene_path(str(path), "scan", axis, base)
     axes = {name: axis.expand() for name, axis in spec.scan.items()}
@@ -314,10 +321,11 @@ def load_study(path: str | Path) -> Study:
         scene = copy.deepcopy(base)
         for name, value in parameters.items():
             set_path(scene, name, value)
+        scene["outputs"] = {"metrics": list(spec.metrics)}  # the model records only what these need
         try:
-            points.append(Point(index, parameters, scene, Scene.model_validate(scene).model_dump(mode="json", by_alias=True)))
-        except ValidationError as error:
-            problems += [line for line in _point_error(str(path), error, parameters) if line not in problems]
+            points.append(Point(index, parameters, prepare_point(str(path), scene, parameters)))
+        except InputError as error:
+            problems += [line for line in str(error).splitlines() if line not in problems]
     if problems:
         more = f"\n... and {len(problems) - 5} more" if len(problems) > 5 else ""
         raise InputError("\n".join(problems[:5]) + more)
@@ -334,16 +342,14 @@ def _check_rock_name_axis(spec: StudySpec, base: dict[str, Any], source: str) ->
                          "base_overrides: {rock: {name: sandstone}}")
 
 
-def run_point(task: tuple[int, dict[str, Any], list[str], str]) -> dict[str, Any]:
-    """Worker: simulate one point ``(index, scene dict, metric names, formulation)``; a failure is
-    returned, not raised."""
-    index, scene, names, formulation = task
+def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
+    """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics; a
+    failure is returned, not raised."""
+    key, simulation = task
     start = time.perf_counter()
-    try:  # ask the model for the collected metrics only: it then records only what they need
-        result = FORMULATIONS[formulation](Scene.model_validate({"outputs": {"metrics": names}} | scene))
-        metrics = summary_metrics(result)
+    try:
+        metrics = summary_metrics(simulation.run())
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
-        return {"point": index, "status": "failed", "error": f"{type(err).__name__}: {err}",
+        return {"point": key, "status": "failed", "error": f"{type(err).__name__}: {err}",
                 "wall_time_s": time.perf_counter() - start, "metrics": {}}
-    return {"point": index, "status": "ok", "error": "", "wall_time_s": time.perf_counter() - start,
-            "metrics": {name: metrics[name] for name in names}}
+    return {"point": key, "status": "ok", "error": "", "wall_time_s": time.perf_counter() - start, "metrics": metrics}

@@ -20,13 +20,13 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
-from rpdrill.models.scene import Scene
+from tqdm import tqdm
+
 from rpdrill.studies.loading import InputError
 from rpdrill.studies.outputs import write_json
 from rpdrill.studies.runners import select
 from rpdrill.studies.study import Point, Study, load_study, run_point
 from rpdrill.studies.study_plots import draw_plots
-from tqdm import tqdm
 
 STATUS_COLUMNS = ("status", "error", "wall_time_s")
 
@@ -52,7 +52,7 @@ def study_provenance(study: Study, out: Path) -> dict[str, Any]:
             raise InputError(f"{out}: holds results.csv but no study.json; use a new --out directory")
         return {"study": study.spec.name, "study_file": str(study.source), "hash": study.hash,
                 "rpdrill_version": importlib.metadata.version("rpdrill"), "exudyn_version": importlib.metadata.version("exudyn"),
-                "points": len(study.points), "solver": Scene.model_validate(study.base).solver.model_dump(), "resolved_study": study.resolved(),
+                "points": len(study.points), "resolved_study": study.resolved(),
                 "sessions": [], "point_wall_time_s": {}}
     provenance = json.loads(path.read_text(encoding="utf-8"))
     if provenance.get("hash") != study.hash:
@@ -104,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"{study.spec.name}: {len(study.points)} points, {len(done)} finished earlier, "
           f"running {len(todo)} on {label}", file=sys.stderr)
     start = time.perf_counter()
-    tasks = [(p.index, p.scene, list(study.spec.metrics), study.spec.formulation) for p in todo]
+    tasks = [(p.index, p.simulation) for p in todo]
     with results.open("a", newline="", encoding="utf-8") as handle, \
             tqdm(total=len(study.points), initial=len(done), desc=study.spec.name, unit="point",
                  disable=args.quiet) as bar:

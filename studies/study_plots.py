@@ -15,6 +15,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+
 from rpdrill.studies.study import Plot, Study
 
 Row = dict[str, str]

@@ -7,7 +7,10 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+
+from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import prepare
 
 PAPER_BASE = Path(__file__).resolve().parent / "test_drill.yaml"
 
@@ -40,3 +43,8 @@ def scene(**overrides: Any) -> Scene:
 
 def crushing_scene(**overrides: Any) -> Scene:
     return scene(**({k.replace(".", "__"): v for k, v in CRUSHING.items()} | overrides))
+
+
+def simulate(scene: Scene, formulation: str | None = None, **options: Any) -> SimulationResult:
+    """Run ``scene`` with ``formulation`` (default: the scene's) and solver ``options``."""
+    return prepare(scene.with_solver(formulation, **options)).run()

@@ -1,5 +1,5 @@
-"""Work-precision harness: measured convergence orders on a linear case against its matrix
-exponential, the Pareto front, and the ``rpdrill accuracy`` study end to end and on bad input."""
+"""Work-precision harness: measured convergence orders on a linear case against its exact solution,
+the Pareto front, and the ``rpdrill accuracy`` study end to end and on bad input."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 import yaml
-from rpdrill.models.exudyn_model import simulate_exudyn
-from rpdrill.models.linear_reference import linear_reference
+from scenes import PAPER_BASE, PER_BODY, scene_dict, simulate
+
 from rpdrill.models.scene import Scene
 from rpdrill.models.workprecision import (
     convergence_order,
@@ -24,7 +24,6 @@ from rpdrill.models.workprecision import (
 )
 from rpdrill.studies.accuracy import TimeLimitExceeded, cpu_time_limit
 from rpdrill.studies.cli import main
-from scenes import PAPER_BASE, PER_BODY, scene_dict
 
 END_S = 0.04  # two blows at 50 Hz
 GRID = uniform_grid_s(END_S, 1e-4)
@@ -45,8 +44,10 @@ def linear_scene(solver_type: str, step_s: float) -> Scene:
 
 @pytest.fixture(scope="module")
 def reference():
-    result = linear_reference(linear_scene("rk44", 1e-5), GRID)
-    assert result.info["min_penetration_m"] > 0  # the bit stays on the rock: the model is linear
+    result = simulate(linear_scene("rk44", 1e-5), "exact")
+    # the bit meets the rock at t = 0+ (from rest) and stays on it: the model is linear
+    assert all(t < 1e-9 for t in result.info["switch_times_s"])
+    assert result.bit_position_m[result.time_s > 0].min() > 0
     return signature(result, GRID)
 
 
@@ -61,7 +62,7 @@ def test_measured_order_of_fixed_step_solvers(reference, solver_type, order, ste
     for step in steps_s:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            run = simulate_exudyn(linear_scene(solver_type, step))
+            run = simulate(linear_scene(solver_type, step))
         measured.append(errors(reference, signature(run, GRID))["bit_velocity_rms_error_rel"])
     assert abs(convergence_order(steps_s, measured) - order) < 0.3, measured
 
@@ -87,13 +88,13 @@ def write_study(path: Path, **changes) -> Path:
         "base_overrides": {"metrics": {"transient_blows": 1, "block_blows": 2}},
         "blows": 3,
         "repeats": 1,
-        "reference": {"formulation": "exact"},
-        "reference_check": {"formulation": "ode", "method": "DOP853", "rtol": 1e-11},
+        "reference": {"solver": {"formulation": "exact"}},
+        "reference_check": {"solver": {"formulation": "ode", "method": "DOP853", "relative_tolerance": 1e-11}},
         "families": [
-            {"label": "rk44", "formulation": "exudyn", "solver": {"type": "rk44"}, "sweep": {"step_s": [2e-5, 1e-5]}},
-            {"label": "midpoint", "formulation": "exudyn", "solver": {"type": "explicit_midpoint"},
+            {"label": "rk44", "solver": {"formulation": "exudyn", "type": "rk44"}, "sweep": {"step_s": [2e-5, 1e-5]}},
+            {"label": "midpoint", "solver": {"formulation": "exudyn", "type": "explicit_midpoint"},
              "sweep": {"step_s": [1e-4]}},  # far beyond its stability limit: diverges
-            {"label": "DOP853", "formulation": "ode", "sweep": {"rtol": [1e-5]}},
+            {"label": "DOP853", "solver": {"formulation": "ode"}, "sweep": {"relative_tolerance": [1e-5]}},
         ],
     }
     study.update(changes)
@@ -126,12 +127,14 @@ def test_accuracy_study_end_to_end(tmp_path):
 
 @pytest.mark.parametrize("changes, expected", [
     ({"blows": 0}, "blows"),
-    ({"families": [{"label": "x", "formulation": "ode", "solver": {"method": "RK45"}, "sweep": {"rtol": [1e-3]}}]},
-     "method: 'RK45'"),
-    ({"families": [{"label": "x", "formulation": "exudyn", "solver": {"type": "rk5"}, "sweep": {"step_s": [1e-5]}}]},
+    ({"families": [{"label": "x", "solver": {"formulation": "ode", "method": "RK45"},
+                    "sweep": {"relative_tolerance": [1e-3]}}]}, "solver.method: 'RK45'"),
+    ({"families": [{"label": "x", "solver": {"formulation": "exudyn", "type": "rk5"}, "sweep": {"step_s": [1e-5]}}]},
      "solver.type"),
-    ({"families": [{"label": "x", "formulation": "exudyn", "sweep": {"step_s": [1e-5], "preset": ["fast"]}}]},
+    ({"families": [{"label": "x", "solver": {"formulation": "exudyn"}, "sweep": {"step_s": [1e-5], "preset": ["fast"]}}]},
      "families.0.sweep"),
+    ({"families": [{"label": "x", "solver": {"formulation": "exact"}, "sweep": {"step_s": [1e-5]}}]},
+     "a key of formulation 'exudyn', not of 'exact'"),
 ])
 def test_bad_input_exits_2(tmp_path, capsys, changes, expected):
     study = write_study(tmp_path / "bad.yaml", **changes)

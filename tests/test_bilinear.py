@@ -6,15 +6,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import yaml
+from scenes import scene, scene_dict, simulate
+
 from rpdrill.models.compare import compare_runs, verdict
 from rpdrill.models.energy import energy_account
-from rpdrill.models.exudyn_model import simulate_exudyn
 from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.ode_model import simulate_ode
+from rpdrill.models.simulation import prepare
 from rpdrill.rocklaw import BilinearRock, force_and_state
 from rpdrill.studies.cli import main
 from rpdrill.studies.crosscheck import DEFAULT_STEP_S
-from scenes import scene, scene_dict
 
 K_LOAD, K_UNLOAD = 2e8, 1e9
 LAW = BilinearRock(K_LOAD, K_UNLOAD)
@@ -89,11 +89,11 @@ def test_invalid_and_elastic_parameters():
 
 
 def test_scene_builds_the_law_and_its_effects():
-    s = scene(rock=ROCK)
-    assert s.rock_law() == LAW and not s.effects.rock_damping and s.effects.rock_plasticity
-    assert s.rock_law().name == "bilinear"
-    elastic = scene(rock=ROCK, effects={"joint_damping": True}, outputs={"metrics": ["bit_velocity_peak_m_per_s"]})
-    assert not elastic.effects.rock_plasticity and elastic.rock_law() == BilinearRock(K_LOAD, K_LOAD)
+    s = prepare(scene(rock=ROCK))
+    assert s.rock == LAW and not s.effects.rock_damping and s.effects.rock_plasticity
+    assert s.rock.name == "bilinear"
+    elastic = prepare(scene(rock=ROCK, effects={"joint_damping": True}, outputs={"metrics": ["bit_velocity_peak_m_per_s"]}))
+    assert not elastic.effects.rock_plasticity and elastic.rock == BilinearRock(K_LOAD, K_LOAD)
     with pytest.raises(ValueError, match="has no rock damping"):
         scene(rock=ROCK, effects={"rock_damping": True})
 
@@ -128,7 +128,7 @@ def window(**overrides: object):
 @pytest.fixture(scope="module", params=["rest", "preloaded"])
 def runs(request):
     s = window(start=request.param)
-    return simulate_ode(s), simulate_exudyn(s)
+    return simulate(s, "ode", preset="reference"), simulate(s)
 
 
 def test_exudyn_agrees_with_ode(runs):

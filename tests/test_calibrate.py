@@ -5,9 +5,10 @@ import json
 import numpy as np
 import pytest
 import yaml
+from scenes import PAPER_BASE
+
 from rpdrill.studies.calibrate import load_calibration, optimum_hz
 from rpdrill.studies.cli import main
-from scenes import PAPER_BASE
 
 
 def test_parabola_vertex_recovers_a_peak_between_scan_points():

@@ -6,8 +6,9 @@ import sys
 
 import pytest
 import yaml
-from rpdrill.studies.cli import main
 from scenes import scene_dict
+
+from rpdrill.studies.cli import main
 
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}
 

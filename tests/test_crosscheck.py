@@ -11,13 +11,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scenes import PAPER_BASE, PER_BODY, scene_dict, simulate
+
 from rpdrill.models.compare import compare_runs, verdict
-from rpdrill.models.exudyn_model import simulate_exudyn
-from rpdrill.models.ode_model import simulate_ode
 from rpdrill.models.scene import Scene
 from rpdrill.studies.cli import main
 from rpdrill.studies.crosscheck import DEFAULT_STEP_S
-from scenes import PAPER_BASE, PER_BODY, scene_dict
 
 BLOWS = 15
 LIFT_OFF_M = 1e-9  # a gap below this (round-off of the start from rest, ~1e-19 m) is no lift-off
@@ -56,7 +55,7 @@ CASES = {
 def test_exudyn_agrees_with_ode(case: str) -> None:
     changes, crushes, lifts_off = CASES[case]
     scene = scene_from_base(**changes)
-    ode, exudyn = simulate_ode(scene), simulate_exudyn(scene)
+    ode, exudyn = simulate(scene, "ode", preset="reference"), simulate(scene)
     report = compare_runs(ode, exudyn, scene.solver.end_time_s)
     checks = verdict(report)
     assert all(c["passed"] for c in checks.values()), checks

@@ -10,16 +10,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 from pydantic import ValidationError
-from rpdrill.models.chain import axial_chain, initial_positions_m, link_load_n
+from scenes import scene, scene_dict, simulate
+
+from rpdrill.models.chain import axial_chain, link_load_n
 from rpdrill.models.energy import energy_account
-from rpdrill.models.exudyn_model import simulate_exudyn
-from rpdrill.models.links import Coupling
+from rpdrill.models.links import RATE, STRETCH, Coupling, Link
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import prepare
 from rpdrill.models.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.rocklaw.modes import check_mode_forces
 from rpdrill.studies.cli import main
 from rpdrill.studies.loading import load_scene, read_yaml
-from scenes import scene, scene_dict
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 ROD = {"length_m": 3.66, "diameter_m": 0.045, "bore_diameter_m": 0.012}
@@ -86,7 +88,7 @@ def test_bad_drill_strings_are_refused_with_the_reason(change, message):
 
 def test_collar_metrics_need_a_collar():
     s = rod_string()
-    assert "collar_velocity_peak_m_per_s" not in s.outputs.metrics  # left out of the default outputs
+    assert "collar_velocity_peak_m_per_s" not in prepare(s).outputs.metrics  # left out of the default outputs
     with pytest.raises(ValidationError, match="need a body named collar"):
         Scene.model_validate({**s.model_dump(by_alias=True, exclude={"effects", "outputs"}),
                               "outputs": {"metrics": ["collar_velocity_peak_m_per_s"]}})
@@ -94,7 +96,8 @@ def test_collar_metrics_need_a_collar():
 
 def test_preloaded_string_with_couplings_is_in_static_equilibrium():
     s = rod_string(segments=3).model_copy(update={"start": "preloaded"})
-    chain, q0 = axial_chain(s), initial_positions_m(s)
+    prepared = prepare(s)
+    chain, q0 = prepared.chain, prepared.initial_positions_m
     rock = np.zeros(chain.size)
     rock[chain.bit_body] = s.rock.stiffness_n_per_m * q0[chain.bit_body]
     residual = chain.constant_forces() + link_load_n(chain, q0, np.zeros_like(q0)) - rock
@@ -105,11 +108,11 @@ def test_preloaded_string_with_couplings_is_in_static_equilibrium():
 @pytest.fixture(scope="module")
 def four_rod_run():
     s = load_scene(SCENES / "four_rod_string.yaml")
-    return simulate_exudyn(s.model_copy(update={"solver": s.solver.model_copy(update={"end_time_s": 0.3})}))
+    return simulate(s.model_copy(update={"solver": s.solver.model_copy(update={"end_time_s": 0.3})}))
 
 
 def test_paper_scene_and_four_rod_string_run_through_the_same_builder(four_rod_run):
-    paper = simulate_exudyn(load_scene(SCENES / "paper_base.yaml"))
+    paper = simulate(load_scene(SCENES / "paper_base.yaml"))
     for run, bodies in ((paper, 4), (four_rod_run, 1 + 1 + 4 * 4 + 1)):
         assert run.position_m.shape[1] == bodies
         metrics = summary_metrics(run)
@@ -119,7 +122,7 @@ def test_paper_scene_and_four_rod_string_run_through_the_same_builder(four_rod_r
 
 
 def test_couplings_never_pull_and_do_open():
-    run = simulate_exudyn(rod_string(segments=2))
+    run = simulate(rod_string(segments=2))
     chain = run.chain
     couplings = [i for i, link in enumerate(chain.links) if isinstance(link, Coupling)]
     stretch, rate = chain.link_stretch(run.position_m), chain.link_stretch(run.velocity_m_per_s)
@@ -132,7 +135,7 @@ def test_couplings_never_pull_and_do_open():
 def wave_run(segments: int):
     data = read_yaml(SCENES / "wave_rod.yaml")
     data["drill_string"]["bodies"]["rod"]["segments"] = segments
-    return simulate_exudyn(Scene.model_validate(data))
+    return simulate(Scene.model_validate(data))
 
 
 def test_stress_wave_converges_and_travels_at_the_bar_speed():
@@ -155,3 +158,15 @@ def test_resolved_scene_uses_the_scene_file_keys(tmp_path):
     resolved = (out / "scene.resolved.yaml").read_text()
     assert "from: carriage" in resolved and "from_body" not in resolved
     assert load_scene(out / "scene.resolved.yaml").drill_string == load_scene(SCENES / "four_rod_string.yaml").drill_string
+
+
+@pytest.mark.parametrize("link", [Link("bonded", 0, 1, 2e9, 1e3), Coupling("tight", 0, 1, 2e9, 0.0),
+                                  Coupling("damped", 0, 1, 2e9, 1e4), Coupling("play", 0, 1, 2e9, 1e4, gap_m=1e-4)],
+                         ids=lambda link: link.name)
+def test_declared_link_modes_agree_with_the_closed_form(link):
+    """Each connector type's mode rows (the exact and ODE formulations) equal its closed-form force
+    (the Exudyn user function) in whatever mode a state lies, and the samples visit every mode."""
+    rng = np.random.default_rng(2)
+    samples = [{STRETCH: s, RATE: r} for s, r in zip(rng.uniform(-3e-4, 1e-4, 400), rng.uniform(-20.0, 20.0, 400))]
+    assert check_mode_forces(link, samples, lambda v: link.force_n(v[STRETCH], v[RATE])) == []
+    assert {link.initial_mode(v) for v in samples} == set(link.modes())

@@ -3,10 +3,12 @@
 import numpy as np
 import pytest
 import yaml
-from rpdrill.models.exudyn_model import build_exudyn, simulate_exudyn
+from scenes import CRUSHING, scene, scene_dict, simulate
+
+from rpdrill.models.exudyn_model import build_exudyn
 from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.simulation import prepare
 from rpdrill.studies.cli import main
-from scenes import CRUSHING, scene, scene_dict
 
 SHORT = {"solver__end_time_s": 0.25, "metrics__transient_blows": 3, "metrics__block_blows": 4}
 CRUSH = {k.replace(".", "__"): v for k, v in CRUSHING.items()}
@@ -16,24 +18,25 @@ RATE_ONLY = {"effects": {"rock_damping": True, "joint_damping": True},
 
 
 def test_full_model_when_no_effects_section():
-    s = scene()
+    s = prepare(scene())
     assert s.effects.torsion and s.effects.rock_damping and s.effects.rock_plasticity and s.effects.joint_damping
     assert "full model" in s.effects.reasons["torsion"]
-    assert "rock_force_n" in s.outputs.timeseries and "energy" in s.needed_data()
+    assert "rock_force_n" in s.outputs.timeseries and "energy" in s.needed_data
 
 
 def test_rate_only_scene_drops_torsion_sensors_and_storage():
-    full, lean = build_exudyn(scene(**CRUSH)), build_exudyn(scene(**CRUSH, **RATE_ONLY))
+    full, lean = build_exudyn(prepare(scene(**CRUSH))), build_exudyn(prepare(scene(**CRUSH, **RATE_ONLY)))
     assert (full.coordinate_count, lean.coordinate_count) == (5, 4)
     assert set(full.sensors) - set(lean.sensors) == {"rock", "impact", "phi", "omega"}
-    assert lean.settings.solution.sensors.writePeriod == lean.scene.solver.output_interval_s
+    assert lean.settings.solution.sensors.writePeriod == lean.simulation.settings.output_interval_s
     assert full.settings.solution.sensors.writePeriod == 0.0  # energy needs every step
-    assert lean.scene.effects.rock_plasticity and "needed by outputs" in lean.scene.effects.reasons["rock_plasticity"]
+    effects = lean.simulation.effects
+    assert effects.rock_plasticity and "needed by outputs" in effects.reasons["rock_plasticity"]
 
 
 def test_dropping_decoupled_or_unused_parts_leaves_axial_results_unchanged():
-    full = simulate_exudyn(scene(**CRUSH, **SHORT))
-    lean = simulate_exudyn(scene(**CRUSH, **SHORT, **RATE_ONLY))
+    full = simulate(scene(**CRUSH, **SHORT))
+    lean = simulate(scene(**CRUSH, **SHORT, **RATE_ONLY))
     assert full.torsion_angle_rad is not None and lean.torsion_angle_rad is None
     rate_full = summary_metrics(full)["penetration_rate_m_per_s"]
     rate_lean = summary_metrics(lean)["penetration_rate_m_per_s"]
@@ -43,7 +46,7 @@ def test_dropping_decoupled_or_unused_parts_leaves_axial_results_unchanged():
 
 
 def test_an_output_pulls_in_its_effect():
-    s = scene(effects={}, outputs={"timeseries": ["torsion_angle_rad"]})
+    s = prepare(scene(effects={}, outputs={"timeseries": ["torsion_angle_rad"]}))
     assert s.effects.torsion and s.effects.reasons["torsion"] == "needed by outputs: torsion_angle_rad"
     assert not s.effects.rock_damping and s.effects.reasons["rock_damping"] == "not asked for"
     assert not s.effects.rock_plasticity  # nothing asked for the penetration
@@ -65,14 +68,14 @@ def test_torsion_needs_its_section():
 def test_elastic_rock_without_plasticity_never_crushes():
     s = scene(**CRUSH, **SHORT, effects={"rock_damping": True, "joint_damping": True},
               outputs={"timeseries": ["rock_force_n"]})
-    r = simulate_exudyn(s)
-    assert not s.effects.rock_plasticity and not s.rock_law().crushes
+    r = simulate(s)
+    assert not r.simulation.effects.rock_plasticity and not r.simulation.rock.crushes
     assert np.all(r.bottom_m == 0.0)
     assert r.rock_force_n.max() > s.rock.threshold_n  # no cap without the slider
 
 
 def test_rock_damping_off_removes_the_term():
-    law = scene(effects={"rock_plasticity": True}).rock_law()
+    law = prepare(scene(effects={"rock_plasticity": True})).rock
     assert law.damping_n_s_per_m == 0.0 and law.force(1e-5, 3.0, law.initial_state()) == law.force(1e-5, 0.0, law.initial_state())
 
 
@@ -89,12 +92,10 @@ def test_resolved_scene_lists_effects_and_reasons(tmp_path):
 
 def test_ode_and_exact_formulations_follow_the_same_switches():
     """Like with like: without torsion, rock damping and plasticity, all three build the same model."""
-    from rpdrill.models.exact_model import simulate_exact
-    from rpdrill.models.ode_model import simulate_ode
-
+        
     lean = scene(**CRUSH, solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2,
                  effects={"joint_damping": True}, outputs={"timeseries": ["rock_force_n"]})
-    runs = {"exudyn": simulate_exudyn(lean), "ode": simulate_ode(lean, rtol=1e-9), "exact": simulate_exact(lean)}
+    runs = {"exudyn": simulate(lean), "ode": simulate(lean, "ode", relative_tolerance=1e-9), "exact": simulate(lean, "exact")}
     for result in runs.values():
         assert result.torsion_angle_rad is None and np.all(result.bottom_m == 0.0)
         assert result.rock_force_n.max() > lean.rock.threshold_n  # no slider: the spring is not capped

@@ -7,13 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from scenes import scene_dict, simulate
+
 from rpdrill.models.compare import compare_bottom_at, compare_histories
 from rpdrill.models.energy import energy_account
-from rpdrill.models.exudyn_model import simulate_exudyn
 from rpdrill.models.links import LINK_TYPES
-from rpdrill.models.ode_model import simulate_ode
 from rpdrill.models.scene import Scene
-from scenes import scene_dict
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "extending.md"
 SHORT = {"solver.end_time_s": 0.2, "metrics.transient_blows": 3, "metrics.block_blows": 3,
@@ -40,7 +39,7 @@ def _scene(joint_type, **joint) -> Scene:
 
 
 def test_joint_with_play_transmits_nothing_inside_its_play_and_keeps_the_energy_balance(joint_type):
-    run = simulate_exudyn(_scene(joint_type))
+    run = simulate(_scene(joint_type))
     chain = run.chain
     i = next(k for k, link in enumerate(chain.links) if link.name == "collar_bit_joint")
     link = chain.links[i]
@@ -60,13 +59,13 @@ def test_exudyn_agrees_with_the_ode_formulation_on_the_new_type(joint_type):
     s = Scene.model_validate(s.model_dump(by_alias=True, exclude={"effects", "outputs"}) | {
         "solver": {"type": "rk44", "step_s": 1e-6, "end_time_s": 0.045},
         "metrics": {"transient_blows": 0, "block_blows": 2}})
-    ode, exudyn = simulate_ode(s, rtol=1e-10, atol=1e-13), simulate_exudyn(s)
+    ode, exudyn = simulate(s, "ode", relative_tolerance=1e-10, absolute_tolerance=1e-13), simulate(s)
     velocity = compare_histories(ode, exudyn, 0.044)["bit_velocity_m_per_s"]["max_rel_to_range"]
     assert velocity < 2e-3  # measured 6.4e-4
     assert compare_bottom_at(ode, exudyn, 0.044)["rel"] < 1e-5  # measured 2e-7
 
 
 def test_zero_play_reproduces_the_bonded_joint(joint_type):
-    played = simulate_exudyn(_scene(joint_type, gap_m=0.0))
-    bonded = simulate_exudyn(_scene(joint_type, type="spring_damper", gap_m=None))
+    played = simulate(_scene(joint_type, gap_m=0.0))
+    bonded = simulate(_scene(joint_type, type="spring_damper", gap_m=None))
     np.testing.assert_allclose(played.bottom_m, bonded.bottom_m, rtol=0, atol=1e-12)

@@ -4,10 +4,13 @@ import warnings
 
 import numpy as np
 import pytest
+from scenes import PER_BODY, crushing_scene, scene, simulate
+
+from rpdrill.models import exudyn_model
 from rpdrill.models.energy import energy_account
-from rpdrill.models.exudyn_model import build_exudyn, simulate_exudyn
+from rpdrill.models.exudyn_model import build_exudyn
 from rpdrill.models.metrics import summary_metrics
-from scenes import PER_BODY, crushing_scene, scene
+from rpdrill.models.simulation import prepare
 
 SHORT = {"solver__end_time_s": 0.3, "metrics__transient_blows": 4, "metrics__block_blows": 3}
 PER_BODY_KW = {k.replace(".", "__"): v for k, v in PER_BODY.items()}
@@ -15,7 +18,7 @@ PER_BODY_KW = {k.replace(".", "__"): v for k, v in PER_BODY.items()}
 
 @pytest.fixture(scope="module")
 def crushing_run():
-    return simulate_exudyn(crushing_scene(**SHORT))
+    return simulate(crushing_scene(**SHORT))
 
 
 @pytest.mark.parametrize(
@@ -28,19 +31,19 @@ def crushing_run():
     ],
 )
 def test_coordinate_count(overrides, coordinates):
-    assert build_exudyn(scene(**overrides)).coordinate_count == coordinates
+    assert build_exudyn(prepare(scene(**overrides))).coordinate_count == coordinates
 
 
 def test_no_deprecation_warnings():
     with warnings.catch_warnings():
         warnings.simplefilter("error", DeprecationWarning)
-        simulate_exudyn(scene(solver__end_time_s=0.2, metrics__transient_blows=2, metrics__block_blows=2))
+        simulate(scene(solver__end_time_s=0.2, metrics__transient_blows=2, metrics__block_blows=2))
 
 
 def test_bottom_is_return_mapping_of_bit_path(crushing_run):
     """x_n at every step is the running max of x_bit - F_th/k_n (Eq. 2 with per-step return mapping)."""
     r = crushing_run
-    law = r.scene.rock_law()
+    law = r.simulation.rock
     expected = np.maximum.accumulate(np.maximum(r.bit_position_m - law.crushing_penetration_m, 0.0))
     np.testing.assert_allclose(r.bottom_m, expected, rtol=0, atol=1e-15)
     advancing_blows = np.unique(np.floor(r.time_s[np.diff(r.bottom_m, prepend=0.0) > 0] * r.scene.impact.frequency_hz))
@@ -49,7 +52,7 @@ def test_bottom_is_return_mapping_of_bit_path(crushing_run):
 
 def test_rock_force_never_pulls_and_is_capped(crushing_run):
     r = crushing_run
-    law = r.scene.rock_law()
+    law = r.simulation.rock
     assert r.rock_force_n.min() >= 0.0
     # spring part capped at F_th; the rest is the rock damper c_n v
     cap = law.threshold_n + law.damping_n_s_per_m * np.maximum(r.bit_velocity_m_per_s, 0.0)
@@ -60,7 +63,7 @@ def test_rock_force_never_pulls_and_is_capped(crushing_run):
 
 def test_symbolic_and_python_user_functions_agree():
     s = crushing_scene(solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2)
-    symbolic, python = simulate_exudyn(s), simulate_exudyn(s, symbolic=False)
+    symbolic, python = simulate(s), exudyn_model.simulate(s, symbolic=False)
     np.testing.assert_allclose(symbolic.position_m, python.position_m, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(symbolic.bottom_m, python.bottom_m, rtol=1e-12, atol=1e-15)
 
@@ -68,7 +71,7 @@ def test_symbolic_and_python_user_functions_agree():
 def test_energy_balance_within_one_percent_and_shrinking_with_step():
     errors = []
     for step in (2e-5, 1e-5, 5e-6):
-        account = energy_account(simulate_exudyn(crushing_scene(solver__step_s=step, **SHORT)))
+        account = energy_account(simulate(crushing_scene(solver__step_s=step, **SHORT)))
         assert account.crushing_work_j[-1] > 0.1 * account.impact_work_j[-1]
         errors.append(account.relative_residual())
     assert errors[0] < 0.01
@@ -78,10 +81,10 @@ def test_energy_balance_within_one_percent_and_shrinking_with_step():
 def test_carriage_carries_the_feed_and_anchored_absorber_takes_it_up():
     """Carriage: the shock absorber passes the feed force on (mean over the last blows ~ F_feed).
     Anchored to ground: k1 x_shank grows with depth and takes over the feed of the bodies."""
-    carriage = simulate_exudyn(crushing_scene(**SHORT))
-    anchored = simulate_exudyn(crushing_scene(**PER_BODY_KW, feed__force_n=10e3, **SHORT))
+    carriage = simulate(crushing_scene(**SHORT))
+    anchored = simulate(crushing_scene(**PER_BODY_KW, feed__force_n=10e3, **SHORT))
     for r in (carriage, anchored):
-        assert r.bottom_m[-1] > 2 * r.scene.rock_law().crushing_penetration_m  # both crushed
+        assert r.bottom_m[-1] > 2 * r.simulation.rock.crushing_penetration_m  # both crushed
     k1 = carriage.scene.drill_string.connectors["shock_absorber"].stiffness_n_per_m
     last = carriage.time_s > carriage.time_s[-1] - 3 * carriage.scene.impact.period_s
     shank, rig = carriage.chain.index("shank"), carriage.chain.index("carriage")
@@ -114,18 +117,16 @@ def test_resampled_output_grid(crushing_run):
 
 
 def test_preloaded_start_is_the_static_equilibrium_and_all_formulations_use_it():
-    from rpdrill.models.chain import axial_chain, initial_positions_m
-    from rpdrill.models.exact_model import simulate_exact
-
     s = crushing_scene(start="preloaded", solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2)
-    chain, q0 = axial_chain(s), initial_positions_m(s)
+    prepared = prepare(s)
+    chain, q0 = prepared.chain, prepared.initial_positions_m
     rock_force = s.rock.stiffness_n_per_m * q0[chain.bit_body]
     assert 0 < rock_force < s.rock.threshold_n
     residual = chain.stiffness_matrix() @ q0 - chain.constant_forces()
     residual[chain.bit_body] += rock_force
     np.testing.assert_allclose(residual, 0.0, atol=1e-6 * s.feed.force_n)  # K q0 + F_rock = F_feed
     assert rock_force == pytest.approx(s.feed.force_n)  # the carriage's feed rests on the rock
-    exudyn, exact = simulate_exudyn(s), simulate_exact(s)
+    exudyn, exact = simulate(s), simulate(s, "exact")
     np.testing.assert_allclose(exudyn.position_m[0], q0)
     np.testing.assert_allclose(exact.position_m[0], q0)
     assert exudyn.bottom_m[-1] == pytest.approx(exact.bottom_m[-1], rel=1e-3)
@@ -134,4 +135,4 @@ def test_preloaded_start_is_the_static_equilibrium_and_all_formulations_use_it()
 
 def test_preload_that_would_crush_is_refused():
     with pytest.raises(ValueError, match="static feed alone crushes the rock"):
-        scene(start="preloaded", feed__force_n=200e3)
+        prepare(scene(start="preloaded", feed__force_n=200e3))

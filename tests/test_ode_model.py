@@ -10,12 +10,12 @@ import sys
 import numpy as np
 import pytest
 import yaml
+from scenes import PAPER_BASE, simulate
+
 from rpdrill.models import ode_model
 from rpdrill.models.energy import energy_account
-from rpdrill.models.ode_model import simulate_ode
 from rpdrill.models.scene import Scene
 from rpdrill.models.stability import SimulationFailed
-from scenes import PAPER_BASE
 
 
 def scene_from_base(blows: float = 15, **changes: object) -> Scene:
@@ -37,7 +37,7 @@ CASES = {
 
 @functools.cache
 def result(case: str):
-    return simulate_ode(scene_from_base(**CASES[case]))
+    return simulate(scene_from_base(**CASES[case]), "ode", preset="reference")
 
 
 def test_does_not_import_exudyn() -> None:
@@ -74,7 +74,7 @@ def test_crushing_runs_at_threshold_and_lift_off_without_crushing() -> None:
     r = result("crushing_contact")
     crushing = np.diff(r.bottom_m) > 0
     assert r.bottom_m[-1] > 1e-4 and r.info["switches_into"]["crushing"] > 5
-    spring = r.scene.rock_law().spring_force(r.bit_position_m, r.rock_states())
+    spring = r.simulation.rock.spring_force(r.bit_position_m, r.rock_states())
     np.testing.assert_allclose(spring[1:][crushing], r.scene.rock.threshold_n, rtol=1e-9)
     lift = result("lift_off_no_crushing")
     assert lift.bottom_m.max() == 0.0 and "crushing" not in lift.info["switches_into"]
@@ -95,8 +95,8 @@ def _one_blow(**changes: object) -> Scene:
 @pytest.mark.parametrize("method", ["Radau", "LSODA"])
 def test_methods_agree_with_dop853(method: str) -> None:
     scene = _one_blow(**{"rock.threshold_n": 60e3})
-    reference = simulate_ode(scene)
-    other = simulate_ode(scene, method=method, rtol=1e-9, atol=1e-12)
+    reference = simulate(scene, "ode", preset="reference")
+    other = simulate(scene, "ode", method=method, relative_tolerance=1e-9, absolute_tolerance=1e-12)
     assert other.info["mode_switches"] == reference.info["mode_switches"]
     assert other.bottom_m[-1] == pytest.approx(reference.bottom_m[-1], rel=1e-5)
     v = np.interp(reference.time_s, other.time_s, other.bit_velocity_m_per_s)
@@ -105,7 +105,7 @@ def test_methods_agree_with_dop853(method: str) -> None:
 
 def test_rectangular_pulse_is_evaluated_on_each_side_of_its_switches() -> None:
     scene = _one_blow(**{"impact.shape": "rectangular"})
-    r = simulate_ode(scene)
+    r = simulate(scene, "ode", preset="reference")
     on = r.time_s < scene.impact.duration_s * (1 - 1e-9)
     assert np.all(r.impact_force_n[on] == scene.impact.amplitude_n)
     assert np.all(r.impact_force_n[r.time_s > scene.impact.duration_s * (1 + 1e-9)] == 0.0)
@@ -113,7 +113,7 @@ def test_rectangular_pulse_is_evaluated_on_each_side_of_its_switches() -> None:
 
 def test_unknown_method_is_rejected() -> None:
     with pytest.raises(ValueError, match="RK45"):
-        simulate_ode(_one_blow(), method="RK45")
+        simulate(_one_blow(), "ode", preset="reference", method="RK45")
 
 
 def test_solver_failure_raises_simulation_failed(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -126,4 +126,4 @@ def test_solver_failure_raises_simulation_failed(monkeypatch: pytest.MonkeyPatch
 
     monkeypatch.setattr(ode_model, "solve_ivp", failing)
     with pytest.raises(SimulationFailed, match="ODE solver DOP853 failed"):
-        simulate_ode(_one_blow())
+        simulate(_one_blow(), "ode", preset="reference")

@@ -5,7 +5,10 @@ import math
 
 import numpy as np
 import pytest
+
 from rpdrill.rocklaw import LAWS, TABLE_1, BilinearRock, JenkinsRock, RockLaw, force_and_state
+from rpdrill.rocklaw.base import local_values
+from rpdrill.rocklaw.modes import check_mode_forces, evaluate
 
 ROCK = JenkinsRock(stiffness_n_per_m=5e8, damping_n_s_per_m=0.0, threshold_n=138e3)
 CRUSH = ROCK.crushing_penetration_m  # 276 um
@@ -98,20 +101,25 @@ def test_return_map_is_idempotent_and_gives_the_preload_state(name):
 
 
 def follow_modes(law: RockLaw, time_s: np.ndarray, path_m: np.ndarray) -> np.ndarray:
-    """The law's ODE side along a prescribed path: states integrated at ``state_rate`` of the mode,
-    modes switched where an event function crosses zero in its direction (first order in the step)."""
+    """The law's mode table (rocklaw.modes) along a prescribed path: states integrated at the mode's
+    rates, modes switched where an exit surface crosses zero in its direction, entry values applied
+    (the bottom never decreasing); first order in the step."""
     velocity = np.gradient(path_m, time_s)
+    table, names, bottom = law.modes(), law.state_names, law.bottom_index
     state = np.array(law.initial_state())
-    mode = law.initial_mode(path_m[0], velocity[0], state)
+    mode = law.initial_mode(local_values(law, path_m[0], velocity[0], state))
     states = [state]
     for i in range(len(time_s) - 1):
-        state = state + np.array(law.state_rate(mode, velocity[i])) * (time_s[i + 1] - time_s[i])
-        for event, direction, following in law.transitions(mode):
-            before = event(path_m[i], velocity[i], states[-1])
-            after = event(path_m[i + 1], velocity[i + 1], state)
-            if direction * before <= 0 < direction * after:
-                mode = following
-                state = np.array(law.enter(mode, path_m[i + 1], tuple(state)))
+        values = local_values(law, path_m[i], velocity[i], state)
+        state = state + np.array([evaluate(table[mode].rates.get(name, {}), values) for name in names]) \
+            * (time_s[i + 1] - time_s[i])
+        before, after = values, local_values(law, path_m[i + 1], velocity[i + 1], state)
+        for switch in table[mode].exits:
+            if switch.direction * evaluate(switch.surface, before) <= 0 < switch.direction * evaluate(switch.surface, after):
+                mode = switch.next_mode
+                entry = {name: evaluate(row, after) for name, row in table[mode].entry.items()}
+                state = np.array([entry.get(name, value) for name, value in zip(names, state, strict=True)])
+                state[bottom] = max(state[bottom], after[names[bottom]])
                 break
         states.append(state)
     return np.array(states)
@@ -119,7 +127,7 @@ def follow_modes(law: RockLaw, time_s: np.ndarray, path_m: np.ndarray) -> np.nda
 
 @pytest.mark.parametrize("name", ["jenkins", "jenkins_damped", "jenkins_elastic", "bilinear", "bilinear_elastic"])
 def test_mode_table_reproduces_the_return_map(name):
-    """Integrating the mode table's state rates and switching at its events follows the return map."""
+    """Integrating the mode table's state rates and switching at its exits follows the return map."""
     law = LAW_CASES[name]
     time_s = np.linspace(0.0, 6.0, 30001)
     path = blows(2e-4, points=len(time_s))
@@ -129,6 +137,25 @@ def test_mode_table_reproduces_the_return_map(name):
     assert np.max(np.abs(followed[:, bottom] - mapped[:, bottom])) < 1e-3 * max(mapped[-1, bottom], CRUSH)
     forces = law.spring_force(path, tuple(followed.T)), law.spring_force(path, tuple(mapped.T))
     assert np.max(np.abs(forces[0] - forces[1])) < 5e-3 * np.max(forces[1])
+
+
+@pytest.mark.parametrize("name", sorted(LAW_CASES))
+def test_declared_force_rows_agree_with_the_closed_form(name):
+    """In whatever mode a state lies (initial_mode), the mode's force row equals the closed-form force
+    that Exudyn records: the two descriptions of a law cannot drift apart."""
+    law = LAW_CASES[name]
+    rng = np.random.default_rng(1)
+    scale = max(CRUSH, 1e-4)
+    samples = []
+    for _ in range(400):  # reachable states: the return map along a few random positions
+        state = law.initial_state()
+        for x in rng.uniform(-scale, 3 * scale, 4):
+            state = law.return_map(x, state)
+        samples.append(local_values(law, x, rng.uniform(-5.0, 5.0), state))
+    problems = check_mode_forces(law, samples, lambda v: law.force(
+        v["position"], v["velocity"], [v[n] for n in law.state_names]))
+    assert problems == []
+    assert {law.initial_mode(v) for v in samples} == set(law.modes())  # the samples visit every mode
 
 
 @pytest.mark.parametrize("mode", ["contact", "always"])
@@ -162,6 +189,7 @@ def test_symbolic_recording_matches_numeric_in_every_branch(name):
     set through the element (off, elastic, crushing; bilinear loading, unloading, reloading)."""
     import exudyn as exu
     from exudyn.itemInterface import MarkerNodeCoordinate, Node1D, NodePointGround, ObjectMass1D
+
     from rpdrill.rocklaw.exudyn_element import ExudynRockContact
 
     law = LAW_CASES[name]

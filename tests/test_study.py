@@ -14,12 +14,12 @@ from pathlib import Path
 
 import pytest
 import yaml
-from rpdrill.models.exudyn_model import simulate_exudyn
+from scenes import PAPER_BASE, simulate
+
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.studies.cli import main
 from rpdrill.studies.study import METRIC_NAMES, load_study, run_point
-from scenes import PAPER_BASE
 
 ROOT = Path(__file__).resolve().parents[1]
 SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}
@@ -65,7 +65,8 @@ def test_axes_expand_and_combine(tmp_path):
     assert study.axes["impact.frequency_hz"] == [40.0, 45.0, 50.0]
     assert study.axes["rock.stiffness_n_per_m"] == pytest.approx([1e8, 1e8 * 10**0.5, 1e9])
     assert len(study.points) == 9
-    assert {(p.scene["rock"]["stiffness_n_per_m"], p.scene["rock"]["damping_n_s_per_m"]) for p in study.points} \
+    assert {(p.simulation.scene.rock.stiffness_n_per_m, p.simulation.scene.rock.damping_n_s_per_m)
+            for p in study.points} \
         == set(zip(study.axes["rock.stiffness_n_per_m"], [1e3, 2e3, 3e3]))
 
 
@@ -74,12 +75,13 @@ def test_axes_expand_and_combine(tmp_path):
 def test_paper_studies_expand(name, count):
     study = load_study(ROOT / "studies" / "paper" / f"{name}.yaml")
     assert len(study.points) == count
-    assert study.points[0].scene["impact"]["frequency_hz"] == 10.0
+    assert study.points[0].simulation.scene.impact.frequency_hz == 10.0
 
 
 def test_rock_name_axis_supplies_rock_values():
     study = load_study(ROOT / "studies" / "paper" / "rock_table.yaml")
-    rocks = {p.resolved["rock"]["name"]: p.resolved["rock"]["stiffness_n_per_m"] for p in study.points}
+    rocks = {p.simulation.scene.rock.name: p.simulation.resolved_scene()["rock"]["stiffness_n_per_m"]
+             for p in study.points}
     assert rocks == {"conglomerate": 8.4e8, "sandstone": 5.1e8, "soft_limestone": 2.1e8}
 
 
@@ -87,14 +89,14 @@ def test_points_run_on_a_base_scene_with_default_solver(tmp_path):
     base = {key: value for key, value in yaml.safe_load(PAPER_BASE.read_text()).items() if key != "solver"}
     study = load_study(write_study(tmp_path / "s.yaml", base_scene=base, scan={"impact.frequency_hz": [40]},
                                    base_overrides=SHORT, plots=[]))
-    outcome = run_point((0, study.points[0].scene, ["bit_velocity_peak_m_per_s"], "exudyn"))
+    outcome = run_point((0, study.points[0].simulation))
     assert outcome["status"] == "ok", outcome["error"]
 
 
 def test_metric_names_are_those_of_summary_metrics():
     scene = Scene.model_validate({**yaml.safe_load(PAPER_BASE.read_text()), "metrics": SHORT["metrics"],
                                   "solver": {"end_time_s": 0.1}})
-    assert set(summary_metrics(simulate_exudyn(scene))) == set(METRIC_NAMES)
+    assert set(summary_metrics(simulate(scene))) == set(METRIC_NAMES)
 
 
 def test_study_end_to_end(small_run):
@@ -109,7 +111,7 @@ def test_study_end_to_end(small_run):
     assert provenance["hash"] == load_study(study).hash
     assert provenance["exudyn_version"] and provenance["rpdrill_version"]
     assert provenance["resolved_study"]["base_scene"]["rock"]["threshold_n"] == 138e3
-    assert provenance["solver"]["end_time_s"] == 0.15
+    assert provenance["resolved_study"]["base_scene"]["solver"]["end_time_s"] == 0.15
     assert len(provenance["point_wall_time_s"]) == 4
     assert len(list(out.glob("*.png"))) == 2
 
@@ -187,9 +189,8 @@ def test_dask_local_cluster(tmp_path):
      "plots.0.x: 'rock.threshold_n': not a scan axis"),
     ({"scan": {"drill_string.bodies.colar.mass_kg": [2e3]}, "plots": []},
      "scan.drill_string.bodies.colar.mass_kg: 'colar' is not in the base scene's drill_string.bodies"),
-    ({"formulation": "exact", "base_overrides": {**SHORT, "rock": {"law": "bilinear", "loading_stiffness_n_per_m": 2e8,
-                                                                   "unloading_stiffness_n_per_m": 1e9}}},
-     "formulation: 'exact' cannot run the base scene: rock law 'bilinear'"),
+    ({"base_overrides": {**SHORT, "solver.method": "DOP853"}},
+     "solver.method: 'DOP853': a key of formulation 'ode', not of 'exudyn'"),
 ])
 def test_bad_input_exits_2_naming_file_and_key(tmp_path, capsys, changes, expected):
     study = write_study(tmp_path / "bad.yaml", **changes)
@@ -203,9 +204,9 @@ def test_exact_formulation_as_the_fast_path_agrees_with_exudyn(tmp_path):
     """The same crushing points with formulation exact and exudyn (standard preset, 0.3 % stated)."""
     rates = {}
     for formulation in ("exudyn", "exact"):
-        study = write_study(tmp_path / f"{formulation}.yaml", formulation=formulation, plots=[],
-                            scan={"impact.frequency_hz": [45, 50]},
-                            base_overrides={"solver.end_time_s": 0.4, "impact.amplitude_n": 400e3,
+        study = write_study(tmp_path / f"{formulation}.yaml", plots=[], scan={"impact.frequency_hz": [45, 50]},
+                            base_overrides={"solver": {"formulation": formulation, "end_time_s": 0.4},
+                                            "impact.amplitude_n": 400e3,
                                             "metrics": {"transient_blows": 5, "block_blows": 5}})
         out = tmp_path / formulation
         assert main(["study", str(study), "--out", str(out), "--workers", "1", "--quiet"]) == 0

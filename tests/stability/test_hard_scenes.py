@@ -7,18 +7,19 @@ import functools
 
 import numpy as np
 import pytest
-from rpdrill.models.exudyn_model import simulate_exudyn
+from scenes import scene_dict, simulate
+
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import SOLVER_PRESETS, Scene
+from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import prepare
+from rpdrill.models.solver_settings import EXUDYN_PRESETS
 from rpdrill.models.stability import (
     STABLE_STEP_FACTOR,
     SimulationFailed,
     StepLimitWarning,
     largest_stable_step_s,
 )
-from scenes import scene_dict
-
 from stability.hard_scenes import HARD_SCENES, LONG_RUN, SHORT
 
 
@@ -30,7 +31,7 @@ def make(overrides: dict, solver: dict) -> Scene:
 
 @functools.cache
 def run(name: str, preset: str) -> tuple[SimulationResult, dict]:
-    result = simulate_exudyn(make(HARD_SCENES[name], {"preset": preset}))
+    result = simulate(make(HARD_SCENES[name], {"preset": preset}))
     return result, summary_metrics(result)
 
 
@@ -45,12 +46,12 @@ def rate_error(metrics: dict, reference: dict) -> float:
     return abs(metrics["penetration_rate_m_per_s"] - ref) / max(abs(ref), 1e-9)
 
 
-@pytest.mark.parametrize("preset", list(SOLVER_PRESETS))
+@pytest.mark.parametrize("preset", list(EXUDYN_PRESETS))
 @pytest.mark.parametrize("name", list(HARD_SCENES))
 def test_preset_is_stable_and_within_its_stated_errors(name, preset):
     result, metrics = run(name, preset)
     assert_physical(result)
-    stated = SOLVER_PRESETS[preset]
+    stated = EXUDYN_PRESETS[preset]
     assert metrics["energy_balance_relative_error"] <= stated["energy_balance_error"]
     if preset != "reference":
         assert rate_error(metrics, run(name, "reference")[1]) <= stated["penetration_rate_error"]
@@ -60,8 +61,8 @@ def test_preset_is_stable_and_within_its_stated_errors(name, preset):
 @pytest.mark.parametrize("name", list(HARD_SCENES))
 def test_fixed_step_at_documented_limit_stays_stable(name, solver):
     base = make(HARD_SCENES[name], {"preset": "standard"})
-    step = min(largest_stable_step_s(base, solver), base.impact.duration_s / 5, base.impact.period_s / 20)
-    result = simulate_exudyn(make(HARD_SCENES[name], {"type": solver, "step_s": step}))
+    step = min(largest_stable_step_s(prepare(base), solver), base.impact.duration_s / 5, base.impact.period_s / 20)
+    result = simulate(make(HARD_SCENES[name], {"type": solver, "step_s": step}))
     assert_physical(result)
 
 
@@ -79,21 +80,21 @@ def test_crushing_scenes_do_crush(name):
 
 @pytest.mark.slow
 def test_long_run_650_blows():
-    results = {p: simulate_exudyn(make(LONG_RUN, {"preset": p})) for p in ("fast", "standard")}
+    results = {p: simulate(make(LONG_RUN, {"preset": p})) for p in ("fast", "standard")}
     for result in results.values():
         assert_physical(result)
         assert result.time_s[-1] * result.scene.impact.frequency_hz >= 650
     fast, standard = (summary_metrics(results[p]) for p in ("fast", "standard"))
-    assert standard["energy_balance_relative_error"] <= SOLVER_PRESETS["standard"]["energy_balance_error"]
-    assert rate_error(fast, standard) <= SOLVER_PRESETS["fast"]["penetration_rate_error"]
+    assert standard["energy_balance_relative_error"] <= EXUDYN_PRESETS["standard"]["energy_balance_error"]
+    assert rate_error(fast, standard) <= EXUDYN_PRESETS["fast"]["penetration_rate_error"]
 
 
 def test_unstable_step_is_reported_with_time_and_remedy():
-    limit = largest_stable_step_s(make(HARD_SCENES["no_damping"], {"preset": "standard"}), "rk44")
+    limit = largest_stable_step_s(prepare(make(HARD_SCENES["no_damping"], {"preset": "standard"})), "rk44")
     scene = make(HARD_SCENES["no_damping"], {"type": "rk44", "step_s": 1.5 * limit})
     with pytest.warns(StepLimitWarning, match="exceeds the stability limit"), \
             pytest.raises(SimulationFailed) as failure:
-        simulate_exudyn(scene)
+        simulate(scene)
     message = str(failure.value)
     assert "diverged at t =" in message and "rk44" in message and "try solver.step_s" in message
 
@@ -104,5 +105,5 @@ def test_automatic_step_at_its_minimum_is_reported_not_returned():
     scene = make(HARD_SCENES["stiffest_rock_stiff_joints"],
                  {"type": "dopri5", "step_s": 1e-4, "relative_tolerance": 1e-9, "absolute_tolerance": 1e-12})
     with pytest.raises(SimulationFailed, match="reached the minimum step") as failure:
-        simulate_exudyn(scene)
+        simulate(scene)
     assert "try relative_tolerance" in str(failure.value)

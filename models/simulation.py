@@ -1,0 +1,118 @@
+"""One scene prepared for a run: everything a formulation needs, resolved once.
+
+:func:`prepare` turns a validated :class:`~rpdrill.models.scene.Scene` (data only) into a
+:class:`Simulation`: the effects built and why, the outputs asked for, the axial chain, the rock law
+as built, the solver settings of the scene's formulation (an accuracy preset resolved into a step
+or tolerances), and the initial state (rest, or the static preload). Every formulation, the metrics,
+the energy account and the stability checks read these fields; nothing derives them again.
+:meth:`Simulation.run` dispatches through the formulation registry (models.formulations).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from rpdrill.models.chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
+from rpdrill.models.formulations import simulate
+from rpdrill.models.outputs import needs
+from rpdrill.models.scene import (
+    BuiltEffects,
+    Impact,
+    Outputs,
+    Scene,
+    Torsion,
+    built_effects,
+    requested_outputs,
+)
+from rpdrill.models.solver_settings import Settings, resolve_settings
+from rpdrill.models.stability import spectral_radius_per_s
+from rpdrill.rocklaw import RockLaw, State
+
+if TYPE_CHECKING:
+    from rpdrill.models.results import SimulationResult
+
+
+class SceneError(ValueError):
+    """A scene that validates but cannot be run as given: names the key path and its value."""
+
+    def __init__(self, location: tuple[str, ...], value: Any, message: str) -> None:
+        super().__init__(message)
+        self.location, self.value = location, value
+
+
+@dataclass(frozen=True)
+class Simulation:
+    """A scene prepared for a run (module doc)."""
+
+    scene: Scene
+    effects: BuiltEffects
+    outputs: Outputs
+    chain: AxialChain
+    rock: RockLaw
+    settings: Settings
+    initial_positions_m: np.ndarray
+    initial_rock_state: State
+    initial_torsion_angle_rad: float
+    spectral_radius_per_s: float | None  # |lambda|_max with the bit on the rock (Exudyn runs only)
+
+    @property
+    def name(self) -> str:
+        return self.scene.name
+
+    @property
+    def impact(self) -> Impact:
+        return self.scene.impact
+
+    @property
+    def torsion(self) -> Torsion | None:
+        """The torsion line when its effect is built."""
+        return self.scene.torsion if self.effects.torsion else None
+
+    @property
+    def needed_data(self) -> frozenset[str]:
+        """What must be recorded for the requested outputs: ``forces``, ``energy``."""
+        return needs(self.outputs.metrics, self.outputs.timeseries).data
+
+    def run(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
+        """Simulate with the scene's formulation; ``progress(t)`` as simulated time advances."""
+        return simulate(self, progress)
+
+    def resolved_scene(self) -> dict[str, Any]:
+        """The scene as run: rock values filled in, the effects built and why, the outputs, and the
+        solver settings of the formulation (a preset resolved)."""
+        data = self.scene.model_dump(mode="json", by_alias=True, exclude_none=True)
+        data["rock"] = self.scene.rock.completed().model_dump(mode="json", exclude_none=True)
+        data["effects"] = {**self.effects.as_dict(), "reasons": dict(self.effects.reasons)}
+        data["outputs"] = self.outputs.model_dump(mode="json")
+        data["solver"] = {key: value for key, value in vars(self.settings).items() if value is not None}
+        return data
+
+
+def prepare(scene: Scene) -> Simulation:
+    """Resolve ``scene`` for a run (module doc); SceneError where it cannot run as given."""
+    effects = built_effects(scene)
+    outputs = requested_outputs(scene, effects)
+    chain = axial_chain(scene, joint_damping=effects.joint_damping)
+    rock = scene.rock.build(damping=effects.rock_damping, plasticity=effects.rock_plasticity)
+    radius = spectral_radius_per_s(chain, rock) if scene.solver.formulation == "exudyn" else None
+    settings = resolve_settings(scene.solver, scene.impact.duration_s, lambda: radius,
+                                "energy" in needs(outputs.metrics, outputs.timeseries).data)
+    positions, angle = np.zeros(chain.size), 0.0
+    if scene.start == "preloaded":
+        try:
+            positions = static_preload_m(chain, rock)
+        except ValueError as err:
+            raise SceneError(("start",), scene.start, str(err)) from None
+        if effects.torsion:
+            angle = static_torsion_angle_rad(scene.torsion)
+    state = rock.return_map(float(positions[chain.bit_body]), rock.initial_state())
+    return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, radius)
+
+
+def as_simulation(run: Scene | Simulation) -> Simulation:
+    """A prepared simulation (a scene is prepared here)."""
+    return run if isinstance(run, Simulation) else prepare(run)
