@@ -1,176 +1,223 @@
-"""Calibration: fit scene parameters within bounds so that scans put their optima where wanted.
+"""Calibration: fit scene parameters within bounds so that scans put their main-lobe optima where
+the paper does.
 
-A calibration file names a base scene (as a study does), the ``parameters`` to fit (dotted scene
-path -> [lower, upper]), the frequency axis scanned for every target, the ``metric`` whose
-maximum is the optimum, and the ``targets``: scene overrides (e.g. an impulse or a rock) with
-the optimum frequency the paper reports. Each evaluation runs every target's scan on the
-runner; the optimum of a scan is the vertex of the parabola through the best point and its
-neighbours. The objective is sum(((f_opt - f_target) / f_target)^2), a scan with no positive
-metric counting as a relative miss of 1. SciPy's bounded Nelder-Mead (or differential
-evolution) minimises it over the parameters scaled to [0, 1].
+An evaluation of a parameter set runs every target's frequency scan (studies.calibration_spec)
+and finds each scan's main-lobe optimum (studies.optima, main lobe chosen by the rock-mode
+resonance estimate of studies.resonance). Its objective is
+
+    J = sum_t w_t m_t^2 + rising_weight sum_(a before b) max(0, f_a - f_b) / f_b*,
+
+m_t = (f_t - f_t*) / f_t* the relative miss of target t (1 when its metric is nowhere positive),
+the second sum over neighbouring labels of each ``rising`` list, f* the paper's optima. SciPy's
+differential evolution (vectorized: a whole population's scans go to the runner together) or
+bounded Nelder-Mead minimise J over the unit cube. Every evaluation is recorded as it finishes
+(studies.calibration_log) and replayed on a rerun. The best parameter set is then scanned once
+more with points every ``refine_hz`` around its optima, for the report.
 """
 
 from __future__ import annotations
 
 import copy
+import itertools
+import json
 import math
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any, Literal
+import time
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from typing import Any
 
 import numpy as np
-from pydantic import Field, model_validator
 from scipy import optimize
 
-from rpdrill.models.outputs import METRICS
-from rpdrill.studies.loading import InputError, parse, read_yaml
+from rpdrill.models.modal import rock_mode_frequency_hz
+from rpdrill.studies.calibration_log import EvaluationLog, Record, unit_key
+from rpdrill.studies.calibration_spec import FREQUENCY, Calibration
+from rpdrill.studies.loading import InputError
+from rpdrill.studies.optima import curve_optimum
 from rpdrill.studies.runners import Runner
-from rpdrill.studies.study import (
-    Axis,
-    StrictSpec,
-    base_scene_dict,
-    check_scene_path,
-    prepare_point,
-    run_point,
-    set_path,
-)
+from rpdrill.studies.study import prepare_point, run_point, set_path
 
-FREQUENCY = "impact.frequency_hz"
+# (key, scene dict, metric, frequencies)
+ScanTask = tuple[Any, dict[str, Any], str, list[float]]
+Progress = Callable[[Record, bool], None]  # (record, replayed)
 
 
-class Target(StrictSpec):
-    """One scan: overrides on the base scene, where its optimum should be [Hz], and the metric
-    whose maximum is that optimum (default: the calibration's ``metric``)."""
-
-    overrides: dict[str, Any] = Field(default_factory=dict)
-    optimum_hz: float = Field(gt=0)
-    metric: str | None = None
-
-
-class CalibrationSpec(StrictSpec):
-    name: str
-    base_scene: str | dict[str, Any]
-    base_overrides: dict[str, Any] = Field(default_factory=dict)
-    parameters: dict[str, tuple[float, float]] = Field(min_length=1)
-    frequency_hz: Axis
-    metric: str = "penetration_rate_m_per_s"
-    targets: list[Target] = Field(min_length=1)
-    method: Literal["nelder-mead", "differential-evolution"] = "nelder-mead"
-    max_evaluations: int = Field(40, ge=1)
-
-    @model_validator(mode="after")
-    def _bounds(self) -> CalibrationSpec:
-        for path, (lower, upper) in self.parameters.items():
-            if not lower < upper:
-                raise ValueError(f"parameters.{path}: lower bound {lower} must be below upper bound {upper}")
-        return self
+def scan_target(task: ScanTask) -> dict[str, Any]:
+    """Worker: one target's scan, the metric at every frequency (NaN where a run failed; failures
+    are counted, not raised), the scene's rock-mode frequency (None if it has none) and CPU seconds."""
+    key, scene, metric, frequencies = task
+    start = time.process_time()
+    values, errors, resonance = [], [], None
+    for frequency in frequencies:
+        try:
+            simulation = prepare_point("calibration scan", {**set_frequency(scene, frequency),
+                                                            "outputs": {"metrics": [metric]}}, {})
+        except InputError as error:
+            values.append(math.nan)
+            errors.append(str(error))
+            continue
+        resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock) or None
+        outcome = run_point((key, simulation))
+        values.append(outcome["metrics"].get(metric, math.nan))
+        if outcome["status"] != "ok":
+            errors.append(outcome["error"])
+    return {"key": key, "values": values, "resonance_hz": resonance, "failed_runs": len(errors),
+            "error": errors[0] if errors else "", "cpu_time_s": time.process_time() - start}
 
 
-@dataclass
-class Calibration:
-    source: Path
-    spec: CalibrationSpec
-    base: dict[str, Any]
-    frequencies: list[float]
-    history: list[dict[str, Any]] = field(default_factory=list)
-
-    def scene(self, values: dict[str, float], target: Target | None = None, frequency: float | None = None) -> dict:
-        """The base scene with parameter values, a target's overrides and a frequency set."""
-        scene = copy.deepcopy(self.base)
-        for path, value in {**values, **(target.overrides if target else {})}.items():
-            set_path(scene, path, value)
-        if frequency is not None:
-            set_path(scene, FREQUENCY, frequency)
-        return scene
+def set_frequency(scene: dict[str, Any], frequency_hz: float) -> dict[str, Any]:
+    point = copy.deepcopy(scene)
+    set_path(point, FREQUENCY, frequency_hz)
+    return point
 
 
-def load_calibration(path: str | Path) -> Calibration:
-    path = Path(path)
-    spec = parse(CalibrationSpec, read_yaml(path), str(path))
-    for key, metric in [("metric", spec.metric)] + [(f"targets.{i}.metric", t.metric) for i, t in
-                                                     enumerate(spec.targets) if t.metric]:
-        if metric not in METRICS:
-            raise InputError(f"{path}: {key}: {metric!r}: not a metric; allowed: {', '.join(METRICS)}")
-    base = base_scene_dict(spec, path)
-    for key in spec.parameters:
-        check_scene_path(str(path), "parameters", key, base)
-    for i, target in enumerate(spec.targets):
-        for key in target.overrides:
-            check_scene_path(str(path), f"targets.{i}.overrides", key, base)
-    return Calibration(path, spec, base, spec.frequency_hz.expand())
+def target_result(calibration: Calibration, index: int, frequencies_hz: list[float], scan: dict[str, Any]) -> Record:
+    """Optima of one target's scan: main lobe (refined frequency, peak value, bands), global
+    maximum, the relative miss of the main-lobe optimum."""
+    target = calibration.spec.targets[index]
+    optimum = curve_optimum(frequencies_hz, scan["values"], scan["resonance_hz"])
+    main, highest = optimum.main_lobe, optimum.global_lobe
+    return {
+        "label": calibration.labels[index], "resonance_hz": scan["resonance_hz"],
+        "main_hz": None if main is None else main.peak_hz, "main_value": 0.0 if main is None else main.peak_value,
+        "main_at_scan_end": main is not None and main.peak_at_scan_end,
+        "band_80_hz": None if main is None else list(main.band_80_hz),
+        "band_50_hz": None if main is None else list(main.band_50_hz),
+        "global_hz": None if highest is None else highest.peak_hz,
+        "global_value": 0.0 if highest is None else highest.peak_value,
+        "miss": 1.0 if main is None else (main.peak_hz - target.optimum_hz) / target.optimum_hz,
+        "failed_runs": scan["failed_runs"], "error": scan["error"],
+    }
 
 
-def optimum_hz(frequencies: list[float], values: list[float]) -> float | None:
-    """Vertex of the parabola through the maximum and its neighbours (the maximum itself at an end
-    of the scan or where the three points are not concave); None when nothing is positive."""
-    y = np.asarray(values, dtype=float)
-    if not np.any(y > 0):
-        return None
-    best = int(np.nanargmax(y))
-    if best in (0, len(y) - 1):
-        return float(frequencies[best])
-    (f0, f1, f2), (y0, y1, y2) = frequencies[best - 1:best + 2], y[best - 1:best + 2]
-    numerator = (f1 - f0) ** 2 * (y1 - y2) - (f1 - f2) ** 2 * (y1 - y0)
-    denominator = (f1 - f0) * (y1 - y2) - (f1 - f2) * (y1 - y0)
-    if denominator <= 0:
-        return float(f1)
-    return float(np.clip(f1 - 0.5 * numerator / denominator, f0, f2))
+def rising_penalty(calibration: Calibration, results: list[Record]) -> float:
+    """sum over neighbours (a, b) of each rising list of max(0, f_a - f_b) / f_b* (pairs where a
+    target has no optimum are left out: their misses already count 1)."""
+    found = {r["label"]: r["main_hz"] for r in results}
+    paper = {label: t.optimum_hz for label, t in zip(calibration.labels, calibration.spec.targets, strict=True)}
+    penalty = 0.0
+    for chain in calibration.spec.rising:
+        for a, b in itertools.pairwise(chain):
+            if found[a] is not None and found[b] is not None:
+                penalty += max(0.0, found[a] - found[b]) / paper[b]
+    return penalty
 
 
-def evaluate(calibration: Calibration, values: dict[str, float], runner: Runner) -> dict[str, Any]:
-    """Run every target's scan at these parameter values: optima and objective."""
+def objective(calibration: Calibration, results: list[Record]) -> tuple[float, float]:
+    """(J, its rising penalty) of an evaluation's per-target results (module docstring)."""
+    penalty = rising_penalty(calibration, results)
+    misses = sum(t.weight * r["miss"] ** 2 for t, r in zip(calibration.spec.targets, results, strict=True))
+    return misses + calibration.spec.rising_weight * penalty, penalty
+
+
+def scan_tasks(calibration: Calibration, key: Any, values: dict[str, float],
+               frequencies_hz: Callable[[int], list[float]]) -> list[ScanTask]:
+    """One task per target: the scene at these parameter values, the target's frequencies."""
     spec = calibration.spec
-    metrics = [target.metric or spec.metric for target in spec.targets]
-    tasks = [((t, i), prepare_point(str(calibration.source), {**calibration.scene(values, target, f),
-                                                               "outputs": {"metrics": [metrics[t]]}}, values))
-             for t, target in enumerate(spec.targets) for i, f in enumerate(calibration.frequencies)]
-    metric = {}
-    for outcome in runner(run_point, tasks):
-        (t, _) = outcome["point"]
-        metric[outcome["point"]] = outcome["metrics"].get(metrics[t], float("nan"))
-    optima, objective = [], 0.0
-    for t, target in enumerate(spec.targets):
-        found = optimum_hz(calibration.frequencies, [metric[(t, i)] for i in range(len(calibration.frequencies))])
-        optima.append(found)
-        miss = 1.0 if found is None else (found - target.optimum_hz) / target.optimum_hz
-        objective += miss**2
-    return {"parameters": values, "optima_hz": optima, "objective": objective}
+    return [((key, t), calibration.scene(values, t), calibration.metric(t), frequencies_hz(t))
+            for t in range(len(spec.targets))]
 
 
-def calibrate(calibration: Calibration, runner: Runner,
-              progress: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
-    """Minimise the objective; returns the best evaluation (all are in ``calibration.history``)."""
-    spec = calibration.spec
-    names = list(spec.parameters)
-    lower = np.array([spec.parameters[n][0] for n in names])
-    span = np.array([spec.parameters[n][1] for n in names]) - lower
+def run_scans(runner: Runner, tasks: list[ScanTask]) -> Iterator[tuple[list[Any], dict[str, Any]]]:
+    """Run the scans on the runner, each distinct (scene, metric, frequencies) once
+    (two targets may be the same scan); yields (the keys of the tasks it answers, scan) as scans end."""
+    keys: dict[str, list[Any]] = {}
+    first: dict[str, ScanTask] = {}
+    for task in tasks:
+        signature = json.dumps(task[1:], sort_keys=True)
+        keys.setdefault(signature, []).append(task[0])
+        first.setdefault(signature, task)
+    served = {task[0]: keys[signature] for signature, task in first.items()}
+    for scan in runner(scan_target, list(first.values())) if first else ():
+        yield served[scan["key"]], scan
 
-    def objective(unit: np.ndarray) -> float:
-        values = {n: float(v) for n, v in zip(names, lower + span * np.clip(unit, 0, 1), strict=True)}
-        record = evaluate(calibration, values, runner)
-        calibration.history.append(record)
-        if progress:
-            progress(record)
-        return record["objective"]
 
-    base_values = [_get(calibration.base, n) for n in names]
-    start = np.clip([(v - lo) / s if isinstance(v, (int, float)) else 0.5
-                     for v, lo, s in zip(base_values, lower, span, strict=True)], 0, 1)
-    bounds = [(0.0, 1.0)] * len(names)
-    if spec.method == "nelder-mead":
-        optimize.minimize(objective, start, method="Nelder-Mead", bounds=bounds,
-                          options={"maxfev": spec.max_evaluations, "xatol": 1e-3, "fatol": 1e-6,
-                                   "initial_simplex": _simplex(start)})
+def scan_cost(scans: list[dict[str, Any]]) -> dict[str, Any]:
+    """Simulations, failed runs and CPU seconds of distinct scans."""
+    return {"simulations": sum(len(scan["values"]) for scan in scans),
+            "failed_runs": sum(scan["failed_runs"] for scan in scans),
+            "cpu_time_s": sum(scan["cpu_time_s"] for scan in scans)}
+
+
+class Evaluator:
+    """J for batches of unit points: recorded points are replayed, the others' scans (every target
+    of every point) go to the runner in one batch; each point is recorded as its last scan ends."""
+
+    def __init__(self, calibration: Calibration, runner: Runner, log: EvaluationLog,
+                 progress: Progress | None = None) -> None:
+        self.calibration, self.runner, self.log, self.progress = calibration, runner, log, progress
+        self.memo = {unit_key(r["unit"]): r for r in log.records}
+        self.evaluated = self.replayed = self.simulations = 0
+        self.cpu_time_s = 0.0
+
+    def __call__(self, units: np.ndarray) -> np.ndarray:
+        """J of each row of ``units`` (S, n)."""
+        keys = [unit_key(u) for u in units]
+        for key in keys:
+            if key in self.memo and self.progress:
+                self.replayed += 1
+                self.progress(self.memo[key], True)
+        todo = list(dict.fromkeys(k for k in keys if k not in self.memo))
+        self._run(todo)
+        return np.array([self.memo[k]["objective"] for k in keys])
+
+    def _run(self, keys: list[tuple[float, ...]]) -> None:
+        calibration = self.calibration
+        count = len(calibration.spec.targets)
+        frequencies = list(calibration.frequencies_hz)
+        values = {k: calibration.values(np.array(k)) for k in keys}
+        tasks = [task for k in keys for task in scan_tasks(calibration, k, values[k], lambda _: frequencies)]
+        scans: dict[tuple[float, ...], dict[int, dict[str, Any]]] = {k: {} for k in keys}
+        ran: dict[tuple[float, ...], list[dict[str, Any]]] = {k: [] for k in keys}  # distinct scans
+        for served, scan in run_scans(self.runner, tasks):
+            key = served[0][0]
+            ran[key].append(scan)
+            scans[key].update({target: scan for _, target in served})
+            if len(scans[key]) == count:
+                self._record(key, values[key], [scans[key][t] for t in range(count)], scan_cost(ran[key]))
+
+    def _record(self, key: tuple[float, ...], values: dict[str, float], scans: list[dict[str, Any]],
+                cost: dict[str, Any]) -> None:
+        results = [target_result(self.calibration, t, list(self.calibration.frequencies_hz), scan)
+                   for t, scan in enumerate(scans)]
+        total, penalty = objective(self.calibration, results)
+        record = {"unit": list(key), "parameters": values, "targets": results, "rising_penalty": penalty,
+                  "objective": total, **cost}
+        self.log.append(record)
+        self.memo[key] = record
+        self.evaluated += 1
+        self.simulations += cost["simulations"]
+        self.cpu_time_s += cost["cpu_time_s"]
+        if self.progress:
+            self.progress(record, False)
+
+
+def planned_evaluations(calibration: Calibration) -> int:
+    """The search's budget in evaluations (DE: a population of popsize x n, at least 5, per
+    generation and for the initial population)."""
+    search = calibration.spec.search
+    if search.method == "nelder-mead":
+        return search.max_evaluations
+    return max(5, search.popsize * len(calibration.names)) * (search.max_generations + 1)
+
+
+def search(calibration: Calibration, evaluate: Callable[[np.ndarray], np.ndarray]) -> None:
+    """Minimise J over the unit cube, starting from the base scene's values."""
+    settings, start = calibration.spec.search, calibration.start_unit()
+    bounds = [(0.0, 1.0)] * len(start)
+    if settings.method == "differential-evolution":
+        optimize.differential_evolution(lambda units: evaluate(units.T), bounds, popsize=settings.popsize,
+                                        maxiter=settings.max_generations, rng=settings.seed, polish=False,
+                                        x0=start, updating="deferred", vectorized=True)
     else:
-        population = max(2, math.ceil(spec.max_evaluations / (len(names) * 5)) - 1)
-        optimize.differential_evolution(objective, bounds, maxiter=population, popsize=5, x0=start,
-                                        polish=False, seed=1, tol=1e-6)
-    return min(calibration.history, key=lambda r: r["objective"])
+        optimize.minimize(lambda unit: float(evaluate(unit[None, :])[0]), start, method="Nelder-Mead",
+                          bounds=bounds, options={"maxfev": settings.max_evaluations, "xatol": 1e-3, "fatol": 1e-6,
+                                                  "initial_simplex": _simplex(start)})
 
 
 def _simplex(start: np.ndarray) -> np.ndarray:
-    """A simplex of steps of 0.25 (a quarter of each bound's width) around the start."""
+    """A simplex of steps of 0.25 (a quarter of each parameter's unit range) around the start."""
     points = [start]
     for i in range(len(start)):
         point = start.copy()
@@ -179,7 +226,63 @@ def _simplex(start: np.ndarray) -> np.ndarray:
     return np.array(points)
 
 
-def _get(data: dict[str, Any], path: str) -> Any:
-    for key in path.split("."):
-        data = data.get(key, {}) if isinstance(data, dict) else {}
-    return data
+def refined_frequencies_hz(axis_hz: tuple[float, ...], around_hz: Iterable[float | None], step_hz: float | None) -> list[float]:
+    """The scan axis plus points every ``step_hz`` within one axis spacing of each given frequency."""
+    points = set(axis_hz)
+    spacing = max(b - a for a, b in itertools.pairwise(axis_hz))
+    for centre in around_hz if step_hz else ():
+        if centre is not None:
+            first, last = math.ceil((centre - spacing) / step_hz), math.floor((centre + spacing) / step_hz)
+            points |= {float(f"{i * step_hz:.12g}") for i in range(first, last + 1)}
+    return sorted(f for f in points if axis_hz[0] <= f <= axis_hz[-1])
+
+
+@dataclass(frozen=True)
+class FinalScan:
+    """The best parameter set scanned on the refined axes: per-target results and curves."""
+
+    results: list[Record]
+    curves: list[tuple[list[float], list[float]]]  # (frequencies, metric values) per target
+    cost: dict[str, Any]  # scan_cost
+
+
+def final_scan(calibration: Calibration, best: Record, runner: Runner) -> FinalScan:
+    """Scan every target of the best evaluation again, refined around its main and global optima."""
+    axes = [refined_frequencies_hz(calibration.frequencies_hz, (r["main_hz"], r["global_hz"]),
+                                   calibration.spec.refine_hz) for r in best["targets"]]
+    tasks = scan_tasks(calibration, "best", best["parameters"], lambda t: axes[t])
+    scans, ran = {}, []
+    for served, scan in run_scans(runner, tasks):
+        scans.update({target: scan for _, target in served})
+        ran.append(scan)
+    results = [target_result(calibration, t, axes[t], scans[t]) for t in range(len(tasks))]
+    return FinalScan(results, [(axes[t], scans[t]["values"]) for t in range(len(tasks))], scan_cost(ran))
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    """Every recorded evaluation, the best one (None if every simulation of every evaluation
+    failed), its final scan, and what this session cost."""
+
+    records: list[Record]
+    best: Record | None
+    final: FinalScan | None
+    session: dict[str, Any]
+
+
+def calibrate(calibration: Calibration, runner: Runner, log: EvaluationLog,
+              progress: Progress | None = None, runner_label: str = "") -> CalibrationResult:
+    """Search (replaying what ``log`` holds), then scan the best parameter set for the report."""
+    start_wall = time.perf_counter()
+    evaluator = Evaluator(calibration, runner, log, progress)
+    search(calibration, evaluator)
+    usable = [r for r in log.records if r["failed_runs"] < r["simulations"]]
+    best = min(usable, key=lambda r: r["objective"]) if usable else None
+    final = final_scan(calibration, best, runner) if best else None
+    session = {"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"), "runner": runner_label,
+               "evaluations_run": evaluator.evaluated, "evaluations_replayed": evaluator.replayed,
+               "simulations": evaluator.simulations + (final.cost["simulations"] if final else 0),
+               "simulation_cpu_time_s": evaluator.cpu_time_s + (final.cost["cpu_time_s"] if final else 0.0),
+               "wall_time_s": time.perf_counter() - start_wall}
+    log.add_session(session)
+    return CalibrationResult(list(log.records), best, final, session)

@@ -1,7 +1,11 @@
-"""Fit scene parameters so that frequency scans peak where the targets say.
+"""``rpdrill calibrate CALIBRATION.yaml --out DIR``: fit scene parameters so that frequency scans
+put their main-lobe optima where the paper does (studies.calibrate, file format in
+studies.calibration_spec).
 
-Writes DIR/calibration.json (every evaluation: parameters, optima, objective) and
-DIR/calibrated_scene.yaml (the base scene with the best parameters).
+Every evaluation is appended to DIR/evaluations.jsonl as it finishes; a rerun into the same DIR
+replays them and continues (a different calibration is refused). At the end DIR holds
+calibrated_scene.yaml, targets.csv, targets.md, pareto.csv, best_curves.csv and calibration.json
+(studies.calibration_report). Exit status 1, and no scene, when every simulation failed.
 """
 
 from __future__ import annotations
@@ -11,38 +15,53 @@ import contextlib
 import sys
 from pathlib import Path
 
-import yaml
 from tqdm import tqdm
 
-from rpdrill.studies.calibrate import calibrate, load_calibration
-from rpdrill.studies.outputs import staged_directory, write_json
-from rpdrill.studies.runners import process_pool, sequential
+from rpdrill.studies.calibrate import calibrate, planned_evaluations
+from rpdrill.studies.calibration_log import EvaluationLog, Record
+from rpdrill.studies.calibration_report import write_report
+from rpdrill.studies.calibration_spec import load_calibration
+from rpdrill.studies.outputs import staged_directory
+from rpdrill.studies.runners import pool
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("calibration", help="calibration YAML file")
-    parser.add_argument("--out", required=True, help="output directory")
-    parser.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    parser.add_argument("--out", required=True, help="output directory (reused to resume)")
+    parser.add_argument("--dask", nargs="?", const="", metavar="ADDRESS",
+                        help="run on a Dask cluster at ADDRESS, or on a LocalCluster when no address is given")
+    parser.add_argument("--workers", type=int, help="worker processes (default: all cores; 1: in this process)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def run(args: argparse.Namespace) -> int:
     calibration = load_calibration(args.calibration)
-    spec = calibration.spec
-    with tqdm(total=spec.max_evaluations, desc=spec.name, unit="eval", disable=args.quiet) as bar, \
-            (contextlib.nullcontext(sequential) if args.workers == 1 else process_pool(args.workers)) as runner:
-        def progress(record: dict) -> None:
+    spec, out = calibration.spec, Path(args.out)
+    with contextlib.closing(EvaluationLog(out, calibration)) as log, pool(args.dask, args.workers) as (label, runner), \
+            tqdm(total=planned_evaluations(calibration), desc=spec.name, unit="eval", disable=args.quiet) as bar:
+        print(f"{spec.name}: {len(calibration.names)} parameters, {len(spec.targets)} targets x "
+              f"{len(calibration.frequencies_hz)} frequencies, {len(log.records)} evaluations recorded earlier, "
+              f"on {label}", file=sys.stderr)
+        best = [float("inf")]
+
+        def progress(record: Record, replayed: bool) -> None:
+            best[0] = min(best[0], record["objective"])
             bar.update(1)
-            bar.set_postfix(objective=f"{record['objective']:.3g}")
-        best = calibrate(calibration, runner, progress)
-    scene = calibration.scene(best["parameters"])
-    with staged_directory(args.out) as stage:
-        write_json(stage / "calibration.json", {
-            "calibration": spec.model_dump(mode="json", by_alias=True), "best": best,
-            "targets_hz": [t.optimum_hz for t in spec.targets], "history": calibration.history})
-        (stage / "calibrated_scene.yaml").write_text(yaml.safe_dump(scene, sort_keys=False), encoding="utf-8")
-    optima = ", ".join("none" if f is None else f"{f:.1f}" for f in best["optima_hz"])
-    targets = ", ".join(f"{t.optimum_hz:g}" for t in spec.targets)
-    print(f"{spec.name}: best objective {best['objective']:.3g} after {len(calibration.history)} evaluations; "
-          f"optima {optima} Hz (targets {targets} Hz); wrote {Path(args.out)}", file=sys.stdout)
+            bar.set_postfix(best=f"{best[0]:.4g}", replayed="yes" if replayed else "no")
+
+        result = calibrate(calibration, runner, log, progress, label)
+    if result.best is None:
+        print(f"{spec.name}: every simulation of all {len(result.records)} evaluations failed; first error: "
+              f"{next((t['error'] for r in result.records for t in r['targets'] if t['error']), 'none')}; "
+              "no scene written",
+              file=sys.stderr)
+        return 1
+    with staged_directory(out) as stage:
+        write_report(stage, calibration, result, log.checkpoint["sessions"])
+    reached = ", ".join(f"{r['label']}: {'none' if r['main_hz'] is None else format(r['main_hz'], '.1f')}"
+                        for r in result.final.results)
+    session = result.session
+    print(f"{spec.name}: best objective {result.best['objective']:.4g} of {len(result.records)} evaluations "
+          f"({session['evaluations_run']} run, {session['evaluations_replayed']} replayed, "
+          f"{session['wall_time_s']:.0f} s); main-lobe optima [Hz] {reached}; wrote {out}", file=sys.stderr)
     return 0

@@ -73,9 +73,10 @@ def processes(function: Callable[[Arg], Result], arguments: Sequence[Arg],
         yield from run(function, arguments)
 
 
-def dask(function: Callable[[Arg], Result], arguments: Sequence[Arg],
-         address: str | None = None, workers: int | None = None) -> Iterator[Result]:
-    """A Dask cluster at ``address`` (``tcp://host:8786``), or a LocalCluster of single-thread workers."""
+@contextlib.contextmanager
+def dask_pool(address: str | None = None, workers: int | None = None) -> Iterator[Runner[Any, Any]]:
+    """A runner bound to one Dask client, kept for many calls: a cluster at ``address``
+    (``tcp://host:8786``), or a LocalCluster of single-thread workers."""
     from dask.distributed import Client, LocalCluster
     from dask.distributed import as_completed as dask_completed
 
@@ -87,12 +88,37 @@ def dask(function: Callable[[Arg], Result], arguments: Sequence[Arg],
                 n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
                 dashboard_address=":0", silence_logs=logging.ERROR, env=SINGLE_THREAD))
             client = stack.enter_context(Client(cluster))
-        futures = client.map(function, list(arguments), pure=False)
-        try:
-            for future in dask_completed(futures):
-                yield future.result()
-        finally:
-            client.cancel(futures)
+
+        def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
+            futures = client.map(function, list(arguments), pure=False)
+            try:
+                for future in dask_completed(futures):
+                    yield future.result()
+            finally:
+                client.cancel(futures)
+
+        yield run
+
+
+def dask(function: Callable[[Arg], Result], arguments: Sequence[Arg],
+         address: str | None = None, workers: int | None = None) -> Iterator[Result]:
+    """A Dask cluster at ``address`` (``tcp://host:8786``), or a LocalCluster of single-thread workers."""
+    with dask_pool(address, workers) as run:
+        yield from run(function, arguments)
+
+
+@contextlib.contextmanager
+def pool(dask_address: str | None, workers: int | None) -> Iterator[tuple[str, Runner[Any, Any]]]:
+    """A runner kept for many calls, for the command line options: its description and the callable
+    (``--workers 1``: in this process; ``--dask [ADDRESS]``: Dask; otherwise a process pool)."""
+    if dask_address is not None:
+        with dask_pool(dask_address or None, workers) as run:
+            yield f"dask ({dask_address or 'LocalCluster'})", run
+    elif workers == 1:
+        yield "sequential", sequential
+    else:
+        with process_pool(workers) as run:
+            yield f"processes ({workers or os.cpu_count()} workers)", run
 
 
 def select(dask_address: str | None, workers: int | None) -> tuple[str, Runner[Any, Any]]:

@@ -266,7 +266,7 @@ def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]
         if len(related) == 1:
             lines.append(f"{source}: scan.{related[0]}: {parameters[related[0]]!r}: {message}")
         else:
-            lines.append(f"{source}: scan point {parameters}: {loc or 'scene'}: {message}")
+            lines.append(f"{source}: {_point(parameters)}{loc or 'scene'}: {message}")
     return lines
 
 
@@ -289,6 +289,10 @@ def base_scene_dict(spec: StudySpec, source: Path) -> dict[str, Any]:
     return data
 
 
+def _point(parameters: dict[str, Any]) -> str:
+    return f"scan point {parameters}: " if parameters else ""
+
+
 def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]) -> Simulation:
     """Validate and prepare one point's scene; InputError naming the scan axis that made it invalid
     (or the point), and when its formulation cannot run it."""
@@ -298,7 +302,7 @@ def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]
         raise InputError("\n".join(_point_error(source, error, parameters))) from None
     except SceneError as error:
         where = ".".join(error.location)
-        raise InputError(f"{source}: scan point {parameters}: {where}: {error.value!r}: {error}") from None
+        raise InputError(f"{source}: {_point(parameters)}{where}: {error.value!r}: {error}") from None
     formulation = simulation.settings.formulation
     why = unsupported(formulation, simulation)
     if why:

@@ -1,0 +1,85 @@
+"""The checkpoint of a calibration: every evaluation as one JSON line, as soon as it finishes.
+
+``OUT/evaluations.jsonl`` holds the evaluations (unit point, parameters, per-target optima,
+objective, cost); ``OUT/checkpoint.json`` the calibration's hash and one entry per session. A
+rerun into the same OUT replays the recorded evaluations (by their exact unit point) instead of
+recomputing them, so a seeded search retraces its path and continues where it stopped; a
+different calibration is refused (InputError). A line cut by a kill is dropped.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, TextIO
+
+from rpdrill.studies.calibration_spec import Calibration
+from rpdrill.studies.loading import InputError
+from rpdrill.studies.outputs import write_json
+
+Record = dict[str, Any]
+EVALUATIONS = "evaluations.jsonl"
+CHECKPOINT = "checkpoint.json"
+
+
+def unit_key(unit: Any) -> tuple[float, ...]:
+    """The memo key of a unit point: its exact coordinates."""
+    return tuple(float(u) for u in unit)
+
+
+def _complete_records(path: Path) -> list[Record]:
+    """The records of whole lines (a last line cut by a kill is left out)."""
+    records = []
+    for line in path.read_text(encoding="utf-8").splitlines(keepends=True) if path.exists() else ():
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError:
+            if line.endswith("\n"):
+                raise
+    return records
+
+
+class EvaluationLog:
+    """The recorded evaluations of one calibration in one output directory (close it when done)."""
+
+    def __init__(self, out: Path, calibration: Calibration) -> None:
+        self.out = out
+        self.checkpoint = self._checkpoint(calibration)
+        path = out / EVALUATIONS
+        self.records = _complete_records(path)
+        temporary = path.with_suffix(".jsonl.tmp")
+        temporary.write_text("".join(json.dumps(r) + "\n" for r in self.records), encoding="utf-8")
+        os.replace(temporary, path)
+        self._handle: TextIO = path.open("a", encoding="utf-8")
+
+    def _checkpoint(self, calibration: Calibration) -> dict[str, Any]:
+        path = self.out / CHECKPOINT
+        self.out.mkdir(parents=True, exist_ok=True)
+        if not path.exists():
+            if (self.out / EVALUATIONS).exists():
+                raise InputError(f"{self.out}: holds {EVALUATIONS} but no {CHECKPOINT}; use a new --out directory")
+            checkpoint = {"calibration": calibration.spec.name, "calibration_file": str(calibration.source),
+                          "hash": calibration.hash, "sessions": []}
+            write_json(path, checkpoint)
+            return checkpoint
+        checkpoint = json.loads(path.read_text(encoding="utf-8"))
+        if checkpoint.get("hash") != calibration.hash:
+            raise InputError(
+                f"{calibration.source}: the calibration differs from the one whose evaluations are in "
+                f"{self.out} (hash {calibration.hash[:12]} vs {str(checkpoint.get('hash'))[:12]}); "
+                "use a new --out directory or delete the old one")
+        return checkpoint
+
+    def append(self, record: Record) -> None:
+        """Record an evaluation now (one line, flushed)."""
+        self._handle.write(json.dumps(record) + "\n")
+        self._handle.flush()
+        self.records.append(record)
+
+    def add_session(self, session: dict[str, Any]) -> None:
+        self.checkpoint["sessions"].append(session)
+        write_json(self.out / CHECKPOINT, self.checkpoint)
+
+    def close(self) -> None:
+        self._handle.close()

@@ -1,0 +1,277 @@
+"""The calibration file: what to fit, within which bounds and why, and the paper's optima to reach.
+
+A calibration names a base scene (as a study does; its ``solver.formulation`` runs every point,
+e.g. ``base_overrides: {solver.formulation: exact}``), the ``frequency_hz`` axis scanned for every
+target, the default ``metric`` whose maximum is the optimum, and:
+
+* ``parameters``: dotted scene path -> ``{bounds: [lo, hi], scale: linear|log, reason: "..."}``;
+  a reason is required, bounds are finite with lo < hi (log scale: lo > 0);
+* ``targets``: scene ``overrides``, ``metric``, the paper's ``optimum_hz`` (centre of its band),
+  optional ``band_hz: [lo, hi]``, ``label``, ``weight`` (1) and ``tolerance`` (0.15: within 15 %
+  of the centre);
+* ``rising``: lists of target labels whose main-lobe optima must increase in that order, with
+  ``rising_weight`` on the penalty;
+* ``search``: ``method`` (``differential-evolution``: ``popsize``, ``max_generations``, ``seed``;
+  ``nelder-mead``: ``max_evaluations``);
+* ``refine_hz``: step of the scan around each optimum of the best parameter set, for the report.
+
+The search works in unit coordinates u in [0, 1]^n: value = lo + u (hi - lo), or lo (hi/lo)^u on
+a log scale. Example: ``studies/paper/calibration.yaml``.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import Field, ValidationInfo, field_validator, model_validator
+
+from rpdrill.models.scene import Scene
+from rpdrill.studies.loading import InputError, parse, read_yaml
+from rpdrill.studies.study import (
+    NUMBER,
+    Axis,
+    MetricName,
+    StrictSpec,
+    base_scene_dict,
+    check_scene_path,
+    prepare_point,
+    set_path,
+)
+
+FREQUENCY = "impact.frequency_hz"
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+# keys that do not change what an evaluation gives: a rerun may change them and continue
+BUDGET_KEYS = ("max_generations", "max_evaluations")
+
+
+class Parameter(StrictSpec):
+    """One fitted scene value: its bounds, how the search scales them, and the physical reason."""
+
+    scale: Literal["linear", "log"] = "linear"
+    bounds: tuple[FiniteFloat, FiniteFloat]
+    reason: str = Field(min_length=1)
+
+    @field_validator("bounds")
+    @classmethod
+    def _ordered(cls, bounds: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
+        lower, upper = bounds
+        if not lower < upper:
+            raise ValueError(f"{list(bounds)}: the lower bound must be below the upper bound")
+        if info.data.get("scale") == "log" and lower <= 0:
+            raise ValueError(f"{list(bounds)}: scale log needs a positive lower bound")
+        return bounds
+
+    def value(self, unit: float) -> float:
+        """The value at unit coordinate u: lo + u (hi - lo), or lo (hi/lo)^u; clipped to the bounds."""
+        lower, upper = self.bounds
+        raw = lower * (upper / lower) ** unit if self.scale == "log" else lower + unit * (upper - lower)
+        return float(np.clip(raw, lower, upper))
+
+    def unit(self, value: float) -> float:
+        """The unit coordinate of a value (inverse of :meth:`value`), clipped to [0, 1]."""
+        lower, upper = self.bounds
+        raw = math.log(value / lower) / math.log(upper / lower) if self.scale == "log" and value > 0 \
+            else (value - lower) / (upper - lower)
+        return float(np.clip(raw, 0.0, 1.0))
+
+
+class Target(StrictSpec):
+    """One frequency scan of the base scene with ``overrides``, and where the paper puts its optimum."""
+
+    label: str | None = None
+    overrides: dict[str, Any] = Field(default_factory=dict)
+    metric: MetricName | None = None
+    optimum_hz: PositiveFloat
+    band_hz: tuple[PositiveFloat, PositiveFloat] | None = None
+    weight: PositiveFloat = 1.0
+    tolerance: PositiveFloat = 0.15
+
+    @model_validator(mode="after")
+    def _band_around_optimum(self) -> Target:
+        if self.band_hz is not None and not self.band_hz[0] <= self.optimum_hz <= self.band_hz[1]:
+            raise ValueError(f"band_hz {list(self.band_hz)} must contain optimum_hz {self.optimum_hz} "
+                             "(lower <= optimum <= upper)")
+        return self
+
+
+class Search(StrictSpec):
+    """How the objective is minimised over the unit cube."""
+
+    method: Literal["differential-evolution", "nelder-mead"] = "differential-evolution"
+    popsize: int = Field(8, ge=1, description="DE: population = popsize x number of parameters")
+    max_generations: int = Field(15, ge=0, description="DE: generations after the initial population")
+    seed: int = 1
+    max_evaluations: int = Field(100, ge=1, description="Nelder-Mead: evaluation budget")
+
+    @model_validator(mode="after")
+    def _keys_of_method(self) -> Search:
+        own = {"differential-evolution": {"popsize", "max_generations", "seed"},
+               "nelder-mead": {"max_evaluations"}}[self.method]
+        foreign = sorted(self.model_fields_set - own - {"method"})
+        if foreign:
+            raise ValueError(f"{', '.join(foreign)}: not a setting of method {self.method!r}; "
+                             f"its settings: {', '.join(sorted(own))}")
+        return self
+
+    @property
+    def population(self) -> int:
+        return 1 if self.method == "nelder-mead" else self.popsize
+
+
+class CalibrationSpec(StrictSpec):
+    """The calibration file as written (module docstring)."""
+
+    name: str
+    description: str = ""
+    base_scene: str | dict[str, Any]
+    base_overrides: dict[str, Any] = Field(default_factory=dict)
+    frequency_hz: Axis
+    refine_hz: PositiveFloat | None = None
+    metric: MetricName = "penetration_rate_m_per_s"
+    parameters: dict[str, Parameter] = Field(min_length=1)
+    targets: list[Target] = Field(min_length=1)
+    rising: list[Annotated[list[str], Field(min_length=2)]] = Field(default_factory=list)
+    rising_weight: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1.0
+    search: Search = Search()
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A validated calibration: the base scene (overrides set), scan frequencies and target labels."""
+
+    source: Path
+    spec: CalibrationSpec
+    base: dict[str, Any]
+    frequencies_hz: tuple[float, ...]
+    labels: tuple[str, ...]
+
+    @property
+    def names(self) -> list[str]:
+        return list(self.spec.parameters)
+
+    def metric(self, index: int) -> str:
+        return self.spec.targets[index].metric or self.spec.metric
+
+    def values(self, unit: np.ndarray) -> dict[str, float]:
+        """Parameter values at a point of the unit cube."""
+        return {name: parameter.value(float(u))
+                for (name, parameter), u in zip(self.spec.parameters.items(), unit, strict=True)}
+
+    def scene(self, values: dict[str, float], target: int | None = None, frequency_hz: float | None = None) -> dict:
+        """The base scene with parameter values, then a target's overrides and a frequency, set."""
+        scene = copy.deepcopy(self.base)
+        overrides = self.spec.targets[target].overrides if target is not None else {}
+        for path, value in {**values, **overrides}.items():
+            set_path(scene, path, value)
+        if frequency_hz is not None:
+            set_path(scene, FREQUENCY, frequency_hz)
+        return scene
+
+    def start_unit(self) -> np.ndarray:
+        """The base scene's values in unit coordinates (0.5 where the base scene gives none)."""
+        units = []
+        for name, parameter in self.spec.parameters.items():
+            value = _number(_get(self.base, name))
+            units.append(0.5 if value is None else parameter.unit(value))
+        return np.array(units)
+
+    @property
+    def hash(self) -> str:
+        """SHA-256 of what determines the evaluations and the search path: everything but the
+        name, description, report refinement and budget (a larger budget continues a search)."""
+        spec = self.spec.model_dump(mode="json", by_alias=True,
+                                    exclude={"name", "description", "refine_hz", "base_scene", "base_overrides"})
+        for key in BUDGET_KEYS:
+            spec["search"].pop(key)
+        content = {"spec": spec, "base_scene": Scene.model_validate(self.base).model_dump(mode="json", by_alias=True),
+                   "frequencies_hz": list(self.frequencies_hz), "labels": list(self.labels)}
+        return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
+
+
+def _get(data: Any, path: str) -> Any:
+    for key in path.split("."):
+        data = data.get(key) if isinstance(data, dict) else None
+    return data
+
+
+def _number(value: Any) -> float | None:
+    """A number of a scene file (YAML 1.1 reads ``1.7e6`` as a string), None if absent; ValueError
+    if something else."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)) or \
+            (isinstance(value, str) and not NUMBER.fullmatch(value)):
+        raise ValueError(f"{value!r} is not a number")
+    return float(value)
+
+
+def _labels(spec: CalibrationSpec, source: str) -> tuple[str, ...]:
+    labels = tuple(target.label or f"target {i}" for i, target in enumerate(spec.targets))
+    for i, label in enumerate(labels):
+        if labels.index(label) != i:
+            raise InputError(f"{source}: targets.{i}.label: {label!r}: already the label of "
+                             f"targets.{labels.index(label)}; labels must be unique")
+    for i, chain in enumerate(spec.rising):
+        for j, label in enumerate(chain):
+            if label not in labels:
+                raise InputError(f"{source}: rising.{i}.{j}: {label!r}: not a target label; labels: "
+                                 f"{', '.join(labels)}")
+    return labels
+
+
+def _check_scene(source: str, key: str, scene: dict[str, Any], where: str) -> None:
+    """InputError unless ``scene`` validates and prepares (its formulation able to run it)."""
+    try:
+        prepare_point(source, scene, {})
+    except InputError as error:
+        first = str(error).splitlines()[0].removeprefix(f"{source}: ")
+        raise InputError(f"{source}: {key}: {where} is not a valid scene: {first}") from None
+
+
+def _check_scenes(calibration: Calibration) -> None:
+    """Every target at both ends of the scan must be a valid scene at the start values and with
+    each parameter at each bound (the others at their start values)."""
+    source, spec = str(calibration.source), calibration.spec
+    start = calibration.values(calibration.start_unit())
+    ends = (calibration.frequencies_hz[0], calibration.frequencies_hz[-1])
+    cases = [("targets.{i}.overrides", start, "")] + [
+        (f"parameters.{name}.bounds", start | {name: bound}, f" with {name} = {bound:g} ({side} bound)")
+        for name, parameter in spec.parameters.items() for side, bound in zip(("lower", "upper"), parameter.bounds)]
+    for key, values, note in cases:
+        for i, label in enumerate(calibration.labels):
+            for frequency in ends:
+                _check_scene(source, key.format(i=i), calibration.scene(values, i, frequency),
+                             f"target {label!r} at {frequency:g} Hz{note}")
+
+
+def load_calibration(path: str | Path) -> Calibration:
+    """Read and validate a calibration file; InputError naming the file, key path and value otherwise."""
+    path = Path(path)
+    spec = parse(CalibrationSpec, read_yaml(path), str(path))
+    base = base_scene_dict(spec, path)
+    for name in spec.parameters:
+        check_scene_path(str(path), "parameters", name, base)
+        try:
+            _number(_get(base, name))
+        except ValueError as error:
+            raise InputError(f"{path}: parameters.{name}: the base scene holds {error}; "
+                             "a fitted parameter must be a number") from None
+    for i, target in enumerate(spec.targets):
+        for key in target.overrides:
+            check_scene_path(str(path), f"targets.{i}.overrides", key, base)
+    frequencies = spec.frequency_hz.expand()
+    if len(frequencies) < 3 or any(not isinstance(f, (int, float)) or f <= 0 for f in frequencies) \
+            or any(b <= a for a, b in itertools.pairwise(frequencies)):
+        raise InputError(f"{path}: frequency_hz: {frequencies}: need at least 3 increasing positive frequencies")
+    calibration = Calibration(path, spec, base, tuple(float(f) for f in frequencies), _labels(spec, str(path)))
+    _check_scenes(calibration)
+    return calibration
