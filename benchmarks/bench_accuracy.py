@@ -40,7 +40,7 @@ def preset_cost(base: dict, preset: str, seconds: float, repeats: int) -> tuple[
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("study", nargs="?", default=ROOT / "studies" / "accuracy" / "paper_base.yaml")
+    parser.add_argument("study", nargs="?", default=ROOT / "studies" / "accuracy_studies" / "paper_base.yaml")
     parser.add_argument("--level", type=float, nargs="+", default=[1e-4, 1e-6, 1e-8],
                         help="penetration-rate errors at which the ratio is taken")
     parser.add_argument("--repeats", type=int, default=3)

@@ -36,6 +36,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
+import math
 import signal
 import statistics
 import time
@@ -49,9 +50,18 @@ from pydantic import Field
 
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
-from rpdrill.models.workprecision import Signature, signature, uniform_grid_s
+from rpdrill.models.workprecision import (
+    ERROR_MEASURES,
+    Signature,
+    errors,
+    pareto_front,
+    signature,
+    uniform_grid_s,
+)
 from rpdrill.studies.loading import parse, prepare_scene, read_yaml
-from rpdrill.studies.study import Axis, Point, StrictSpec, base_scene_dict
+from rpdrill.studies.resumable import STATUS_COLUMNS, result_row
+from rpdrill.studies.specs import Axis, SceneSpec, StrictSpec
+from rpdrill.studies.study import Point
 
 # Exudyn runs store every step (a write period below any step): the error of a run includes the
 # linear interpolation of its own steps onto the grid, not that of a coarser storage interval.
@@ -78,13 +88,9 @@ class Family(StrictSpec):
     repeats: int | None = Field(None, ge=1)
 
 
-class AccuracySpec(StrictSpec):
+class AccuracySpec(SceneSpec):
     """The study file as written."""
 
-    name: str
-    description: str = ""
-    base_scene: str | dict[str, Any]
-    base_overrides: dict[str, Any] = Field(default_factory=dict)
     blows: int = Field(ge=1)
     repeats: int = Field(3, ge=1)
     grid_interval_s: float = Field(1e-5, gt=0)
@@ -169,7 +175,7 @@ def load_accuracy_study(path: str | Path) -> AccuracyStudy:
     """Read, validate and expand a work-precision study; InputError naming file and key otherwise."""
     path = Path(path)
     spec = parse(AccuracySpec, read_yaml(path), str(path))
-    base = base_scene_dict(spec, path)
+    base = spec.base_scene_dict(path)
     scene = windowed_scene(base, spec.blows)
     parse(Scene, scene, f"{path} (base scene over blows: {spec.blows})")
     grid = spec.grid_interval_s
@@ -255,3 +261,70 @@ def reference_signature(study: AccuracyStudy, setting: Setting) -> Signature:
     """Run a reference setting once in this process (its failure propagates)."""
     result = simulate_setting(study.scene, setting, study.spec.grid_interval_s)
     return signature(result, uniform_grid_s(result.scene.solver.end_time_s, study.spec.grid_interval_s))
+
+
+PARAMETERS = ("family", "formulation", "solver", "setting", "value")
+VALUES = ("cpu_time_s", "cpu_time_s_runs", "bottom_end_error_m", *ERROR_MEASURES, "penetration_rate_m_per_s")
+COLUMNS = ["point", *PARAMETERS, *STATUS_COLUMNS, *VALUES]
+Row = dict[str, str]
+
+
+def outcome_row(study: AccuracyStudy, reference: Signature, outcome: dict[str, Any]) -> dict[str, Any]:
+    """The CSV row of a finished setting, its errors measured against ``reference``."""
+    if outcome["status"] == "ok":
+        sig: Signature = outcome["signature"]
+        outcome["metrics"].update({k: f"{v:.6g}" for k, v in errors(reference, sig).items()},
+                                  penetration_rate_m_per_s=f"{sig.penetration_rate_m_per_s:.10g}")
+        outcome["metrics"]["cpu_time_s"] = f"{outcome['metrics']['cpu_time_s']:.6g}"
+    return result_row(study.points[outcome["point"]], outcome)
+
+
+def number(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def pareto_rows(rows: list[Row]) -> list[dict[str, Any]]:
+    """The Pareto front of every error measure over the settings that ran."""
+    ok = [r for r in rows if r["status"] == "ok"]
+    out = []
+    for measure in ERROR_MEASURES:
+        cost, error = [number(r["cpu_time_s"]) for r in ok], [number(r[measure]) for r in ok]
+        for i in pareto_front(cost, error):
+            out.append({"measure": measure, **{k: ok[i][k] for k in ("point", *PARAMETERS)},
+                        "cpu_time_s": ok[i]["cpu_time_s"], "error": ok[i][measure]})
+    return out
+
+
+def smallest_errors(rows: list[Row]) -> dict[str, float]:
+    """The smallest positive error of each measure over the settings that ran (what the plot shows)."""
+    out = {}
+    for measure in ERROR_MEASURES:
+        values = [v for v in (number(r[measure]) for r in rows if r["status"] == "ok") if v > 0 and math.isfinite(v)]
+        out[measure] = min(values, default=math.nan)
+    return out
+
+
+def reference_report(study: AccuracyStudy, reference: Signature, check: Signature | None,
+                     rows: list[Row]) -> dict[str, Any]:
+    """Both references, their agreement per measure and whether it is below the smallest plotted error."""
+    report: dict[str, Any] = {
+        "reference": {**study.reference.solver,
+                      "cpu_time_s": reference.cpu_time_s, "bottom_end_m": reference.bottom_end_m,
+                      "penetration_rate_m_per_s": reference.penetration_rate_m_per_s},
+        "smallest_plotted_error": smallest_errors(rows),
+    }
+    if check is None or study.reference_check is None:
+        return report
+    agreement = errors(reference, check)
+    report["reference_check"] = {
+                                 **study.reference_check.solver, "cpu_time_s": check.cpu_time_s}
+    report["agreement"] = agreement
+    report["agreement_below_smallest_error"] = {
+        m: bool(not math.isfinite(report["smallest_plotted_error"][m])
+                or agreement[m] < report["smallest_plotted_error"][m]) for m in ERROR_MEASURES}
+    return report
+
+

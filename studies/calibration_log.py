@@ -15,8 +15,8 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from rpdrill.studies.calibration_spec import Calibration
-from rpdrill.studies.loading import InputError
-from rpdrill.studies.outputs import write_json
+from rpdrill.studies.resumable import checked_record
+from rpdrill.studies.run_files import write_json
 
 Record = dict[str, Any]
 EVALUATIONS = "evaluations.jsonl"
@@ -54,21 +54,11 @@ class EvaluationLog:
         self._handle: TextIO = path.open("a", encoding="utf-8")
 
     def _checkpoint(self, calibration: Calibration) -> dict[str, Any]:
-        path = self.out / CHECKPOINT
         self.out.mkdir(parents=True, exist_ok=True)
-        if not path.exists():
-            if (self.out / EVALUATIONS).exists():
-                raise InputError(f"{self.out}: holds {EVALUATIONS} but no {CHECKPOINT}; use a new --out directory")
-            checkpoint = {"calibration": calibration.spec.name, "calibration_file": str(calibration.source),
-                          "hash": calibration.hash, "sessions": []}
-            write_json(path, checkpoint)
-            return checkpoint
-        checkpoint = json.loads(path.read_text(encoding="utf-8"))
-        if checkpoint.get("hash") != calibration.hash:
-            raise InputError(
-                f"{calibration.source}: the calibration differs from the one whose evaluations are in "
-                f"{self.out} (hash {calibration.hash[:12]} vs {str(checkpoint.get('hash'))[:12]}); "
-                "use a new --out directory or delete the old one")
+        fresh = {"calibration": calibration.spec.name, "calibration_file": str(calibration.source),
+                 "hash": calibration.hash, "sessions": []}
+        checkpoint = checked_record(self.out / CHECKPOINT, fresh, calibration.source, [self.out / EVALUATIONS])
+        write_json(self.out / CHECKPOINT, checkpoint)
         return checkpoint
 
     def append(self, record: Record) -> None:

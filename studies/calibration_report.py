@@ -20,10 +20,10 @@ from typing import Any
 import numpy as np
 import yaml
 
-from rpdrill.studies.calibrate import CalibrationResult
+from rpdrill.studies.calibration import CalibrationResult
 from rpdrill.studies.calibration_log import Record
 from rpdrill.studies.calibration_spec import Calibration
-from rpdrill.studies.outputs import write_json
+from rpdrill.studies.run_files import write_json
 
 TARGET_COLUMNS = ("label", "metric", "paper_optimum_hz", "paper_band_low_hz", "paper_band_high_hz",
                   "resonance_estimate_hz", "main_lobe_optimum_hz", "main_lobe_band_80_low_hz",

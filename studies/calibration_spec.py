@@ -35,16 +35,8 @@ from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from rpdrill.models.scene import Scene
 from rpdrill.studies.loading import InputError, parse, read_yaml
-from rpdrill.studies.study import (
-    NUMBER,
-    Axis,
-    MetricName,
-    StrictSpec,
-    base_scene_dict,
-    check_scene_path,
-    prepare_point,
-    set_path,
-)
+from rpdrill.studies.points import prepare_point
+from rpdrill.studies.specs import NUMBER, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
 
 FREQUENCY = "impact.frequency_hz"
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
@@ -127,13 +119,9 @@ class Search(StrictSpec):
         return 1 if self.method == "nelder-mead" else self.popsize
 
 
-class CalibrationSpec(StrictSpec):
+class CalibrationSpec(SceneSpec):
     """The calibration file as written (module docstring)."""
 
-    name: str
-    description: str = ""
-    base_scene: str | dict[str, Any]
-    base_overrides: dict[str, Any] = Field(default_factory=dict)
     frequency_hz: Axis
     refine_hz: PositiveFloat | None = None
     metric: MetricName = "penetration_rate_m_per_s"
@@ -257,7 +245,7 @@ def load_calibration(path: str | Path) -> Calibration:
     """Read and validate a calibration file; InputError naming the file, key path and value otherwise."""
     path = Path(path)
     spec = parse(CalibrationSpec, read_yaml(path), str(path))
-    base = base_scene_dict(spec, path)
+    base = spec.base_scene_dict(path)
     for name in spec.parameters:
         check_scene_path(str(path), "parameters", name, base)
         try:

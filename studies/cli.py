@@ -14,11 +14,11 @@ from rpdrill.studies.loading import InputError
 
 # name: (module, one-line help); a module is imported only when its command runs
 COMMANDS = {
-    "simulate": ("rpdrill.studies.simulate_command", "run one scene: time histories, summary, plot"),
-    "crosscheck": ("rpdrill.studies.crosscheck", "run the Exudyn model and the ODE of Eq. 4 and compare them"),
-    "study": ("rpdrill.studies.study_command", "run a YAML study (scan) on all cores or a Dask cluster"),
-    "accuracy": ("rpdrill.studies.accuracy_command", "work-precision study: error against CPU time of solver settings"),
-    "calibrate": ("rpdrill.studies.calibrate_command", "fit scene parameters to target optimum frequencies"),
+    "simulate": ("rpdrill.studies.commands.simulate", "run one scene: time histories, summary, plot"),
+    "crosscheck": ("rpdrill.studies.commands.crosscheck", "run the Exudyn model and the ODE of Eq. 4 and compare them"),
+    "study": ("rpdrill.studies.commands.study", "run a YAML study (scan) on all cores or a Dask cluster"),
+    "accuracy": ("rpdrill.studies.commands.accuracy", "work-precision study: error against CPU time of solver settings"),
+    "calibrate": ("rpdrill.studies.commands.calibrate", "fit scene parameters to target optimum frequencies"),
 }
 
 

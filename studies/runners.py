@@ -1,8 +1,11 @@
 """Runners: plug-ins that map a top-level function over arguments, yielding results as they complete.
 
-Each runner is ``runner(function, arguments) -> Iterator[result]`` (options bound with
-:func:`functools.partial`). Results come in completion order, so the function's result must say
-which argument it belongs to. Workers run one thread each (OMP/OpenBLAS/MKL set to 1).
+Each runner is ``runner(function, arguments) -> Iterator[result]``: :func:`sequential` (in this
+process), or one bound to a pool that lives for many calls, :func:`process_pool` (spawned
+single-thread workers, all cores by default) and :func:`dask_pool` (a Dask cluster or a
+LocalCluster); :func:`pool` picks one for the command line options. Results come in completion
+order, so the function's result must say which argument it belongs to. Workers run one BLAS
+thread each (OMP/OpenBLAS/MKL set to 1).
 """
 
 from __future__ import annotations
@@ -66,13 +69,6 @@ def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def processes(function: Callable[[Arg], Result], arguments: Sequence[Arg],
-              workers: int | None = None) -> Iterator[Result]:
-    """A pool of freshly spawned worker processes, all cores by default."""
-    with process_pool(min(workers or os.cpu_count() or 1, max(len(arguments), 1))) as run:
-        yield from run(function, arguments)
-
-
 @contextlib.contextmanager
 def dask_pool(address: str | None = None, workers: int | None = None) -> Iterator[Runner[Any, Any]]:
     """A runner bound to one Dask client, kept for many calls: a cluster at ``address``
@@ -100,13 +96,6 @@ def dask_pool(address: str | None = None, workers: int | None = None) -> Iterato
         yield run
 
 
-def dask(function: Callable[[Arg], Result], arguments: Sequence[Arg],
-         address: str | None = None, workers: int | None = None) -> Iterator[Result]:
-    """A Dask cluster at ``address`` (``tcp://host:8786``), or a LocalCluster of single-thread workers."""
-    with dask_pool(address, workers) as run:
-        yield from run(function, arguments)
-
-
 @contextlib.contextmanager
 def pool(dask_address: str | None, workers: int | None) -> Iterator[tuple[str, Runner[Any, Any]]]:
     """A runner kept for many calls, for the command line options: its description and the callable
@@ -119,13 +108,3 @@ def pool(dask_address: str | None, workers: int | None) -> Iterator[tuple[str, R
     else:
         with process_pool(workers) as run:
             yield f"processes ({workers or os.cpu_count()} workers)", run
-
-
-def select(dask_address: str | None, workers: int | None) -> tuple[str, Runner[Any, Any]]:
-    """The runner for the command line options: its description and the bound callable."""
-    if dask_address is not None:
-        where = dask_address or "LocalCluster"
-        return f"dask ({where})", lambda f, a: dask(f, a, address=dask_address or None, workers=workers)
-    if workers == 1:
-        return "sequential", sequential
-    return f"processes ({workers or os.cpu_count()} workers)", lambda f, a: processes(f, a, workers=workers)

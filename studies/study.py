@@ -4,12 +4,9 @@ A study names a ``base_scene`` (a file relative to the study file, or an inline 
 optional ``base_overrides`` (dotted path -> value, each replacing what is at that path, e.g.
 ``solver.end_time_s: 1.5`` or ``rock: {name: sandstone}``), the ``scan`` axes, how they
 ``combine`` (``grid``, ``zip``, or a list of groups zipped inside and crossed with each
-other), the ``metrics`` to collect and the ``plots`` to draw. Every point's scene is validated and
-prepared once, at load (models.simulation.prepare: the chain, the rock law, the solver settings,
-the initial state); workers receive the prepared simulation and build the formulation's model
-themselves (Exudyn systems cannot be pickled). The formulation is the scene's
-``solver.formulation`` (e.g. ``base_overrides: {solver.formulation: exact}``). :func:`run_point`
-is the worker function.
+other), the ``metrics`` to collect and the ``plots`` to draw. Every point is prepared once, at load
+(studies.points); the formulation is the scene's ``solver.formulation`` (e.g. ``base_overrides:
+{solver.formulation: exact}``).
 
 Example (``studies/paper/stiffness_scan.yaml`` has the full file)::
 
@@ -37,80 +34,25 @@ import copy
 import hashlib
 import itertools
 import json
-import math
-import re
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import Field, model_validator
 
-from rpdrill.models.formulations import unsupported
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.outputs import METRICS
 from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import SceneError, Simulation, prepare
-from rpdrill.studies.loading import InputError, allowed_keys, parse, read_yaml
-
-METRIC_NAMES = tuple(METRICS)
-NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
-MetricName = Literal[METRIC_NAMES]  # type: ignore[valid-type]
-
-
-class StrictSpec(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
-
-
-class Axis(StrictSpec):
-    """Values of one scan axis: a list ``[..]``, ``{from, to, step}`` or ``{from, to, num, spacing}``."""
-
-    values: list[Any] | None = Field(None, min_length=1)
-    start: float | None = Field(None, alias="from", allow_inf_nan=False)
-    to: float | None = Field(None, allow_inf_nan=False)
-    step: float | None = Field(None, allow_inf_nan=False)
-    num: int | None = Field(None, ge=2)
-    spacing: Literal["linear", "log"] = "linear"
-
-    @model_validator(mode="before")
-    @classmethod
-    def _list_is_values(cls, data: Any) -> Any:
-        return {"values": data} if isinstance(data, list) else data
-
-    @field_validator("values")
-    @classmethod
-    def _numbers(cls, values: list[Any] | None) -> list[Any] | None:
-        """YAML 1.1 reads ``1.2e5`` (no exponent sign) as a string: make such strings numbers."""
-        return None if values is None else [float(v) if isinstance(v, str) and NUMBER.fullmatch(v) else v
-                                            for v in values]
-
-    @model_validator(mode="after")
-    def _one_form(self) -> Axis:
-        if self.values is not None:
-            if any(v is not None for v in (self.start, self.to, self.step, self.num)):
-                raise ValueError("give either a list of values or from/to with step or num, not both")
-            return self
-        if self.start is None or self.to is None or (self.step is None) == (self.num is None):
-            raise ValueError("give a list [..], {from, to, step} or {from, to, num, spacing: linear|log}")
-        if self.step is not None and (self.step == 0 or (self.to - self.start) * self.step < 0):
-            raise ValueError(f"step {self.step} does not lead from {self.start} to {self.to}")
-        if self.spacing == "log" and (self.num is None or self.start <= 0 or self.to <= 0):
-            raise ValueError("spacing: log needs num and positive from and to")
-        return self
-
-    def expand(self) -> list[Any]:
-        """The axis values; ranges include ``to`` and are rounded to 12 significant digits."""
-        if self.values is not None:
-            return list(self.values)
-        if self.step is not None:
-            count = math.floor((self.to - self.start) / self.step + 1e-9) + 1
-            raw = [self.start + i * self.step for i in range(count)]
-        elif self.spacing == "log":
-            ratio = math.log(self.to / self.start) / (self.num - 1)
-            raw = [self.start * math.exp(i * ratio) for i in range(self.num)]
-        else:
-            raw = [self.start + i * (self.to - self.start) / (self.num - 1) for i in range(self.num)]
-        return [float(f"{v:.12g}") for v in raw]
+from rpdrill.models.simulation import Simulation
+from rpdrill.studies.loading import InputError, parse, read_yaml
+from rpdrill.studies.points import prepare_point
+from rpdrill.studies.specs import (
+    METRIC_NAMES,
+    Axis,
+    MetricName,
+    SceneSpec,
+    StrictSpec,
+    check_scene_path,
+    set_path,
+)
 
 
 class Plot(StrictSpec):
@@ -141,17 +83,13 @@ class Plot(StrictSpec):
         return [self.x, self.y] if self.kind == "map" else [self.x] + ([self.curves] if self.curves else [])
 
 
-class StudySpec(StrictSpec):
+class StudySpec(SceneSpec):
     """The study file as written."""
 
-    name: str
-    description: str = ""
-    base_scene: str | dict[str, Any]
-    base_overrides: dict[str, Any] = {}
     scan: dict[str, Axis] = Field(min_length=1)
     combine: Literal["grid", "zip"] | list[list[str]] = "grid"
     metrics: list[MetricName] = Field(list(METRIC_NAMES), min_length=1)
-    plots: list[Plot] = []
+    plots: list[Plot] = Field(default_factory=list)
     format: Literal["png", "svg", "pdf"] = "png"
 
 
@@ -185,34 +123,6 @@ class Study:
         """SHA-256 of what determines the results: the point scenes and the collected metrics."""
         content = {"points": [p.simulation.resolved_scene() for p in self.points], "metrics": list(self.spec.metrics)}
         return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
-
-
-def set_path(data: dict[str, Any], path: str, value: Any) -> None:
-    """Set ``data[a][b][c] = value`` for ``path`` 'a.b.c', creating missing mappings."""
-    *parents, leaf = path.split(".")
-    for key in parents:
-        data = data.setdefault(key, {})
-    data[leaf] = copy.deepcopy(value)
-
-
-def check_scene_path(source: str, key: str, path: str, base: dict[str, Any] | None = None) -> None:
-    """A scan or override path must name a scene key; a name in a mapping (``drill_string.bodies.X``)
-    must exist in the ``base`` scene (a typo there would add a body, not change one)."""
-    parts = tuple(path.split("."))
-    allowed = allowed_keys(Scene, parts)
-    if allowed is None or parts[-1] not in allowed:
-        hint = f"allowed keys here: {', '.join(allowed)}" if allowed else "not a path to a scene key"
-        raise InputError(f"{source}: {key}.{path}: unknown scene key path; {hint}")
-    node: Any = base
-    for depth, part in enumerate(parts[:-1]):
-        if not isinstance(node, dict):
-            return
-        free_name = allowed_keys(Scene, parts[:depth + 1]) is None  # a key of a mapping of models
-        if free_name and part not in node:
-            names = ", ".join(node)
-            raise InputError(f"{source}: {key}.{path}: {part!r} is not in the base scene's "
-                             f"{'.'.join(parts[:depth])}; there: {names}")
-        node = node.get(part)
 
 
 def _groups(spec: StudySpec, source: str) -> list[list[str]]:
@@ -256,65 +166,11 @@ def _check_plots(spec: StudySpec, axes: dict[str, list[Any]], source: str) -> No
                                  f"metrics: {', '.join(spec.metrics)}")
 
 
-def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]) -> list[str]:
-    """Problems of one point, each tied to the scan axis that caused it when there is one."""
-    lines = []
-    for item in error.errors():
-        loc = ".".join(str(p) for p in item["loc"] if p != "function-after")
-        related = [a for a in parameters if a == loc or a.startswith(loc + ".") or loc.startswith(a + ".")]
-        message = item["msg"].removeprefix("Value error, ")
-        if len(related) == 1:
-            lines.append(f"{source}: scan.{related[0]}: {parameters[related[0]]!r}: {message}")
-        else:
-            lines.append(f"{source}: {_point(parameters)}{loc or 'scene'}: {message}")
-    return lines
-
-
-def base_scene_dict(spec: StudySpec, source: Path) -> dict[str, Any]:
-    """The base scene as written, with the overrides set (not filled in: a scanned ``rock.name``
-    must still supply the rock values)."""
-    if isinstance(spec.base_scene, str):
-        path = source.parent / spec.base_scene
-        if not path.is_file():
-            raise InputError(f"{source}: base_scene: {spec.base_scene!r}: no scene file {path}")
-        data = read_yaml(path)
-        parse(Scene, data, str(path))
-    else:
-        data = copy.deepcopy(spec.base_scene)
-        parse(Scene, data, str(source), ("base_scene",))
-    for path, value in spec.base_overrides.items():
-        check_scene_path(str(source), "base_overrides", path, data)
-        set_path(data, path, value)
-    parse(Scene, data, f"{source} (base_scene with base_overrides)")
-    return data
-
-
-def _point(parameters: dict[str, Any]) -> str:
-    return f"scan point {parameters}: " if parameters else ""
-
-
-def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]) -> Simulation:
-    """Validate and prepare one point's scene; InputError naming the scan axis that made it invalid
-    (or the point), and when its formulation cannot run it."""
-    try:
-        simulation = prepare(Scene.model_validate(scene))
-    except ValidationError as error:
-        raise InputError("\n".join(_point_error(source, error, parameters))) from None
-    except SceneError as error:
-        where = ".".join(error.location)
-        raise InputError(f"{source}: {_point(parameters)}{where}: {error.value!r}: {error}") from None
-    formulation = simulation.settings.formulation
-    why = unsupported(formulation, simulation)
-    if why:
-        raise InputError(f"{source}: solver.formulation: {formulation!r} cannot run scan point {parameters}: {why}")
-    return simulation
-
-
 def load_study(path: str | Path) -> Study:
     """Read, validate and expand a study file; InputError naming the file and key path otherwise."""
     path = Path(path)
     spec = parse(StudySpec, read_yaml(path), str(path))
-    base = base_scene_dict(spec, path)
+    base = spec.base_scene_dict(path)
     for axis in spec.scan:
         check_scene_path(str(path), "scan", axis, base)
     axes = {name: axis.expand() for name, axis in spec.scan.items()}
@@ -346,14 +202,3 @@ def _check_rock_name_axis(spec: StudySpec, base: dict[str, Any], source: str) ->
                          "base_overrides: {rock: {name: sandstone}}")
 
 
-def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
-    """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics; a
-    failure is returned, not raised."""
-    key, simulation = task
-    start = time.perf_counter()
-    try:
-        metrics = summary_metrics(simulation.run())
-    except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
-        return {"point": key, "status": "failed", "error": f"{type(err).__name__}: {err}",
-                "wall_time_s": time.perf_counter() - start, "metrics": {}}
-    return {"point": key, "status": "ok", "error": "", "wall_time_s": time.perf_counter() - start, "metrics": metrics}

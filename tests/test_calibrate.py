@@ -13,8 +13,8 @@ import pytest
 import yaml
 from scenes import PAPER_BASE
 
-from rpdrill.studies import calibrate as calibrate_module
-from rpdrill.studies.calibrate import objective, refined_frequencies_hz
+from rpdrill.studies import calibration as calibrate_module
+from rpdrill.studies.calibration import objective, refined_frequencies_hz
 from rpdrill.studies.calibration_report import non_dominated
 from rpdrill.studies.calibration_spec import Parameter, load_calibration
 from rpdrill.studies.cli import main

@@ -19,7 +19,9 @@ from scenes import PAPER_BASE, simulate
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.studies.cli import main
-from rpdrill.studies.study import METRIC_NAMES, load_study, run_point
+from rpdrill.studies.points import run_point
+from rpdrill.studies.specs import METRIC_NAMES
+from rpdrill.studies.study import load_study
 
 ROOT = Path(__file__).resolve().parents[1]
 SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}

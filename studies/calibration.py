@@ -35,8 +35,9 @@ from rpdrill.studies.calibration_log import EvaluationLog, Record, unit_key
 from rpdrill.studies.calibration_spec import FREQUENCY, Calibration
 from rpdrill.studies.loading import InputError
 from rpdrill.studies.optima import curve_optimum
+from rpdrill.studies.points import prepare_point, run_point
 from rpdrill.studies.runners import Runner
-from rpdrill.studies.study import prepare_point, run_point, set_path
+from rpdrill.studies.specs import set_path
 
 # (key, scene dict, metric, frequencies)
 ScanTask = tuple[Any, dict[str, Any], str, list[float]]

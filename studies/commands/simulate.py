@@ -11,9 +11,9 @@ import sys
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.stability import SimulationFailed
 from rpdrill.studies.loading import load_scene, prepare_scene
-from rpdrill.studies.outputs import staged_directory, write_columns_csv, write_json, write_resolved
-from rpdrill.studies.plots import plot_timeseries
+from rpdrill.studies.plots.timeseries import plot_timeseries
 from rpdrill.studies.progress import time_progress
+from rpdrill.studies.run_files import staged_directory, write_columns_csv, write_json, write_resolved
 
 HEADLINE = ("penetration_rate_m_per_s", "advance_per_blow_m", "energy_transfer_efficiency",
             "energy_balance_relative_error")

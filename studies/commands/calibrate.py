@@ -1,5 +1,5 @@
 """``rpdrill calibrate CALIBRATION.yaml --out DIR``: fit scene parameters so that frequency scans
-put their main-lobe optima where the paper does (studies.calibrate, file format in
+put their main-lobe optima where the paper does (studies.calibration, file format in
 studies.calibration_spec).
 
 Every evaluation is appended to DIR/evaluations.jsonl as it finishes; a rerun into the same DIR
@@ -17,21 +17,19 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from rpdrill.studies.calibrate import calibrate, planned_evaluations
+from rpdrill.studies.calibration import calibrate, planned_evaluations
 from rpdrill.studies.calibration_log import EvaluationLog, Record
 from rpdrill.studies.calibration_report import write_report
 from rpdrill.studies.calibration_spec import load_calibration
-from rpdrill.studies.outputs import staged_directory
+from rpdrill.studies.commands import add_runner_arguments
+from rpdrill.studies.run_files import staged_directory
 from rpdrill.studies.runners import pool
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("calibration", help="calibration YAML file")
     parser.add_argument("--out", required=True, help="output directory (reused to resume)")
-    parser.add_argument("--dask", nargs="?", const="", metavar="ADDRESS",
-                        help="run on a Dask cluster at ADDRESS, or on a LocalCluster when no address is given")
-    parser.add_argument("--workers", type=int, help="worker processes (default: all cores; 1: in this process)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_runner_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:

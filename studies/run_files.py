@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import csv
 import json
 import os
 import shutil
@@ -43,3 +44,11 @@ def write_json(path: Path, data: Any) -> None:
 def write_resolved(path: Path, data: dict[str, Any]) -> None:
     """A resolved scene (every value filled in) as YAML."""
     path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+
+
+def write_rows_csv(path: Path, rows: list[dict[str, Any]], empty_header: tuple[str, ...] = ()) -> None:
+    """Rows of equal keys as CSV (header from the first row; ``empty_header`` when there are none)."""
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, list(rows[0]) if rows else list(empty_header))
+        writer.writeheader()
+        writer.writerows(rows)

@@ -1,0 +1,60 @@
+"""``rpdrill crosscheck SCENE.yaml``: the Exudyn model against the paper's Eq. 4 as a plain ODE over the
+first blows (studies.crosscheck); exit 0 when they agree within the paper tolerances, 1 if not."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from rpdrill.models.compare import compare_runs, verdict
+from rpdrill.models.formulations import ODE_METHODS
+from rpdrill.models.stability import SimulationFailed
+from rpdrill.studies.crosscheck import DEFAULT_STEP_S, comparison_table, window_scenes
+from rpdrill.studies.loading import load_scene, prepare_scene
+from rpdrill.studies.plots.crosscheck import plot_overlay
+from rpdrill.studies.run_files import staged_directory, write_json
+
+
+def _positive(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{text}: must be a positive number")
+    return value
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="scene YAML file")
+    parser.add_argument("--out", help="output directory for crosscheck.json and crosscheck.png")
+    parser.add_argument("--blows", type=int, default=20, help="compared window in impact periods (default 20)")
+    parser.add_argument("--step", type=_positive, default=DEFAULT_STEP_S,
+                        help=f"Exudyn step [s] (default {DEFAULT_STEP_S:g}; solver type from the scene)")
+    parser.add_argument("--method", choices=ODE_METHODS, default="DOP853", help="ODE method (default DOP853)")
+    parser.add_argument("--rtol", type=_positive, default=1e-10, help="ODE relative tolerance (default 1e-10)")
+
+
+def run(args: argparse.Namespace) -> int:
+    exudyn_scene, ode_scene = window_scenes(load_scene(args.scene), args.blows, args.step, args.method, args.rtol,
+                                            args.scene)
+    scene = exudyn_scene
+    try:
+        exudyn = prepare_scene(exudyn_scene, args.scene).run()
+        ode = prepare_scene(ode_scene, args.scene).run()
+    except SimulationFailed as err:
+        print(f"rpdrill: {err}", file=sys.stderr)
+        return 1
+    report = compare_runs(ode, exudyn, scene.solver.end_time_s)
+    checks = verdict(report)
+    passed = all(c["passed"] for c in checks.values())
+    print(f"{scene.name}: {args.blows} blows, exudyn {exudyn.simulation.settings.type} at {args.step:g} s, "
+          f"ode {args.method} at rtol {args.rtol:g} ({ode.info['mode_switches']} rock mode switches)")
+    print(comparison_table(report, checks))
+    if args.out:
+        with staged_directory(args.out) as stage:
+            write_json(stage / "crosscheck.json", {"scene": scene.name, "blows": args.blows,
+                                                    "exudyn": {"solver": exudyn.simulation.settings.type,
+                                                               "step_s": args.step,
+                                                               **exudyn.info},
+                                                    "ode": ode.info, "checks": checks, "passed": passed, **report})
+            plot_overlay(ode, exudyn, f"{scene.name}: first {args.blows} blows", stage / "crosscheck.png")
+        print(f"wrote {args.out}")
+    return 0 if passed else 1

@@ -1,0 +1,140 @@
+"""Resumable runs of many points into an output directory: a results table appended point by point,
+and the provenance beside it.
+
+``DIR/study.json`` records what produced the results (the study's hash, versions, the resolved
+study, every session); ``DIR/<table>.csv`` gets one row per finished point as it finishes. A rerun
+into the same directory keeps the complete rows (a row cut by a kill is dropped), runs only the
+points without one, and refuses a study whose hash differs. Failed points count as finished
+(their errors are in the table; delete their rows to retry them).
+
+A study is anything with ``spec.name``, ``source``, ``hash``, ``points`` (each with ``index`` and
+``parameters``) and ``resolved()``: studies.study.Study and studies.accuracy.AccuracyStudy.
+"""
+
+from __future__ import annotations
+
+import csv
+import importlib.metadata
+import io
+import json
+import os
+import sys
+import time
+from collections.abc import Callable, Sequence
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Protocol
+
+from tqdm import tqdm
+
+from rpdrill.studies.loading import InputError
+from rpdrill.studies.run_files import write_json
+from rpdrill.studies.runners import Runner
+
+STATUS_COLUMNS = ("status", "error", "wall_time_s")
+Row = dict[str, str]
+
+
+class Point(Protocol):
+    index: int
+    parameters: dict[str, Any]
+
+
+class ResumableStudy(Protocol):
+    source: Path
+    points: Sequence[Point]
+
+    @property
+    def spec(self) -> Any: ...
+    @property
+    def hash(self) -> str: ...
+    def resolved(self) -> dict[str, Any]: ...
+
+
+def checked_record(path: Path, fresh: dict[str, Any], source: Path, results: list[Path]) -> dict[str, Any]:
+    """The record (JSON) at ``path`` when it has ``fresh``'s hash, else ``fresh`` for a new run;
+    InputError when it holds another hash (another study into the same directory) or when ``results``
+    exist without a record."""
+    out = path.parent
+    if not path.exists():
+        found = [r.name for r in results if r.exists()]
+        if found:
+            raise InputError(f"{out}: holds {', '.join(found)} but no {path.name}; use a new --out directory")
+        return fresh
+    record = json.loads(path.read_text(encoding="utf-8"))
+    if record.get("hash") != fresh["hash"]:
+        raise InputError(
+            f"{source}: differs from the run whose results are in {out} (hash {fresh['hash'][:12]} vs "
+            f"{str(record.get('hash'))[:12]}); use a new --out directory or delete the old one")
+    return record
+
+
+def provenance(study: ResumableStudy, out: Path, table: str) -> dict[str, Any]:
+    """study.json as found in ``out`` (refused if from another study) or a new one."""
+    fresh = {"study": study.spec.name, "study_file": str(study.source), "hash": study.hash,
+             "rpdrill_version": importlib.metadata.version("rpdrill"),
+             "exudyn_version": importlib.metadata.version("exudyn"),
+             "points": len(study.points), "resolved_study": study.resolved(), "sessions": [], "point_wall_time_s": {}}
+    return checked_record(out / "study.json", fresh, study.source, [out / table])
+
+
+def finished_rows(path: Path, columns: list[str], count: int) -> dict[int, Row]:
+    """Complete rows of earlier runs by point index; the file is rewritten with just those."""
+    text = path.read_text(encoding="utf-8") if path.exists() else ""
+    rows: dict[int, Row] = {}
+    for row in csv.DictReader(io.StringIO(text[: text.rfind("\n") + 1], newline="")):  # drop a cut last line
+        if list(row) == columns and None not in row.values() and row["status"] in ("ok", "failed") \
+                and row["point"].isdigit() and int(row["point"]) < count:
+            rows.setdefault(int(row["point"]), row)
+    temporary = path.with_suffix(".csv.tmp")
+    with temporary.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, columns)
+        writer.writeheader()
+        writer.writerows(rows[i] for i in sorted(rows))
+    os.replace(temporary, path)
+    return rows
+
+
+def read_rows(path: Path) -> list[Row]:
+    with path.open(newline="", encoding="utf-8") as handle:
+        return list(csv.DictReader(handle))
+
+
+def result_row(point: Point, outcome: dict[str, Any]) -> dict[str, Any]:
+    """A table row: the point, its parameters, status, error, wall time and the outcome's metrics."""
+    return {"point": point.index, **point.parameters, "status": outcome["status"], "error": outcome["error"],
+            "wall_time_s": f"{outcome['wall_time_s']:.4g}", **outcome["metrics"]}
+
+
+def run_points(study: ResumableStudy, out: Path, table: str, columns: list[str], task: Callable[[Point], Any],
+               worker: Callable[[Any], dict[str, Any]], runner: tuple[str, Runner], quiet: bool,
+               row: Callable[[dict[str, Any]], dict[str, Any]] | None = None) -> list[Row]:
+    """Run every point of ``study`` without a finished row in ``out/table`` (module doc): ``task(point)``
+    is what ``worker`` receives, ``row(outcome)`` the table row of its outcome (default
+    :func:`result_row`). Prints what it runs, shows progress, records the session; returns all rows."""
+    out.mkdir(parents=True, exist_ok=True)
+    record = provenance(study, out, table)
+    write_json(out / "study.json", record)
+    path = out / table
+    done = finished_rows(path, columns, len(study.points))
+    todo = [p for p in study.points if p.index not in done]
+    label, run = runner
+    name = study.spec.name
+    print(f"{name}: {len(study.points)} points, {len(done)} finished earlier, running {len(todo)} on {label}",
+          file=sys.stderr)
+    to_row = row or (lambda outcome: result_row(study.points[outcome["point"]], outcome))
+    start = time.perf_counter()
+    with path.open("a", newline="", encoding="utf-8") as handle, \
+            tqdm(total=len(study.points), initial=len(done), desc=name, unit="point", disable=quiet) as bar:
+        writer = csv.DictWriter(handle, columns)
+        for outcome in run(worker, [task(p) for p in todo]) if todo else ():
+            writer.writerow(to_row(outcome))
+            handle.flush()
+            bar.update(1)
+    rows = read_rows(path)
+    record["sessions"].append({"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+                               "runner": label, "points_run": len(todo),
+                               "wall_time_s": round(time.perf_counter() - start, 3)})
+    record["point_wall_time_s"] = {r["point"]: float(r["wall_time_s"]) for r in sorted(rows, key=lambda r: int(r["point"]))}
+    write_json(out / "study.json", record)
+    return rows
