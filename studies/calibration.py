@@ -2,8 +2,7 @@
 the paper does.
 
 An evaluation of a parameter set runs every target's frequency scan (studies.calibration_spec)
-and finds each scan's main-lobe optimum (studies.optima, main lobe chosen by the rock-mode
-resonance estimate of studies.resonance). Its objective is
+and finds each scan's main-lobe optimum (studies.targets). Its objective is
 
     J = sum_t w_t m_t^2 + rising_weight sum_(a before b) max(0, f_a - f_b) / f_b*,
 
@@ -17,12 +16,10 @@ more with points every ``refine_hz`` around its optima, for the report.
 
 from __future__ import annotations
 
-import copy
 import itertools
-import json
 import math
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from typing import Any
@@ -30,79 +27,29 @@ from typing import Any
 import numpy as np
 from scipy import optimize
 
-from rpdrill.models.modal import rock_mode_frequency_hz
 from rpdrill.studies.calibration_log import EvaluationLog, Record, unit_key
-from rpdrill.studies.calibration_spec import FREQUENCY, Calibration
-from rpdrill.studies.loading import InputError
-from rpdrill.studies.optima import curve_optimum
-from rpdrill.studies.points import prepare_point, run_point
+from rpdrill.studies.calibration_spec import Calibration
 from rpdrill.studies.runners import Runner
-from rpdrill.studies.specs import set_path
+from rpdrill.studies.targets import ScanTask, rising_shortfalls, run_scans, scan_all, scan_cost, scan_optimum
 
-# (key, scene dict, metric, frequencies)
-ScanTask = tuple[Any, dict[str, Any], str, list[float]]
 Progress = Callable[[Record, bool], None]  # (record, replayed)
 
 
-def scan_target(task: ScanTask) -> dict[str, Any]:
-    """Worker: one target's scan, the metric at every frequency (NaN where a run failed; failures
-    are counted, not raised), the scene's rock-mode frequency (None if it has none) and CPU seconds."""
-    key, scene, metric, frequencies = task
-    start = time.process_time()
-    values, errors, resonance = [], [], None
-    for frequency in frequencies:
-        try:
-            simulation = prepare_point("calibration scan", {**set_frequency(scene, frequency),
-                                                            "outputs": {"metrics": [metric]}}, {})
-        except InputError as error:
-            values.append(math.nan)
-            errors.append(str(error))
-            continue
-        resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock) or None
-        outcome = run_point((key, simulation))
-        values.append(outcome["metrics"].get(metric, math.nan))
-        if outcome["status"] != "ok":
-            errors.append(outcome["error"])
-    return {"key": key, "values": values, "resonance_hz": resonance, "failed_runs": len(errors),
-            "error": errors[0] if errors else "", "cpu_time_s": time.process_time() - start}
-
-
-def set_frequency(scene: dict[str, Any], frequency_hz: float) -> dict[str, Any]:
-    point = copy.deepcopy(scene)
-    set_path(point, FREQUENCY, frequency_hz)
-    return point
-
-
 def target_result(calibration: Calibration, index: int, frequencies_hz: list[float], scan: dict[str, Any]) -> Record:
-    """Optima of one target's scan: main lobe (refined frequency, peak value, bands), global
-    maximum, the relative miss of the main-lobe optimum."""
+    """Optima of one target's scan (studies.targets.scan_optimum) and the relative miss of its
+    main-lobe optimum."""
     target = calibration.spec.targets[index]
-    optimum = curve_optimum(frequencies_hz, scan["values"], scan["resonance_hz"])
-    main, highest = optimum.main_lobe, optimum.global_lobe
-    return {
-        "label": calibration.labels[index], "resonance_hz": scan["resonance_hz"],
-        "main_hz": None if main is None else main.peak_hz, "main_value": 0.0 if main is None else main.peak_value,
-        "main_at_scan_end": main is not None and main.peak_at_scan_end,
-        "band_80_hz": None if main is None else list(main.band_80_hz),
-        "band_50_hz": None if main is None else list(main.band_50_hz),
-        "global_hz": None if highest is None else highest.peak_hz,
-        "global_value": 0.0 if highest is None else highest.peak_value,
-        "miss": 1.0 if main is None else (main.peak_hz - target.optimum_hz) / target.optimum_hz,
-        "failed_runs": scan["failed_runs"], "error": scan["error"],
-    }
+    result = scan_optimum(calibration.labels[index], frequencies_hz, scan, calibration.metric(index))
+    main = result["main_hz"]
+    return {**result, "miss": 1.0 if main is None else (main - target.optimum_hz) / target.optimum_hz}
 
 
 def rising_penalty(calibration: Calibration, results: list[Record]) -> float:
     """sum over neighbours (a, b) of each rising list of max(0, f_a - f_b) / f_b* (pairs where a
     target has no optimum are left out: their misses already count 1)."""
-    found = {r["label"]: r["main_hz"] for r in results}
     paper = {label: t.optimum_hz for label, t in zip(calibration.labels, calibration.spec.targets, strict=True)}
-    penalty = 0.0
-    for chain in calibration.spec.rising:
-        for a, b in itertools.pairwise(chain):
-            if found[a] is not None and found[b] is not None:
-                penalty += max(0.0, found[a] - found[b]) / paper[b]
-    return penalty
+    shortfalls = rising_shortfalls(calibration.spec.rising, {r["label"]: r["main_hz"] for r in results})
+    return sum(max(0.0, shortfall) / paper[b] for _, b, shortfall in shortfalls)
 
 
 def objective(calibration: Calibration, results: list[Record]) -> tuple[float, float]:
@@ -115,30 +62,8 @@ def objective(calibration: Calibration, results: list[Record]) -> tuple[float, f
 def scan_tasks(calibration: Calibration, key: Any, values: dict[str, float],
                frequencies_hz: Callable[[int], list[float]]) -> list[ScanTask]:
     """One task per target: the scene at these parameter values, the target's frequencies."""
-    spec = calibration.spec
-    return [((key, t), calibration.scene(values, t), calibration.metric(t), frequencies_hz(t))
-            for t in range(len(spec.targets))]
-
-
-def run_scans(runner: Runner, tasks: list[ScanTask]) -> Iterator[tuple[list[Any], dict[str, Any]]]:
-    """Run the scans on the runner, each distinct (scene, metric, frequencies) once
-    (two targets may be the same scan); yields (the keys of the tasks it answers, scan) as scans end."""
-    keys: dict[str, list[Any]] = {}
-    first: dict[str, ScanTask] = {}
-    for task in tasks:
-        signature = json.dumps(task[1:], sort_keys=True)
-        keys.setdefault(signature, []).append(task[0])
-        first.setdefault(signature, task)
-    served = {task[0]: keys[signature] for signature, task in first.items()}
-    for scan in runner(scan_target, list(first.values())) if first else ():
-        yield served[scan["key"]], scan
-
-
-def scan_cost(scans: list[dict[str, Any]]) -> dict[str, Any]:
-    """Simulations, failed runs and CPU seconds of distinct scans."""
-    return {"simulations": sum(len(scan["values"]) for scan in scans),
-            "failed_runs": sum(scan["failed_runs"] for scan in scans),
-            "cpu_time_s": sum(scan["cpu_time_s"] for scan in scans)}
+    return [((key, t), calibration.scene(values, t), [calibration.metric(t)], frequencies_hz(t))
+            for t in range(len(calibration.spec.targets))]
 
 
 class Evaluator:
@@ -252,12 +177,10 @@ def final_scan(calibration: Calibration, best: Record, runner: Runner) -> FinalS
     axes = [refined_frequencies_hz(calibration.frequencies_hz, (r["main_hz"], r["global_hz"]),
                                    calibration.spec.refine_hz) for r in best["targets"]]
     tasks = scan_tasks(calibration, "best", best["parameters"], lambda t: axes[t])
-    scans, ran = {}, []
-    for served, scan in run_scans(runner, tasks):
-        scans.update({target: scan for _, target in served})
-        ran.append(scan)
-    results = [target_result(calibration, t, axes[t], scans[t]) for t in range(len(tasks))]
-    return FinalScan(results, [(axes[t], scans[t]["values"]) for t in range(len(tasks))], scan_cost(ran))
+    scans, cost = scan_all(runner, tasks)
+    results = [target_result(calibration, t, axes[t], scans[("best", t)]) for t in range(len(tasks))]
+    curves = [(axes[t], scans[("best", t)]["values"][calibration.metric(t)]) for t in range(len(tasks))]
+    return FinalScan(results, curves, cost)
 
 
 @dataclass(frozen=True)

@@ -37,8 +37,8 @@ from rpdrill.models.scene import Scene
 from rpdrill.studies.loading import InputError, parse, read_yaml
 from rpdrill.studies.points import prepare_point
 from rpdrill.studies.specs import NUMBER, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
+from rpdrill.studies.targets import FREQUENCY, Scan
 
-FREQUENCY = "impact.frequency_hz"
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 # keys that do not change what an evaluation gives: a rerun may change them and continue
@@ -76,12 +76,9 @@ class Parameter(StrictSpec):
         return float(np.clip(raw, 0.0, 1.0))
 
 
-class Target(StrictSpec):
-    """One frequency scan of the base scene with ``overrides``, and where the paper puts its optimum."""
+class Target(Scan):
+    """A scan (studies.targets) and where the paper puts its optimum."""
 
-    label: str | None = None
-    overrides: dict[str, Any] = Field(default_factory=dict)
-    metric: MetricName | None = None
     optimum_hz: PositiveFloat
     band_hz: tuple[PositiveFloat, PositiveFloat] | None = None
     weight: PositiveFloat = 1.0

@@ -13,7 +13,7 @@ import pytest
 import yaml
 from scenes import PAPER_BASE
 
-from rpdrill.studies import calibration as calibrate_module
+from rpdrill.studies import targets
 from rpdrill.studies.calibration import objective, refined_frequencies_hz
 from rpdrill.studies.calibration_report import non_dominated
 from rpdrill.studies.calibration_spec import Parameter, load_calibration
@@ -190,7 +190,7 @@ def test_every_simulation_failing_exits_1_without_a_scene(tmp_path, monkeypatch,
     def failing(task):
         return {"point": task[0], "status": "failed", "error": "RuntimeError: diverged", "wall_time_s": 0.0,
                 "metrics": {}}
-    monkeypatch.setattr(calibrate_module, "run_point", failing)  # runs in this process (--workers 1)
+    monkeypatch.setattr(targets, "run_point", failing)  # runs in this process (--workers 1)
     path = write(tmp_path / "c.yaml", spec(search={"popsize": 2, "max_generations": 0, "seed": 3}))
     assert calibrate(path, tmp_path / "out") == 1
     assert "RuntimeError: diverged" in capsys.readouterr().err
