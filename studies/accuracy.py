@@ -266,6 +266,7 @@ def reference_signature(study: AccuracyStudy, setting: Setting) -> Signature:
 PARAMETERS = ("family", "formulation", "solver", "setting", "value")
 VALUES = ("cpu_time_s", "cpu_time_s_runs", "bottom_end_error_m", *ERROR_MEASURES, "penetration_rate_m_per_s")
 COLUMNS = ["point", *PARAMETERS, *STATUS_COLUMNS, *VALUES]
+PARETO_COLUMNS = ("measure", "point", *PARAMETERS, "cpu_time_s", "error")
 Row = dict[str, str]
 
 

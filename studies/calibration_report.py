@@ -13,7 +13,6 @@
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 from typing import Any
 
@@ -23,7 +22,7 @@ import yaml
 from rpdrill.studies.calibration import CalibrationResult
 from rpdrill.studies.calibration_log import Record
 from rpdrill.studies.calibration_spec import Calibration
-from rpdrill.studies.run_files import write_json
+from rpdrill.studies.run_files import write_json, write_rows_csv
 
 TARGET_COLUMNS = ("label", "metric", "paper_optimum_hz", "paper_band_low_hz", "paper_band_high_hz",
                   "resonance_estimate_hz", "main_lobe_optimum_hz", "main_lobe_band_80_low_hz",
@@ -99,13 +98,6 @@ def pareto_rows(calibration: Calibration, records: list[Record]) -> list[dict[st
             for i in front]
 
 
-def _write_csv(path: Path, rows: list[dict[str, Any]], columns: list[str]) -> None:
-    with path.open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, columns)
-        writer.writeheader()
-        writer.writerows(rows)
-
-
 def write_report(directory: Path, calibration: Calibration, result: CalibrationResult,
                  sessions: list[dict[str, Any]]) -> None:
     """Every output file of a calibration with a best evaluation (module docstring)."""
@@ -113,17 +105,17 @@ def write_report(directory: Path, calibration: Calibration, result: CalibrationR
     scene = calibration.scene(best["parameters"])
     (directory / "calibrated_scene.yaml").write_text(yaml.safe_dump(scene, sort_keys=False), encoding="utf-8")
     rows = target_rows(calibration, final.results)
-    _write_csv(directory / "targets.csv", rows, list(TARGET_COLUMNS))
+    write_rows_csv(directory / "targets.csv", rows, list(TARGET_COLUMNS))
     step = calibration.spec.refine_hz
     note = (f"optima of the best parameter set scanned again with points every {step:g} Hz around its optima"
             if step else "optima on the calibration's frequency axis")
     (directory / "targets.md").write_text(targets_markdown(calibration, rows, note), encoding="utf-8")
     pareto = pareto_rows(calibration, result.records)
-    _write_csv(directory / "pareto.csv", pareto, list(pareto[0]))
+    write_rows_csv(directory / "pareto.csv", pareto, list(pareto[0]))
     curves = [{"target": label, "frequency_hz": f, "metric": calibration.metric(t), "value": v}
               for t, (label, (frequencies, values)) in enumerate(zip(calibration.labels, final.curves, strict=True))
               for f, v in zip(frequencies, values, strict=True)]
-    _write_csv(directory / "best_curves.csv", curves, ["target", "frequency_hz", "metric", "value"])
+    write_rows_csv(directory / "best_curves.csv", curves, ["target", "frequency_hz", "metric", "value"])
     write_json(directory / "calibration.json", {
         "calibration": calibration.spec.model_dump(mode="json", by_alias=True), "hash": calibration.hash,
         "best": best, "report": final.results,

@@ -19,6 +19,8 @@ COMMANDS = {
     "study": ("rpdrill.studies.commands.study", "run a YAML study (scan) on all cores or a Dask cluster"),
     "accuracy": ("rpdrill.studies.commands.accuracy", "work-precision study: error against CPU time of solver settings"),
     "calibrate": ("rpdrill.studies.commands.calibrate", "fit scene parameters to target optimum frequencies"),
+    "reproduce": ("rpdrill.studies.commands.reproduce",
+                  "the paper's headline cases and figures on the shipped scene, and the generated docs"),
     "sensitivity": ("rpdrill.studies.commands.sensitivity",
                     "how the frequency optima move with each scene parameter (+-10 %, SALib global indices)"),
 }

@@ -1,130 +1,184 @@
-"""The paper-versus-rpdrill table, generated from the outputs of the three paper scans.
+"""The paper reproduced: each of its headline cases scanned on the shipped scene, the optima beside the
+paper's, its trends checked, the lobes below the main resonance listed.
 
-    python -m rpdrill.studies.reproduction RUNS_DIR [--out docs/reproduction.md]
-
-RUNS_DIR holds ``frequency_scan/``, ``impulse_scan/`` and ``stiffness_scan/`` as written by
-``rpdrill study studies/paper/<name>.yaml --out RUNS_DIR/<name>``. Optima are the global maxima of
-studies.optima (vertex of the parabola through the best scan point and its neighbours); a band is
-the interval around that peak where the penetration rate stays at or above 80 % of it. Nothing in
-the table is typed by hand.
+A reproduction file (``studies/paper/reproduction.yaml``) names the base scene with overrides
+(studies.specs), the ``frequency_hz`` axis, the ``metrics`` recorded, the ``cases`` (studies.targets
+scans, each with what the ``paper`` says: ``optimum_hz``, ``band_hz`` and the words), the ``rising``
+trends, the case whose lobes explain the sawtooth below the resonance (``sub_harmonics``) and the
+``figures`` to redraw (cases and metrics of each). Every case's optimum is the maximum of its main
+lobe (the lobe nearest to the rock-mode resonance of models.modal), refined by the parabola through
+the best point and its neighbours (studies.optima); the global maximum is given beside it, so that a
+sub-harmonic lobe as high as the main one is never taken for it silently.
 """
 
 from __future__ import annotations
 
-import argparse
-import csv
-import json
-from collections import defaultdict
+import copy
+import math
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from rpdrill.studies.optima import curve_optimum
+from pydantic import Field, model_validator
 
-RATE = "penetration_rate_m_per_s"
-COLLAR = "collar_velocity_peak_m_per_s"
-FREQUENCY = "impact.frequency_hz"
+from rpdrill.studies.loading import parse, read_yaml
+from rpdrill.studies.optima import CurveOptimum, curve_optimum
+from rpdrill.studies.runners import Runner
+from rpdrill.studies.specs import Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
+from rpdrill.studies.targets import Scan, rising_shortfalls, scan_all, scan_optimum
 
-
-def _curves(results: Path, by: str | None) -> dict[float | None, tuple[list[float], dict[str, list[float]]]]:
-    """Scan rows grouped by the ``by`` axis, sorted by frequency: {value: (frequencies, {metric: values})}."""
-    groups: dict[float | None, list[dict[str, str]]] = defaultdict(list)
-    with results.open(newline="") as handle:
-        for row in csv.DictReader(handle):
-            if row["status"] == "ok":
-                groups[float(row[by]) if by else None].append(row)
-    curves = {}
-    for key, rows in sorted(groups.items(), key=lambda item: (item[0] is None, item[0])):
-        rows.sort(key=lambda r: float(r[FREQUENCY]))
-        curves[key] = ([float(r[FREQUENCY]) for r in rows],
-                       {m: [float(r[m]) for r in rows] for m in (RATE, COLLAR)})
-    return curves
+PositiveFloat = Field(gt=0, allow_inf_nan=False)
 
 
-def _band(frequencies: list[float], rates: list[float]) -> str:
-    peak = curve_optimum(frequencies, rates).global_lobe
-    return "no penetration" if peak is None else f"{peak.band_80_hz[0]:.3g}-{peak.band_80_hz[1]:.3g} Hz"
+class PaperResult(StrictSpec):
+    """What the paper reports for a case: its optimum (the centre of its band), its band, its words."""
+
+    optimum_hz: float | None = Field(None, gt=0, allow_inf_nan=False)
+    band_hz: tuple[float, float] | None = None
+    says: str
 
 
-def _optimum(frequencies: list[float], values: list[float]) -> str:
-    found = curve_optimum(frequencies, values).global_hz
-    return "no penetration" if found is None else f"{found:.1f} Hz"
+class Case(Scan):
+    """A scan of the paper (studies.targets.Scan) and what the paper says about it."""
+
+    paper: PaperResult
 
 
-def frequency_rows(runs: Path) -> list[tuple[str, str, str]]:
-    (frequencies, values), = _curves(runs / "frequency_scan" / "results.csv", None).values()
-    rates = values[RATE]
-    peak = max(rates)
-    silent = [f for f, r in zip(frequencies, rates, strict=True) if f > frequencies[rates.index(peak)] and r <= 0]
-    return [
-        ("3.1 a) optimum at k = 5e8 N/m", "about 65 Hz", _optimum(frequencies, rates)),
-        ("3.1 a) optimal band (rpdrill: rate >= 80 % of its peak, around the peak)", "50-70 Hz", _band(frequencies, rates)),
-        ("3.1 a) peak penetration rate", "(not given)", f"{peak * 1e3:.3g} mm/s"),
-        ("3.1 a) no crushing well above resonance", "sliding ceases",
-         f"no penetration from {min(silent):g} Hz up" if silent else "penetration up to the scan's end"),
-    ]
+class Figure(StrictSpec):
+    """One of the paper's figures: the cases it shows and the metrics of its panels."""
+
+    number: int
+    title: str
+    cases: list[str] = Field(min_length=1)
+    metrics: list[MetricName] = Field(min_length=1)
 
 
-def impulse_rows(runs: Path) -> list[tuple[str, str, str]]:
-    paper = {120e3: "(not given)", 160e3: "55-65 Hz", 220e3: "60-70 Hz", 280e3: "75-85 Hz"}
-    rows = []
-    for amplitude, (frequencies, values) in _curves(runs / "impulse_scan" / "results.csv", "impact.amplitude_n").items():
-        rows.append((f"3.1 b) optimum at I = {amplitude / 1e3:g} kN", paper.get(amplitude, "-"),
-                     f"{_optimum(frequencies, values[RATE])} (band {_band(frequencies, values[RATE])})"))
-    return rows
+class ReproductionSpec(SceneSpec):
+    """The reproduction file as written (module docstring)."""
+
+    frequency_hz: Axis
+    metric: MetricName = "penetration_rate_m_per_s"
+    metrics: list[MetricName] = Field(min_length=1)
+    tolerance: float = Field(0.15, gt=0)
+    cases: list[Case] = Field(min_length=1)
+    rising: list[list[str]] = Field(default_factory=list)
+    sub_harmonics: str
+    figures: list[Figure] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _labels_refer_to_cases(self) -> ReproductionSpec:
+        labels = [case.label for case in self.cases]
+        if None in labels or len(set(labels)) < len(labels):
+            raise ValueError("every case needs a label, and labels must be unique")
+        named = [label for chain in self.rising for label in chain] + [self.sub_harmonics] + \
+            [label for figure in self.figures for label in figure.cases]
+        unknown = sorted({label for label in named if label not in labels})
+        if unknown:
+            raise ValueError(f"{', '.join(map(repr, unknown))}: not a case label; labels: {', '.join(labels)}")
+        used = {case.metric or self.metric for case in self.cases} | {m for f in self.figures for m in f.metrics}
+        missing = sorted(used - set(self.metrics))
+        if missing:
+            raise ValueError(f"metrics must list {', '.join(missing)} (used by a case or a figure)")
+        return self
 
 
-def stiffness_rows(runs: Path) -> list[tuple[str, str, str]]:
-    paper = {8.93e7: "32 Hz", 8.4e8: "69 Hz"}
-    rows = []
-    for stiffness, (frequencies, values) in _curves(runs / "stiffness_scan" / "results.csv",
-                                                    "rock.stiffness_n_per_m").items():
-        rows.append((f"3.2 optimum at k = {stiffness:.3g} N/m (collar velocity / penetration rate)",
-                     paper.get(stiffness, "-"),
-                     f"{_optimum(frequencies, values[COLLAR])} / {_optimum(frequencies, values[RATE])}"))
-    return rows
+@dataclass(frozen=True)
+class Reproduction:
+    """A validated reproduction file."""
+
+    source: Path
+    spec: ReproductionSpec
+    base: dict[str, Any]
+    frequencies_hz: list[float]
+
+    def metric(self, case: Case) -> str:
+        return case.metric or self.spec.metric
+
+    def scene(self, case: Case) -> dict[str, Any]:
+        scene = copy.deepcopy(self.base)
+        for path, value in case.overrides.items():
+            set_path(scene, path, value)
+        return scene
 
 
-def _provenance(runs: Path) -> str:
-    lines = []
-    for name in ("frequency_scan", "impulse_scan", "stiffness_scan"):
-        info = json.loads((runs / name / "study.json").read_text())
-        wall = sum(session["wall_time_s"] for session in info["sessions"])
-        lines.append(f"- `{name}`: {info['points']} points in {wall:.0f} s wall time, rpdrill "
-                     f"{info['rpdrill_version']}, Exudyn {info['exudyn_version']}, study hash `{info['hash'][:12]}`")
-    return "\n".join(lines)
+@dataclass(frozen=True)
+class CaseResult:
+    """A case on the shipped scene: the curves of every metric, its optima (studies.targets.scan_optimum),
+    the lobes of its metric, and from which frequency on nothing is crushed (None if it crushes to the
+    scan's end; only for a penetration metric)."""
+
+    case: Case
+    metric: str
+    curves: dict[str, list[float]]
+    optimum: dict[str, Any]
+    lobes: CurveOptimum
+    silent_from_hz: float | None
 
 
-def render(runs: Path) -> str:
-    table = frequency_rows(runs) + impulse_rows(runs) + stiffness_rows(runs)
-    body = "\n".join(f"| {what} | {paper} | {ours} |" for what, paper, ours in table)
-    return f"""# Reproduction of the paper's headline results
-
-Generated by `python -m rpdrill.studies.reproduction {runs}` from the outputs of
-`rpdrill study studies/paper/{{frequency,impulse,stiffness}}_scan.yaml`; do not edit by hand.
-Parameters the paper leaves out: docs/parameters.md (studies/scenes/paper_base.yaml).
-
-| result | paper | rpdrill |
-|---|---|---|
-{body}
-
-Scans used:
-{_provenance(runs)}
-
-Where rpdrill differs from the paper, docs/parameters.md explains why (in short: with Eq. 1, 2
-and 4 the optimum does not rise with the impulse; bigger blows crush more and lift the bit off
-more often, which softens the contact and lowers the resonance; no plausible parameter set found
-in the calibration reverses this).
-"""
+def load_reproduction(path: str | Path) -> Reproduction:
+    """Read and validate a reproduction file; InputError naming the file and key otherwise."""
+    path = Path(path)
+    spec = parse(ReproductionSpec, read_yaml(path), str(path))
+    base = spec.base_scene_dict(path)
+    for i, case in enumerate(spec.cases):
+        for key in case.overrides:
+            check_scene_path(str(path), f"cases.{i}.overrides", key, base)
+    return Reproduction(path, spec, base, spec.frequency_hz.expand())
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("runs", type=Path, help="directory with the three scans' output directories")
-    parser.add_argument("--out", type=Path, default=Path("docs/reproduction.md"))
-    args = parser.parse_args(argv)
-    args.out.write_text(render(args.runs), encoding="utf-8")
-    print(f"wrote {args.out}")
-    return 0
+def _silent_from_hz(frequencies_hz: list[float], values: list[float], main_hz: float | None) -> float | None:
+    """The lowest frequency above the main optimum from which the metric stays zero to the scan's end."""
+    if main_hz is None:
+        return None
+    silent = None
+    for frequency, value in zip(reversed(frequencies_hz), reversed(values), strict=True):
+        if frequency <= main_hz or not (math.isfinite(value) and value <= 0.0):
+            break
+        silent = frequency
+    return silent
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+def reproduce(reproduction: Reproduction, runner: Runner) -> tuple[list[CaseResult], dict[str, Any]]:
+    """Scan every case (all on the runner at once): its results, and what the scans cost."""
+    spec, frequencies = reproduction.spec, reproduction.frequencies_hz
+    tasks = [(i, reproduction.scene(case), list(spec.metrics), frequencies) for i, case in enumerate(spec.cases)]
+    scans, cost = scan_all(runner, tasks)
+    results = []
+    for i, case in enumerate(spec.cases):
+        scan, metric = scans[i], reproduction.metric(case)
+        optimum = scan_optimum(case.label, frequencies, scan, metric)
+        lobes = curve_optimum(frequencies, scan["values"][metric], scan["resonance_hz"])
+        silent = _silent_from_hz(frequencies, scan["values"][metric], optimum["main_hz"]) \
+            if metric in ("penetration_rate_m_per_s", "advance_per_blow_m") else None
+        results.append(CaseResult(case, metric, scan["values"], optimum, lobes, silent))
+    return results, cost
+
+
+def within(value_hz: float | None, paper: PaperResult, tolerance: float) -> bool | None:
+    """Whether an optimum lies within ``tolerance`` of the paper's (None where the paper gives none)."""
+    if paper.optimum_hz is None:
+        return None
+    return value_hz is not None and abs(value_hz - paper.optimum_hz) <= tolerance * paper.optimum_hz
+
+
+def trend_checks(reproduction: Reproduction, results: list[CaseResult]) -> list[dict[str, Any]]:
+    """Per rising list: the main-lobe optima in order and whether they rise (the shortfalls if not)."""
+    optima = {r.case.label: r.optimum["main_hz"] for r in results}
+    return [{"cases": chain, "optima_hz": [optima[label] for label in chain],
+             "shortfalls": rising_shortfalls([chain], optima),
+             "rises": all(optima[label] is not None for label in chain) and not rising_shortfalls([chain], optima)}
+            for chain in reproduction.spec.rising]
+
+
+def sub_harmonic_lobes(reproduction: Reproduction, results: list[CaseResult]) -> list[dict[str, Any]]:
+    """The lobes of the ``sub_harmonics`` case, each with the rock-mode resonance f_r over its peak and the
+    nearest whole number n: a lobe near f_r / n is driven in phase by every n-th blow."""
+    result = next(r for r in results if r.case.label == reproduction.spec.sub_harmonics)
+    resonance = result.optimum["resonance_hz"]
+    lobes = []
+    for lobe in result.lobes.lobes:
+        ratio = resonance / lobe.peak_hz if resonance else math.nan
+        lobes.append({"peak_hz": lobe.peak_hz, "peak_value": lobe.peak_value, "band_50_hz": lobe.band_50_hz,
+                      "resonance_over_peak": ratio, "nearest_n": round(ratio) if math.isfinite(ratio) else None,
+                      "main": lobe is result.lobes.main_lobe})
+    return lobes

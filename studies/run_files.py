@@ -8,7 +8,7 @@ import json
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -46,9 +46,9 @@ def write_resolved(path: Path, data: dict[str, Any]) -> None:
     path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
 
 
-def write_rows_csv(path: Path, rows: list[dict[str, Any]], empty_header: tuple[str, ...] = ()) -> None:
-    """Rows of equal keys as CSV (header from the first row; ``empty_header`` when there are none)."""
+def write_rows_csv(path: Path, rows: list[dict[str, Any]], columns: Sequence[str] = ()) -> None:
+    """Rows as CSV under ``columns`` (default: the keys of the first row)."""
     with path.open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, list(rows[0]) if rows else list(empty_header))
+        writer = csv.DictWriter(handle, list(columns) or list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)

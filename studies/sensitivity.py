@@ -47,6 +47,8 @@ from rpdrill.studies.targets import (
 SECTIONS = ("drill_string", "feed", "impact", "rock")
 NOT_VARIED = (FREQUENCY, "segments")  # the scanned axis and counts
 NOMINAL = "nominal"
+ONE_AT_A_TIME_COLUMNS = ("parameter", "change", "scan", "metric", "optimum_hz", "optimum_change", "peak", "peak_change")
+TREND_COLUMNS = ("parameter", "change", "every_scan_has_an_optimum", "rising_kept", "shortfalls")
 Row = dict[str, str]
 
 

@@ -28,6 +28,7 @@ from pathlib import Path
 from rpdrill.models.workprecision import Signature
 from rpdrill.studies.accuracy import (
     COLUMNS,
+    PARETO_COLUMNS,
     AccuracyStudy,
     Setting,
     load_accuracy_study,
@@ -75,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
                           lambda p: (p.index, study.scene, study.runs[p.index], spec.grid_interval_s, spec.time_limit_s),
                           run_setting, runner, args.quiet, lambda outcome: outcome_row(study, reference, outcome))
     front = pareto_rows(rows)
-    write_rows_csv(out / "pareto.csv", front, ("measure",))
+    write_rows_csv(out / "pareto.csv", front, PARETO_COLUMNS)
     report = reference_report(study, reference, check, rows)
     write_json(out / "reference.json", report)
     plot = out / f"workprecision.{spec.format}"

@@ -19,6 +19,8 @@ from rpdrill.studies.resumable import run_points
 from rpdrill.studies.run_files import write_json, write_rows_csv
 from rpdrill.studies.runners import pool
 from rpdrill.studies.sensitivity import (
+    ONE_AT_A_TIME_COLUMNS,
+    TREND_COLUMNS,
     columns,
     global_indices,
     load_sensitivity,
@@ -44,8 +46,8 @@ def run(args: argparse.Namespace) -> int:
         rows = run_points(study, out, "results.csv", columns(study), lambda p: task(study, p), run_variation,
                           runner, args.quiet, lambda outcome: row_of(study, outcome))
     changes, kept, indices = one_at_a_time(study, rows), trends(study, rows), global_indices(study, rows)
-    write_rows_csv(out / "one_at_a_time.csv", changes, ("parameter",))
-    write_rows_csv(out / "trends.csv", [{**k, "shortfalls": "; ".join(k["shortfalls"])} for k in kept], ("parameter",))
+    write_rows_csv(out / "one_at_a_time.csv", changes, ONE_AT_A_TIME_COLUMNS)
+    write_rows_csv(out / "trends.csv", [{**k, "shortfalls": "; ".join(k["shortfalls"])} for k in kept], TREND_COLUMNS)
     if indices:
         write_rows_csv(out / "global.csv", indices)
     result = summary(study, changes, kept)
