@@ -54,7 +54,7 @@ from threadpoolctl import ThreadpoolController
 
 from rpdrill.models.chain import torsion_first_order_matrix
 from rpdrill.models.exact_kernels import DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
-from rpdrill.models.piecewise import Element, elements
+from rpdrill.models.piecewise import Element, elements, undeclared
 from rpdrill.models.pulse import PHASES, generator_states, phase_generator, phase_pieces, phase_row
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
@@ -330,6 +330,10 @@ def _switch_counts(model: Model, before: Modes, entered: list[Modes]) -> dict[st
     return counts
 
 
+def unsupported(simulation: Simulation) -> str | None:
+    """Why this formulation cannot run ``simulation`` (its switching comes from the laws' declared modes)."""
+    return undeclared(simulation.chain, simulation.rock)
+
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Exact solution of the simulation from its start to its end time (formulation "exact").
 
@@ -339,6 +343,9 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     at the end (a run takes milliseconds).
     """
     simulation = as_simulation(run)
+    why = unsupported(simulation)
+    if why:
+        raise ValueError(f"scene '{simulation.name}': the exact formulation cannot run it: {why}")
     start = time.process_time()
     with BLAS.limit(limits=1, user_api="blas"):
         solver = ExactSolver(simulation)

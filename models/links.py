@@ -51,7 +51,10 @@ class Link:
         return self.stiffness_n_per_m * stretch_m + self.damping_n_s_per_m * rate_m_per_s
 
     def modes(self) -> ModeTable:
-        """One mode: F = k delta + c delta'."""
+        """One mode: F = k delta + c delta'. A nonlinear type must declare its own (NotImplementedError
+        otherwise: inheriting the bonded mode would run the wrong law)."""
+        if not self.linear:
+            raise NotImplementedError(f"connector type {type(self).__name__} declares no modes (rocklaw.modes)")
         return {BONDED: Mode({STRETCH: self.stiffness_n_per_m, RATE: self.damping_n_s_per_m}, ())}
 
     def initial_mode(self, values: Mapping[str, float]) -> str:

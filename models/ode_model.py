@@ -30,7 +30,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rpdrill.models.chain import link_load_n, torsion_first_order_matrix
-from rpdrill.models.piecewise import Element, elements
+from rpdrill.models.piecewise import Element, elements, undeclared
 from rpdrill.models.pulse import impact_force, switch_times
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Impact
@@ -241,6 +241,10 @@ def _integrate_segment(system: _System, record: _Record, y: np.ndarray, modes: M
     return y, modes
 
 
+def unsupported(simulation: Simulation) -> str | None:
+    """Why this formulation cannot run ``simulation`` (its switching comes from the laws' declared modes)."""
+    return undeclared(simulation.chain, simulation.rock)
+
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Integrate Eq. 4 from the simulation's start (rest or preloaded; the rock state consistent with
     it) to its end time, with the scene's ODE settings (models.solver_settings: ``method``, a SciPy
@@ -248,6 +252,9 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     accepted step is stored, and the solver's dense output fills steps longer than
     ``sample_interval_s``, so that the trapezoidal energy account (models.energy) balances."""
     simulation = as_simulation(run)
+    why = unsupported(simulation)
+    if why:
+        raise ValueError(f"scene '{simulation.name}': the ODE formulation cannot run it: {why}")
     system = _system(simulation)
     y = np.zeros(system.state_size)
     y[:system.n] = simulation.initial_positions_m

@@ -83,6 +83,17 @@ def link_element(chain: AxialChain, link: Link, size: int) -> Element:
     return Element(link.name, link, link.modes(), {STRETCH: ends, RATE: rates}, {}, None, load)
 
 
+def undeclared(chain: AxialChain, rock: RockLaw) -> str | None:
+    """Why the piecewise elements cannot be placed: the laws that declare no modes, or None."""
+    missing = []
+    for name, law in (("rock law " + rock.name, rock), *((f"connector {link.name}", link) for link in chain.nonlinear_links())):
+        try:
+            law.modes()
+        except NotImplementedError:
+            missing.append(name)
+    return f"{', '.join(missing)} declare no modes (rocklaw.modes)" if missing else None
+
+
 def elements(chain: AxialChain, rock: RockLaw, size: int) -> tuple[Element, ...]:
     """The rock and every nonlinear link of the chain, rows over a state of ``size`` entries."""
     return (rock_element(chain, rock, size), *(link_element(chain, link, size) for link in chain.nonlinear_links()))

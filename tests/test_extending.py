@@ -11,8 +11,9 @@ from scenes import scene_dict, simulate
 
 from rpdrill.models.compare import compare_bottom_at, compare_histories
 from rpdrill.models.energy import energy_account
-from rpdrill.models.links import LINK_TYPES
+from rpdrill.models.links import LINK_TYPES, RATE, STRETCH, Link
 from rpdrill.models.scene import Scene
+from rpdrill.rocklaw.modes import check_mode_forces
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "extending.md"
 SHORT = {"solver.end_time_s": 0.2, "metrics.transient_blows": 3, "metrics.block_blows": 3,
@@ -69,3 +70,36 @@ def test_zero_play_reproduces_the_bonded_joint(joint_type):
     played = simulate(_scene(joint_type, gap_m=0.0))
     bonded = simulate(_scene(joint_type, type="spring_damper", gap_m=None))
     np.testing.assert_allclose(played.bottom_m, bonded.bottom_m, rtol=0, atol=1e-12)
+
+
+def test_declared_modes_agree_with_the_closed_form(joint_type):
+    link = joint_type("play", 0, 1, 1e10, 1e3, gap_m=2e-5)
+    rng = np.random.default_rng(3)
+    samples = [{STRETCH: s, RATE: r} for s, r in zip(rng.uniform(-6e-5, 6e-5, 300), rng.uniform(-2.0, 2.0, 300))]
+    assert check_mode_forces(link, samples, lambda v: link.force_n(v[STRETCH], v[RATE])) == []
+    assert {link.initial_mode(v) for v in samples} == set(link.modes())
+
+
+def test_exact_formulation_runs_the_new_type_from_its_modes(joint_type):
+    """Two blows, the second crushing (the rattle amplifies differences over many): the exact solution
+    against the ODE."""
+    s = _scene(joint_type)
+    s = Scene.model_validate(s.model_dump(by_alias=True, exclude={"effects", "outputs"}) | {
+        "solver": {"formulation": "exact", "end_time_s": 2 / 45.0}, "metrics": {"transient_blows": 0, "block_blows": 2}})
+    exact, ode = simulate(s), simulate(s, "ode", relative_tolerance=1e-12, absolute_tolerance=1e-15)
+    assert exact.bottom_m[-1] > 0 and exact.info["mode_switches"] == ode.info["mode_switches"]
+    assert abs(exact.bottom_m[-1] - ode.bottom_m[-1]) <= 1e-9 * exact.bottom_m[-1]
+
+
+def test_a_nonlinear_type_without_modes_is_refused_by_the_formulations_that_need_them(joint_type):
+    class Undeclared(joint_type):
+        modes = Link.modes  # back to the base class's: only a linear link has that one
+
+    LINK_TYPES["undeclared"] = Undeclared
+    try:
+        s = _scene(joint_type, type="undeclared")
+        for formulation in ("exact", "ode"):
+            with pytest.raises(ValueError, match="connector collar_bit_joint declare no modes"):
+                simulate(s, formulation)
+    finally:
+        LINK_TYPES.pop("undeclared")
