@@ -32,9 +32,26 @@ def _yes(flag: bool | None) -> str:
     return "-" if flag is None else ("yes" if flag else "**no**")
 
 
-def reproduction_page(reproduction: Reproduction, results: list[CaseResult], provenance: dict[str, Any]) -> str:
-    """docs/reproduction.md: the paper against rpdrill, case by case, the trends and the sub-harmonic lobes."""
-    spec = reproduction.spec
+def _variants_section(reproduction: Reproduction, by_variant: dict[str | None, list[CaseResult]]) -> str:
+    """Each case's main-lobe optimum on the shipped drill and on every variant, and whether the trends rise."""
+    labels = list(by_variant)
+    header = "| case | paper | " + " | ".join("shipped" if v is None else v for v in labels) + " |"
+    rows = [header, "|---|---|" + "---|" * len(labels)]
+    for i, case in enumerate(reproduction.spec.cases):
+        rows.append(f"| {case.label} | {_hz(case.paper.optimum_hz) if case.paper.optimum_hz else '-'} | "
+                    + " | ".join(_hz(by_variant[v][i].optimum["main_hz"]) for v in labels) + " |")
+    for t, chain in enumerate(reproduction.spec.rising):
+        rows.append(f"| trend: {' < '.join(chain)} | rises | "
+                    + " | ".join(_yes(trend_checks(reproduction, by_variant[v])[t]["rises"]) for v in labels) + " |")
+    described = "\n".join(f"* **{v.label}**: {' '.join(v.description.split())}" for v in reproduction.spec.variants)
+    return f"{described}\n\n" + "\n".join(rows)
+
+
+def reproduction_page(reproduction: Reproduction, by_variant: dict[str | None, list[CaseResult]],
+                      provenance: dict[str, Any]) -> str:
+    """docs/reproduction.md: the paper against rpdrill, case by case, the trends, the sub-harmonic lobes,
+    and the variants of the drill."""
+    spec, results = reproduction.spec, by_variant[None]
     rows = []
     for r in results:
         o, paper = r.optimum, r.case.paper
@@ -90,6 +107,13 @@ narrow lobes at one or two points, which draws them as a sawtooth.
 | lobe peak [Hz] | peak value | f_r / lobe peak | nearest n | |
 |---|---|---|---|---|
 {chr(10).join(lobes)}
+
+## What the result depends on: the upper string
+
+The same cases (main-lobe optima) on drills that differ only above the shock absorber, from
+`variants` in `studies/paper/reproduction.yaml` (the arrangement and its physics: [model.md](model.md)):
+
+{_variants_section(reproduction, by_variant) if spec.variants else "(no variants in the reproduction file)"}
 
 Figures: [figures.md](figures.md). Parameters and why: [parameters.md](parameters.md).
 Sensitivity (the paper's section 3.3): [sensitivity.md](sensitivity.md).

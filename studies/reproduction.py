@@ -8,7 +8,9 @@ trends, the case whose lobes explain the sawtooth below the resonance (``sub_har
 ``figures`` to redraw (cases and metrics of each). Every case's optimum is the maximum of its main
 lobe (the lobe nearest to the rock-mode resonance of models.modal), refined by the parabola through
 the best point and its neighbours (studies.optima); the global maximum is given beside it, so that a
-sub-harmonic lobe as high as the main one is never taken for it silently.
+sub-harmonic lobe as high as the main one is never taken for it silently. ``variants`` repeat every case
+on another drill (another upper string: bodies and connectors added, paths overridden), to show what
+the result depends on.
 """
 
 from __future__ import annotations
@@ -17,11 +19,11 @@ import copy
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from rpdrill.studies.loading import parse, read_yaml
+from rpdrill.studies.loading import InputError, parse, read_yaml
 from rpdrill.studies.optima import CurveOptimum, curve_optimum
 from rpdrill.studies.runners import Runner
 from rpdrill.studies.specs import Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
@@ -53,6 +55,16 @@ class Figure(StrictSpec):
     metrics: list[MetricName] = Field(min_length=1)
 
 
+class Variant(StrictSpec):
+    """Another upper string (or any change of the drill): ``overrides`` of the base scene's paths, and
+    bodies and connectors ``add``-ed under new names (``add: {bodies: {..}, connectors: {..}}``)."""
+
+    label: str
+    description: str
+    overrides: dict[str, Any] = Field(default_factory=dict)
+    add: dict[Literal["bodies", "connectors"], dict[str, Any]] = Field(default_factory=dict)
+
+
 class ReproductionSpec(SceneSpec):
     """The reproduction file as written (module docstring)."""
 
@@ -64,6 +76,7 @@ class ReproductionSpec(SceneSpec):
     rising: list[list[str]] = Field(default_factory=list)
     sub_harmonics: str
     figures: list[Figure] = Field(default_factory=list)
+    variants: list[Variant] = Field(default_factory=list)
 
     @model_validator(mode="after")
     def _labels_refer_to_cases(self) -> ReproductionSpec:
@@ -94,8 +107,14 @@ class Reproduction:
     def metric(self, case: Case) -> str:
         return case.metric or self.spec.metric
 
-    def scene(self, case: Case) -> dict[str, Any]:
+    def scene(self, case: Case, variant: Variant | None = None) -> dict[str, Any]:
+        """The base scene (with a variant's additions and overrides) with the case's overrides."""
         scene = copy.deepcopy(self.base)
+        if variant is not None:
+            for part, named in variant.add.items():
+                scene["drill_string"][part].update(copy.deepcopy(named))
+            for path, value in variant.overrides.items():
+                set_path(scene, path, value)
         for path, value in case.overrides.items():
             set_path(scene, path, value)
         return scene
@@ -123,6 +142,17 @@ def load_reproduction(path: str | Path) -> Reproduction:
     for i, case in enumerate(spec.cases):
         for key in case.overrides:
             check_scene_path(str(path), f"cases.{i}.overrides", key, base)
+    for i, variant in enumerate(spec.variants):
+        for part, named in variant.add.items():
+            taken = sorted(set(named) & set(base["drill_string"][part]))
+            if taken:
+                raise InputError(f"{path}: variants.{i}.add.{part}: {', '.join(taken)}: already in the base scene; "
+                                 "change it with overrides")
+        extended = copy.deepcopy(base)
+        for part, named in variant.add.items():
+            extended["drill_string"][part].update(named)
+        for key in variant.overrides:
+            check_scene_path(str(path), f"variants.{i}.overrides", key, extended)
     return Reproduction(path, spec, base, spec.frequency_hz.expand())
 
 
@@ -138,20 +168,30 @@ def _silent_from_hz(frequencies_hz: list[float], values: list[float], main_hz: f
     return silent
 
 
-def reproduce(reproduction: Reproduction, runner: Runner) -> tuple[list[CaseResult], dict[str, Any]]:
-    """Scan every case (all on the runner at once): its results, and what the scans cost."""
+def reproduce(reproduction: Reproduction, runner: Runner) -> tuple[dict[str | None, list[CaseResult]], dict[str, Any]]:
+    """Scan every case of the shipped scene (key None) and of every variant (key: its label), all on the
+    runner at once: the results, and what the scans cost."""
     spec, frequencies = reproduction.spec, reproduction.frequencies_hz
-    tasks = [(i, reproduction.scene(case), list(spec.metrics), frequencies) for i, case in enumerate(spec.cases)]
+    variants: list[Variant | None] = [None, *spec.variants]
+    tasks = [((v, i), reproduction.scene(case, variant), list(spec.metrics), frequencies)
+             for v, variant in enumerate(variants) for i, case in enumerate(spec.cases)]
     scans, cost = scan_all(runner, tasks)
+    return {None if variant is None else variant.label: _case_results(reproduction, [scans[(v, i)] for i in
+                                                                                     range(len(spec.cases))])
+            for v, variant in enumerate(variants)}, cost
+
+
+def _case_results(reproduction: Reproduction, scans: list[dict[str, Any]]) -> list[CaseResult]:
+    frequencies = reproduction.frequencies_hz
     results = []
-    for i, case in enumerate(spec.cases):
-        scan, metric = scans[i], reproduction.metric(case)
+    for case, scan in zip(reproduction.spec.cases, scans, strict=True):
+        metric = reproduction.metric(case)
         optimum = scan_optimum(case.label, frequencies, scan, metric)
         lobes = curve_optimum(frequencies, scan["values"][metric], scan["resonance_hz"])
         silent = _silent_from_hz(frequencies, scan["values"][metric], optimum["main_hz"]) \
             if metric in ("penetration_rate_m_per_s", "advance_per_blow_m") else None
         results.append(CaseResult(case, metric, scan["values"], optimum, lobes, silent))
-    return results, cost
+    return results
 
 
 def within(value_hz: float | None, paper: PaperResult, tolerance: float) -> bool | None:

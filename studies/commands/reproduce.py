@@ -46,10 +46,11 @@ def run(args: argparse.Namespace) -> int:
     with pool(args.dask, args.workers) as (label, runner):
         print(f"{reproduction.spec.name}: {len(reproduction.spec.cases)} cases x {len(reproduction.frequencies_hz)} "
               f"frequencies on {label}", file=sys.stderr)
-        results, cost = reproduce(reproduction, runner)
+        by_variant, cost = reproduce(reproduction, runner)
+    results = by_variant[None]
     provenance = {"cases": len(results), **cost, "rpdrill_version": importlib.metadata.version("rpdrill"),
                   "exudyn_version": importlib.metadata.version("exudyn")}
-    pages = {"reproduction.md": reproduction_page(reproduction, results, provenance),
+    pages = {"reproduction.md": reproduction_page(reproduction, by_variant, provenance),
              "parameters.md": parameters_page(reproduction, results, calibration, args.calibration)}
     with staged_directory(args.out) as stage:
         (stage / "figures").mkdir()
@@ -68,8 +69,9 @@ def run(args: argparse.Namespace) -> int:
         write_rows_csv(stage / "cases.csv", [
             {"case": r.case.label, "frequency_hz": f, **{m: r.curves[m][i] for m in r.curves}}
             for r in results for i, f in enumerate(reproduction.frequencies_hz)])
-        write_json(stage / "reproduction.json", {"provenance": provenance, "optima": [r.optimum for r in results],
-                                                 "trends": trend_checks(reproduction, results)})
+        write_json(stage / "reproduction.json", {"provenance": provenance, "variants": {
+            str(label): {"optima": [r.optimum for r in found], "trends": trend_checks(reproduction, found)}
+            for label, found in by_variant.items()}})
     if args.docs is not None:
         args.docs.mkdir(parents=True, exist_ok=True)
         shutil.copytree(Path(args.out) / "figures", args.docs / "figures", dirs_exist_ok=True)
