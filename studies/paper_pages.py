@@ -148,12 +148,12 @@ def _calibration_run(run: Path | None) -> str:
             f"scanned again around its optima):\n{targets}")
 
 
-def parameters_page(reproduction: Reproduction, results: list[CaseResult], calibration: Calibration,
+def parameters_page(reproduction: Reproduction, results: list[CaseResult], calibration: Calibration | None,
                     calibration_run: Path | None) -> str:
     """docs/parameters.md: every number of the shipped scene, where it comes from, the fitted ones' bounds
     and reasons, the rock-mode resonance of each case, and the calibration run."""
     values = scene_values(reproduction.base)
-    fitted = calibration.spec.parameters
+    fitted = {} if calibration is None else calibration.spec.parameters
     best = {}
     if calibration_run is not None and (calibration_run / "calibration.json").exists():
         best = json.loads((calibration_run / "calibration.json").read_text(encoding="utf-8"))["best"]["parameters"]

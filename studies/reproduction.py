@@ -77,6 +77,8 @@ class ReproductionSpec(SceneSpec):
     sub_harmonics: str
     figures: list[Figure] = Field(default_factory=list)
     variants: list[Variant] = Field(default_factory=list)
+    calibration: str | None = Field(None, description="the calibration file (relative to this file) whose bounds "
+                                                      "and reasons the parameters page lists")
 
     @model_validator(mode="after")
     def _labels_refer_to_cases(self) -> ReproductionSpec:
@@ -103,6 +105,10 @@ class Reproduction:
     spec: ReproductionSpec
     base: dict[str, Any]
     frequencies_hz: list[float]
+
+    @property
+    def calibration_file(self) -> Path | None:
+        return None if self.spec.calibration is None else self.source.parent / self.spec.calibration
 
     def metric(self, case: Case) -> str:
         return case.metric or self.spec.metric

@@ -3,8 +3,9 @@
 Scans every case of the reproduction file (default ``studies/paper/reproduction.yaml``) on a 1 Hz
 grid with the exact formulation and writes into DIR: ``reproduction.md`` (the paper against rpdrill,
 the trends, the sub-harmonic lobes), ``figures.md`` with the paper's Figs. 2-6 redrawn
-(``figures/fig<N>.png``/``.svg``), ``parameters.md`` (the shipped scene's values, the calibration's bounds
-and reasons, the rock-mode resonances, and the calibration run given by ``--calibration``),
+(``figures/fig<N>.png``/``.svg``), ``parameters.md`` (the shipped scene's values, the bounds and reasons of
+the reproduction file's ``calibration`` file, the rock-mode resonances, and the calibration run given by
+``--calibration``),
 ``sensitivity.md`` when ``--sensitivity`` names a sensitivity run, ``cases.csv`` (every curve) and
 ``reproduction.json``. With ``--docs DIR`` the pages and figures are also copied into that folder
 (``--docs docs`` in a checkout). Exit 1 when a case has no optimum or a trend does not hold.
@@ -42,7 +43,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     reproduction = load_reproduction(args.reproduction)
-    calibration = load_calibration(PAPER / "calibration.yaml")
+    calibration = None if reproduction.calibration_file is None else load_calibration(reproduction.calibration_file)
     with pool(args.dask, args.workers) as (label, runner):
         print(f"{reproduction.spec.name}: {len(reproduction.spec.cases)} cases x {len(reproduction.frequencies_hz)} "
               f"frequencies on {label}", file=sys.stderr)

@@ -1,0 +1,98 @@
+"""``rpdrill reproduce``: the paper's values stated once (the reproduction file and the calibration's
+targets agree), the pages generated from the runs (numbers on the page equal the run's record), written
+into --out only and into the docs folder only when asked, a variant, and bad input."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+import yaml
+
+from rpdrill.studies.calibration_spec import load_calibration
+from rpdrill.studies.cli import main
+from rpdrill.studies.reproduction import load_reproduction
+
+ROOT = Path(__file__).resolve().parents[1]
+PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"
+
+
+def test_the_paper_is_stated_once():
+    """Every case with a paper optimum is a calibration target with the same optimum and band, and the
+    calibration's targets are reproduction cases with the same scene overrides."""
+    reproduction = load_reproduction(ROOT / "studies" / "paper" / "reproduction.yaml")
+    calibration = load_calibration(ROOT / "studies" / "paper" / "calibration.yaml")
+    cases = {case.label: case for case in reproduction.spec.cases}
+    for label, target in zip(calibration.labels, calibration.spec.targets, strict=True):
+        if label == "3.1 a)":  # the 3.1 a) scan is the 220 kN case of 3.1 b) (docs/parameters.md)
+            continue
+        case = cases[label]
+        assert (case.paper.optimum_hz, case.paper.band_hz) == (target.optimum_hz, target.band_hz), label
+        assert case.overrides == target.overrides and case.metric == target.metric, label
+
+
+def spec(**changes) -> dict:
+    """Two cases of the frozen pipe drill on a coarse grid around their optima, one figure, one variant."""
+    return {
+        "name": "tiny_reproduction", "base_scene": str(PIPE_DRILL),
+        "base_overrides": {"solver": {"formulation": "exact", "end_time_s": 1.0}},
+        "frequency_hz": {"from": 50, "to": 80, "step": 3}, "metrics": ["penetration_rate_m_per_s", "advance_per_blow_m"],
+        "cases": [{"label": "160 kN", "overrides": {"impact.amplitude_n": 160e3},
+                   "paper": {"optimum_hz": 60, "band_hz": [55, 65], "says": "55-65 Hz"}},
+                  {"label": "280 kN", "overrides": {"impact.amplitude_n": 280e3},
+                   "paper": {"optimum_hz": 80, "band_hz": [75, 85], "says": "75-85 Hz"}}],
+        "rising": [["160 kN", "280 kN"]], "sub_harmonics": "160 kN",
+        "figures": [{"number": 4, "title": "impulse", "cases": ["160 kN", "280 kN"], "metrics": ["advance_per_blow_m"]}],
+        "variants": [{"label": "lighter pipe", "description": "a 6 t pipe",
+                      "overrides": {"drill_string.bodies.pipe.length_m": 225.0}}],
+    } | changes
+
+
+def write(path: Path, data: dict) -> Path:
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def test_reproduce_writes_generated_pages_into_out_and_docs_only_when_asked(tmp_path):
+    source, out, docs = write(tmp_path / "r.yaml", spec()), tmp_path / "out", tmp_path / "docs"
+    assert main(["reproduce", str(source), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    assert {p.name for p in out.iterdir()} >= {"reproduction.md", "figures.md", "parameters.md", "cases.csv",
+                                               "reproduction.json", "figures"}
+    assert {p.name for p in (out / "figures").iterdir()} == {"fig4.png", "fig4.svg"}
+    assert not docs.exists()
+    record = json.loads((out / "reproduction.json").read_text())["variants"]
+    page = (out / "reproduction.md").read_text()
+    for optimum in record["None"]["optima"]:  # the page's optima are the run's, as recorded
+        assert f"| {optimum['label']} | penetration_rate_m_per_s | " in page
+        assert f"{optimum['main_hz']:.1f} Hz" in page
+    assert record["None"]["trends"][0]["rises"]  # the frozen drill's optimum rises with the impulse
+    assert "lighter pipe" in record and "| trend: 160 kN < 280 kN | rises |" in page
+    assert main(["reproduce", str(source), "--out", str(tmp_path / "again"), "--docs", str(docs), "--workers", "1",
+                 "--quiet"]) == 0
+    assert (docs / "reproduction.md").read_text() == (tmp_path / "again" / "reproduction.md").read_text()
+    assert (docs / "figures" / "fig4.svg").exists()
+
+
+@pytest.mark.parametrize("changes, fragment", [
+    ({"sub_harmonics": "3.1 a)"}, "'3.1 a)': not a case label"),
+    ({"metrics": ["penetration_rate_m_per_s"]}, "metrics must list advance_per_blow_m"),
+    ({"variants": [{"label": "x", "description": "y", "add": {"bodies": {"pipe": {"mass_kg": 1.0}}}}]},
+     "variants.0.add.bodies: pipe: already in the base scene"),
+    ({"variants": [{"label": "x", "description": "y", "overrides": {"drill_string.bodies.pipo.length_m": 1.0}}]},
+     "'pipo' is not in the base scene"),
+])
+def test_bad_reproduction_files_exit_2(tmp_path, capsys, changes, fragment):
+    path = write(tmp_path / "bad.yaml", spec(**changes))
+    assert main(["reproduce", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert fragment in err and str(path) in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_no_result_number_is_typed_into_the_generated_page_templates():
+    """The page module holds no numbers of results: every number it prints is formatted from a value."""
+    text = (ROOT / "studies" / "paper_pages.py").read_text()
+    literals = re.findall(r"(?<![\w.{:])\d+\.\d+ ?(?:Hz|mm/s|m/s|%)", text)
+    assert literals == []
