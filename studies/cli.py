@@ -24,6 +24,7 @@ COMMANDS = {
     "study": ("rpdrill.studies.commands.study", "run a YAML study (scan) on all cores or a Dask cluster"),
     "accuracy": ("rpdrill.studies.commands.accuracy", "work-precision study: error against CPU time of solver settings"),
     "calibrate": ("rpdrill.studies.commands.calibrate", "fit scene parameters to target optimum frequencies"),
+    "advise": ("rpdrill.studies.commands.advise", "the operating point that maximises a metric within bounds"),
 }
 
 
