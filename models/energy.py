@@ -46,6 +46,11 @@ class EnergyAccount:
         return float(np.max(np.abs(self.residual_j)) / max(self.impact_work_j[-1], 1e-300))
 
 
+def impact_work_j(result: SimulationResult) -> np.ndarray:
+    """W_impact = int F_d v_impact dt, cumulative at every stored step (trapezoidal rule)."""
+    return _cumulative(result.impact_force_n * result.velocity_m_per_s[:, result.chain.impact_body], result.time_s)
+
+
 def energy_account(result: SimulationResult) -> EnergyAccount:
     simulation, t = result.simulation, result.time_s
     chain, rock = simulation.chain, simulation.rock
@@ -68,7 +73,7 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
         feed = feed + (tor.drive_torque_n_m - tor.resisting_torque_n_m) * (phi - phi[0])
     return EnergyAccount(
         time_s=t,
-        impact_work_j=_cumulative(result.impact_force_n * v[:, chain.impact_body], t),
+        impact_work_j=impact_work_j(result),
         feed_work_j=feed,
         kinetic_j=kinetic,
         elastic_j=elastic,

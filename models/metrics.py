@@ -3,7 +3,9 @@
 Window: blows ``transient_blows`` .. N of the run (N whole periods that fit), cut into
 blocks of ``block_blows`` blows (a trailing partial block is dropped).
 Penetration rate = (x_n(end) - x_n(start)) / window length; its spread is the standard
-deviation of the block rates. Only the metrics the scene's outputs ask for are computed.
+deviation of the block rates. Penetration per impact energy = (x_n(end) - x_n(start)) / W_impact
+over the window (= penetration rate / mean impact power; W_impact = int F_d v dt, models.energy,
+without the rest of the energy account). Only the metrics the scene's outputs ask for are computed.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from functools import cached_property
 import numpy as np
 from scipy.integrate import trapezoid
 
-from rpdrill.models.energy import EnergyAccount, energy_account
+from rpdrill.models.energy import EnergyAccount, energy_account, impact_work_j
 from rpdrill.models.results import SimulationResult
 
 
@@ -47,6 +49,14 @@ class _Window:
     def energy(self) -> EnergyAccount:
         return self._energy or energy_account(self.result)
 
+    @cached_property
+    def impact_work(self) -> float:
+        """W_impact over the window, from the energy account when there is one."""
+        return self.work(self._energy.impact_work_j if self._energy else impact_work_j(self.result))
+
+    def advance_per_impact_work(self) -> float:
+        return float(self.per_blow.sum() / self.impact_work) if self.impact_work > 0 else float("nan")
+
     def work(self, cumulative: np.ndarray) -> float:
         """Increase of a cumulative energy over the window."""
         t = self.result.time_s
@@ -60,7 +70,7 @@ class _Window:
 
     def efficiency(self) -> float:
         """Crushing work / work put in by the impacts and the feed over the window."""
-        put_in = self.work(self.energy.impact_work_j) + self.work(self.energy.feed_work_j)
+        put_in = self.impact_work + self.work(self.energy.feed_work_j)
         return self.work(self.energy.crushing_work_j) / put_in if put_in > 0 else float("nan")
 
 
@@ -73,6 +83,7 @@ METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
     "penetration_rate_block_std_m_per_s": lambda w: _spread(w.block_rates),
     "penetration_rate_block_min_m_per_s": lambda w: float(w.block_rates.min()),
     "penetration_rate_block_max_m_per_s": lambda w: float(w.block_rates.max()),
+    "penetration_per_impact_energy_m_per_j": lambda w: w.advance_per_impact_work(),
     "advance_per_blow_m": lambda w: float(w.per_blow.mean()),
     "advance_per_blow_std_m": lambda w: _spread(w.per_blow),
     "borehole_bottom_final_m": lambda w: float(w.result.bottom_m[-1]),
@@ -81,7 +92,7 @@ METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
     "collar_velocity_peak_m_per_s": lambda w: w.peak(w.result.body_velocity_m_per_s("collar")),
     "collar_velocity_rms_m_per_s": lambda w: w.rms(w.result.body_velocity_m_per_s("collar")),
     "rock_force_max_n": lambda w: float(np.max(w.result.rock_force_n[w.mask])),
-    "impact_energy_j": lambda w: w.work(w.energy.impact_work_j),
+    "impact_energy_j": lambda w: w.impact_work,
     "feed_energy_j": lambda w: w.work(w.energy.feed_work_j),
     "crushing_work_j": lambda w: w.work(w.energy.crushing_work_j),
     "energy_transfer_efficiency": lambda w: w.efficiency(),

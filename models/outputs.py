@@ -33,6 +33,8 @@ METRICS: dict[str, Need] = {
     "penetration_rate_block_std_m_per_s": PENETRATION,
     "penetration_rate_block_min_m_per_s": PENETRATION,
     "penetration_rate_block_max_m_per_s": PENETRATION,
+    # advance over the window / impact work over the window (m per joule of impact energy)
+    "penetration_per_impact_energy_m_per_j": _need(("rock_plasticity",), ("forces", "energy")),
     "advance_per_blow_m": PENETRATION,
     "advance_per_blow_std_m": PENETRATION,
     "borehole_bottom_final_m": PENETRATION,

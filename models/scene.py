@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
@@ -349,6 +349,14 @@ class Solver(Strict):
         return self
 
 
+def switch_formulation(solver: dict[str, Any], formulation: str) -> dict[str, Any]:
+    """A ``solver`` section (as written) switched to ``formulation``: the options of the old
+    formulation dropped, the common ones (end time, preset, output interval) kept."""
+    if formulation == solver.get("formulation", Solver.model_fields["formulation"].default):
+        return dict(solver)
+    return {**{key: value for key, value in solver.items() if key in COMMON_SOLVER_KEYS}, "formulation": formulation}
+
+
 EFFECTS = ("torsion", "rock_damping", "rock_plasticity", "joint_damping")
 
 
@@ -406,12 +414,11 @@ class Scene(Strict):
         "equilibrium under the feed (and torque) with the bit pressed on the rock")
 
     def with_solver(self, formulation: str | None = None, **options: object) -> Scene:
-        """This scene with another formulation (the options of the old one dropped, the common ones
-        kept) and/or other solver options (a new, validated scene)."""
+        """This scene with another formulation (:func:`switch_formulation`) and/or other solver
+        options (a new, validated scene)."""
         solver = self.solver.model_dump(exclude_none=True)
-        if formulation is not None and formulation != solver["formulation"]:
-            solver = {key: value for key, value in solver.items() if key in COMMON_SOLVER_KEYS}
-            solver["formulation"] = formulation
+        if formulation is not None:
+            solver = switch_formulation(solver, formulation)
         data = self.model_dump(by_alias=True, exclude_none=True)
         return Scene.model_validate({**data, "solver": {**solver, **options}})
 

@@ -19,6 +19,7 @@ import numpy as np
 from rpdrill.models.chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
 from rpdrill.models.formulations import simulate
 from rpdrill.models.outputs import needs
+from rpdrill.models.pulse import impulse_per_blow_n_s
 from rpdrill.models.scene import (
     BuiltEffects,
     Impact,
@@ -71,6 +72,19 @@ class Simulation:
     def torsion(self) -> Torsion | None:
         """The torsion line when its effect is built."""
         return self.scene.torsion if self.effects.torsion else None
+
+    @property
+    def feed_total_n(self) -> float:
+        """The sum of the feed forces on the chain (F_dt, or F_dt on every body)."""
+        return float(np.sum(self.chain.constant_forces()))
+
+    @property
+    def mean_thrust_n(self) -> float:
+        """The mean force on the rock in steady drilling, F_feed + f J (J the impulse of one blow): over a
+        period the chain's momentum returns, so the rock takes all the feed and the blows push (a link
+        from ground would take a share). Where it reaches the rock's threshold F_th, a Jenkins rock
+        yields under the mean load and the bit sinks at a rate set only by the rock damper."""
+        return self.feed_total_n + impulse_per_blow_n_s(self.impact) * self.impact.frequency_hz
 
     @property
     def needed_data(self) -> frozenset[str]:

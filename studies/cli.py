@@ -1,14 +1,19 @@
 """The ``rpdrill`` command line: one subcommand per module, each with ``add_arguments`` and ``run``.
 
-Exit status: 0 success, 1 a run failed or a check did not pass, 2 bad input.
+Exit status: 0 success, 1 a run failed or a check did not pass, 2 bad input. While a command runs,
+a warning prints as one line, ``rpdrill: warning: ...`` (warnings of worker processes come back
+to this process and print here, once each: studies.runners).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import importlib.metadata
 import sys
 import warnings
+from collections.abc import Iterator
 
 from rpdrill.studies.loading import InputError
 
@@ -23,6 +28,7 @@ COMMANDS = {
                   "the paper's headline cases and figures on the shipped scene, and the generated docs"),
     "sensitivity": ("rpdrill.studies.commands.sensitivity",
                     "how the frequency optima move with each scene parameter (+-10 %, SALib global indices)"),
+    "advise": ("rpdrill.studies.commands.advise", "the operating point that maximises a metric within bounds"),
 }
 
 
@@ -37,10 +43,25 @@ def _one_line_warning(message, category, filename, lineno, line=None) -> str:
     return f"rpdrill: warning: {message}\n"
 
 
-def main(argv: list[str] | None = None) -> int:
+@contextlib.contextmanager
+def one_line_warnings() -> Iterator[None]:
+    """Warnings print as one line while the block runs; the formatting before is restored after."""
+    saved = warnings.formatwarning
     warnings.formatwarning = _one_line_warning
+    try:
+        yield
+    finally:
+        warnings.formatwarning = saved
+
+
+def _version() -> str:
+    return f"rpdrill {importlib.metadata.version('rpdrill')} (Exudyn {importlib.metadata.version('exudyn')})"
+
+
+def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = _Parser(prog="rpdrill", description="Rotary-percussive drilling simulator on Exudyn")
+    parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     module = None
     for name, (module_name, help_text) in COMMANDS.items():
@@ -49,14 +70,15 @@ def main(argv: list[str] | None = None) -> int:
             module = importlib.import_module(module_name)
             module.add_arguments(command_parser)
     args = parser.parse_args(argv)
-    try:
-        return int(module.run(args))
-    except InputError as err:
-        print(str(err), file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("rpdrill: interrupted", file=sys.stderr)
-        return 130
+    with one_line_warnings():
+        try:
+            return int(module.run(args))
+        except InputError as err:
+            print(str(err), file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print("rpdrill: interrupted", file=sys.stderr)
+            return 130
 
 
 if __name__ == "__main__":

@@ -37,8 +37,15 @@ def write_columns_csv(path: Path, columns: dict[str, np.ndarray]) -> None:
     np.savetxt(path, table, delimiter=",", header=",".join(columns), comments="", fmt="%.12g")
 
 
+def _plain(value: Any) -> Any:
+    """NumPy arrays and scalars (a formulation's run info) as JSON lists and numbers."""
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serializable")
+
+
 def write_json(path: Path, data: Any) -> None:
-    path.write_text(json.dumps(data, indent=2, sort_keys=False) + "\n", encoding="utf-8")
+    path.write_text(json.dumps(data, indent=2, sort_keys=False, default=_plain) + "\n", encoding="utf-8")
 
 
 def write_resolved(path: Path, data: dict[str, Any]) -> None:
@@ -47,8 +54,8 @@ def write_resolved(path: Path, data: dict[str, Any]) -> None:
 
 
 def write_rows_csv(path: Path, rows: list[dict[str, Any]], columns: Sequence[str] = ()) -> None:
-    """Rows as CSV under ``columns`` (default: the keys of the first row)."""
+    """Rows as CSV under ``columns`` (default: the keys of the first row; none without rows)."""
     with path.open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, list(columns) or list(rows[0]))
+        writer = csv.DictWriter(handle, list(columns) or (list(rows[0]) if rows else []))
         writer.writeheader()
         writer.writerows(rows)

@@ -5,14 +5,18 @@ process), or one bound to a pool that lives for many calls, :func:`process_pool`
 single-thread workers, all cores by default) and :func:`dask_pool` (a Dask cluster or a
 LocalCluster); :func:`pool` picks one for the command line options. Results come in completion
 order, so the function's result must say which argument it belongs to. Workers run one BLAS
-thread each (OMP/OpenBLAS/MKL set to 1).
+thread each (OMP/OpenBLAS/MKL set to 1). A worker's warnings come back with its result and are
+issued again in this process (its filters and formatting apply; each distinct warning once per
+pool), so that workers print nothing themselves.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import os
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from multiprocessing import get_context
@@ -23,6 +27,23 @@ Result = TypeVar("Result")
 Runner = Callable[[Callable[[Arg], Result], Sequence[Arg]], Iterator[Result]]
 
 SINGLE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+Caught = list[tuple[str, type[Warning], str, int]]
+
+
+def _caught(function: Callable[[Arg], Result], argument: Arg) -> tuple[Result, Caught]:
+    """Worker side: ``function(argument)`` and the warnings it issued (text, category, file, line)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = function(argument)
+    return result, [(str(w.message), w.category, w.filename, w.lineno) for w in caught]
+
+
+def _reissued(outcome: tuple[Result, Caught], registry: dict[Any, Any]) -> Result:
+    """The worker's result, after issuing its warnings here (``registry``: those issued already)."""
+    result, caught = outcome
+    for text, category, filename, lineno in caught:
+        warnings.warn_explicit(text, category, filename, lineno, registry=registry)
+    return result
 
 
 def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
@@ -54,11 +75,13 @@ def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
     with _environment(SINGLE_THREAD):  # workers start on demand: the setting lasts the pool's life
         pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
 
+        registry: dict[Any, Any] = {}
+
         def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
-            futures = [pool.submit(function, argument) for argument in arguments]
+            futures = [pool.submit(_caught, function, argument) for argument in arguments]
             try:
                 for future in as_completed(futures):
-                    yield future.result()
+                    yield _reissued(future.result(), registry)
             finally:
                 for future in futures:
                     future.cancel()
@@ -85,11 +108,13 @@ def dask_pool(address: str | None = None, workers: int | None = None) -> Iterato
                 dashboard_address=":0", silence_logs=logging.ERROR, env=SINGLE_THREAD))
             client = stack.enter_context(Client(cluster))
 
+        registry: dict[Any, Any] = {}
+
         def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
-            futures = client.map(function, list(arguments), pure=False)
+            futures = client.map(functools.partial(_caught, function), list(arguments), pure=False)
             try:
                 for future in dask_completed(futures):
-                    yield future.result()
+                    yield _reissued(future.result(), registry)
             finally:
                 client.cancel(futures)
 

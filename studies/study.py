@@ -40,7 +40,7 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from rpdrill.models.scene import Scene
+from rpdrill.models.scene import Scene, switch_formulation
 from rpdrill.models.simulation import Simulation
 from rpdrill.studies.loading import InputError, parse, read_yaml
 from rpdrill.studies.points import prepare_point
@@ -57,8 +57,9 @@ from rpdrill.studies.specs import (
 
 class Plot(StrictSpec):
     """``curves``: metric(s) ``y`` against axis ``x``, one curve per value of the other axes
-    (labelled by axis ``curves``), maximum of each curve marked. ``map``: metric ``z`` over
-    axes ``x`` and ``y`` with the ridge of maxima along ``x`` for each ``y``."""
+    (``curves``: the axis the plot is about; every varied value is in the legend), the optimum of
+    each curve marked. ``map``: metric ``z`` over axes ``x`` and ``y`` as cells, the optimum along
+    ``x`` of each ``y`` marked (studies.plots.scans)."""
 
     kind: Literal["curves", "map"] = "curves"
     x: str
@@ -90,7 +91,7 @@ class StudySpec(SceneSpec):
     combine: Literal["grid", "zip"] | list[list[str]] = "grid"
     metrics: list[MetricName] = Field(list(METRIC_NAMES), min_length=1)
     plots: list[Plot] = Field(default_factory=list)
-    format: Literal["png", "svg", "pdf"] = "png"
+    format: Literal["png", "svg", "pdf"] = "png"  # an SVG is written beside a PNG or PDF
 
 
 @dataclass(frozen=True)
@@ -166,11 +167,15 @@ def _check_plots(spec: StudySpec, axes: dict[str, list[Any]], source: str) -> No
                                  f"metrics: {', '.join(spec.metrics)}")
 
 
-def load_study(path: str | Path) -> Study:
-    """Read, validate and expand a study file; InputError naming the file and key path otherwise."""
+def load_study(path: str | Path, formulation: str | None = None) -> Study:
+    """Read, validate and expand a study file, every point with ``formulation`` when given (the base
+    scene's solver options of another formulation dropped); InputError naming the file and key path
+    otherwise."""
     path = Path(path)
     spec = parse(StudySpec, read_yaml(path), str(path))
     base = spec.base_scene_dict(path)
+    if formulation is not None:
+        base["solver"] = switch_formulation(base.get("solver", {}), formulation)
     for axis in spec.scan:
         check_scene_path(str(path), "scan", axis, base)
     axes = {name: axis.expand() for name, axis in spec.scan.items()}

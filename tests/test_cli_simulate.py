@@ -8,6 +8,7 @@ import pytest
 import yaml
 from scenes import scene_dict
 
+from rpdrill.models.stability import StepLimitWarning
 from rpdrill.studies.cli import main
 
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}
@@ -24,7 +25,7 @@ def test_simulate_writes_all_outputs(tmp_path):
     out = tmp_path / "out"
     assert main(["simulate", str(path), "--out", str(out), "--quiet"]) == 0
     assert {p.name for p in out.iterdir()} == {"timeseries.csv", "summary.json", "scene.resolved.yaml",
-                                              "timeseries.png"}
+                                              "timeseries.png", "timeseries.svg"}
     header = (out / "timeseries.csv").read_text().splitlines()[0].split(",")
     assert header[0] == "time_s" and "bit_velocity_m_per_s" in header and "rock_force_n" in header
     assert len((out / "timeseries.csv").read_text().splitlines()) == 1 + 1001  # 0.1 s every 1e-4 s
@@ -89,7 +90,8 @@ def test_diverged_run_is_an_error_not_a_result(tmp_path, capsys):
     """Explicit Euler far beyond its stability limit: exit 1 and the message names the setting."""
     path = write(tmp_path, scene_dict(**QUICK, **{"solver.type": "explicit_euler", "solver.step_s": 2e-4}))
     out = tmp_path / "out"
-    assert main(["simulate", str(path), "--out", str(out), "--quiet"]) == 1
+    with pytest.warns(StepLimitWarning, match="explicit_euler is unstable"):
+        assert main(["simulate", str(path), "--out", str(out), "--quiet"]) == 1
     err = capsys.readouterr().err
     assert "diverged" in err and "explicit_euler" in err and "step_s" in err
     assert not out.exists()

@@ -18,6 +18,7 @@ from scenes import PAPER_BASE, simulate
 
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
+from rpdrill.models.stability import StepLimitWarning
 from rpdrill.studies.cli import main
 from rpdrill.studies.points import run_point
 from rpdrill.studies.specs import METRIC_NAMES
@@ -121,7 +122,8 @@ def test_study_end_to_end(small_run):
 def test_failed_point_is_recorded_and_the_study_goes_on(tmp_path):
     study = write_study(tmp_path / "fail.yaml", scan={"solver.step_s": [2e-5, 1e-3]},
                         base_overrides={**SHORT, "impact.frequency_hz": 40}, plots=[])
-    assert main(["study", str(study), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"]) == 1
+    with pytest.warns(StepLimitWarning, match="exceeds the stability limit"):
+        assert main(["study", str(study), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"]) == 1
     by_step = {float(r["solver.step_s"]): r for r in rows(tmp_path / "out")}
     assert by_step[2e-5]["status"] == "ok" and by_step[2e-5]["error"] == ""
     error = by_step[1e-3]["error"]

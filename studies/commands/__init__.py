@@ -13,3 +13,11 @@ def add_runner_arguments(parser: argparse.ArgumentParser, dask: bool = True) -> 
                             help="run on a Dask cluster at ADDRESS, or on a LocalCluster when no address is given")
     parser.add_argument("--workers", type=int, help="worker processes (default: all cores; 1: in this process)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def positive_number(text: str) -> float:
+    """An argparse type: a number > 0."""
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{text}: must be a positive number")
+    return value

@@ -10,8 +10,8 @@ Runs the study's reference and reference check in this process, then every solve
 * DIR/pareto.csv: the Pareto front (cheapest settings for their accuracy) of each error measure;
 * DIR/reference.json: both references, their agreement, and whether it is below the smallest
   plotted error (so the plotted errors are errors of the settings, not of the reference);
-* DIR/workprecision.png: error against CPU time, log-log, one line per solver family, one panel
-  per error measure, the Pareto front and the references' agreement marked;
+* DIR/workprecision.png (and .svg): error against CPU time, log-log, one line per solver family,
+  one panel per error measure, the Pareto front and the references' agreement marked;
 * DIR/study.json: provenance (as ``rpdrill study``).
 
 Exit status 0 when the study ran (failed settings are results), 1 when the reference failed or
@@ -79,11 +79,10 @@ def run(args: argparse.Namespace) -> int:
     write_rows_csv(out / "pareto.csv", front, PARETO_COLUMNS)
     report = reference_report(study, reference, check, rows)
     write_json(out / "reference.json", report)
-    plot = out / f"workprecision.{spec.format}"
-    plot_workprecision(study, rows, front, report, plot)
+    plots = plot_workprecision(study, rows, front, report, out / f"workprecision.{spec.format}")
     failed = [row for row in rows if row["status"] != "ok"]
     print(f"{spec.name}: {len(rows) - len(failed)} settings ok, {len(failed)} failed; wrote {out / 'workprecision.csv'}, "
-          f"{out / 'pareto.csv'}, {out / 'reference.json'}, {plot}", file=sys.stderr)
+          f"{out / 'pareto.csv'}, {out / 'reference.json'}, {', '.join(map(str, plots))}", file=sys.stderr)
     for row in failed[:5]:
         print(f"  {row['family']} {row['setting']} {row['value']}: {row['error'][:160]}", file=sys.stderr)
     below = report.get("agreement_below_smallest_error", {})

@@ -9,27 +9,21 @@ import sys
 from rpdrill.models.compare import compare_runs, verdict
 from rpdrill.models.formulations import ODE_METHODS
 from rpdrill.models.stability import SimulationFailed
+from rpdrill.studies.commands import positive_number
 from rpdrill.studies.crosscheck import DEFAULT_STEP_S, comparison_table, window_scenes
 from rpdrill.studies.loading import load_scene, prepare_scene
 from rpdrill.studies.plots.crosscheck import plot_overlay
 from rpdrill.studies.run_files import staged_directory, write_json
 
 
-def _positive(text: str) -> float:
-    value = float(text)
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"{text}: must be a positive number")
-    return value
-
-
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="scene YAML file")
-    parser.add_argument("--out", help="output directory for crosscheck.json and crosscheck.png")
+    parser.add_argument("--out", help="output directory for crosscheck.json and crosscheck.png (and .svg)")
     parser.add_argument("--blows", type=int, default=20, help="compared window in impact periods (default 20)")
-    parser.add_argument("--step", type=_positive, default=DEFAULT_STEP_S,
+    parser.add_argument("--step", type=positive_number, default=DEFAULT_STEP_S,
                         help=f"Exudyn step [s] (default {DEFAULT_STEP_S:g}; solver type from the scene)")
     parser.add_argument("--method", choices=ODE_METHODS, default="DOP853", help="ODE method (default DOP853)")
-    parser.add_argument("--rtol", type=_positive, default=1e-10, help="ODE relative tolerance (default 1e-10)")
+    parser.add_argument("--rtol", type=positive_number, default=1e-10, help="ODE relative tolerance (default 1e-10)")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -1,6 +1,7 @@
 """Run one scene: time histories, summary figures and a plot.
 
-Writes DIR/timeseries.csv, DIR/summary.json, DIR/scene.resolved.yaml and DIR/timeseries.png.
+Writes DIR/timeseries.csv, DIR/summary.json, DIR/scene.resolved.yaml and DIR/timeseries.png (and
+.svg): the whole run beside its last blows.
 """
 
 from __future__ import annotations
@@ -8,8 +9,10 @@ from __future__ import annotations
 import argparse
 import sys
 
+from rpdrill.models.formulations import FORMULATIONS
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.stability import SimulationFailed
+from rpdrill.studies.catalogue import metric
 from rpdrill.studies.loading import load_scene, prepare_scene
 from rpdrill.studies.plots.timeseries import plot_timeseries
 from rpdrill.studies.progress import time_progress
@@ -22,11 +25,16 @@ HEADLINE = ("penetration_rate_m_per_s", "advance_per_blow_m", "energy_transfer_e
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="scene YAML file")
     parser.add_argument("--out", required=True, help="output directory")
+    parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
+                        help="run with this formulation (default: the scene's solver.formulation; the scene's "
+                             "options of another formulation are dropped)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
+    if args.formulation:
+        scene = scene.with_solver(args.formulation)
     simulation = prepare_scene(scene, args.scene)
     try:
         with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
@@ -41,8 +49,8 @@ def run(args: argparse.Namespace) -> int:
         write_json(stage / "summary.json", {"scene": scene.name, "formulation": result.formulation,
                                             "metrics": summary, "run": result.info})
         write_resolved(stage / "scene.resolved.yaml", simulation.resolved_scene())
-        plot_timeseries(columns, f"{scene.name}: {scene.impact.frequency_hz:g} Hz, "
-                        f"{scene.impact.amplitude_n / 1e3:g} kN", stage / "timeseries.png")
-    shown = ", ".join(f"{name} {value:.4g}" for name, value in summary.items() if name in HEADLINE)
-    print(f"{scene.name}: {shown}; wrote {args.out}")
+        plot_timeseries(columns, scene, stage / "timeseries.png")
+    shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}" for name, value in summary.items()
+                      if name in HEADLINE)
+    print(f"{scene.name} ({result.formulation}): {shown}; wrote {args.out}")
     return 0

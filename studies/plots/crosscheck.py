@@ -4,29 +4,30 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-
 from rpdrill.models.results import SimulationResult
+from rpdrill.studies.catalogue import series
+from rpdrill.studies.plots.style import OKABE_ITO, plt, save
+
+# result attribute -> time-history column (studies.catalogue)
+PANELS = {"bottom_m": "borehole_bottom_m", "bit_velocity_m_per_s": "bit_velocity_m_per_s", "rock_force_n": "rock_force_n"}
 
 
-def plot_overlay(ode: SimulationResult, exudyn: SimulationResult, title: str, path: Path) -> None:
-    """x_n, bit velocity and rock force of both formulations against time."""
-    panels = [("bottom_m", 1e3, "borehole bottom x_n [mm]"), ("bit_velocity_m_per_s", 1.0, "bit velocity [m/s]"),
-              ("rock_force_n", 1e-3, "rock force [kN]")]
-    fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(9, 8))
-    for ax, (name, scale, label) in zip(axes, panels):
-        ax.plot(ode.time_s, getattr(ode, name) * scale, lw=1.6, label="ODE (Eq. 4, events)")
-        ax.plot(exudyn.time_s, getattr(exudyn, name) * scale, lw=0.8, ls="--", label="Exudyn")
-        ax.set_ylabel(label)
+def plot_overlay(ode: SimulationResult, exudyn: SimulationResult, title: str, path: Path) -> list[Path]:
+    """x_n, bit velocity and rock force of both formulations against time; the files written."""
+    fig, axes = plt.subplots(len(PANELS), 1, sharex=True, figsize=(9, 8))
+    time = series("time_s")
+    for ax, (name, column) in zip(axes, PANELS.items()):
+        quantity = series(column)
+        ax.plot(time.display(ode.time_s), quantity.display(getattr(ode, name)), lw=1.6, color=OKABE_ITO[2],
+                label="ODE (Eq. 4, events)")
+        ax.plot(time.display(exudyn.time_s), quantity.display(getattr(exudyn, name)), lw=0.8, ls="--",
+                color=OKABE_ITO[0], label="Exudyn")
+        ax.set_ylabel(quantity.label())
         ax.grid(alpha=0.3)
     axes[0].legend(loc="best")
     axes[0].set_title(title)
-    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlabel(time.label())
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    return save(fig, path)
 
 

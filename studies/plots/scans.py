@@ -1,87 +1,123 @@
 """Figures of a study drawn from its results table (matplotlib, no screen needed).
 
-``curves``: each metric against axis x, one curve per combination of the other axes, the
-maximum of each curve marked. ``map``: filled contours of a metric over two axes with the
-optimum ridge (argmax along x for each y). Flat curves and rows have no optimum to mark.
+Labels, units and scales come from studies.catalogue; the title names the scene, its rock and its
+impact (what the scan varies left out); each legend entry lists every varied value of its curve
+(the plot's ``curves`` axis first).
+
+``curves``: each metric against axis x, one line per combination of the other axes; where the
+study's optima (studies.study_optima) run along x, each curve's refined optimum is a star and its
+80 % band a bar at 80 % of the peak, otherwise the grid maximum is a star. Failed runs are crosses
+on the x axis. ``map``: a metric over two axes as discrete cells, one per scan point (studies.plots.cells:
+nothing interpolated; few values are labelled rows); the optimum of each row (refined, as in the
+curves) is marked. A plot whose metrics have no finite value anywhere (every
+point failed) is not drawn.
 """
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 
+from rpdrill.models.scene import Scene
+from rpdrill.studies.catalogue import Quantity, describe_scene, metric, quantity
+from rpdrill.studies.plots.cells import cell_map, no_result_patch
+from rpdrill.studies.plots.style import line_styles, plt, save
 from rpdrill.studies.study import Plot, Study
-
-Row = dict[str, str]
-
-
-def _label(text: str) -> str:
-    try:
-        return f"{float(text):g}"
-    except ValueError:
-        return text
+from rpdrill.studies.study_optima import Record, Row, curves, metric_value, number_or_text
 
 
-def _metric(row: Row, name: str) -> float:
-    return float(row[name]) if row["status"] == "ok" and row[name] != "" else float("nan")
+def curve_label(values: dict[str, str]) -> str:
+    """'$I$ = 160 kN, rock sandstone': every varied value of a curve."""
+    parts = []
+    for axis, text in values.items():
+        q = quantity(axis)
+        value = number_or_text(text)
+        parts.append(f"{q.name} {value}" if q.categorical or isinstance(value, str) else
+                     f"${q.symbol}$ = {q.show_with_unit(value, 3)}")
+    return ", ".join(parts)
 
 
-def _curves(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
+def title(study: Study, what: str) -> str:
+    return f"{study.spec.name}: {what}\n{describe_scene(Scene.model_validate(study.base), study.axes)}"
+
+
+def _optimum(optima: list[Record], name: str, along: str, curve: dict[str, str]) -> Record | None:
+    """The optimum record of the curve that has the values ``curve`` (a subset of its axes), if one does."""
+    found = [r for r in optima if r["metric"] == name and r["along"] == along
+             and all(r["curve"].get(axis) == value for axis, value in curve.items())]
+    return found[0] if len(found) == 1 else None
+
+
+def _mark_optimum(ax: Any, record: Record | None, x: np.ndarray, y: np.ndarray, xq: Quantity, yq: Quantity,
+                  color: str) -> None:
+    """The refined optimum and its 80 % band, or the grid maximum of a curve that is not flat."""
+    if record is not None and record["optimum"] is not None:
+        peak = yq.display(record["optimum_value"])
+        ax.plot(xq.display(record["optimum"]), peak, marker="*", ms=13, color=color, mec="white", mew=0.8, ls="none")
+        ax.plot([xq.display(b) for b in record["band_80"]], [0.8 * peak] * 2, color=color, lw=3, alpha=0.5,
+                solid_capstyle="butt")
+    elif record is None and np.isfinite(y).any() and np.nanmax(y) > np.nanmin(y):
+        best = int(np.nanargmax(y))
+        ax.plot(x[best], y[best], marker="*", ms=13, color=color, mec="white", mew=0.8, ls="none")
+
+
+def _curves(plot: Plot, study: Study, rows: list[Row], optima: list[Record], path: Path) -> list[Path]:
+    xq = quantity(plot.x)
+    groups = curves(study, rows, plot.x)
     others = [a for a in study.axes if a != plot.x]
-    label_axes = [plot.curves] if plot.curves else others
-    groups: dict[tuple[str, ...], list[Row]] = defaultdict(list)
-    for row in rows:
-        groups[tuple(row[a] for a in others)].append(row)
-    fig, axes = plt.subplots(len(plot.metrics), 1, sharex=True, figsize=(8, 2.6 * len(plot.metrics) + 1),
-                             squeeze=False)
-    for ax, metric in zip(axes[:, 0], plot.metrics):
-        for key, members in groups.items():
-            members = sorted(members, key=lambda r: float(r[plot.x]))
-            x = np.array([float(r[plot.x]) for r in members])
-            y = np.array([_metric(r, metric) for r in members])
-            label = ", ".join(f"{a}={_label(dict(zip(others, key))[a])}" for a in label_axes)
-            (line,) = ax.plot(x, y, marker=".", lw=1, label=label or None)
-            if np.isfinite(y).any() and np.nanmax(y) > np.nanmin(y):  # a flat curve has no optimum
-                best = int(np.nanargmax(y))
-                ax.plot(x[best], y[best], marker="*", ms=12, color=line.get_color())
-                ax.annotate(f"{x[best]:.4g}", (x[best], y[best]), textcoords="offset points", xytext=(4, 4),
-                            fontsize=8, color=line.get_color())
-        ax.set_ylabel(metric, fontsize=8)
+    styles = line_styles(len(groups))
+    fig, axes = plt.subplots(len(plot.metrics), 1, sharex=True, figsize=(9, 2.7 * len(plot.metrics) + 1.2),
+                             squeeze=False, layout="constrained")
+    for ax, name in zip(axes[:, 0], plot.metrics):
+        yq = metric(name)
+        for style, (key, members) in zip(styles, groups.items()):
+            curve = dict(zip(others, key, strict=True))
+            x = np.array([xq.display(float(r[plot.x])) for r in members])
+            y = np.array([yq.display(metric_value(r, name)) for r in members])
+            leading = {plot.curves: curve[plot.curves]} if plot.curves else {}  # the plot's own axis first
+            ax.plot(x, y, lw=1.2, ms=4, label=curve_label({**leading, **curve}) or None, **style.kwargs())
+            _mark_optimum(ax, _optimum(optima, name, plot.x, curve), x, y, xq, yq, style.color)
+            failed = x[[r["status"] != "ok" for r in members]]
+            if failed.size:
+                ax.plot(failed, np.zeros_like(failed), "x", color=style.color, ms=7, mew=1.5,
+                        clip_on=False, transform=ax.get_xaxis_transform())
+        ax.set_ylabel(yq.label(), fontsize=9)
         ax.grid(alpha=0.3)
-    axes[-1, 0].set_xlabel(plot.x)
+    axes[-1, 0].set_xlabel(xq.label())
+    marks = "star: refined optimum, bar: 80 % band" if any(r["along"] == plot.x for r in optima) else "star: maximum"
+    axes[0, 0].set_title(title(study, marks + (", x on the axis: failed run" if any(
+        r["status"] != "ok" for r in rows) else "")), fontsize=9)
     if len(groups) > 1:
-        axes[0, 0].legend(fontsize=7)
-    axes[0, 0].set_title(f"{study.spec.name}: maxima marked")
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+        fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside right upper", fontsize=8)
+    return save(fig, path)
 
 
-def _map(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
+def _map(plot: Plot, study: Study, rows: list[Row], optima: list[Record], path: Path) -> list[Path]:
+    xq, yq, zq = quantity(plot.x), quantity(plot.y), metric(plot.z)
     xs, ys = sorted(set(study.axes[plot.x])), sorted(set(study.axes[plot.y]))
     z = np.full((len(ys), len(xs)), np.nan)
     for row in rows:
-        z[ys.index(float(row[plot.y])), xs.index(float(row[plot.x]))] = _metric(row, plot.z)
-    fig, ax = plt.subplots(figsize=(8, 6))
-    filled = ax.contourf(xs, ys, np.ma.masked_invalid(z), levels=20)
-    fig.colorbar(filled, ax=ax, label=plot.z)
-    ridge = [(xs[int(np.nanargmax(line))], y) for line, y in zip(z, ys)
-             if np.isfinite(line).any() and np.nanmax(line) > np.nanmin(line)]
-    if ridge:
-        ax.plot(*zip(*ridge), "w-o", lw=2, label="optimum ridge (max along x)")
-        ax.legend(fontsize=8)
-    ax.set_xlabel(plot.x)
-    ax.set_ylabel(plot.y)
-    ax.set_title(f"{study.spec.name}: {plot.z}")
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+        z[ys.index(float(row[plot.y])), xs.index(float(row[plot.x]))] = metric_value(row, plot.z)
+    fig, ax = plt.subplots(figsize=(9, 2.2 + 0.5 * min(len(ys), 12)), layout="constrained")
+    position = cell_map(fig, ax, xs, ys, z, xq, yq, zq)
+    marked, texts = [], {float(r[plot.y]): r[plot.y] for r in rows}
+    for i, y in enumerate(ys):
+        record = _optimum(optima, plot.z, plot.x, {plot.y: texts.get(y)})
+        if record is not None and record["optimum"] is not None:
+            marked.append(position(record["optimum"], y))
+        elif record is None and np.isfinite(z[i]).any() and np.nanmax(z[i]) > np.nanmin(z[i]):
+            marked.append(position(xs[int(np.nanargmax(z[i]))], y))
+    handles = no_result_patch(z)
+    if marked:
+        (line,) = ax.plot(*zip(*marked), "o", color="white", mec="black", ms=8,
+                          label="optimum of each row" + (" (refined)" if optima else ""))
+        handles.insert(0, line)
+    if handles:
+        ax.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(0, -0.12), ncols=2, frameon=False)
+    ax.set_title(title(study, zq.name), fontsize=9)
+    return save(fig, path)
 
 
 def plot_name(plot: Plot) -> str:
@@ -90,11 +126,15 @@ def plot_name(plot: Plot) -> str:
     return f"{'_'.join(plot.metrics) if len(plot.metrics) == 1 else 'metrics'}_vs_{plot.x}".replace(".", "_")
 
 
-def draw_plots(study: Study, rows: list[Row], out: Path) -> list[Path]:
-    """Draw every plot of the study into ``out``; the paths written."""
-    paths = []
+def draw_plots(study: Study, rows: list[Row], optima: list[Record], out: Path) -> tuple[list[Path], list[str]]:
+    """Draw every plot of the study that has a result into ``out``: (the files written, the names of
+    the plots left out because none of their metrics has a finite value)."""
+    written, skipped = [], []
     for i, plot in enumerate(study.spec.plots):
-        path = out / f"{i:02d}_{plot_name(plot)}.{study.spec.format}"
-        (_map if plot.kind == "map" else _curves)(plot, study, rows, path)
-        paths.append(path)
-    return paths
+        name = f"{i:02d}_{plot_name(plot)}"
+        if not any(np.isfinite(metric_value(row, m)) for row in rows for m in plot.metrics):
+            skipped.append(name)
+            continue
+        draw = _map if plot.kind == "map" else _curves
+        written += draw(plot, study, rows, optima, out / f"{name}.{study.spec.format}")
+    return written, skipped

@@ -8,35 +8,27 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-
 from rpdrill.models.workprecision import ERROR_LABELS, ERROR_MEASURES
 from rpdrill.studies.accuracy import AccuracyStudy, Row, number
+from rpdrill.studies.plots.style import line_styles, plt, save
 
 
 def plot_workprecision(study: AccuracyStudy, rows: list[Row], front: list[dict[str, Any]],
-                       report: dict[str, Any], path: Path) -> None:
-    """Error against median CPU time, log-log, one panel per measure, one line per family."""
+                       report: dict[str, Any], path: Path) -> list[Path]:
+    """Error against median CPU time, log-log, one panel per measure, one line per family
+    (colour-blind-safe styles, studies.plots.style); the files written."""
     fig, axes = plt.subplots(1, len(ERROR_MEASURES), figsize=(6 * len(ERROR_MEASURES), 5.5))
     families: dict[str, list[Row]] = defaultdict(list)
     for row in sorted(rows, key=lambda r: int(r["point"])):
         families[row["family"]].append(row)
-    markers = "osD^v<>ph*X"
-    colors = plt.cm.tab20(range(20))
+    styles = line_styles(len(families))
     for ax, measure in zip(axes, ERROR_MEASURES):
-        for k, (label, members) in enumerate(families.items()):
+        for style, (label, members) in zip(styles, families.items()):
             pairs = [(number(r["cpu_time_s"]), number(r[measure])) for r in members if r["status"] == "ok"]
             pairs = [(c, e) for c, e in pairs if c > 0 and e > 0 and math.isfinite(e)]
             failed = sum(r["status"] != "ok" for r in members)
             name = label + (f" ({failed} failed)" if failed else "")
-            if pairs:
-                ax.loglog(*zip(*pairs), marker=markers[k % len(markers)], ms=4, lw=1, label=name,
-                          color=colors[(2 * k) % 20 + (k // 10) % 2])
-            else:
-                ax.plot([], [], marker=markers[k % len(markers)], label=name, color=colors[(2 * k) % 20])
+            ax.loglog(*(zip(*pairs) if pairs else ([], [])), ms=4, lw=1, label=name, **style.kwargs())
         points = [(number(p["cpu_time_s"]), number(p["error"])) for p in front if p["measure"] == measure]
         points = [(c, e) for c, e in points if c > 0 and e > 0]
         if points:
@@ -48,12 +40,11 @@ def plot_workprecision(study: AccuracyStudy, rows: list[Row], front: list[dict[s
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("CPU time [s] (median of repeats)")
-        ax.set_ylabel(ERROR_LABELS[measure])
+        ax.set_ylabel(f"{ERROR_LABELS[measure]} [-]")
         ax.grid(alpha=0.3, which="both")
     axes[0].legend(fontsize=7, loc="lower left")
     fig.suptitle(f"{study.spec.name}: {study.spec.blows} blows, reference {study.reference.solver}")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return save(fig, path, dpi=110)
 
 

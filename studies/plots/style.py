@@ -1,0 +1,51 @@
+"""What every figure shares: colour-blind-safe line styles, the map colour scale, titles naming the
+scene, and saving as SVG beside the raster file.
+
+Lines: the Okabe-Ito colours (distinct for the common colour-vision deficiencies; yellow left out,
+too pale on white), then the same colours dashed, dotted and dash-dotted, each line with its own
+marker, so that 28 lines stay distinguishable without colour. Maps: cividis (perceptually
+uniform, readable with deuteranopia and in grey).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from matplotlib.figure import Figure
+
+OKABE_ITO = ("#000000", "#E69F00", "#56B4E9", "#009E73", "#0072B2", "#D55E00", "#CC79A7")
+LINE_STYLES = ("-", "--", ":", "-.")
+MARKERS = ("o", "s", "^", "D", "v", "P", "X", "<", ">", "h", "*", "p")
+MAP_COLORMAP = "cividis"
+NO_RESULT_COLOR = "0.85"  # the background of map cells without a result (failed runs)
+
+
+@dataclass(frozen=True)
+class LineStyle:
+    color: str
+    linestyle: str
+    marker: str
+
+    def kwargs(self) -> dict[str, str]:
+        return {"color": self.color, "linestyle": self.linestyle, "marker": self.marker}
+
+
+def line_styles(count: int) -> list[LineStyle]:
+    """``count`` distinct styles: the colours solid, then dashed, dotted, dash-dotted; markers cycle
+    on their own."""
+    return [LineStyle(OKABE_ITO[k % len(OKABE_ITO)], LINE_STYLES[k // len(OKABE_ITO) % len(LINE_STYLES)],
+                      MARKERS[k % len(MARKERS)]) for k in range(count)]
+
+
+def save(fig: Figure, path: Path, dpi: int = 120) -> list[Path]:
+    """Write ``fig`` to ``path`` and, unless ``path`` is an SVG, to an SVG beside it; close it."""
+    paths = [path] + ([path.with_suffix(".svg")] if path.suffix != ".svg" else [])
+    for target in paths:
+        fig.savefig(target, dpi=dpi, bbox_inches="tight")
+    plt.close(fig)
+    return paths

@@ -1,0 +1,154 @@
+"""``rpdrill advise`` (studies.advice): the search against brute force, the thrust limit, the
+feed-force reading of the map, the penetration per impact energy, and the command."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+import yaml
+from scenes import crushing_scene, scene, scene_dict, simulate
+
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.pulse import impulse_per_blow_n_s
+from rpdrill.models.simulation import prepare
+from rpdrill.studies.advice import (
+    FEED,
+    FREQUENCY,
+    PARAMETERS,
+    AdviseParameter,
+    Evaluator,
+    Request,
+    advise,
+    at_point,
+    feed_response,
+    limit_feed_n,
+    runnable_scene,
+    thrust_ratio,
+)
+from rpdrill.studies.cli import main
+from rpdrill.studies.runners import sequential
+
+RATE = "penetration_rate_m_per_s"
+SHORT = {"solver": {"end_time_s": 0.3}, "metrics": {"transient_blows": 4, "block_blows": 4}}
+
+
+def short_scene(**overrides) -> dict:
+    return scene(**SHORT, **overrides).model_dump(by_alias=True, exclude_none=True)
+
+
+def test_advise_finds_the_best_of_a_fine_grid():
+    """Differential evolution against every point of a 1 Hz x 1 kN grid over the same bounds."""
+    base = short_scene()
+    request = Request(RATE, {FREQUENCY: (45.0, 70.0), FEED: (35e3, 60e3)})
+    grid = [{FREQUENCY: f, FEED: feed} for f in np.arange(45.0, 70.1, 1.0) for feed in np.arange(35e3, 60.1e3, 1e3)]
+    data = runnable_scene(base, None, request, "test")
+    brute = np.nanmax(Evaluator(data, request, sequential)(grid).values)
+    advice = advise(data, None, request, sequential)
+    assert brute > 0
+    assert advice.best_value >= 0.99 * brute
+    assert advice.formulation == "exact" and advice.runs < len(grid)
+    for path, (low, high) in request.bounds.items():
+        curve = advice.slices[path]
+        assert low <= advice.best[path] <= high and advice.best[path] in curve["values"]
+        assert np.nanmax(curve["metric"]) <= 1.01 * advice.best_value  # no point of the curves is better
+        assert curve["band_80"][0] <= advice.best[path] <= curve["band_80"][1]
+    assert np.array(advice.feed_map["metric"]).shape == (12, 12)
+
+
+def test_mean_thrust_is_the_mean_rock_force_of_a_steady_run():
+    """Momentum over the averaging window: the rock takes the feed and the blows' impulse."""
+    simulation = prepare(crushing_scene(solver={"end_time_s": 1.0, "formulation": "exact"},
+                                        outputs={"metrics": ["rock_force_max_n", RATE]}))
+    expected = simulation.scene.feed.force_n + impulse_per_blow_n_s(simulation.impact) * simulation.impact.frequency_hz
+    assert simulation.mean_thrust_n == pytest.approx(expected)
+    result = simulation.run()
+    window = result.time_s >= 10 / simulation.impact.frequency_hz
+    t, force = result.time_s[window], result.rock_force_n[window]
+    assert np.trapezoid(force, t) / (t[-1] - t[0]) == pytest.approx(simulation.mean_thrust_n, rel=1e-3)
+    per_body = prepare(scene(feed={"force_n": 30e3, "acts_on": "every_body"}))
+    assert per_body.feed_total_n == pytest.approx(30e3 * len(per_body.chain.bodies))
+
+
+def test_points_beyond_the_thrust_limit_are_not_run():
+    base = short_scene()
+    request = Request(RATE, {FREQUENCY: (45.0, 70.0), FEED: (35e3, 200e3)})
+    data = runnable_scene(base, None, request, "test")
+    limit = limit_feed_n(data, 60.0, 1.0)
+    assert thrust_ratio(at_point(data, {FREQUENCY: 60.0, FEED: limit})) == pytest.approx(1.0)
+    evaluate = Evaluator(data, request, sequential)
+    evaluation = evaluate([{FREQUENCY: 60.0, FEED: 0.9 * limit}, {FREQUENCY: 60.0, FEED: 1.1 * limit}])
+    assert math.isfinite(evaluation.values[0]) and math.isnan(evaluation.values[1])
+    assert (evaluate.runs, evaluate.beyond_limit) == (1, 1)
+    objective = evaluation.objective()
+    assert objective[0] <= 0 < objective[1]  # beyond the limit is worse than any point below it
+    half = Evaluator(data, Request(RATE, request.bounds, max_thrust_ratio=0.5), sequential)
+    assert math.isnan(half([{FREQUENCY: 60.0, FEED: 0.9 * limit}]).values[0])
+
+
+def test_feed_response_reads_where_the_rate_is_highest_along_the_feed():
+    nan = float("nan")
+    grid = {FREQUENCY: [40.0, 50.0, 60.0, 70.0],
+            "metric": [[0.0, 0.0, 3.0, 0.0],   # lowest feed (rows: feeds, columns: frequencies)
+                       [2.0, 0.0, 2.0, 0.0],
+                       [1.0, 0.0, 1.0, 1.0],
+                       [0.5, 0.0, nan, nan]]}  # beyond the thrust limit at 60 and 70 Hz
+    response = feed_response(grid)
+    assert response["best_feed_at"] == ["interior", "none", "lowest feed", "highest feed"]
+    assert response["frequencies_by_kind"]["highest feed"] == [70.0]
+
+
+def test_penetration_per_impact_energy_is_the_advance_over_the_impact_work():
+    per_joule = "penetration_per_impact_energy_m_per_j"
+    result = simulate(crushing_scene(outputs={"metrics": [per_joule, RATE, "impact_energy_j", "window_start_s",
+                                                          "window_end_s"]}), "exact")
+    metrics = summary_metrics(result)
+    advance = metrics[RATE] * (metrics["window_end_s"] - metrics["window_start_s"])
+    assert metrics[per_joule] == pytest.approx(advance / metrics["impact_energy_j"], rel=1e-9)
+    assert metrics[per_joule] > 0
+
+
+def test_parameters_are_data_and_make_their_options():
+    assert [p.option for p in PARAMETERS] == ["--frequency-hz", "--feed-kn", "--amplitude-kn"]
+    assert AdviseParameter("pulse", "impact.duration_s", False).option == "--pulse-ms"
+    assert PARAMETERS[1].si_bounds((20.0, 100.0)) == (20e3, 100e3)
+
+
+def write_scene(tmp_path) -> str:
+    path = tmp_path / "drill.yaml"
+    path.write_text(yaml.safe_dump(scene_dict(solver=SHORT["solver"], metrics=SHORT["metrics"])))
+    return str(path)
+
+
+def test_advise_command_writes_the_advice(tmp_path, capsys):
+    out, markdown = tmp_path / "out", tmp_path / "advice.md"
+    assert main(["advise", write_scene(tmp_path), "--frequency-hz", "45", "70", "--feed-kn", "35", "60",
+                 "--rock", "sandstone", "--popsize", "4", "--generations", "3", "--out", str(out),
+                 "--markdown", str(markdown), "--workers", "1", "--quiet"]) == 0
+    printed = capsys.readouterr().out
+    assert "sandstone: best penetration rate" in printed and "along feed force" in printed
+    assert {p.name for p in out.iterdir()} == {
+        "advice.json", "advice.md", "sandstone_curves.png", "sandstone_curves.svg",
+        "sandstone_feed_frequency_map.png", "sandstone_feed_frequency_map.svg"}
+    record = json.loads((out / "advice.json").read_text())
+    (result,) = record["results"]
+    assert result["rock"] == "sandstone" and result["formulation"] == "exact"
+    assert 45.0 <= result["best"][FREQUENCY] <= 70.0 and 35e3 <= result["best"][FEED] <= 60e3
+    text = markdown.read_text()
+    assert text == (out / "advice.md").read_text()
+    assert "--frequency-hz 45 70 --feed-kn 35 60" in record["command"] and record["command"] in text
+    assert "| sandstone |" in text and "feed force [kN]" in text
+
+
+@pytest.mark.parametrize("arguments, expected", [
+    (["--frequency-hz", "70", "45", "--feed-kn", "35", "60"], "--frequency-hz 70 45: the lower bound must be below"),
+    (["--frequency-hz", "45", "2000", "--feed-kn", "35", "60"],
+     "cannot run at the corner --frequency-hz 2000 --feed-kn 35 of the bounds"),
+])
+def test_advise_bad_bounds_exit_2(tmp_path, capsys, arguments, expected):
+    assert main(["advise", write_scene(tmp_path), *arguments, "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert expected in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
