@@ -37,6 +37,11 @@ t_start + min_switch_interval_s, the switch is placed there. More than ``max_swi
 switches per blow on average raise :class:`SimulationFailed`, and so does a diverged state
 (models.stability's criterion, checked at every switch, pulse switch and batch end; the message
 names the first diverged sample).
+
+Blow starts. A law that resets at blow starts (the state the next blow meets: models.indexing) is
+linear between blows; the compiled loop stops at each blow start, the rock states are set here
+(any function of the state, e.g. of the torsion angle turned since the last blow) and the rock's
+mode found again, and the loop goes on.
 """
 
 from __future__ import annotations
@@ -53,9 +58,9 @@ from scipy.linalg.lapack import dgebal
 from threadpoolctl import ThreadpoolController
 
 from rpdrill.models.chain import torsion_first_order_matrix
-from rpdrill.models.exact_kernels import DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
+from rpdrill.models.exact_kernels import BLOW_START, DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
 from rpdrill.models.piecewise import Element, elements
-from rpdrill.models.pulse import PHASES, generator_states, phase_generator, phase_pieces, phase_row
+from rpdrill.models.pulse import PHASES, blow_start_times, generator_states, phase_generator, phase_pieces, phase_row
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import Simulation, as_simulation
@@ -270,6 +275,19 @@ class ExactSolver:
         self.step_s = settings.sample_interval_s / self.per_sample
         self.operators = Operators(self.model, self.step_s, taylor_order(norm * self.step_s),
                                    len(self.model.pieces[0].table) * len(set(self.phases)))
+        self.blows = simulation.blow_starts()
+        blows = blow_start_times(self.impact, settings.end_time_s) if self.blows else np.empty(0)
+        self.blow_phases = np.isin(self.phase_times[:, 0], blows).astype(np.int64)
+
+    def start_blow(self, w: np.ndarray, mode_id: int) -> int:
+        """Set the rock states of w to those the blow starting now meets; the mode id with the rock's
+        mode found again."""
+        layout, rock = self.layout, self.model.pieces[0]
+        states = slice(2 * layout.n, 2 * layout.n + layout.rock_states)
+        angle = w[layout.angle] if layout.torsion else 0.0
+        w[states] = self.blows(w[self.simulation.chain.bit_body], tuple(w[states]), angle)
+        modes = self.operators.modes[mode_id]
+        return self.operators.mode_id((rock.initial_mode(w), *modes[1:]))
 
     def run(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Modes]]:
         """From the simulation's start (rest, off the bottom; or preloaded, in contact) through every
@@ -297,13 +315,17 @@ class ExactSolver:
         while True:
             status = run_events(
                 ops.taylor, ops.one_step, ops.anchors, ops.readout, ops.exit_counts, ops.directions, ops.next_modes,
-                ops.rock_rows, ops.impact_rows, ops.key_of, self.phase_times, phase_ids, pulse, ops.reset_counts,
+                ops.rock_rows, ops.impact_rows, ops.key_of, self.phase_times, phase_ids, pulse, self.blow_phases,
+                ops.reset_counts,
                 ops.reset_targets, ops.reset_rows, self.model.pieces[0].monotone, self.step_s, PER_ANCHOR,
                 self.per_sample, self.min_switch_interval_s, self.max_switches, n, POSITION_LIMIT_M, progress, clock,
                 w, time_s, rows, switch_times, switch_modes)
-            if status != MISSING_KEY:
+            if status == BLOW_START:
+                progress[1] = self.start_blow(w, progress[1])
+            elif status == MISSING_KEY:
+                ops.add(ops.modes[progress[1]], self.phases[progress[0]])
+            else:
                 break
-            ops.add(ops.modes[progress[1]], self.phases[progress[0]])
         filled, switches = progress[2], progress[3]
         time_s, rows, switch_times = time_s[:filled], rows[:filled], switch_times[:switches]
         if status == TOO_MANY_SWITCHES:
@@ -373,5 +395,6 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
             "switch_modes": entered,  # the modes entered at each switch time
             "operator_keys": solver.operators.built,
             "min_switch_interval_s": solver.min_switch_interval_s,
+            **({"fresh_fractions": solver.blows.fresh_fractions} if solver.blows else {}),
         },
     )

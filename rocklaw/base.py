@@ -15,6 +15,9 @@ and the state:
   switches: :meth:`RockLaw.modes` over the local variables ``position``, ``velocity``, the state
   names and ``one``, and :meth:`RockLaw.initial_mode`. The ODE and the exact formulations
   generate their events, state rates, resets and matrices from it;
+* blows: :meth:`RockLaw.start_blow` gives the state the next blow meets from the share of its
+  footprint on fresh rock (1 without an indexing model, models.indexing); ``resets_at_blows`` says
+  whether it changes anything (the formulations apply it at every blow start only then);
 * energy: the rock stores F_spring^2 / (2 k_unload) and dissipates the plastic (crushing) work
   W_p = int F_spring d(x_n) (:meth:`RockLaw.plastic_work_j`).
 
@@ -77,6 +80,16 @@ class RockLaw(Protocol):
 
     def return_map(self, bit_position_m: float, state: State) -> State:
         """The state after the bit reached ``bit_position_m`` (once per step, before the step)."""
+        ...
+
+    @property
+    def resets_at_blows(self) -> bool:
+        """Whether :meth:`start_blow` changes the state (else no formulation calls it)."""
+        ...
+
+    def start_blow(self, bit_position_m: float, state: State, fresh_fraction: float) -> State:
+        """The state the next blow meets when ``fresh_fraction`` (0 < eta <= 1) of its footprint lands
+        on fresh rock (applied at every blow start)."""
         ...
 
     def plastic_work_j(self, spring_force_n: np.ndarray, bottom_m: np.ndarray) -> np.ndarray:

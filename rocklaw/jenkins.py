@@ -31,6 +31,12 @@ crushing   v falls through 0 (crushing ends)                contact
 
 With damping_mode ``always``, or without rock damping, there is no ``clipped`` mode (k_n d + c_n v
 = 0 is then d = 0); an elastic rock (F_th infinite) has no ``crushing`` mode.
+
+Crater memory: the law keeps x_n when contact is lost, and a contact regained reloads along k_n up
+to F_th, so within a blow it remembers its crater. Between blows an indexing model may set the
+threshold the next blow meets (``threshold_state``: the threshold becomes a second state, constant
+between blows and set by :meth:`JenkinsRock.start_blow` to F_th / eta, eta the share of the blow
+that advances the hole; models.indexing); the mode rows stay affine in the states.
 """
 
 from __future__ import annotations
@@ -43,12 +49,12 @@ from typing import Any, Literal
 import numpy as np
 
 from rpdrill.rocklaw.backends import NUMERIC, Backend
-from rpdrill.rocklaw.base import POSITION, VELOCITY, State
+from rpdrill.rocklaw.base import POSITION, VELOCITY, State, trapezoidal_plastic_work_j
 from rpdrill.rocklaw.modes import ONE, Mode, ModeTable, Switch
 
 DampingMode = Literal["contact", "always"]
 FREE, CONTACT, CLIPPED, CRUSHING = "free", "contact", "clipped", "crushing"
-BOTTOM = "bottom_m"
+BOTTOM, THRESHOLD = "bottom_m", "threshold_n"
 
 
 @dataclass(frozen=True)
@@ -59,9 +65,9 @@ class JenkinsRock:
     damping_n_s_per_m: float
     threshold_n: float
     damping_mode: DampingMode = "contact"
+    threshold_state: bool = False  # the threshold a state set per blow (module doc)
 
     name = "jenkins"
-    state_names = (BOTTOM,)
     bottom_index = 0
 
     def __post_init__(self) -> None:
@@ -86,13 +92,27 @@ class JenkinsRock:
         """False for an elastic rock (F_th infinite): no slider, no return mapping."""
         return math.isfinite(self.threshold_n)
 
+    @property
+    def resets_at_blows(self) -> bool:
+        """Only the threshold state is set per blow."""
+        return self.threshold_state
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """x_n, and the threshold of the current blow with ``threshold_state``."""
+        return (BOTTOM, THRESHOLD) if self.threshold_state else (BOTTOM,)
+
     def initial_state(self) -> State:
-        return (0.0,)
+        return (0.0, self.threshold_n) if self.threshold_state else (0.0,)
+
+    def _threshold(self, state: Sequence[Any]) -> Any:
+        """F_th, or the current blow's threshold state."""
+        return state[1] if self.threshold_state else self.threshold_n
 
     def spring_force(self, bit_position_m: Any, state: Sequence[Any], backend: Backend = NUMERIC) -> Any:
         """Eq. 1: clip(k_n d, 0, F_th) with d = x_bit - x_n, the force of the spring-slider pair."""
         elastic = self.stiffness_n_per_m * (bit_position_m - state[0])
-        capped = backend.minimum(elastic, self.threshold_n) if self.crushes else elastic
+        capped = backend.minimum(elastic, self._threshold(state)) if self.crushes else elastic
         return backend.where(elastic > 0, capped, 0.0)
 
     def force(self, bit_position_m: Any, bit_velocity_m_per_s: Any, state: Sequence[Any],
@@ -104,18 +124,27 @@ class JenkinsRock:
         if self.damping_n_s_per_m == 0.0:
             return self.spring_force(bit_position_m, state, backend)
         elastic = self.stiffness_n_per_m * (bit_position_m - state[0])
-        spring = backend.minimum(elastic, self.threshold_n) if self.crushes else elastic
+        spring = backend.minimum(elastic, self._threshold(state)) if self.crushes else elastic
         damping = self.damping_n_s_per_m * bit_velocity_m_per_s
         if self.damping_mode == "always":
             return backend.where(elastic > 0, spring, 0.0) + damping
         return backend.where(elastic > 0, backend.maximum(spring + damping, 0.0), 0.0)
 
     def return_map(self, bit_position_m: float, state: State) -> State:
-        """Eq. 2 integrated over a step: x_n <- max(x_n, x_bit - F_th / k_n), state = (x_n,)."""
-        return (max(state[0], bit_position_m - self.crushing_penetration_m),)
+        """Eq. 2 integrated over a step: x_n <- max(x_n, x_bit - F_th / k_n) (the threshold kept)."""
+        bottom = max(state[0], bit_position_m - self._threshold(state) / self.stiffness_n_per_m)
+        return (bottom, *state[1:])
+
+    def start_blow(self, bit_position_m: float, state: State, fresh_fraction: float) -> State:
+        """The state the next blow meets: with ``threshold_state`` the threshold F_th / eta (eta of the
+        crushing advances the hole; models.indexing); else unchanged (Eq. 1, 2 have no blows)."""
+        return (state[0], self.threshold_n / fresh_fraction) if self.threshold_state else state
 
     def plastic_work_j(self, spring_force_n: np.ndarray, bottom_m: np.ndarray) -> np.ndarray:
-        """W_p = F_th (x_n - x_n(0)): the bottom moves only while the spring carries F_th."""
+        """W_p = F_th (x_n - x_n(0)): the bottom moves only while the spring carries F_th (trapezoidal
+        int F d(x_n) with a threshold state, exact while it is constant)."""
+        if self.threshold_state:
+            return trapezoidal_plastic_work_j(spring_force_n, bottom_m)
         return (self.threshold_n if self.crushes else 0.0) * (bottom_m - bottom_m[0])
 
     def modes(self) -> ModeTable:
@@ -123,12 +152,15 @@ class JenkinsRock:
         F_r rows k_n (x - x_n) + c_n v (contact), F_th + c_n v with x_n' = v (crushing; entered at
         x_n = x - F_th / k_n, the return map on the switching surface), 0 (clipped; free unless the
         damping acts ``always``)."""
-        k, c, threshold = self.stiffness_n_per_m, self.damping_n_s_per_m, self.threshold_n
+        k, c = self.stiffness_n_per_m, self.damping_n_s_per_m
+        # the threshold: a constant, or the state set per blow
+        threshold = {THRESHOLD: 1.0} if self.threshold_state else {ONE: self.threshold_n}
         penetration = {POSITION: 1.0, BOTTOM: -1.0}
         total = {POSITION: k, BOTTOM: -k, VELOCITY: c}
         contact_exits = [Switch(penetration, -1, FREE)]
         if self.crushes:
-            contact_exits.append(Switch({POSITION: k, BOTTOM: -k, ONE: -threshold}, 1, CRUSHING))
+            contact_exits.append(Switch({POSITION: k, BOTTOM: -k, **{name: -value for name, value in threshold.items()}},
+                                        1, CRUSHING))
         if self._clips:
             contact_exits.append(Switch(total, -1, CLIPPED))
         table = {
@@ -139,16 +171,17 @@ class JenkinsRock:
         if self._clips:
             table[CLIPPED] = Mode({}, (Switch(total, 1, CONTACT), Switch(penetration, -1, FREE)))
         if self.crushes:
-            table[CRUSHING] = Mode({ONE: threshold, VELOCITY: c}, (Switch({VELOCITY: 1.0}, -1, CONTACT),),
+            table[CRUSHING] = Mode({**threshold, VELOCITY: c}, (Switch({VELOCITY: 1.0}, -1, CONTACT),),
                                    rates={BOTTOM: {VELOCITY: 1.0}},
-                                   entry={BOTTOM: {POSITION: 1.0, ONE: -self.crushing_penetration_m}})
+                                   entry={BOTTOM: {POSITION: 1.0, **{name: -value / k for name, value in threshold.items()}}})
         return table
 
     def initial_mode(self, values: Mapping[str, float]) -> str:
         d, v = values[POSITION] - values[BOTTOM], values[VELOCITY]
         if d <= 0:
             return FREE
-        if self.crushes and self.stiffness_n_per_m * d >= self.threshold_n and v > 0:
+        threshold = values[THRESHOLD] if self.threshold_state else self.threshold_n
+        if self.crushes and self.stiffness_n_per_m * d >= threshold and v > 0:
             return CRUSHING
         return CLIPPED if self._clips and self.stiffness_n_per_m * d + self.damping_n_s_per_m * v <= 0 else CONTACT
 
