@@ -58,9 +58,23 @@ from scipy.linalg.lapack import dgebal
 from threadpoolctl import ThreadpoolController
 
 from rpdrill.models.chain import torsion_first_order_matrix
-from rpdrill.models.exact_kernels import BLOW_START, DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
+from rpdrill.models.exact_kernels import (
+    BLOW_START,
+    DIVERGED,
+    MISSING_KEY,
+    TOO_MANY_SWITCHES,
+    assemble,
+    run_events,
+)
 from rpdrill.models.piecewise import Element, elements
-from rpdrill.models.pulse import PHASES, blow_start_times, generator_states, phase_generator, phase_pieces, phase_row
+from rpdrill.models.pulse import (
+    PHASES,
+    blow_start_times,
+    generator_states,
+    phase_generator,
+    phase_pieces,
+    phase_row,
+)
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import Simulation, as_simulation

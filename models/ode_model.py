@@ -32,8 +32,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rpdrill.models.chain import link_load_n, torsion_first_order_matrix
-from rpdrill.models.piecewise import Element, elements
 from rpdrill.models.indexing import BlowStarts
+from rpdrill.models.piecewise import Element, elements
 from rpdrill.models.pulse import blow_start_times, impact_force, switch_times
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Impact

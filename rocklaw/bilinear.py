@@ -128,8 +128,9 @@ class BilinearRock:
         """The state the next blow meets (module doc): s <- s + eta (s_fresh - s), s_fresh = min(p,
         x - F / k_l) with F the current spring force (s_fresh = p off the rock)."""
         surface, bottom = state
-        force = self.spring_force(bit_position_m, state)
-        fresh = min(bottom, bit_position_m - force / self.loading_stiffness_n_per_m)
+        fresh = bottom
+        if bit_position_m > bottom:
+            fresh = min(bottom, bit_position_m - self.spring_force(bit_position_m, state) / self.loading_stiffness_n_per_m)
         return (surface + fresh_fraction * (fresh - surface), bottom)
 
     def plastic_work_j(self, spring_force_n: np.ndarray, bottom_m: np.ndarray) -> np.ndarray:
