@@ -77,7 +77,7 @@ from rpdrill.models.pulse import (
 )
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import Simulation, as_simulation
+from rpdrill.models.simulation import SceneError, Simulation, as_simulation
 from rpdrill.models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
 from rpdrill.rocklaw.modes import Affine
 
@@ -299,7 +299,7 @@ class ExactSolver:
         layout, rock = self.layout, self.model.pieces[0]
         states = slice(2 * layout.n, 2 * layout.n + layout.rock_states)
         angle = w[layout.angle] if layout.torsion else 0.0
-        w[states] = self.blows(w[self.simulation.chain.bit_body], tuple(w[states]), angle)
+        _, w[states] = self.blows(w[self.simulation.chain.bit_body], tuple(w[states]), angle)  # one law (unsupported)
         modes = self.operators.modes[mode_id]
         return self.operators.mode_id((rock.initial_mode(w), *modes[1:]))
 
@@ -366,6 +366,18 @@ def _switch_counts(model: Model, before: Modes, entered: list[Modes]) -> dict[st
     return counts
 
 
+def unsupported(simulation: Simulation) -> str | None:
+    """Why the exact formulation cannot run ``simulation``, or None: an indexing share taken from the
+    torsion line blow by blow into a law whose mode rows carry it (Jenkins: the crushing rates), so
+    that its matrices would change at every blow."""
+    indexing = simulation.indexing
+    if indexing is not None and indexing.speed_rpm is None and simulation.rock.modes_follow_fresh_fraction:
+        return (f"the {simulation.rock.name} law's crushing rates carry the indexing share of each blow, which "
+                "comes from the torsion angle and changes from blow to blow, so the matrices would change at "
+                "every blow; give rotation.speed_rpm (a constant share) or use the ode or exudyn formulation")
+    return None
+
+
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Exact solution of the simulation from its start to its end time (formulation "exact").
 
@@ -375,6 +387,9 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     at the end (a run takes milliseconds).
     """
     simulation = as_simulation(run)
+    why = unsupported(simulation)
+    if why:
+        raise SceneError(("solver", "formulation"), "exact", why)
     start = time.process_time()
     with BLAS.limit(limits=1, user_api="blas"):
         solver = ExactSolver(simulation)

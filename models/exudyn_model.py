@@ -170,8 +170,11 @@ def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
     start_blow = None
     if blows is not None:
         def start_blow(position: float, state: tuple[float, ...]) -> tuple[float, ...]:
+            """The state the blow meets; the contact's return map takes the blow's law."""
             angle = mbs.GetNodeOutput(torsion_node, COORDINATE) if torsion_node is not None else 0.0
-            return blows(position, state, angle)
+            law, state = blows(position, state, angle)
+            rock.set_law(law)
+            return state
     rock = ExudynRockContact(mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], simulation.rock,
                              symbolic=symbolic, initial_state=simulation.initial_rock_state, start_blow=start_blow,
                              blow_period_s=impact.period_s)

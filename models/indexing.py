@@ -21,10 +21,11 @@ default the button diameter d). The share of the blow that advances the hole is
                     does not remove: the hole advances over w of every e of the track)
 
 so eta = 1 (a fresh surface, craters just touching) at e = w, and eta >= ``MIN_FRESH_FRACTION``
-(a blow in its own crater still deepens it). The rock law turns eta into the state the next blow
-meets (``RockLaw.start_blow``): Jenkins, the threshold F_th / eta (the crushing work per unit of
-hole advance); bilinear, the loading surface moved a share eta of the way to fresh rock (1 - eta
-of the old crater's stiff reload kept). At a constant rotation speed the index per blow is
+(a blow in its own crater still deepens it). The rock law runs each blow with its eta
+(``fresh_fraction``; rocklaw): Jenkins, only eta of the bit's crushing stroke advances the hole and
+the crushing force hardens along k_n (1 - eta) (the rest compacts crushed rock), from F_th at every
+blow start; bilinear, the loading surface a share eta of the way to fresh rock at the blow start
+(1 - eta of the old crater's stiff reload kept). At a constant rotation speed the index per blow is
 constant, so the best rotation speed is proportional to the blow frequency:
 
     n_best = 60 f w / (pi D)  [rpm]   (e = w, below the pitch aliasing at s = P / 2).
@@ -36,7 +37,7 @@ torsion line (the change of phi between blow starts; phi does not change before 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from rpdrill.models.scene import Bit
 from rpdrill.rocklaw import RockLaw, State
@@ -84,9 +85,9 @@ class Indexing:
 
 @dataclass
 class BlowStarts:
-    """The rock state at each blow start of one run: the law's ``start_blow`` with the share eta of the
-    angle turned since the last blow start (1 without indexing). Call it at every blow start in order;
-    ``fresh_fractions`` records eta of each blow."""
+    """The rock law and state of each blow of one run: the share eta of the angle turned since the
+    last blow start (1 without indexing), the law with that eta, and its ``start_blow``. Call it at
+    every blow start in order; ``fresh_fractions`` records eta of each blow."""
 
     rock: RockLaw
     indexing: Indexing | None
@@ -96,14 +97,14 @@ class BlowStarts:
     def __post_init__(self) -> None:
         self._last_angle_rad = self.initial_angle_rad
 
-    def __call__(self, bit_position_m: float, state: State, angle_rad: float = 0.0) -> State:
-        """The state the blow starting now meets; ``angle_rad``: the torsion angle now (without a
-        prescribed speed)."""
-        eta = 1.0
+    def __call__(self, bit_position_m: float, state: State, angle_rad: float = 0.0) -> tuple[RockLaw, State]:
+        """(the law of the blow starting now, the state it meets); ``angle_rad``: the torsion angle now
+        (read without a prescribed speed)."""
+        law = self.rock
         if self.indexing is not None:
             turned = self.indexing.prescribed_angle_rad if self.indexing.speed_rpm is not None \
                 else angle_rad - self._last_angle_rad
             self._last_angle_rad = angle_rad
-            eta = self.indexing.fresh_fraction(turned)
-        self.fresh_fractions.append(eta)
-        return tuple(self.rock.start_blow(bit_position_m, state, eta))
+            law = replace(law, fresh_fraction=self.indexing.fresh_fraction(turned))
+        self.fresh_fractions.append(law.fresh_fraction)
+        return law, tuple(law.start_blow(bit_position_m, state))

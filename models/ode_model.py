@@ -26,14 +26,14 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from rpdrill.models.chain import link_load_n, torsion_first_order_matrix
 from rpdrill.models.indexing import BlowStarts
-from rpdrill.models.piecewise import Element, elements
+from rpdrill.models.piecewise import Element, elements, rock_element
 from rpdrill.models.pulse import blow_start_times, impact_force, switch_times
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Impact
@@ -244,15 +244,19 @@ def _integrate_segment(system: _System, record: _Record, y: np.ndarray, modes: M
     return y, modes
 
 
-def _start_blow(system: _System, blows: BlowStarts, record: _Record, y: np.ndarray, modes: Modes) -> tuple[np.ndarray, Modes]:
-    """The rock state the blow starting now meets, the rock's mode found again; the last sample is
-    the blow start in its new state."""
+def _start_blow(system: _System, blows: BlowStarts, record: _Record, y: np.ndarray,
+                modes: Modes) -> tuple[_System, np.ndarray, Modes]:
+    """The blow starting now: its rock law (a new rock element when its rows change), the rock state
+    it meets and the rock's mode found again; the last sample is the blow start in its new state."""
     y = y.copy()
     angle = y[-2] if system.torsion is not None else 0.0
-    y[system.rock_states] = blows(y[system.bit], tuple(y[system.rock_states]), angle)
+    law, y[system.rock_states] = blows(y[system.bit], tuple(y[system.rock_states]), angle)
+    if law != system.pieces[0].law:
+        system = replace(system, pieces=(rock_element(system.simulation.chain, law, system.state_size),
+                                         *system.pieces[1:]))
     if record.time_s:
         record.states[-1][:, -1] = y
-    return y, (system.pieces[0].initial_mode(y), *modes[1:])
+    return system, y, (system.pieces[0].initial_mode(y), *modes[1:])
 
 
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
@@ -275,7 +279,7 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     blow_starts = set(blow_start_times(impact, simulation.settings.end_time_s)) if blows else set()
     for span in itertools.pairwise(switch_times(impact, simulation.settings.end_time_s)):
         if span[0] in blow_starts:
-            y, modes = _start_blow(system, blows, record, y, modes)
+            system, y, modes = _start_blow(system, blows, record, y, modes)
         y, modes = _integrate_segment(system, record, y, modes, span, _SegmentPulse(impact, *span))
         if progress is not None:
             progress(span[1])

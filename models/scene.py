@@ -323,15 +323,15 @@ class Rock(Strict):
 
     def build(self, damping: bool = True, plasticity: bool = True, indexed: bool = False) -> RockLaw:
         """The law; without ``damping`` no rock damper, without ``plasticity`` an elastic rock at the
-        loading stiffness (Jenkins: F_th infinite; bilinear: k_u = k_l); ``indexed`` (an indexing model
-        sets each blow's threshold): a Jenkins rock with its threshold as a state."""
+        loading stiffness (Jenkins: F_th infinite; bilinear: k_u = k_l); ``indexed`` (under an indexing
+        model): a Jenkins rock with the blow's threshold as a state (rocklaw.jenkins)."""
         rock = self.completed()
         if rock.law == "bilinear":
             loading = rock.loading_stiffness_n_per_m
             return BilinearRock(loading, rock.unloading_stiffness_n_per_m if plasticity else loading)
         return JenkinsRock(rock.stiffness_n_per_m, rock.damping_n_s_per_m if damping else 0.0,
                            rock.threshold_n if plasticity else math.inf, rock.damping_mode,
-                           threshold_state=indexed and plasticity)
+                           indexed=indexed and plasticity)
 
 
 def _refuse_foreign_keys(model: BaseModel, what: str, chosen: str, keys: dict[str, tuple[str, ...]],

@@ -12,7 +12,7 @@ the energy account and the stability checks read these fields; nothing derives t
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -124,6 +124,8 @@ def prepare(scene: Scene) -> Simulation:
     indexing = None
     if effects.indexing:
         indexing = Indexing(scene.bit, scene.rotation.speed_rpm if scene.rotation else None, scene.impact.frequency_hz)
+        if indexing.speed_rpm is not None:  # the same share every blow: the law has it from the start
+            rock = replace(rock, fresh_fraction=indexing.fresh_fraction(indexing.prescribed_angle_rad))
     return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, radius, indexing)
 
 

@@ -15,7 +15,8 @@ reloading below the previous maximum follow k_u (x - p) with p fixed.
 Crater memory: within a blow the law keeps its crater. A bit that leaves the rock (x <= p) and
 comes back reloads along k_u up to the previous maximum, then loads on along k_l; losing contact
 changes no state. How the *next blow* meets the rock is set at the blow's start
-(:meth:`BilinearRock.start_blow`): a fraction eta of the footprint on fresh rock moves the surface
+(:meth:`BilinearRock.start_blow`): a share eta (``fresh_fraction``) of the footprint on fresh rock
+moves the surface
 s <- s + eta (s_fresh - s), with s_fresh = min(p, x - F / k_l) the loading line through the current
 point (p off the rock; the force is kept when the bit rests on the rock). eta = 1 (ideal
 indexing, every blow on fresh rock, the default without an indexing model) starts each blow
@@ -70,15 +71,18 @@ class BilinearRock:
 
     loading_stiffness_n_per_m: float
     unloading_stiffness_n_per_m: float
+    fresh_fraction: float = 1.0  # eta, the share of the next blow on fresh rock (models.indexing)
 
     name = "bilinear"
+    modes_follow_fresh_fraction = False  # eta acts at blow starts only
     state_names = (SURFACE, BOTTOM)
     bottom_index = 1
     threshold_n = math.inf
     damping_n_s_per_m = 0.0
 
     def __post_init__(self) -> None:
-        if not 0 < self.loading_stiffness_n_per_m <= self.unloading_stiffness_n_per_m < math.inf:
+        if not 0 < self.loading_stiffness_n_per_m <= self.unloading_stiffness_n_per_m < math.inf \
+                or not 0 < self.fresh_fraction <= 1:
             raise ValueError(f"invalid rock parameters {self}: need 0 < k_l <= k_u < inf")
 
     @property
@@ -104,15 +108,16 @@ class BilinearRock:
     def initial_state(self) -> State:
         return (0.0, 0.0)
 
-    def spring_force(self, bit_position_m: Any, state: Sequence[Any], backend: Backend = NUMERIC) -> Any:
-        """F = max(0, min(k_l (x - s), k_u (x - p)))."""
+    def spring_force(self, bit_position_m: Any, state: Sequence[Any], backend: Backend = NUMERIC,
+                     fresh_fraction: Any = None) -> Any:
+        """F = max(0, min(k_l (x - s), k_u (x - p))) (eta acts at blow starts only)."""
         surface, bottom = state
         loading = self.loading_stiffness_n_per_m * (bit_position_m - surface)
         unloading = self.unloading_stiffness_n_per_m * (bit_position_m - bottom)
         return backend.maximum(backend.minimum(loading, unloading), 0.0)
 
     def force(self, bit_position_m: Any, bit_velocity_m_per_s: Any, state: Sequence[Any],
-              backend: Backend = NUMERIC) -> Any:
+              backend: Backend = NUMERIC, fresh_fraction: Any = None) -> Any:
         """The spring force: no rock damping in this law."""
         return self.spring_force(bit_position_m, state, backend)
 
@@ -124,14 +129,14 @@ class BilinearRock:
             return state
         return (surface, max(bottom, surface + self.indentation_ratio * (bit_position_m - surface)))
 
-    def start_blow(self, bit_position_m: float, state: State, fresh_fraction: float) -> State:
+    def start_blow(self, bit_position_m: float, state: State) -> State:
         """The state the next blow meets (module doc): s <- s + eta (s_fresh - s), s_fresh = min(p,
         x - F / k_l) with F the current spring force (s_fresh = p off the rock)."""
         surface, bottom = state
         fresh = bottom
         if bit_position_m > bottom:
             fresh = min(bottom, bit_position_m - self.spring_force(bit_position_m, state) / self.loading_stiffness_n_per_m)
-        return (surface + fresh_fraction * (fresh - surface), bottom)
+        return (surface + self.fresh_fraction * (fresh - surface), bottom)
 
     def plastic_work_j(self, spring_force_n: np.ndarray, bottom_m: np.ndarray) -> np.ndarray:
         """W_p = int F dp (trapezoidal; exact on the loading line, where F is linear in p)."""

@@ -77,11 +77,16 @@ class ExudynRockContact:
         )
         self._variables = tuple(exu.symbolic.Real(f"rock_{name}", value)
                                 for name, value in zip(rock.state_names, self.state, strict=True)) if symbolic else ()
+        # eta a variable of the expression where the closed form carries it (it may change per blow)
+        self._fresh_fraction = exu.symbolic.Real("rock_fresh_fraction", rock.fresh_fraction) \
+            if symbolic and rock.modes_follow_fresh_fraction else None
         backend = SymbolicBackend() if symbolic else SCALAR
 
         def rock_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
             # recorded once with the symbolic variables, or called at every evaluation with the floats
-            return rock.force(displacement, velocity, self._variables or self.state, backend)
+            if symbolic:
+                return rock.force(displacement, velocity, self._variables, backend, self._fresh_fraction)
+            return self.rock.force(displacement, velocity, self.state, backend)
 
         # Exudyn keeps only a raw pointer to a symbolic expression tree: hold the reference here.
         self._user_function = attach_user_function(
@@ -101,6 +106,12 @@ class ExudynRockContact:
                 variable.SetValue(new)
         self.state = state
         self.state_history.append((time_s, state))
+
+    def set_law(self, rock: RockLaw) -> None:
+        """Go on with ``rock`` (the same law with another eta: models.indexing), in the expression too."""
+        if self._fresh_fraction is not None and rock.fresh_fraction != self.rock.fresh_fraction:
+            self._fresh_fraction.SetValue(rock.fresh_fraction)
+        self.rock = rock
 
     def state_at(self, times_s: np.ndarray) -> np.ndarray:
         """The state (samples x states) at ``times_s``: the last change at or before each time."""

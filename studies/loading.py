@@ -12,6 +12,7 @@ from typing import Any, TypeVar, get_args, get_origin
 import yaml
 from pydantic import BaseModel, ValidationError
 
+from rpdrill.models.formulations import unsupported
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import SceneError, Simulation, prepare
 
@@ -110,8 +111,13 @@ def load_scene(path: str | Path) -> Scene:
 
 def prepare_scene(scene: Scene, source: str) -> Simulation:
     """Prepare a validated scene for a run; InputError naming ``source``, the key path and the value
-    where it cannot run as given (models.simulation.SceneError)."""
+    where it cannot run as given (models.simulation.SceneError, or a formulation that cannot run it)."""
     try:
-        return prepare(scene)
+        simulation = prepare(scene)
     except SceneError as err:
         raise InputError(f"{source}: {'.'.join(err.location)}: {_short(err.value)}: {err}") from None
+    formulation = simulation.settings.formulation
+    why = unsupported(formulation, simulation)
+    if why:
+        raise InputError(f"{source}: solver.formulation: {formulation!r}: {why}")
+    return simulation
