@@ -58,7 +58,8 @@ from rpdrill.studies.specs import (
 class Plot(StrictSpec):
     """``curves``: metric(s) ``y`` against axis ``x``, one curve per value of the other axes
     (labelled by axis ``curves``), maximum of each curve marked. ``map``: metric ``z`` over
-    axes ``x`` and ``y`` with the ridge of maxima along ``x`` for each ``y``."""
+    axes ``x`` and ``y`` with the ridge of maxima along ``x`` for each ``y``, a panel for each
+    combination of the other axes."""
 
     kind: Literal["curves", "map"] = "curves"
     x: str

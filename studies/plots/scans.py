@@ -2,7 +2,8 @@
 
 ``curves``: each metric against axis x, one curve per combination of the other axes, the
 maximum of each curve marked. ``map``: filled contours of a metric over two axes with the
-optimum ridge (argmax along x for each y). Flat curves and rows have no optimum to mark.
+optimum ridge (argmax along x for each y), one panel per combination of the other axes. Flat
+curves and rows have no optimum to mark.
 """
 
 from __future__ import annotations
@@ -64,21 +65,28 @@ def _curves(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
 
 
 def _map(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
+    """One panel per combination of the other axes (one panel when there are none)."""
     xs, ys = sorted(set(study.axes[plot.x])), sorted(set(study.axes[plot.y]))
-    z = np.full((len(ys), len(xs)), np.nan)
+    others = [a for a in study.axes if a not in (plot.x, plot.y)]
+    panels: dict[tuple[str, ...], list[Row]] = defaultdict(list)
     for row in rows:
-        z[ys.index(float(row[plot.y])), xs.index(float(row[plot.x]))] = _metric(row, plot.z)
-    fig, ax = plt.subplots(figsize=(8, 6))
-    filled = ax.contourf(xs, ys, np.ma.masked_invalid(z), levels=20)
-    fig.colorbar(filled, ax=ax, label=plot.z)
-    ridge = [(xs[int(np.nanargmax(line))], y) for line, y in zip(z, ys)
-             if np.isfinite(line).any() and np.nanmax(line) > np.nanmin(line)]
-    if ridge:
-        ax.plot(*zip(*ridge), "w-o", lw=2, label="optimum ridge (max along x)")
-        ax.legend(fontsize=8)
-    ax.set_xlabel(plot.x)
-    ax.set_ylabel(plot.y)
-    ax.set_title(f"{study.spec.name}: {plot.z}")
+        panels[tuple(row[a] for a in others)].append(row)
+    fig, axes = plt.subplots(1, len(panels), figsize=(8 * len(panels), 6), squeeze=False)
+    for ax, (key, members) in zip(axes[0], panels.items()):
+        z = np.full((len(ys), len(xs)), np.nan)
+        for row in members:
+            z[ys.index(float(row[plot.y])), xs.index(float(row[plot.x]))] = _metric(row, plot.z)
+        filled = ax.contourf(xs, ys, np.ma.masked_invalid(z), levels=20)
+        fig.colorbar(filled, ax=ax, label=plot.z)
+        ridge = [(xs[int(np.nanargmax(line))], y) for line, y in zip(z, ys)
+                 if np.isfinite(line).any() and np.nanmax(line) > np.nanmin(line)]
+        if ridge:
+            ax.plot(*zip(*ridge), "w-o", lw=2, label="optimum ridge (max along x)")
+            ax.legend(fontsize=8)
+        ax.set_xlabel(plot.x)
+        ax.set_ylabel(plot.y)
+        label = ", ".join(f"{a}={_label(v)}" for a, v in zip(others, key))
+        ax.set_title(f"{study.spec.name}: {plot.z}" + (f"\n{label}" if label else ""))
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
