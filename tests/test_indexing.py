@@ -6,6 +6,7 @@ ODE, the exact solver or its refusal), rotation speed as a scan axis, bad input.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ from rpdrill.models.indexing import CRATER, FRESH, MIN_FRESH_FRACTION, RIDGES, I
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Bit, Scene
 from rpdrill.models.simulation import prepare
+from rpdrill.studies import rotation_report
 from rpdrill.studies.cli import main
 from rpdrill.studies.crosscheck import DEFAULT_STEP_S
 from rpdrill.studies.loading import InputError, prepare_scene
@@ -185,3 +187,34 @@ def test_resolved_scene_says_why_indexing_was_built():
     resolved = simulation.resolved_scene()
     assert resolved["effects"]["indexing"] and "full model" in resolved["effects"]["reasons"]["indexing"]
     assert resolved["bit"] == BIT and resolved["rotation"] == {"speed_rpm": 45.0}
+
+
+ROTATION_STUDIES = Path(__file__).resolve().parents[1] / "studies" / "rotation"
+
+
+def test_shipped_rotation_studies_are_valid():
+    for name, points in (("rpm_frequency_map", 3 * 13 * 30), ("dth_example", 3 * 81)):
+        study = load_study(ROTATION_STUDIES / f"{name}.yaml")
+        assert len(study.points) == points
+        assert all(p.simulation.effects.indexing and p.simulation.settings.formulation == "exact" for p in study.points)
+
+
+def test_rotation_report_from_two_small_studies(tmp_path):
+    """The documented command: two small scans of the shipped studies' form, then the note and its
+    figure; the note's manual and model speeds are the rule's and the model's formulas."""
+    for name, scan in (("rpm_frequency_map", {"impact.frequency_hz": [36.0, 45.0], "rotation.speed_rpm": [45.0, 60.0]}),
+                       ("dth_example", {"rotation.speed_rpm": [45.0, 60.0, 75.0]})):
+        spec = yaml.safe_load((ROTATION_STUDIES / f"{name}.yaml").read_text())
+        spec.update(base_scene=str(ROTATION_STUDIES.parent / "scenes" / "paper_base.yaml"),
+                    scan={"rock.name": ["conglomerate"], **scan}, plots=[])
+        spec["base_overrides"]["solver"]["end_time_s"] = 0.5
+        spec["base_overrides"]["metrics"] = {"transient_blows": 5, "block_blows": 5}
+        path = tmp_path / f"{name}.yaml"
+        path.write_text(yaml.safe_dump(spec))
+        assert main(["study", str(path), "--out", str(tmp_path / "runs" / name), "--workers", "1", "--quiet"]) == 0
+    note = tmp_path / "rotation.md"
+    assert rotation_report.main([str(tmp_path / "runs"), "--out", str(note), "--rock", "conglomerate"]) == 0
+    text = note.read_text()
+    manual = 1600 * 0.019 / (math.pi * 0.216)
+    assert f"**{manual:.1f} rpm**" in text and f"**{60 * 36 * 0.019 / (math.pi * 0.216):.1f} rpm**" in text
+    assert "| conglomerate | 60 |" in text and (tmp_path / "rotation_map_conglomerate.png").stat().st_size > 0

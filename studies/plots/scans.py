@@ -64,27 +64,36 @@ def _curves(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
     plt.close(fig)
 
 
+def map_panel(fig: plt.Figure, ax: plt.Axes, rows: list[Row], x: str, y: str, z: str, scale: float = 1.0,
+              label: str | None = None, ridge_floor: float = 0.0) -> None:
+    """Filled contours of metric ``z`` (times ``scale``) over axes ``x`` and ``y`` of ``rows``, with the
+    optimum ridge (the best x for each y whose best reaches ``ridge_floor`` of the map's best)."""
+    xs, ys = sorted({float(r[x]) for r in rows}), sorted({float(r[y]) for r in rows})
+    grid = np.full((len(ys), len(xs)), np.nan)
+    for row in rows:
+        grid[ys.index(float(row[y])), xs.index(float(row[x]))] = scale * _metric(row, z)
+    filled = ax.contourf(xs, ys, np.ma.masked_invalid(grid), levels=20)
+    fig.colorbar(filled, ax=ax, label=label or z)
+    floor = ridge_floor * np.nanmax(grid) if np.isfinite(grid).any() else 0.0
+    ridge = [(xs[int(np.nanargmax(line))], value) for line, value in zip(grid, ys)
+             if np.isfinite(line).any() and np.nanmax(line) > np.nanmin(line) and np.nanmax(line) >= floor]
+    if ridge:
+        ax.plot(*zip(*ridge), "w-o", lw=2, label="optimum ridge (max along x)")
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+
+
 def _map(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
     """One panel per combination of the other axes (one panel when there are none)."""
-    xs, ys = sorted(set(study.axes[plot.x])), sorted(set(study.axes[plot.y]))
     others = [a for a in study.axes if a not in (plot.x, plot.y)]
     panels: dict[tuple[str, ...], list[Row]] = defaultdict(list)
     for row in rows:
         panels[tuple(row[a] for a in others)].append(row)
     fig, axes = plt.subplots(1, len(panels), figsize=(8 * len(panels), 6), squeeze=False)
     for ax, (key, members) in zip(axes[0], panels.items()):
-        z = np.full((len(ys), len(xs)), np.nan)
-        for row in members:
-            z[ys.index(float(row[plot.y])), xs.index(float(row[plot.x]))] = _metric(row, plot.z)
-        filled = ax.contourf(xs, ys, np.ma.masked_invalid(z), levels=20)
-        fig.colorbar(filled, ax=ax, label=plot.z)
-        ridge = [(xs[int(np.nanargmax(line))], y) for line, y in zip(z, ys)
-                 if np.isfinite(line).any() and np.nanmax(line) > np.nanmin(line)]
-        if ridge:
-            ax.plot(*zip(*ridge), "w-o", lw=2, label="optimum ridge (max along x)")
+        map_panel(fig, ax, members, plot.x, plot.y, plot.z)
+        if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=8)
-        ax.set_xlabel(plot.x)
-        ax.set_ylabel(plot.y)
         label = ", ".join(f"{a}={_label(v)}" for a, v in zip(others, key))
         ax.set_title(f"{study.spec.name}: {plot.z}" + (f"\n{label}" if label else ""))
     fig.tight_layout()
