@@ -299,7 +299,8 @@ class ExactSolver:
         layout, rock = self.layout, self.model.pieces[0]
         states = slice(2 * layout.n, 2 * layout.n + layout.rock_states)
         angle = w[layout.angle] if layout.torsion else 0.0
-        _, w[states] = self.blows(w[self.simulation.chain.bit_body], tuple(w[states]), angle)  # one law (unsupported)
+        # the law stays the one the matrices were built for: a law whose rows change per blow is unsupported()
+        _, w[states] = self.blows(w[self.simulation.chain.bit_body], tuple(w[states]), angle)
         modes = self.operators.modes[mode_id]
         return self.operators.mode_id((rock.initial_mode(w), *modes[1:]))
 

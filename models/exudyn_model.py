@@ -161,7 +161,7 @@ def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
     impact_function = attach_user_function(mbs, impact_load, "loadUserFunction", piston_force, symbolic)
     tor = simulation.torsion
     torsion_node = None
-    if tor is not None:
+    if tor is not None:  # before the rock: the blow start reads its angle
         torsion_node, torsion_marker = _add_coordinate_body(
             mbs, lambda n: mbs.AddObject(ObjectRotationalMass1D(nodeNumber=n, inertia=tor.inertia_kg_m2)),
             simulation.initial_torsion_angle_rad,
@@ -189,17 +189,17 @@ def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
         sensors["impact"] = _store(mbs, SensorLoad(loadNumber=impact_load, storeInternal=True))
 
     if tor is not None:
-        node, marker = torsion_node, torsion_marker
         mbs.AddObject(
             ObjectConnectorCoordinateSpringDamper(
-                markerNumbers=[ground_marker, marker],
+                markerNumbers=[ground_marker, torsion_marker],
                 stiffness=tor.stiffness_n_m_per_rad,
                 damping=tor.damping_n_m_s_per_rad,
             )
         )
-        mbs.AddLoad(LoadCoordinate(markerNumber=marker, load=tor.drive_torque_n_m - tor.resisting_torque_n_m))
-        sensors["phi"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=COORDINATE))
-        sensors["omega"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=RATE))
+        mbs.AddLoad(LoadCoordinate(markerNumber=torsion_marker, load=tor.drive_torque_n_m - tor.resisting_torque_n_m))
+        sensors["phi"] = _store(mbs, SensorNode(nodeNumber=torsion_node, storeInternal=True,
+                                                outputVariableType=COORDINATE))
+        sensors["omega"] = _store(mbs, SensorNode(nodeNumber=torsion_node, storeInternal=True, outputVariableType=RATE))
 
     mbs.Assemble()
     return ExudynDrill(simulation, chain, container, mbs, rock, sensors, _simulation_settings(simulation),
