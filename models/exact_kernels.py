@@ -15,7 +15,8 @@ import math
 import numpy as np
 from numba import njit
 
-OK, TOO_MANY_SWITCHES, DIVERGED, MISSING_KEY = 0, 1, 2, 3  # kernel status
+OK, TOO_MANY_SWITCHES, DIVERGED, MISSING_KEY, BLOW_START = 0, 1, 2, 3, 4  # kernel status
+RESUME_PHASE, RESUME_MODE = 2, 1  # progress[4]: start the pulse phase (a blow reset applied), go on in a mode
 CHUNK = 4  # anchors whose points are formed per matrix product
 BRENT_MAX_ITERATIONS = 100
 BRENT_RTOL = 4 * np.finfo(float).eps
@@ -155,7 +156,7 @@ def locate(terms: np.ndarray, exit_count: int, directions: np.ndarray, low: floa
 def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, readout: np.ndarray,
                exit_counts: np.ndarray, directions: np.ndarray, next_modes: np.ndarray, rock_rows: np.ndarray,
                impact_rows: np.ndarray, key_of: np.ndarray, phase_times_s: np.ndarray, phase_ids: np.ndarray,
-               phase_pulse_states: np.ndarray, reset_counts: np.ndarray, reset_targets: np.ndarray,
+               phase_pulse_states: np.ndarray, blow_starts: np.ndarray, reset_counts: np.ndarray, reset_targets: np.ndarray,
                reset_rows: np.ndarray, monotone: int, step_s: float, per_anchor: int, per_sample: int,
                min_switch_interval_s: float, max_switches: int, bodies: int, position_limit_m: float,
                progress: np.ndarray, clock: np.ndarray, w: np.ndarray, time_out: np.ndarray, rows: np.ndarray,
@@ -170,8 +171,10 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
     larger of old and new value). Fills ``time_out``, ``rows`` (w, F_r, F_d; both sides of every
     switch) and the switch log. The run's state is progress = (phase, mode id, rows filled, switches,
     resume), clock = (t, mode start) and w: a key not built yet (key_of -1) returns MISSING_KEY with
-    resume = 1, and the call after it is built goes on from there. Returns OK, TOO_MANY_SWITCHES,
-    DIVERGED or MISSING_KEY.
+    resume = 1, and the call after it is built goes on from there. A phase that starts a blow
+    (``blow_starts`` nonzero) returns BLOW_START first, with w at the blow start and resume = 2: the
+    caller sets the rock state the blow meets (and its mode id) and calls again. Returns OK,
+    TOO_MANY_SWITCHES, DIVERGED, MISSING_KEY or BLOW_START.
     """
     size, width = w.shape[0], readout.shape[2] // per_anchor  # m, r
     exits0 = size + 2  # first exit output
@@ -191,13 +194,17 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
     t, mode_start_s = clock[0], clock[1]
     while p < phase_ids.shape[0]:
         end_s, phase = phase_times_s[p, 1], phase_ids[p]
-        if not resume:  # a pulse phase starts
+        if resume == 0 and blow_starts[p]:  # the caller sets the state the blow meets first
+            progress[0], progress[1], progress[2], progress[3], progress[4] = p, mode, row, switches, RESUME_PHASE
+            clock[0], clock[1] = phase_times_s[p, 0], mode_start_s
+            return BLOW_START
+        if resume != RESUME_MODE:  # a pulse phase starts
             t = phase_times_s[p, 0]
             w[size - 2], w[size - 1] = phase_pulse_states[p, 0], phase_pulse_states[p, 1]
         resume = 0
         key = key_of[mode, phase]
         if key < 0:
-            progress[0], progress[1], progress[2], progress[3], progress[4] = p, mode, row, switches, 1
+            progress[0], progress[1], progress[2], progress[3], progress[4] = p, mode, row, switches, RESUME_MODE
             clock[0], clock[1] = t, mode_start_s
             return MISSING_KEY
         taylor_k, step_k, anchors_k, readout_k = taylor[key], one_step[key], anchors[key], readout[key]
@@ -299,7 +306,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                 w[target] = max(final[target], value) if target == monotone else value
             switch_times_s[switches], switch_modes[switches] = t, mode
             switches += 1
-            resume = 1  # the new mode goes on from (t, w) in this pulse phase
+            resume = RESUME_MODE  # the new mode goes on from (t, w) in this pulse phase
             break
         progress[2], progress[3] = row, switches
         if switches > max_switches:

@@ -37,6 +37,11 @@ t_start + min_switch_interval_s, the switch is placed there. More than ``max_swi
 switches per blow on average raise :class:`SimulationFailed`, and so does a diverged state
 (models.stability's criterion, checked at every switch, pulse switch and batch end; the message
 names the first diverged sample).
+
+Blow starts. A law that resets at blow starts (the state the next blow meets: models.indexing) is
+linear between blows; the compiled loop stops at each blow start, the rock states are set here
+(any function of the state, e.g. of the torsion angle turned since the last blow) and the rock's
+mode found again, and the loop goes on.
 """
 
 from __future__ import annotations
@@ -53,12 +58,26 @@ from scipy.linalg.lapack import dgebal
 from threadpoolctl import ThreadpoolController
 
 from rpdrill.models.chain import torsion_first_order_matrix
-from rpdrill.models.exact_kernels import DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
+from rpdrill.models.exact_kernels import (
+    BLOW_START,
+    DIVERGED,
+    MISSING_KEY,
+    TOO_MANY_SWITCHES,
+    assemble,
+    run_events,
+)
 from rpdrill.models.piecewise import Element, elements, undeclared
-from rpdrill.models.pulse import PHASES, generator_states, phase_generator, phase_pieces, phase_row
+from rpdrill.models.pulse import (
+    PHASES,
+    blow_start_times,
+    generator_states,
+    phase_generator,
+    phase_pieces,
+    phase_row,
+)
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import Simulation, as_simulation
+from rpdrill.models.simulation import SceneError, Simulation, as_simulation
 from rpdrill.models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
 from rpdrill.rocklaw.modes import Affine
 
@@ -270,6 +289,20 @@ class ExactSolver:
         self.step_s = settings.sample_interval_s / self.per_sample
         self.operators = Operators(self.model, self.step_s, taylor_order(norm * self.step_s),
                                    len(self.model.pieces[0].table) * len(set(self.phases)))
+        self.blows = simulation.blow_starts()
+        blows = blow_start_times(self.impact, settings.end_time_s) if self.blows else np.empty(0)
+        self.blow_phases = np.isin(self.phase_times[:, 0], blows).astype(np.int64)
+
+    def start_blow(self, w: np.ndarray, mode_id: int) -> int:
+        """Set the rock states of w to those the blow starting now meets; the mode id with the rock's
+        mode found again."""
+        layout, rock = self.layout, self.model.pieces[0]
+        states = slice(2 * layout.n, 2 * layout.n + layout.rock_states)
+        angle = w[layout.angle] if layout.torsion else 0.0
+        # the law stays the one the matrices were built for: a law whose rows change per blow is unsupported()
+        _, w[states] = self.blows(w[self.simulation.chain.bit_body], tuple(w[states]), angle)
+        modes = self.operators.modes[mode_id]
+        return self.operators.mode_id((rock.initial_mode(w), *modes[1:]))
 
     def run(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Modes]]:
         """From the simulation's start (rest, off the bottom; or preloaded, in contact) through every
@@ -297,13 +330,17 @@ class ExactSolver:
         while True:
             status = run_events(
                 ops.taylor, ops.one_step, ops.anchors, ops.readout, ops.exit_counts, ops.directions, ops.next_modes,
-                ops.rock_rows, ops.impact_rows, ops.key_of, self.phase_times, phase_ids, pulse, ops.reset_counts,
+                ops.rock_rows, ops.impact_rows, ops.key_of, self.phase_times, phase_ids, pulse, self.blow_phases,
+                ops.reset_counts,
                 ops.reset_targets, ops.reset_rows, self.model.pieces[0].monotone, self.step_s, PER_ANCHOR,
                 self.per_sample, self.min_switch_interval_s, self.max_switches, n, POSITION_LIMIT_M, progress, clock,
                 w, time_s, rows, switch_times, switch_modes)
-            if status != MISSING_KEY:
+            if status == BLOW_START:
+                progress[1] = self.start_blow(w, progress[1])
+            elif status == MISSING_KEY:
+                ops.add(ops.modes[progress[1]], self.phases[progress[0]])
+            else:
                 break
-            ops.add(ops.modes[progress[1]], self.phases[progress[0]])
         filled, switches = progress[2], progress[3]
         time_s, rows, switch_times = time_s[:filled], rows[:filled], switch_times[:switches]
         if status == TOO_MANY_SWITCHES:
@@ -331,8 +368,19 @@ def _switch_counts(model: Model, before: Modes, entered: list[Modes]) -> dict[st
 
 
 def unsupported(simulation: Simulation) -> str | None:
-    """Why this formulation cannot run ``simulation`` (its switching comes from the laws' declared modes)."""
-    return undeclared(simulation.chain, simulation.rock)
+    """Why the exact formulation cannot run ``simulation``, or None: a law that declares no modes (its
+    switching and matrices come from them), or an indexing share taken from the torsion line blow by
+    blow into a law whose mode rows carry it (Jenkins: the crushing rates), so that its matrices would
+    change at every blow."""
+    undeclared_laws = undeclared(simulation.chain, simulation.rock)
+    if undeclared_laws:
+        return undeclared_laws
+    indexing = simulation.indexing
+    if indexing is not None and indexing.speed_rpm is None and simulation.rock.modes_follow_fresh_fraction:
+        return (f"the {simulation.rock.name} law's crushing rates carry the indexing share of each blow, which "
+                "comes from the torsion angle and changes from blow to blow, so the matrices would change at "
+                "every blow; give rotation.speed_rpm (a constant share) or use the ode or exudyn formulation")
+    return None
 
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Exact solution of the simulation from its start to its end time (formulation "exact").
@@ -345,7 +393,7 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     simulation = as_simulation(run)
     why = unsupported(simulation)
     if why:
-        raise ValueError(f"scene '{simulation.name}': the exact formulation cannot run it: {why}")
+        raise SceneError(("solver", "formulation"), "exact", why)
     start = time.process_time()
     with BLAS.limit(limits=1, user_api="blas"):
         solver = ExactSolver(simulation)
@@ -380,5 +428,6 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
             "switch_modes": entered,  # the modes entered at each switch time
             "operator_keys": solver.operators.built,
             "min_switch_interval_s": solver.min_switch_interval_s,
+            **({"fresh_fractions": solver.blows.fresh_fractions} if solver.blows else {}),
         },
     )

@@ -35,6 +35,7 @@ from exudyn.itemInterface import (
 
 from rpdrill.models.chain import AxialChain, Link
 from rpdrill.models.formulations import AUTOMATIC_STEP_SOLVERS
+from rpdrill.models.indexing import BlowStarts
 from rpdrill.models.pulse import impact_force
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
@@ -69,6 +70,7 @@ class ExudynDrill:
     sensors: dict[str, Any]
     settings: Any
     symbolic_functions: list[Any] = field(default_factory=list)  # kept alive with the system
+    blows: BlowStarts | None = None  # the blow starts of this run (models.indexing)
 
     @property
     def coordinate_count(self) -> int:
@@ -157,8 +159,25 @@ def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
         return impact_force(impact, t, backend)
 
     impact_function = attach_user_function(mbs, impact_load, "loadUserFunction", piston_force, symbolic)
+    tor = simulation.torsion
+    torsion_node = None
+    if tor is not None:  # before the rock: the blow start reads its angle
+        torsion_node, torsion_marker = _add_coordinate_body(
+            mbs, lambda n: mbs.AddObject(ObjectRotationalMass1D(nodeNumber=n, inertia=tor.inertia_kg_m2)),
+            simulation.initial_torsion_angle_rad,
+        )
+    blows = simulation.blow_starts()
+    start_blow = None
+    if blows is not None:
+        def start_blow(position: float, state: tuple[float, ...]) -> tuple[float, ...]:
+            """The state the blow meets; the contact's return map takes the blow's law."""
+            angle = mbs.GetNodeOutput(torsion_node, COORDINATE) if torsion_node is not None else 0.0
+            law, state = blows(position, state, angle)
+            rock.set_law(law)
+            return state
     rock = ExudynRockContact(mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], simulation.rock,
-                             symbolic=symbolic, initial_state=simulation.initial_rock_state)
+                             symbolic=symbolic, initial_state=simulation.initial_rock_state, start_blow=start_blow,
+                             blow_period_s=impact.period_s)
 
     sensors: dict[str, Any] = {}
     for i, node in enumerate(nodes):
@@ -169,26 +188,22 @@ def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
                                                    outputVariableType=exu.OutputVariableType.Force))
         sensors["impact"] = _store(mbs, SensorLoad(loadNumber=impact_load, storeInternal=True))
 
-    tor = simulation.torsion
     if tor is not None:
-        node, marker = _add_coordinate_body(
-            mbs, lambda n: mbs.AddObject(ObjectRotationalMass1D(nodeNumber=n, inertia=tor.inertia_kg_m2)),
-            simulation.initial_torsion_angle_rad,
-        )
         mbs.AddObject(
             ObjectConnectorCoordinateSpringDamper(
-                markerNumbers=[ground_marker, marker],
+                markerNumbers=[ground_marker, torsion_marker],
                 stiffness=tor.stiffness_n_m_per_rad,
                 damping=tor.damping_n_m_s_per_rad,
             )
         )
-        mbs.AddLoad(LoadCoordinate(markerNumber=marker, load=tor.drive_torque_n_m - tor.resisting_torque_n_m))
-        sensors["phi"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=COORDINATE))
-        sensors["omega"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=RATE))
+        mbs.AddLoad(LoadCoordinate(markerNumber=torsion_marker, load=tor.drive_torque_n_m - tor.resisting_torque_n_m))
+        sensors["phi"] = _store(mbs, SensorNode(nodeNumber=torsion_node, storeInternal=True,
+                                                outputVariableType=COORDINATE))
+        sensors["omega"] = _store(mbs, SensorNode(nodeNumber=torsion_node, storeInternal=True, outputVariableType=RATE))
 
     mbs.Assemble()
     return ExudynDrill(simulation, chain, container, mbs, rock, sensors, _simulation_settings(simulation),
-                       [impact_function, *user_functions])
+                       [impact_function, *user_functions], blows)
 
 
 class _MinimumStepGuard:
@@ -275,7 +290,8 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
         torsion_angle_rad=data["phi"][:, 1] if "phi" in data else None,
         torsion_rate_rad_per_s=data["omega"][:, 1] if "omega" in data else None,
         cpu_time_s=cpu,
-        info={"solver_success": bool(ok), "coordinates": drill.coordinate_count},
+        info={"solver_success": bool(ok), "coordinates": drill.coordinate_count,
+              **({"fresh_fractions": drill.blows.fresh_fractions} if drill.blows else {})},
         bottom_events=(history[:, 0], history[:, 1]),
         rock_state_m=rock_state,
     )

@@ -16,7 +16,9 @@ every piecewise element (models.piecewise: the rock law and the nonlinear links,
 are the laws' own declarations) and stops at the first zero crossing of one of the current modes'
 exits; the next piece starts in the element's next mode from its entry state. The piston pulse's
 switch times (models.pulse.switch_times) are breakpoints: the run is integrated segment by segment
-between them, and the pulse is evaluated on the segment's own side of each switch.
+between them, and the pulse is evaluated on the segment's own side of each switch. At a blow start
+the rock law's blow reset (models.indexing.BlowStarts: the state the blow meets) is applied to the
+rock states when the law has one, and the rock's mode is found again.
 """
 
 from __future__ import annotations
@@ -24,14 +26,15 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from rpdrill.models.chain import link_load_n, torsion_first_order_matrix
-from rpdrill.models.piecewise import Element, elements, undeclared
-from rpdrill.models.pulse import impact_force, switch_times
+from rpdrill.models.indexing import BlowStarts
+from rpdrill.models.piecewise import Element, elements, rock_element, undeclared
+from rpdrill.models.pulse import blow_start_times, impact_force, switch_times
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Impact
 from rpdrill.models.simulation import Scene, Simulation, as_simulation
@@ -245,6 +248,21 @@ def unsupported(simulation: Simulation) -> str | None:
     """Why this formulation cannot run ``simulation`` (its switching comes from the laws' declared modes)."""
     return undeclared(simulation.chain, simulation.rock)
 
+
+def _start_blow(system: _System, blows: BlowStarts, record: _Record, y: np.ndarray,
+                modes: Modes) -> tuple[_System, np.ndarray, Modes]:
+    """The blow starting now: its rock law (a new rock element when its rows change), the rock state
+    it meets and the rock's mode found again; the last sample is the blow start in its new state."""
+    y = y.copy()
+    angle = y[-2] if system.torsion is not None else 0.0
+    law, y[system.rock_states] = blows(y[system.bit], tuple(y[system.rock_states]), angle)
+    if law != system.pieces[0].law:
+        system = replace(system, pieces=(rock_element(system.simulation.chain, law, system.state_size),
+                                         *system.pieces[1:]))
+    if record.time_s:
+        record.states[-1][:, -1] = y
+    return system, y, (system.pieces[0].initial_mode(y), *modes[1:])
+
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Integrate Eq. 4 from the simulation's start (rest or preloaded; the rock state consistent with
     it) to its end time, with the scene's ODE settings (models.solver_settings: ``method``, a SciPy
@@ -264,8 +282,11 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     modes = tuple(element.initial_mode(y) for element in system.pieces)
     record = _Record([], [], [], {})
     start = time.process_time()
-    impact = simulation.impact
+    impact, blows = simulation.impact, simulation.blow_starts()
+    blow_starts = set(blow_start_times(impact, simulation.settings.end_time_s)) if blows else set()
     for span in itertools.pairwise(switch_times(impact, simulation.settings.end_time_s)):
+        if span[0] in blow_starts:
+            system, y, modes = _start_blow(system, blows, record, y, modes)
         y, modes = _integrate_segment(system, record, y, modes, span, _SegmentPulse(impact, *span))
         if progress is not None:
             progress(span[1])
@@ -304,5 +325,6 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
             "rhs_evaluations": record.rhs_evaluations,
             "mode_switches": sum(record.switches.values()),
             "switches_into": dict(record.switches),
+            **({"fresh_fractions": blows.fresh_fractions} if blows else {}),
         },
     )

@@ -60,7 +60,7 @@ def _pieces_of_a_period(impact: Impact) -> tuple[tuple[float, float, str], ...]:
 def phase_pieces(impact: Impact, end_time_s: float) -> tuple[np.ndarray, list[str]]:
     """((start, end) rows, phase) of the pieces of F_d covering [0, end_time_s]."""
     pieces = _pieces_of_a_period(impact)
-    starts = np.arange(math.ceil(end_time_s / impact.period_s))[:, None] * impact.period_s
+    starts = blow_start_times(impact, end_time_s)[:, None]
     times = np.stack([starts + [low for low, _, _ in pieces], starts + [high for _, high, _ in pieces]], axis=-1)
     times = times.reshape(-1, 2)
     keep = times[:, 0] < end_time_s
@@ -72,6 +72,11 @@ def switch_times(impact: Impact, end_time_s: float) -> np.ndarray:
     """0, every time F_d changes formula in (0, end_time_s), and end_time_s, sorted and unique."""
     times, _ = phase_pieces(impact, end_time_s)
     return np.unique(np.concatenate([[0.0, end_time_s], times.ravel()]))
+
+
+def blow_start_times(impact: Impact, end_time_s: float) -> np.ndarray:
+    """The start of every blow in [0, end_time_s): k / f (the same floats as the pieces' starts)."""
+    return np.arange(math.ceil(end_time_s / impact.period_s)) * impact.period_s
 
 
 def generator_states(impact: Impact, local_s: np.ndarray) -> np.ndarray:

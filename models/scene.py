@@ -193,6 +193,37 @@ class Torsion(Strict):
     resisting_torque_n_m: Finite = Field(description="M_c")
 
 
+class Bit(Strict):
+    """The bit face as the indexing model sees it (models.indexing): bit diameter D, the gauge
+    (outermost) buttons' diameter d and count, and the width of the crater one button leaves
+    (default d: a crater as wide as the button that made it, the model's assumption)."""
+
+    diameter_m: Positive = Field(description="D, the bit (hole) diameter")
+    gauge_button_diameter_m: Positive = Field(description="d, diameter of a gauge button")
+    gauge_buttons: Annotated[int, Field(ge=1)] = Field(description="gauge buttons on the gauge circle")
+    crater_width_m: Positive | None = Field(None, description="crater width along the gauge track; default d")
+
+    @model_validator(mode="after")
+    def _buttons_fit(self) -> Bit:
+        if self.gauge_buttons * self.gauge_button_diameter_m > math.pi * self.diameter_m:
+            raise ValueError(f"{self.gauge_buttons} gauge buttons of {self.gauge_button_diameter_m} m do not fit on "
+                             f"the gauge circle of a {self.diameter_m} m bit (pi D = {math.pi * self.diameter_m:.4g} m)")
+        return self
+
+    @property
+    def crater_m(self) -> float:
+        """The crater width w (the button diameter unless given)."""
+        return self.crater_width_m or self.gauge_button_diameter_m
+
+
+class Rotation(Strict):
+    """A prescribed rotation speed n of the bit (a stiff rotation drive): it turns 2 pi n / (60 f)
+    between two blow starts. Without this section an indexing model takes the angle from the
+    torsion line."""
+
+    speed_rpm: Positive = Field(description="n, bit revolutions per minute")
+
+
 class Feed(Strict):
     """The feed force: ``force_n`` on body ``acts_on`` (a rig's carriage, say), or on
     ``every_body`` (F_dt on each body, the paper's Eq. 4; a segmented rod's share is split over its
@@ -290,15 +321,17 @@ class Rock(Strict):
         filled = {key: getattr(row, key) for key in JENKINS_VALUES if getattr(self, key) is None}
         return self.model_copy(update={**filled, "damping_mode": self.damping_mode or "contact"})
 
-    def build(self, damping: bool = True, plasticity: bool = True) -> RockLaw:
+    def build(self, damping: bool = True, plasticity: bool = True, indexed: bool = False) -> RockLaw:
         """The law; without ``damping`` no rock damper, without ``plasticity`` an elastic rock at the
-        loading stiffness (Jenkins: F_th infinite; bilinear: k_u = k_l)."""
+        loading stiffness (Jenkins: F_th infinite; bilinear: k_u = k_l); ``indexed`` (under an indexing
+        model): a Jenkins rock with the blow's threshold as a state (rocklaw.jenkins)."""
         rock = self.completed()
         if rock.law == "bilinear":
             loading = rock.loading_stiffness_n_per_m
             return BilinearRock(loading, rock.unloading_stiffness_n_per_m if plasticity else loading)
         return JenkinsRock(rock.stiffness_n_per_m, rock.damping_n_s_per_m if damping else 0.0,
-                           rock.threshold_n if plasticity else math.inf, rock.damping_mode)
+                           rock.threshold_n if plasticity else math.inf, rock.damping_mode,
+                           indexed=indexed and plasticity)
 
 
 def _refuse_foreign_keys(model: BaseModel, what: str, chosen: str, keys: dict[str, tuple[str, ...]],
@@ -357,7 +390,7 @@ def switch_formulation(solver: dict[str, Any], formulation: str) -> dict[str, An
     return {**{key: value for key, value in solver.items() if key in COMMON_SOLVER_KEYS}, "formulation": formulation}
 
 
-EFFECTS = ("torsion", "rock_damping", "rock_plasticity", "joint_damping")
+EFFECTS = ("torsion", "rock_damping", "rock_plasticity", "joint_damping", "indexing")
 
 
 class Effects(Strict):
@@ -367,13 +400,16 @@ class Effects(Strict):
     unless a requested output needs it; no ``effects`` section at all builds every effect the
     scene gives parameters for (the full model); :func:`built_effects` resolves them for a run.
     ``reasons`` is informational (a resolved scene file says there why each effect was built).
-    ``rock_plasticity`` off gives an elastic rock that never crushes.
+    ``rock_plasticity`` off gives an elastic rock that never crushes. ``indexing`` couples rotation
+    to penetration (models.indexing): the angle the bit turned between two blows (``rotation`` or the
+    torsion line) and the ``bit`` geometry set how each blow meets the rock.
     """
 
     torsion: bool | None = None
     rock_damping: bool | None = None
     rock_plasticity: bool | None = None
     joint_damping: bool | None = None
+    indexing: bool | None = None
     reasons: dict[str, str] = Field(default_factory=dict)
 
 
@@ -402,6 +438,8 @@ class Scene(Strict):
     description: str = ""
     drill_string: DrillString
     torsion: Torsion | None = None
+    bit: Bit | None = None
+    rotation: Rotation | None = None
     feed: Feed
     impact: Impact
     rock: Rock
@@ -435,6 +473,12 @@ class Scene(Strict):
         if effects.torsion and self.torsion is None:
             raise ValueError("the torsion effect needs a torsion section (inertia_kg_m2, stiffness_n_m_per_rad, "
                              "damping_n_m_s_per_rad, drive_torque_n_m, resisting_torque_n_m)")
+        if effects.indexing and self.bit is None:
+            raise ValueError("the indexing effect needs a bit section (diameter_m, gauge_button_diameter_m, "
+                             "gauge_buttons)")
+        if effects.indexing and self.rotation is None and not effects.torsion:
+            raise ValueError("the indexing effect needs the angle turned between blows: a rotation section "
+                             "(speed_rpm) or the torsion effect")
         if effects.rock_damping and self.rock.law == "bilinear":
             raise _key_error("Scene", ("effects", "rock_damping"), True,
                              "rock law 'bilinear' has no rock damping; set it false or use law: jenkins")
@@ -478,6 +522,7 @@ class BuiltEffects:
     rock_damping: bool
     rock_plasticity: bool
     joint_damping: bool
+    indexing: bool
     reasons: Mapping[str, str]
 
     def as_dict(self) -> dict[str, bool]:
@@ -491,6 +536,7 @@ def _available(scene: Scene, effect: str) -> bool:
         "rock_damping": scene.rock.law == "jenkins" and scene.rock.completed().damping_n_s_per_m > 0,
         "rock_plasticity": True,
         "joint_damping": any(c.damping_n_s_per_m > 0 for c in scene.drill_string.connectors.values()),
+        "indexing": scene.bit is not None and (scene.rotation is not None or scene.torsion is not None),
     }[effect]
 
 

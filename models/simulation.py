@@ -3,7 +3,8 @@
 :func:`prepare` turns a validated :class:`~rpdrill.models.scene.Scene` (data only) into a
 :class:`Simulation`: the effects built and why, the outputs asked for, the axial chain, the rock law
 as built, the solver settings of the scene's formulation (an accuracy preset resolved into a step
-or tolerances), and the initial state (rest, or the static preload). Every formulation, the metrics,
+or tolerances), the initial state (rest, or the static preload), and the indexing model (the
+``indexing`` effect: models.indexing) whose blow starts every formulation applies. Every formulation, the metrics,
 the energy account and the stability checks read these fields; nothing derives them again.
 :meth:`Simulation.run` dispatches through the formulation registry (models.formulations).
 """
@@ -11,13 +12,14 @@ the energy account and the stability checks read these fields; nothing derives t
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rpdrill.models.chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
 from rpdrill.models.formulations import simulate
+from rpdrill.models.indexing import BlowStarts, Indexing
 from rpdrill.models.outputs import needs
 from rpdrill.models.pulse import impulse_per_blow_n_s
 from rpdrill.models.scene import (
@@ -59,6 +61,7 @@ class Simulation:
     initial_rock_state: State
     initial_torsion_angle_rad: float
     spectral_radius_per_s: float | None  # |lambda|_max with the bit on the rock (Exudyn runs only)
+    indexing: Indexing | None = None
 
     @property
     def name(self) -> str:
@@ -72,6 +75,13 @@ class Simulation:
     def torsion(self) -> Torsion | None:
         """The torsion line when its effect is built."""
         return self.scene.torsion if self.effects.torsion else None
+
+    def blow_starts(self) -> BlowStarts | None:
+        """A new per-run tracker of the blow starts, or None when a blow start changes no rock state
+        (no indexing, a law without blows: the paper's Eq. 4)."""
+        if not self.rock.resets_at_blows:
+            return None
+        return BlowStarts(self.rock, self.indexing, self.initial_torsion_angle_rad)
 
     @property
     def feed_total_n(self) -> float:
@@ -111,7 +121,8 @@ def prepare(scene: Scene) -> Simulation:
     effects = built_effects(scene)
     outputs = requested_outputs(scene, effects)
     chain = axial_chain(scene, joint_damping=effects.joint_damping)
-    rock = scene.rock.build(damping=effects.rock_damping, plasticity=effects.rock_plasticity)
+    rock = scene.rock.build(damping=effects.rock_damping, plasticity=effects.rock_plasticity,
+                            indexed=effects.indexing)
     radius = spectral_radius_per_s(chain, rock) if scene.solver.formulation == "exudyn" else None
     settings = resolve_settings(scene.solver, scene.impact.duration_s, lambda: radius,
                                 "energy" in needs(outputs.metrics, outputs.timeseries).data)
@@ -124,7 +135,12 @@ def prepare(scene: Scene) -> Simulation:
         if effects.torsion:
             angle = static_torsion_angle_rad(scene.torsion)
     state = rock.return_map(float(positions[chain.bit_body]), rock.initial_state())
-    return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, radius)
+    indexing = None
+    if effects.indexing:
+        indexing = Indexing(scene.bit, scene.rotation.speed_rpm if scene.rotation else None, scene.impact.frequency_hz)
+        if indexing.speed_rpm is not None:  # the same share every blow: the law has it from the start
+            rock = replace(rock, fresh_fraction=indexing.fresh_fraction(indexing.prescribed_angle_rad))
+    return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, radius, indexing)
 
 
 def as_simulation(run: Scene | Simulation) -> Simulation:

@@ -15,6 +15,11 @@ and the state:
   switches: :meth:`RockLaw.modes` over the local variables ``position``, ``velocity``, the state
   names and ``one``, and :meth:`RockLaw.initial_mode`. The ODE and the exact formulations
   generate their events, state rates, resets and matrices from it;
+* blows: ``fresh_fraction`` eta is the share of a blow's footprint on fresh rock (1 without an
+  indexing model, models.indexing; a law per blow when it changes, ``modes_follow_fresh_fraction``
+  says whether the mode rows carry it); :meth:`RockLaw.start_blow` gives the state a blow meets, and
+  ``resets_at_blows`` whether it changes anything (the formulations apply it at every blow start
+  only then);
 * energy: the rock stores F_spring^2 / (2 k_unload) and dissipates the plastic (crushing) work
   W_p = int F_spring d(x_n) (:meth:`RockLaw.plastic_work_j`).
 
@@ -67,16 +72,36 @@ class RockLaw(Protocol):
         """The state of an untouched rock with its surface at x = 0."""
         ...
 
-    def force(self, bit_position_m: Any, bit_velocity_m_per_s: Any, state: Sequence[Any], backend: Backend) -> Any:
-        """Total rock force on the bit [N], positive pushing the bit out of the hole."""
+    def force(self, bit_position_m: Any, bit_velocity_m_per_s: Any, state: Sequence[Any], backend: Backend,
+              fresh_fraction: Any = None) -> Any:
+        """Total rock force on the bit [N], positive pushing the bit out of the hole (``fresh_fraction``:
+        eta as a symbolic variable where the closed form carries it; default the law's)."""
         ...
 
-    def spring_force(self, bit_position_m: Any, state: Sequence[Any], backend: Backend) -> Any:
+    def spring_force(self, bit_position_m: Any, state: Sequence[Any], backend: Backend,
+                     fresh_fraction: Any = None) -> Any:
         """The rate-independent part of :meth:`force` [N]."""
         ...
 
     def return_map(self, bit_position_m: float, state: State) -> State:
         """The state after the bit reached ``bit_position_m`` (once per step, before the step)."""
+        ...
+
+    @property
+    def fresh_fraction(self) -> float:
+        """eta, the share of the blow's footprint on fresh rock (0 < eta <= 1)."""
+        ...
+    @property
+    def modes_follow_fresh_fraction(self) -> bool:
+        """Whether the mode rows carry eta (a new table when eta changes)."""
+        ...
+    @property
+    def resets_at_blows(self) -> bool:
+        """Whether :meth:`start_blow` changes the state (else no formulation calls it)."""
+        ...
+
+    def start_blow(self, bit_position_m: float, state: State) -> State:
+        """The state a blow starting now meets (applied at every blow start)."""
         ...
 
     def plastic_work_j(self, spring_force_n: np.ndarray, bottom_m: np.ndarray) -> np.ndarray:

@@ -5,11 +5,14 @@ The force is an Exudyn *symbolic* user function recorded from the law's ``force`
 expression tree, no Python call per evaluation; ``symbolic=False`` gives the same law as a
 Python callback, for benchmarks). The law's states are named symbolic ``Real`` variables
 ``rock_<state name>`` of the expression (plain Python floats with ``symbolic=False``), updated
-once per accepted step, before the step, by the law's return map (a pre-step function).
+once per accepted step, before the step, by the law's return map (a pre-step function), and at the
+first step that starts at or after each blow start by ``start_blow`` (the state the blow meets), when
+the law resets at blow starts.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import exudyn as exu
@@ -38,6 +41,8 @@ class ExudynRockContact:
 
     The initial state is ``initial_state``, by default the law's state consistent with the bit's
     initial coordinate, return_map(x_bit(0), law.initial_state()) (a static preload).
+    ``start_blow(bit position, state)`` gives the state a blow meets; it is applied at the first step
+    starting at or after each multiple of ``blow_period_s``.
     """
 
     def __init__(
@@ -49,8 +54,11 @@ class ExudynRockContact:
         rock: RockLaw,
         symbolic: bool = True,
         initial_state: State | None = None,
+        start_blow: Callable[[float, State], State] | None = None,
+        blow_period_s: float = float("inf"),
     ) -> None:
         self.rock = rock
+        self._start_blow, self._blow_period_s, self._blows = start_blow, blow_period_s, 0
         self._bit_node = bit_node
         if initial_state is None:
             initial_position = mbs.GetNodeParameter(bit_node, "initialCoordinates")[0]
@@ -69,11 +77,16 @@ class ExudynRockContact:
         )
         self._variables = tuple(exu.symbolic.Real(f"rock_{name}", value)
                                 for name, value in zip(rock.state_names, self.state, strict=True)) if symbolic else ()
+        # eta a variable of the expression where the closed form carries it (it may change per blow)
+        self._fresh_fraction = exu.symbolic.Real("rock_fresh_fraction", rock.fresh_fraction) \
+            if symbolic and rock.modes_follow_fresh_fraction else None
         backend = SymbolicBackend() if symbolic else SCALAR
 
         def rock_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
             # recorded once with the symbolic variables, or called at every evaluation with the floats
-            return rock.force(displacement, velocity, self._variables or self.state, backend)
+            if symbolic:
+                return rock.force(displacement, velocity, self._variables, backend, self._fresh_fraction)
+            return self.rock.force(displacement, velocity, self.state, backend)
 
         # Exudyn keeps only a raw pointer to a symbolic expression tree: hold the reference here.
         self._user_function = attach_user_function(
@@ -94,6 +107,12 @@ class ExudynRockContact:
         self.state = state
         self.state_history.append((time_s, state))
 
+    def set_law(self, rock: RockLaw) -> None:
+        """Go on with ``rock`` (the same law with another eta: models.indexing), in the expression too."""
+        if self._fresh_fraction is not None and rock.fresh_fraction != self.rock.fresh_fraction:
+            self._fresh_fraction.SetValue(rock.fresh_fraction)
+        self.rock = rock
+
     def state_at(self, times_s: np.ndarray) -> np.ndarray:
         """The state (samples x states) at ``times_s``: the last change at or before each time."""
         stamps = np.array([t for t, _ in self.state_history])
@@ -106,7 +125,12 @@ class ExudynRockContact:
         Exudyn passes the pre-step function the time at the *end* of the coming step while the
         state is still that of its start; the history is stamped with the start time.
         """
-        state = self.rock.return_map(mbs.GetNodeOutput(self._bit_node, self._coordinate), self.state)
+        position = mbs.GetNodeOutput(self._bit_node, self._coordinate)
+        state = self.rock.return_map(position, self.state)
+        # a step start a round-off before a blow start is that blow start
+        if self._start_blow is not None and self._step_start_s >= (self._blows - 1e-9) * self._blow_period_s:
+            state = self._start_blow(position, state)
+            self._blows += 1
         if state != self.state:
             self.set_state(state, self._step_start_s)
         self._step_start_s = t

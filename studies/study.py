@@ -59,7 +59,7 @@ class Plot(StrictSpec):
     """``curves``: metric(s) ``y`` against axis ``x``, one curve per value of the other axes
     (``curves``: the axis the plot is about; every varied value is in the legend), the optimum of
     each curve marked. ``map``: metric ``z`` over axes ``x`` and ``y`` as cells, the optimum along
-    ``x`` of each ``y`` marked (studies.plots.scans)."""
+    ``x`` of each ``y`` marked, a panel for each combination of the other axes (studies.plots.scans)."""
 
     kind: Literal["curves", "map"] = "curves"
     x: str

@@ -1,6 +1,7 @@
 """The rock laws alone, through the interface (rocklaw.base.RockLaw): pure functions, the ODE mode
 tables against the return maps, and the symbolic recording for Exudyn."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -17,6 +18,7 @@ LAW_CASES = {
     "jenkins_damped": JenkinsRock(5e8, 1.98e3, 138e3),
     "jenkins_always": JenkinsRock(5e8, 1.98e3, 138e3, damping_mode="always"),
     "jenkins_elastic": JenkinsRock(5e8, 0.0, math.inf),
+    "jenkins_indexed": JenkinsRock(5e8, 2e4, 138e3, indexed=True, fresh_fraction=0.6),
     "bilinear": BilinearRock(2e8, 1e9),
     "bilinear_elastic": BilinearRock(2e8, 2e8),
 }
@@ -73,7 +75,7 @@ def test_load_unload_reload_loop():
     assert np.all(force >= 0.0) and np.all(force <= ROCK.threshold_n * (1 + 1e-12))
 
 
-@pytest.mark.parametrize("name", ["jenkins", "jenkins_damped", "bilinear"])
+@pytest.mark.parametrize("name", ["jenkins", "jenkins_damped", "jenkins_indexed", "bilinear"])
 def test_no_pull_monotone_bottom_and_spring_part(name):
     law = LAW_CASES[name]
     path = blows(2e-4)
@@ -125,11 +127,14 @@ def follow_modes(law: RockLaw, time_s: np.ndarray, path_m: np.ndarray) -> np.nda
     return np.array(states)
 
 
-@pytest.mark.parametrize("name", ["jenkins", "jenkins_damped", "jenkins_elastic", "bilinear", "bilinear_elastic"])
+@pytest.mark.parametrize("name", ["jenkins", "jenkins_damped", "jenkins_elastic", "jenkins_indexed", "bilinear",
+                                  "bilinear_elastic"])
 def test_mode_table_reproduces_the_return_map(name):
     """Integrating the mode table's state rates and switching at its exits follows the return map."""
     law = LAW_CASES[name]
-    time_s = np.linspace(0.0, 6.0, 30001)
+    # the walk is first order in the step: the indexed law moves two states while crushing (x_n and
+    # tau), with twice the first-order error of one; half the step keeps the same tolerance
+    time_s = np.linspace(0.0, 6.0, 60001 if name == "jenkins_indexed" else 30001)
     path = blows(2e-4, points=len(time_s))
     _, mapped = walk(path, law)
     followed = follow_modes(law, time_s, path)
@@ -183,7 +188,22 @@ def test_invalid_parameters(bad):
         JenkinsRock(**values)
 
 
-@pytest.mark.parametrize("name", ["jenkins_damped", "jenkins_always", "bilinear"])
+def test_indexed_jenkins_hardens_and_advances_eta_of_the_stroke():
+    """Indexed (a share eta on fresh rock): past F_th the force rises along k_n (1 - eta) and the bottom
+    moves eta of the bit's crushing stroke; a new blow starts at F_th again; eta = 1 is Eq. 1, 2."""
+    eta, stroke = 0.6, 2e-4
+    law = JenkinsRock(5e8, 0.0, 138e3, indexed=True, fresh_fraction=eta)
+    path = np.linspace(0.0, CRUSH + stroke, 201)
+    force, states = walk(path, law)
+    assert force[-1] == pytest.approx(138e3 + 5e8 * (1 - eta) * stroke)
+    assert states[-1, 0] == pytest.approx(eta * stroke) and states[-1, 1] == pytest.approx(force[-1])
+    assert law.start_blow(0.0, tuple(states[-1])) == (states[-1, 0], 138e3)  # off the rock: a fresh F_th
+    plain, _ = walk(path, ROCK)
+    fresh, _ = walk(path, JenkinsRock(5e8, 0.0, 138e3, indexed=True))
+    np.testing.assert_allclose(fresh, plain, rtol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["jenkins_damped", "jenkins_always", "jenkins_indexed", "bilinear"])
 def test_symbolic_recording_matches_numeric_in_every_branch(name):
     """The compiled (symbolic) force equals the pure function in every branch and follows the state
     set through the element (off, elastic, crushing; bilinear loading, unloading, reloading)."""
@@ -209,3 +229,8 @@ def test_symbolic_recording_matches_numeric_in_every_branch(name):
                 expected = law.force(position, velocity, state)
                 got = compiled.Evaluate(mbs, 0.0, 0, position, velocity, 0.0, 0.0, 0.0)
                 assert got == pytest.approx(expected, rel=1e-12, abs=1e-9)
+    if law.modes_follow_fresh_fraction:  # another blow's eta reaches the compiled expression
+        element.set_law(dataclasses.replace(law, fresh_fraction=0.3))
+        got = compiled.Evaluate(mbs, 0.0, 0, 6e-4, 0.0, 0.0, 0.0, 0.0)
+        assert got == pytest.approx(element.rock.force(6e-4, 0.0, element.state), rel=1e-12)
+        assert got != pytest.approx(law.force(6e-4, 0.0, element.state), rel=1e-6)

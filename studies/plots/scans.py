@@ -9,8 +9,8 @@ study's optima (studies.study_optima) run along x, each curve's refined optimum 
 80 % band a bar at 80 % of the peak, otherwise the grid maximum is a star. Failed runs are crosses
 on the x axis. ``map``: a metric over two axes as discrete cells, one per scan point (studies.plots.cells:
 nothing interpolated; few values are labelled rows); the optimum of each row (refined, as in the
-curves) is marked. A plot whose metrics have no finite value anywhere (every
-point failed) is not drawn.
+curves) is marked; one panel per combination of the other axes. A plot whose metrics have no finite
+value anywhere (every point failed) is not drawn.
 """
 
 from __future__ import annotations
@@ -94,29 +94,45 @@ def _curves(plot: Plot, study: Study, rows: list[Row], optima: list[Record], pat
     return save(fig, path)
 
 
-def _map(plot: Plot, study: Study, rows: list[Row], optima: list[Record], path: Path) -> list[Path]:
-    xq, yq, zq = quantity(plot.x), quantity(plot.y), metric(plot.z)
-    xs, ys = sorted(set(study.axes[plot.x])), sorted(set(study.axes[plot.y]))
-    z = np.full((len(ys), len(xs)), np.nan)
+def metric_grid(rows: list[Row], x: str, y: str, z: str) -> tuple[list[float], list[float], np.ndarray]:
+    """(x values, y values, z[y, x] in SI, NaN where a run failed) of the rows of one map."""
+    xs, ys = sorted({float(r[x]) for r in rows}), sorted({float(r[y]) for r in rows})
+    grid = np.full((len(ys), len(xs)), np.nan)
     for row in rows:
-        z[ys.index(float(row[plot.y])), xs.index(float(row[plot.x]))] = metric_value(row, plot.z)
-    fig, ax = plt.subplots(figsize=(9, 2.2 + 0.5 * min(len(ys), 12)), layout="constrained")
-    position = cell_map(fig, ax, xs, ys, z, xq, yq, zq)
-    marked, texts = [], {float(r[plot.y]): r[plot.y] for r in rows}
-    for i, y in enumerate(ys):
-        record = _optimum(optima, plot.z, plot.x, {plot.y: texts.get(y)})
-        if record is not None and record["optimum"] is not None:
-            marked.append(position(record["optimum"], y))
-        elif record is None and np.isfinite(z[i]).any() and np.nanmax(z[i]) > np.nanmin(z[i]):
-            marked.append(position(xs[int(np.nanargmax(z[i]))], y))
-    handles = no_result_patch(z)
-    if marked:
-        (line,) = ax.plot(*zip(*marked), "o", color="white", mec="black", ms=8,
-                          label="optimum of each row" + (" (refined)" if optima else ""))
-        handles.insert(0, line)
+        grid[ys.index(float(row[y])), xs.index(float(row[x]))] = metric_value(row, z)
+    return xs, ys, grid
+
+
+def _map(plot: Plot, study: Study, rows: list[Row], optima: list[Record], path: Path) -> list[Path]:
+    """One panel of cells per combination of the other axes (one panel when there are none)."""
+    xq, yq, zq = quantity(plot.x), quantity(plot.y), metric(plot.z)
+    others = [a for a in study.axes if a not in (plot.x, plot.y)]
+    panels: dict[tuple[str, ...], list[Row]] = {}
+    for row in rows:
+        panels.setdefault(tuple(row[a] for a in others), []).append(row)
+    height = 2.2 + 0.5 * min(len(set(study.axes[plot.y])), 12)
+    fig, axes = plt.subplots(len(panels), 1, figsize=(9, height * len(panels)), squeeze=False, layout="constrained")
+    handles: list[Any] = []
+    for ax, (key, members) in zip(axes[:, 0], panels.items()):
+        xs, ys, z = metric_grid(members, plot.x, plot.y, plot.z)
+        position = cell_map(fig, ax, xs, ys, z, xq, yq, zq)
+        marked, texts = [], {float(r[plot.y]): r[plot.y] for r in members}
+        fixed = dict(zip(others, key, strict=True))
+        for i, y in enumerate(ys):
+            record = _optimum(optima, plot.z, plot.x, {plot.y: texts.get(y), **fixed})
+            if record is not None and record["optimum"] is not None:
+                marked.append(position(record["optimum"], y))
+            elif record is None and np.isfinite(z[i]).any() and np.nanmax(z[i]) > np.nanmin(z[i]):
+                marked.append(position(xs[int(np.nanargmax(z[i]))], y))
+        if marked:
+            (line,) = ax.plot(*zip(*marked), "o", color="white", mec="black", ms=8,
+                              label="optimum of each row" + (" (refined)" if optima else ""))
+            handles = [line]
+        handles += [h for h in no_result_patch(z) if h.get_label() not in {x.get_label() for x in handles}]
+        ax.set_title(title(study, zq.name) + (f"\n{curve_label(fixed)}" if fixed else ""), fontsize=9)
     if handles:
-        ax.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(0, -0.12), ncols=2, frameon=False)
-    ax.set_title(title(study, zq.name), fontsize=9)
+        axes[-1, 0].legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(0, -0.12), ncols=2,
+                           frameon=False)
     return save(fig, path)
 
 

@@ -1,0 +1,33 @@
+"""``rpdrill rotation-report RUNS_DIR --out DIR``: the rotation-speed note from the two rotation studies
+(``rpdrill study studies/rotation/{rpm_frequency_map,dth_example}.yaml --out RUNS_DIR/<name>``):
+``rotation.md`` and the rpm x frequency map of one rock (studies.rotation_report), into DIR; with
+``--docs DIR`` also copied there (``--docs docs`` in a checkout)."""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+from pathlib import Path
+
+from rpdrill.studies.rotation_report import write_report
+from rpdrill.studies.run_files import staged_directory
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("runs", type=Path, help="directory with rpm_frequency_map/ and dth_example/")
+    parser.add_argument("--out", required=True, type=Path, help="output directory")
+    parser.add_argument("--rock", default="sandstone", help="the rock whose map goes into the note")
+    parser.add_argument("--docs", type=Path, help="also copy the note and its figure into this folder (e.g. docs)")
+
+
+def run(args: argparse.Namespace) -> int:
+    with staged_directory(args.out) as stage:
+        written = [args.out / p.name for p in write_report(args.runs, stage, args.rock)]
+    if args.docs is not None:
+        args.docs.mkdir(parents=True, exist_ok=True)
+        for path in written:
+            shutil.copy(path, args.docs / path.name)
+    print(f"wrote {', '.join(map(str, written))}" + (f" and copied them into {args.docs}" if args.docs else ""),
+          file=sys.stderr)
+    return 0

@@ -1,0 +1,219 @@
+"""The indexing effect (models.indexing): the bit geometry and the angle turned between blows set how
+each blow meets the rock. The geometry's regimes, paper mode untouched to the last bit, an optimum in
+rotation speed that scales with the blow frequency, every formulation running it (Exudyn against the
+ODE, the exact solver or its refusal), rotation speed as a scan axis, bad input."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from scenes import CRUSHING, crushing_scene, scene_dict, simulate
+
+from rpdrill.models.indexing import CRATER, FRESH, MIN_FRESH_FRACTION, RIDGES, Indexing
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.scene import Bit, Scene
+from rpdrill.models.simulation import prepare
+from rpdrill.studies.cli import main
+from rpdrill.studies.crosscheck import DEFAULT_STEP_S
+from rpdrill.studies.loading import InputError, prepare_scene
+from rpdrill.studies.study import load_study
+
+BIT = {"diameter_m": 0.216, "gauge_button_diameter_m": 0.019, "gauge_buttons": 12}  # the issue's DTH bit
+DIAMETER, BUTTON = BIT["diameter_m"], BIT["gauge_button_diameter_m"]
+PITCH = math.pi * DIAMETER / BIT["gauge_buttons"]
+SHORT = {"solver__end_time_s": 15 / 45.0, "metrics__transient_blows": 5, "metrics__block_blows": 5}
+FULL = {"torsion": True, "rock_damping": True, "rock_plasticity": True, "joint_damping": True}
+SPINNING = {"torsion__stiffness_n_m_per_rad": 0.0, "torsion__resisting_torque_n_m": 0.0}  # turns at M_x / c_x
+
+
+def angle(arc_m: float) -> float:
+    """The bit angle that moves the gauge buttons by ``arc_m``."""
+    return 2.0 * arc_m / DIAMETER
+
+
+def rate(result) -> float:
+    return summary_metrics(result)["penetration_rate_m_per_s"]
+
+
+@pytest.mark.parametrize("arc, eta, regime", [
+    (BUTTON, 1.0, FRESH),  # craters just touching
+    (0.5 * BUTTON, 0.5, CRATER),  # half the footprint on the last crater
+    (1.4 * BUTTON, 1 / 1.4, RIDGES),  # a ridge 0.4 d wide left between craters (below P / 2)
+    (1.6 * BUTTON, BUTTON / (PITCH - 1.6 * BUTTON), RIDGES),  # past P / 2: nearer the next button's crater
+    (0.0, MIN_FRESH_FRACTION, CRATER),  # no rotation: the same crater
+    (PITCH, MIN_FRESH_FRACTION, CRATER),  # a whole pitch: into the next button's crater
+    (PITCH - BUTTON, 1.0, FRESH),  # just past the next button's crater
+])
+def test_share_of_fresh_rock_from_the_gauge_geometry(arc, eta, regime):
+    indexing = Indexing(Bit(**BIT), None, 36.0)
+    assert indexing.fresh_fraction(angle(arc)) == pytest.approx(eta, rel=1e-12)
+    assert indexing.regime(angle(arc)) == regime
+
+
+def test_best_speed_is_a_constant_index_per_blow():
+    """n = 60 f w / (pi D): the index per blow is one crater width at every frequency."""
+    for frequency in (20.0, 36.0, 80.0):
+        indexing = Indexing(Bit(**BIT), None, frequency)
+        best = indexing.best_speed_rpm()
+        assert best / frequency == pytest.approx(60 * BUTTON / (math.pi * DIAMETER))
+        assert Indexing(Bit(**BIT), best, frequency).fresh_fraction(
+            Indexing(Bit(**BIT), best, frequency).prescribed_angle_rad) == pytest.approx(1.0, rel=1e-12)
+    wider = Indexing(Bit(**BIT, crater_width_m=0.025), None, 36.0)
+    assert wider.best_speed_rpm() == pytest.approx(36.0 * 60 * 0.025 / (math.pi * DIAMETER))
+
+
+@pytest.mark.parametrize("formulation", ["exact", "ode", "exudyn"])
+def test_effect_off_leaves_eq_4_bit_identical(formulation):
+    """A bit and a rotation speed in the scene with indexing off run the paper's Eq. 4 exactly as a
+    scene without them: the same states to the last bit."""
+    paper = crushing_scene(**SHORT, effects=FULL)
+    with_bit = crushing_scene(**SHORT, bit=BIT, rotation={"speed_rpm": 45.0}, effects={**FULL, "indexing": False})
+    assert prepare(paper).rock == prepare(with_bit).rock and prepare(with_bit).blow_starts() is None
+    a, b = simulate(paper, formulation), simulate(with_bit, formulation)
+    for name in ("time_s", "position_m", "velocity_m_per_s", "bottom_m"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+def test_ideal_indexing_is_eq_4():
+    """At the best speed every blow meets fresh rock (eta = 1): the indexed law with its threshold state
+    gives the paper's penetration."""
+    paper = crushing_scene(**SHORT)
+    best = Indexing(Bit(**BIT), None, CRUSHING["impact.frequency_hz"]).best_speed_rpm()
+    indexed = crushing_scene(**SHORT, bit=BIT, rotation={"speed_rpm": best})
+    assert prepare(indexed).rock.indexed and prepare(indexed).rock.fresh_fraction == pytest.approx(1.0, rel=1e-12)
+    assert rate(simulate(indexed, "exact")) == pytest.approx(rate(simulate(paper, "exact")), rel=1e-9)
+
+
+def test_penetration_has_an_optimum_in_rpm_that_scales_with_the_frequency():
+    """At fixed frequency the rate peaks at the best speed and falls on both sides (re-crushed craters
+    below, ridges above, up to the aliasing at half the button pitch, 1.49 n here); at another
+    frequency the peak moves with it."""
+    for frequency in (40.0, 50.0):
+        best = Indexing(Bit(**BIT), None, frequency).best_speed_rpm()
+        factors = (0.5, 0.8, 1.0, 1.2, 1.45)
+        rates = [rate(simulate(crushing_scene(**SHORT, impact__frequency_hz=frequency, bit=BIT,
+                                              rotation={"speed_rpm": factor * best}), "exact")) for factor in factors]
+        assert rates[2] > 0 and int(np.argmax(rates)) == 2, (frequency, rates)
+        assert rates[0] < rates[1] < rates[2] > rates[3] > rates[4]
+
+
+@pytest.fixture(scope="module")
+def cross_checked():
+    """The crushing test drill with indexing: a prescribed 40 rpm, and the torsion line turning freely
+    (k_x = 0: phi' -> M_x / c_x, about 48 rpm), by the ODE (reference) and Exudyn (cross-check step)."""
+    scenes = {"rpm": crushing_scene(**SHORT, bit=BIT, rotation={"speed_rpm": 40.0}),
+              "torsion": crushing_scene(**SHORT, **SPINNING, bit=BIT)}
+    runs = {name: (simulate(s, "ode", preset="reference"), simulate(s, step_s=DEFAULT_STEP_S))
+            for name, s in scenes.items()}
+    return runs | {"paper": rate(simulate(crushing_scene(**SHORT), "exact"))}
+
+
+@pytest.mark.parametrize("name", ["rpm", "torsion"])
+def test_exudyn_agrees_with_ode_with_indexing_on(cross_checked, name):
+    ode, exudyn = cross_checked[name]
+    assert 0 < rate(ode) < 0.9 * cross_checked["paper"]  # indexing costs penetration here
+    assert rate(exudyn) == pytest.approx(rate(ode), rel=1e-4)
+    for result in (ode, exudyn):
+        assert summary_metrics(result)["energy_balance_relative_error"] < 1e-4
+    etas = np.array(ode.info["fresh_fractions"])
+    assert len(etas) == math.ceil(ode.scene.solver.end_time_s * ode.scene.impact.frequency_hz)
+    np.testing.assert_allclose(exudyn.info["fresh_fractions"], etas, rtol=1e-3)
+
+
+def test_torsion_angle_between_blows_sets_each_share(cross_checked):
+    """From the torsion line, eta of blow k is that of the angle turned since blow k - 1 (none before
+    the first blow); the share settles as the bit spins up."""
+    ode, _ = cross_checked["torsion"]
+    indexing = ode.simulation.indexing
+    starts = np.arange(len(ode.info["fresh_fractions"])) * ode.scene.impact.period_s
+    phi = np.interp(starts, ode.time_s, ode.torsion_angle_rad)
+    turned = np.diff(phi, prepend=phi[0])
+    np.testing.assert_allclose(ode.info["fresh_fractions"], [indexing.fresh_fraction(a) for a in turned], rtol=1e-6)
+    assert ode.info["fresh_fractions"][0] == MIN_FRESH_FRACTION and len(set(ode.info["fresh_fractions"])) > 3
+
+
+def test_exact_agrees_with_ode_or_refuses_with_the_reason(cross_checked):
+    ode, _ = cross_checked["rpm"]
+    assert rate(simulate(ode.scene, "exact")) == pytest.approx(rate(ode), rel=1e-6)
+    torsion = cross_checked["torsion"][0].scene.with_solver("exact")
+    with pytest.raises(InputError, match="matrices would change at every blow; give rotation.speed_rpm"):
+        prepare_scene(torsion, "scene.yaml")
+    bilinear = crushing_scene(**SHORT, **SPINNING, bit=BIT, rock={"law": "bilinear", "loading_stiffness_n_per_m": 2e8,
+                                                                  "unloading_stiffness_n_per_m": 1e9})
+    exact, reference = simulate(bilinear, "exact"), simulate(bilinear, "ode", preset="reference")
+    assert exact.info["fresh_fractions"][3] < 1 and rate(exact) == pytest.approx(rate(reference), rel=1e-6)
+
+
+def test_rotation_speed_is_a_scan_axis(tmp_path):
+    study = tmp_path / "study.yaml"
+    study.write_text(yaml.safe_dump({
+        "name": "rpm", "base_scene": scene_dict(bit=BIT, rotation={"speed_rpm": 45.0}),
+        "scan": {"rotation.speed_rpm": [30.0, 60.0], "impact.frequency_hz": [40.0, 60.0]},
+        "metrics": ["penetration_rate_m_per_s"]}))
+    points = load_study(study).points
+    assert sorted((p.simulation.indexing.speed_rpm, p.simulation.impact.frequency_hz) for p in points) == \
+        [(30.0, 40.0), (30.0, 60.0), (60.0, 40.0), (60.0, 60.0)]
+    assert all(p.simulation.effects.indexing for p in points)
+
+
+BAD = [
+    ("no bit", {"effects": {"indexing": True}, "rotation": {"speed_rpm": 45.0}}, ["indexing effect needs a bit section"]),
+    ("no angle", {"effects": {"indexing": True}, "bit": BIT},
+     ["needs the angle turned between blows", "rotation section", "torsion effect"]),
+    ("buttons do not fit", {"bit": {**BIT, "gauge_buttons": 40}, "rotation": {"speed_rpm": 45.0}},
+     ["bit", "40 gauge buttons", "do not fit"]),
+    ("negative speed", {"bit": BIT, "rotation": {"speed_rpm": -5.0}}, ["rotation.speed_rpm", "-5.0"]),
+]
+
+
+@pytest.mark.parametrize("label, changes, expected", BAD, ids=[b[0] for b in BAD])
+def test_bad_indexing_input_one_message_exit_2(tmp_path, capsys, label, changes, expected):
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(scene_dict(**changes)))
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert str(path) in err and "Traceback" not in err
+    for fragment in expected:
+        assert fragment in err
+
+
+def test_resolved_scene_says_why_indexing_was_built():
+    simulation = prepare(Scene.model_validate(scene_dict(bit=BIT, rotation={"speed_rpm": 45.0})))
+    resolved = simulation.resolved_scene()
+    assert resolved["effects"]["indexing"] and "full model" in resolved["effects"]["reasons"]["indexing"]
+    assert resolved["bit"] == BIT and resolved["rotation"] == {"speed_rpm": 45.0}
+
+
+ROTATION_STUDIES = Path(__file__).resolve().parents[1] / "studies" / "rotation"
+
+
+def test_shipped_rotation_studies_are_valid():
+    for name, points in (("rpm_frequency_map", 3 * 13 * 30), ("dth_example", 3 * 81)):
+        study = load_study(ROTATION_STUDIES / f"{name}.yaml")
+        assert len(study.points) == points
+        assert all(p.simulation.effects.indexing and p.simulation.settings.formulation == "exact" for p in study.points)
+
+
+def test_rotation_report_from_two_small_studies(tmp_path):
+    """The documented command: two small scans of the shipped studies' form, then the note and its
+    figure; the note's manual and model speeds are the rule's and the model's formulas."""
+    for name, scan in (("rpm_frequency_map", {"impact.frequency_hz": [36.0, 45.0], "rotation.speed_rpm": [45.0, 60.0]}),
+                       ("dth_example", {"rotation.speed_rpm": [45.0, 60.0, 75.0]})):
+        spec = yaml.safe_load((ROTATION_STUDIES / f"{name}.yaml").read_text())
+        spec.update(base_scene=str(ROTATION_STUDIES.parent / "scenes" / "dth_drill.yaml"),
+                    scan={"rock.name": ["conglomerate"], **scan}, plots=[])
+        spec["base_overrides"]["solver"]["end_time_s"] = 0.5
+        spec["base_overrides"]["metrics"] = {"transient_blows": 5, "block_blows": 5}
+        path = tmp_path / f"{name}.yaml"
+        path.write_text(yaml.safe_dump(spec))
+        assert main(["study", str(path), "--out", str(tmp_path / "runs" / name), "--workers", "1", "--quiet"]) == 0
+    out = tmp_path / "report"
+    assert main(["rotation-report", str(tmp_path / "runs"), "--out", str(out), "--rock", "conglomerate"]) == 0
+    text = (out / "rotation.md").read_text()
+    manual = 1600 * 0.019 / (math.pi * 0.216)
+    assert f"**{manual:.1f} rpm**" in text and f"**{60 * 36 * 0.019 / (math.pi * 0.216):.1f} rpm**" in text
+    assert "| conglomerate | 60 |" in text and (out / "rotation_map_conglomerate.png").stat().st_size > 0
