@@ -14,13 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 
 from rpdrill.models.results import SimulationResult
-
-
-def _cumulative(power: np.ndarray, time_s: np.ndarray) -> np.ndarray:
-    return cumulative_trapezoid(power, time_s, initial=0.0)
+from rpdrill.rocklaw.base import cumulative_trapezoid
 
 
 @dataclass
@@ -54,8 +50,9 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
 
     kinetic = 0.5 * (v**2) @ masses
     spring_force = rock.spring_force(result.bit_position_m, result.rock_states())
-    elastic = chain.elastic_energy_j(x) + 0.5 * spring_force**2 / rock.unloading_stiffness_n_per_m
-    damping_power = chain.damping_power_w(x, v)
+    link_elastic, link_damping = chain.link_energy(x, v)
+    elastic = link_elastic + 0.5 * spring_force**2 / rock.unloading_stiffness_n_per_m
+    damping_power = link_damping
     # what the rock force does beyond its spring-slider part is dissipated in the rock damper
     damping_power = damping_power + (result.rock_force_n - spring_force) * result.bit_velocity_m_per_s
     feed = (x - x[0]) @ chain.constant_forces()
@@ -68,10 +65,10 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
         feed = feed + (tor.drive_torque_n_m - tor.resisting_torque_n_m) * (phi - phi[0])
     return EnergyAccount(
         time_s=t,
-        impact_work_j=_cumulative(result.impact_force_n * v[:, chain.impact_body], t),
+        impact_work_j=cumulative_trapezoid(result.impact_force_n * v[:, chain.impact_body], t),
         feed_work_j=feed,
         kinetic_j=kinetic,
         elastic_j=elastic,
-        damping_j=_cumulative(damping_power, t),
+        damping_j=cumulative_trapezoid(damping_power, t),
         crushing_work_j=rock.plastic_work_j(spring_force, result.bottom_m),
     )

@@ -20,6 +20,8 @@ from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
 from rpdrill.rocklaw.backends import SCALAR, SymbolicBackend
 from rpdrill.rocklaw.base import RockLaw, State
 
+COORDINATE = exu.OutputVariableType.Coordinates
+
 
 def attach_user_function(mbs: Any, item: Any, parameter: str, function: Any, symbolic: bool) -> Any:
     """Set ``function`` as the item's user function: recorded as symbolic (compiled) or as a
@@ -52,10 +54,11 @@ class ExudynRockContact:
     ) -> None:
         self.rock = rock
         self._bit_node = bit_node
+        self._return_map = rock.return_map
         if initial_state is None:
             initial_position = mbs.GetNodeParameter(bit_node, "initialCoordinates")[0]
             initial_state = rock.return_map(initial_position, rock.initial_state())
-        self.state: State = tuple(initial_state)
+        self.state: State = tuple(float(value) for value in initial_state)  # floats: the hook compares them every step
         # (time, state) each time the state changed; the state at t is the step function through these
         self.state_history: list[tuple[float, State]] = [(0.0, self.state)]
         self._step_start_s = 0.0
@@ -79,7 +82,7 @@ class ExudynRockContact:
         self._user_function = attach_user_function(
             mbs, self.object, "springForceUserFunction", rock_force, symbolic
         )
-        self._coordinate = exu.OutputVariableType.Coordinates
+        self._read = mbs.GetNodeOutput  # bound once: the pre-step hook runs at every step
 
     @property
     def bottom_history(self) -> list[tuple[float, float]]:
@@ -106,7 +109,7 @@ class ExudynRockContact:
         Exudyn passes the pre-step function the time at the *end* of the coming step while the
         state is still that of its start; the history is stamped with the start time.
         """
-        state = self.rock.return_map(mbs.GetNodeOutput(self._bit_node, self._coordinate), self.state)
+        state = self._return_map(self._read(self._bit_node, COORDINATE), self.state)
         if state != self.state:
             self.set_state(state, self._step_start_s)
         self._step_start_s = t

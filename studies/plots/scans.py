@@ -9,16 +9,25 @@ from __future__ import annotations
 
 from collections import defaultdict
 from pathlib import Path
+from types import ModuleType
+from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 
 from rpdrill.studies.study import Plot, Study
 
 Row = dict[str, str]
+
+
+def _pyplot() -> ModuleType:
+    """matplotlib's pyplot without a screen, imported when a plot is drawn (by a worker), not when a
+    command starts."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
 
 
 def _label(text: str) -> str:
@@ -32,8 +41,9 @@ def _metric(row: Row, name: str) -> float:
     return float(row[name]) if row["status"] == "ok" and row[name] != "" else float("nan")
 
 
-def _curves(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
-    others = [a for a in study.axes if a != plot.x]
+def _curves(plot: Plot, axes_values: dict[str, list[Any]], name: str, rows: list[Row], path: Path) -> None:
+    plt = _pyplot()
+    others = [a for a in axes_values if a != plot.x]
     label_axes = [plot.curves] if plot.curves else others
     groups: dict[tuple[str, ...], list[Row]] = defaultdict(list)
     for row in rows:
@@ -57,14 +67,15 @@ def _curves(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
     axes[-1, 0].set_xlabel(plot.x)
     if len(groups) > 1:
         axes[0, 0].legend(fontsize=7)
-    axes[0, 0].set_title(f"{study.spec.name}: maxima marked")
+    axes[0, 0].set_title(f"{name}: maxima marked")
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
 
 
-def _map(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
-    xs, ys = sorted(set(study.axes[plot.x])), sorted(set(study.axes[plot.y]))
+def _map(plot: Plot, axes_values: dict[str, list[Any]], name: str, rows: list[Row], path: Path) -> None:
+    plt = _pyplot()
+    xs, ys = sorted(set(axes_values[plot.x])), sorted(set(axes_values[plot.y]))
     z = np.full((len(ys), len(xs)), np.nan)
     for row in rows:
         z[ys.index(float(row[plot.y])), xs.index(float(row[plot.x]))] = _metric(row, plot.z)
@@ -78,7 +89,7 @@ def _map(plot: Plot, study: Study, rows: list[Row], path: Path) -> None:
         ax.legend(fontsize=8)
     ax.set_xlabel(plot.x)
     ax.set_ylabel(plot.y)
-    ax.set_title(f"{study.spec.name}: {plot.z}")
+    ax.set_title(f"{name}: {plot.z}")
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
@@ -90,11 +101,17 @@ def plot_name(plot: Plot) -> str:
     return f"{'_'.join(plot.metrics) if len(plot.metrics) == 1 else 'metrics'}_vs_{plot.x}".replace(".", "_")
 
 
-def draw_plots(study: Study, rows: list[Row], out: Path) -> list[Path]:
-    """Draw every plot of the study into ``out``; the paths written."""
-    paths = []
-    for i, plot in enumerate(study.spec.plots):
-        path = out / f"{i:02d}_{plot_name(plot)}.{study.spec.format}"
-        (_map if plot.kind == "map" else _curves)(plot, study, rows, path)
-        paths.append(path)
-    return paths
+PlotTask = tuple[Plot, dict[str, list[Any]], str, list[Row], Path]  # plot, scan axes, study name, rows, file
+
+
+def plot_tasks(study: Study, rows: list[Row], out: Path) -> list[PlotTask]:
+    """One task per plot of the study: what :func:`draw_plot` needs (no prepared points: small to send)."""
+    return [(plot, study.axes, study.spec.name, rows, out / f"{i:02d}_{plot_name(plot)}.{study.spec.format}")
+            for i, plot in enumerate(study.spec.plots)]
+
+
+def draw_plot(task: PlotTask) -> Path:
+    """Worker: draw one plot of a study's results; the path written."""
+    plot, axes, name, rows, path = task
+    (_map if plot.kind == "map" else _curves)(plot, axes, name, rows, path)
+    return path
