@@ -82,6 +82,7 @@ def test_does_not_import_exudyn() -> None:
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("damping_mode", ["contact", "always"])
 @pytest.mark.parametrize("feed", list(FEEDS))
 def test_agrees_with_tight_ode(feed: str, damping_mode: str) -> None:
@@ -95,6 +96,7 @@ def test_agrees_with_tight_ode(feed: str, damping_mode: str) -> None:
     assert abs(end[0] - end[1]) < AGREEMENT * abs(end[1])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shape", ["rectangular", "triangular"])
 def test_other_pulse_shapes_agree_with_tight_ode(shape: str) -> None:
     """The rectangular pulse (constant state) and the triangular one (ramp state, two phases)."""

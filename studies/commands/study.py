@@ -1,7 +1,7 @@
 """``rpdrill study STUDY.yaml --out DIR``: run a YAML study (a scan of scenes) on all cores or a Dask cluster.
 
-Writes DIR/results.csv (one row per point, appended as points finish), DIR/study.json
-(provenance) and the study's plots. Running again into the same DIR skips finished points;
+Writes DIR/results.csv (one row per point, appended batch by batch as points finish), DIR/study.json
+(provenance) and the study's plots (drawn by the workers once the results are complete). Running again into the same DIR skips finished points;
 a changed study is refused (studies.resumable). The exit status is 1 when some point failed.
 """
 
