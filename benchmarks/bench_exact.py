@@ -28,12 +28,14 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import time
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import yaml
 
+from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
@@ -134,8 +136,11 @@ def main() -> None:
             print(f"{name:<21} {label:<28} {cpu / args.end_time_s:<15.4f} {error:<16.2e} "
                   f"{error * abs(reference.bottom_m[-1]):<10.1e} {result.bottom_m[-1] * 1e3:.9f}")
             if exact:
+                start = time.process_time()
+                summary_metrics(result)
+                metrics_s = (time.process_time() - start) / args.end_time_s
                 print(f"{'':<24}({result.info['mode_switches']} switches, {result.info['samples']} samples, "
-                      f"every {result.info['sample_interval_s']:.0e} s)")
+                      f"every {result.info['sample_interval_s']:.0e} s; its metrics: {metrics_s:.4f} CPU s / sim s)")
             del result
         print(f"{name:<21} reference: exact, sub-step {reference.info['sub_step_s']:.3g} s")
 

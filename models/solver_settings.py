@@ -6,7 +6,7 @@ a preset and without explicit accuracy options the ``standard`` preset applies.
 * exudyn: the preset's fixed-step solver (fast: RK44, standard and reference: RK67) at the smallest of
   a cap, a fraction of the pulse duration (a step must resolve the pulse) and a multiple of
   1/|lambda|_max (the stiffest or fastest mode, models.stability.spectral_radius_per_s); explicit
-  ``type`` or ``step_s`` win. The stated errors (penetration rate relative to the exact formulation,
+  ``type`` or ``step_s`` win (a step or tolerances without a preset and without a type: RK44). The stated errors (penetration rate relative to the exact formulation,
   energy balance relative to the impact work) are the largest measured on the hard scenes of
   tests/stability, rounded up (docs/stability.md); the suite checks them.
 * ode: DOP853 at the preset's tolerances (absolute tolerance in the state's SI units), dense
@@ -52,6 +52,8 @@ EXUDYN_PRESETS: dict[str, ExudynPreset] = {
     "standard": ExudynPreset("rk67", 5e-5, 20, 0.8, penetration_rate_error=5e-4, energy_balance_error=5e-3),
     "reference": ExudynPreset("rk67", 1e-5, 100, 0.2, penetration_rate_error=1e-4, energy_balance_error=3e-4),
 }
+# the solver of a scene that gives its own step or tolerances, neither a preset nor a type
+UNPRESET_TYPE = "rk44"
 ODE_PRESETS: dict[str, dict[str, float]] = {
     "fast": {"relative_tolerance": 1e-6, "absolute_tolerance": 1e-9},
     "standard": {"relative_tolerance": 1e-8, "absolute_tolerance": 1e-11},
@@ -125,7 +127,7 @@ def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_pe
         step = solver.step_s
         if step is None:
             step = tier.step(pulse_duration_s, spectral_radius_per_s())
-        return ExudynSettings(type=solver.type or tier.type, step_s=step,
+        return ExudynSettings(type=solver.type or (tier.type if preset else UNPRESET_TYPE), step_s=step,
                               spectral_radius=_given(solver, "spectral_radius", 1.0),
                               relative_tolerance=_given(solver, "relative_tolerance", 1e-8),
                               absolute_tolerance=_given(solver, "absolute_tolerance", 1e-12), preset=preset, **common)

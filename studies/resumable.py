@@ -1,4 +1,4 @@
-"""Resumable runs of many points into an output directory: a results table appended point by point,
+"""Resumable runs of many points into an output directory: a results table appended batch by batch,
 and the provenance beside it.
 
 ``DIR/study.json`` records what produced the results (the study's hash, versions, the resolved

@@ -10,7 +10,7 @@ batches of arguments (:func:`batches`), so a run pays the process machinery once
 per batch, not per argument. A pool's call submits its work at once and returns the iterator of
 results, so work submitted earlier (plots) goes on while the caller waits for later work. Results come in
 completion order, so the function's result must say which argument it belongs to. Workers run one
-BLAS thread each (OMP/OpenBLAS/MKL set to 1).
+BLAS thread each and keep freed memory (WORKER_ENVIRONMENT).
 """
 
 from __future__ import annotations
@@ -30,7 +30,12 @@ Arg = TypeVar("Arg")
 Result = TypeVar("Result")
 Runner = Callable[[Callable[[Arg], Result], Sequence[Arg]], Iterator[list[Result]]]
 
-SINGLE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+# A worker's environment: one BLAS thread, and glibc keeping freed memory for reuse (arrays up to 64 MB
+# from the heap, kept up to 256 MB): a run's sample arrays, a few MB each, would otherwise be fresh pages
+# every time, and on this machine their page faults cost more than an exact solution and half its
+# metrics (docs/performance.md).
+WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+                      "MALLOC_MMAP_THRESHOLD_": str(64 << 20), "MALLOC_TRIM_THRESHOLD_": str(256 << 20)}
 BATCHES_PER_WORKER = 4  # enough to even out unequal points; few enough that a batch costs ~nothing to send
 PAPER_SCENE = Path(__file__).resolve().parent / "scenes" / "paper_base.yaml"
 
@@ -96,10 +101,10 @@ def _completed(futures: list[Any], as_done: Callable[[list[Any]], Iterator[Any]]
 
 @contextlib.contextmanager
 def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
-    """A runner bound to one pool of spawned single-thread workers, kept for many calls; every worker is
+    """A runner bound to one pool of spawned workers (WORKER_ENVIRONMENT), kept for many calls; every worker is
     started (and imports, :func:`warm_up`) when the pool opens."""
     workers = workers or os.cpu_count() or 1
-    with _environment(SINGLE_THREAD):  # the workers start inside: the setting reaches them
+    with _environment(WORKER_ENVIRONMENT):  # the workers start inside: the setting reaches them
         executor = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"), initializer=warm_up)
         for _ in range(workers):  # a new worker per task pending when submitted: all start now
             executor.submit(math.sqrt, 0.0)
@@ -127,7 +132,7 @@ def dask_pool(address: str | None = None, workers: int | None = None) -> Iterato
         else:
             cluster = stack.enter_context(LocalCluster(
                 n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                dashboard_address=":0", silence_logs=logging.ERROR, env=SINGLE_THREAD))
+                dashboard_address=":0", silence_logs=logging.ERROR, env=WORKER_ENVIRONMENT))
             client = stack.enter_context(Client(cluster))
         client.run(warm_up)
         slots = sum(client.nthreads().values()) or 1

@@ -22,7 +22,7 @@ from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.studies.cli import main
 from rpdrill.studies.points import run_point
-from rpdrill.studies.runners import SINGLE_THREAD
+from rpdrill.studies.runners import BATCHES_PER_WORKER, WORKER_ENVIRONMENT, batches
 from rpdrill.studies.specs import METRIC_NAMES
 from rpdrill.studies.study import load_study
 
@@ -173,6 +173,14 @@ def test_resume_after_kill(tmp_path, capsys):
     assert all(r == before[r["point"]] for r in after if r["point"] in before)
 
 
+@pytest.mark.parametrize("count, workers", [(0, 2), (1, 2), (7, 2), (92, 2), (207, 3)])
+def test_batches_keep_every_point_once_in_order_and_even(count, workers):
+    parts = batches(list(range(count)), workers)
+    assert [p for part in parts for p in part] == list(range(count))
+    assert len(parts) <= workers * BATCHES_PER_WORKER and all(parts)
+    assert max(map(len, parts), default=0) - min(map(len, parts), default=0) <= 1
+
+
 def test_dask_local_cluster(tmp_path):
     study = write_study(tmp_path / "dask.yaml", scan={"impact.frequency_hz": [40, 60]}, plots=[])
     out = tmp_path / "out"
@@ -188,7 +196,7 @@ def dask_cluster(folder: Path, workers: int) -> Iterator[str]:
     from dask.distributed import Client
 
     scheduler_file = folder / "scheduler.json"
-    environment = {**os.environ, **SINGLE_THREAD}
+    environment = {**os.environ, **WORKER_ENVIRONMENT}
     command = [sys.executable, "-m", "dask"]
     processes = [subprocess.Popen([*command, "scheduler", "--scheduler-file", str(scheduler_file), "--port", "0",
                                    "--no-dashboard"], env=environment, stderr=subprocess.DEVNULL)]
