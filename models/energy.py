@@ -52,9 +52,8 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
     spring_force = rock.spring_force(result.bit_position_m, result.rock_states())
     link_elastic, link_damping = chain.link_energy(x, v)
     elastic = link_elastic + 0.5 * spring_force**2 / rock.unloading_stiffness_n_per_m
-    damping_power = link_damping
     # what the rock force does beyond its spring-slider part is dissipated in the rock damper
-    damping_power = damping_power + (result.rock_force_n - spring_force) * result.bit_velocity_m_per_s
+    damping_power = link_damping + (result.rock_force_n - spring_force) * result.bit_velocity_m_per_s
     feed = (x - x[0]) @ chain.constant_forces()
     if result.torsion_angle_rad is not None:
         tor = simulation.scene.torsion

@@ -6,9 +6,10 @@ a preset and without explicit accuracy options the ``standard`` preset applies.
 * exudyn: the preset's fixed-step solver (fast: RK44, standard and reference: RK67) at the smallest of
   a cap, a fraction of the pulse duration (a step must resolve the pulse) and a multiple of
   1/|lambda|_max (the stiffest or fastest mode, models.stability.spectral_radius_per_s); explicit
-  ``type`` or ``step_s`` win (a step or tolerances without a preset and without a type: RK44). The stated errors (penetration rate relative to the exact formulation,
-  energy balance relative to the impact work) are the largest measured on the hard scenes of
-  tests/stability, rounded up (docs/stability.md); the suite checks them.
+  ``type`` or ``step_s`` win (a step or tolerances without a preset and without a type: RK44). The
+  stated errors (penetration rate relative to the exact formulation, energy balance relative to the
+  impact work) are the largest measured on the hard scenes of tests/stability, rounded up
+  (docs/stability.md); the suite checks them.
 * ode: DOP853 at the preset's tolerances (absolute tolerance in the state's SI units), dense
   output sampled every ``sample_interval_s`` (default 2e-6 s).
 * exact: exact to round-off at every preset; samples every ``output_interval_s`` (at most
@@ -40,6 +41,7 @@ class ExudynPreset:
     energy_balance_error: float
 
     def step(self, pulse_duration_s: float, spectral_radius_per_s: float) -> float:
+        """The step of this preset for a pulse of ``pulse_duration_s`` and |lambda|_max ``spectral_radius_per_s``."""
         return min(self.step_s, pulse_duration_s / self.steps_per_pulse, self.step_times_radius / spectral_radius_per_s)
 
 

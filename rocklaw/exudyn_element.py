@@ -82,7 +82,6 @@ class ExudynRockContact:
         self._user_function = attach_user_function(
             mbs, self.object, "springForceUserFunction", rock_force, symbolic
         )
-        self._read = mbs.GetNodeOutput  # bound once: the pre-step hook runs at every step
 
     @property
     def bottom_history(self) -> list[tuple[float, float]]:
@@ -109,7 +108,7 @@ class ExudynRockContact:
         Exudyn passes the pre-step function the time at the *end* of the coming step while the
         state is still that of its start; the history is stamped with the start time.
         """
-        state = self._return_map(self._read(self._bit_node, COORDINATE), self.state)
+        state = self._return_map(mbs.GetNodeOutput(self._bit_node, COORDINATE), self.state)
         if state != self.state:
             self.set_state(state, self._step_start_s)
         self._step_start_s = t

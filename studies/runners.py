@@ -3,14 +3,14 @@ results as it completes.
 
 Each runner is ``runner(function, arguments) -> Iterator[list[result]]``: :func:`sequential` (in this
 process, one argument per batch), or one bound to a pool that lives for many calls,
-:func:`process_pool` (spawned single-thread workers, all cores by default) and :func:`dask_pool` (a Dask
-cluster or a LocalCluster); :func:`pool` picks one for the command line options. A pool's workers
-start and import rpdrill when the pool opens (while the caller still loads its study) and take
-batches of arguments (:func:`batches`), so a run pays the process machinery once per pool and once
-per batch, not per argument. A pool's call submits its work at once and returns the iterator of
-results, so work submitted earlier (plots) goes on while the caller waits for later work. Results come in
-completion order, so the function's result must say which argument it belongs to. Workers run one
-BLAS thread each and keep freed memory (WORKER_ENVIRONMENT).
+:func:`process_pool` (spawned workers, all cores by default) and :func:`dask_pool` (a Dask cluster or
+a LocalCluster); :func:`pool` picks one for the command line options. A pool's workers start and
+import rpdrill once (a process pool's with its first call, so that a study refused before it runs
+starts none) and take batches of arguments (:func:`batches`): a run pays the process machinery once
+per pool and once per batch, not per argument. A pool's call submits its work at once and returns
+the iterator of results, so work submitted earlier (plots) goes on while the caller waits for later
+work. Results come in completion order, so the function's result must say which argument it belongs
+to. Workers run one BLAS thread each and keep freed memory (WORKER_ENVIRONMENT).
 """
 
 from __future__ import annotations
@@ -101,22 +101,26 @@ def _completed(futures: list[Any], as_done: Callable[[list[Any]], Iterator[Any]]
 
 @contextlib.contextmanager
 def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
-    """A runner bound to one pool of spawned workers (WORKER_ENVIRONMENT), kept for many calls; every worker is
-    started (and imports, :func:`warm_up`) when the pool opens."""
+    """A runner bound to one pool of spawned workers (WORKER_ENVIRONMENT), kept for many calls; every
+    worker starts (and imports, :func:`warm_up`) with the first call, none when nothing is run."""
     workers = workers or os.cpu_count() or 1
-    with _environment(WORKER_ENVIRONMENT):  # the workers start inside: the setting reaches them
-        executor = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"), initializer=warm_up)
-        for _ in range(workers):  # a new worker per task pending when submitted: all start now
-            executor.submit(math.sqrt, 0.0)
+    executors: list[ProcessPoolExecutor] = []
 
     def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
-        futures = [executor.submit(run_batch, (function, batch)) for batch in batches(arguments, workers)]
+        if not executors:
+            with _environment(WORKER_ENVIRONMENT):  # the workers start inside: the setting reaches them
+                executors.append(ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
+                                                     initializer=warm_up))
+                for _ in range(workers):  # a new worker per task pending when submitted: all start now
+                    executors[0].submit(math.sqrt, 0.0)
+        futures = [executors[0].submit(run_batch, (function, batch)) for batch in batches(arguments, workers)]
         return _completed(futures, as_completed, lambda pending: [f.cancel() for f in pending])
 
     try:
         yield run
     finally:
-        executor.shutdown(wait=True, cancel_futures=True)
+        for executor in executors:
+            executor.shutdown(wait=True, cancel_futures=True)
 
 
 @contextlib.contextmanager

@@ -242,8 +242,9 @@ def four_rods_with_couplings() -> Scene:
 BILINEAR = {"law": "bilinear", "loading_stiffness_n_per_m": 2e8, "unloading_stiffness_n_per_m": 1e9}
 
 
-@pytest.mark.parametrize("make", [lambda: crushing_scene(rock=BILINEAR, solver__end_time_s=0.1, **SHORT_METRICS),
-                                  four_rods_with_couplings], ids=["bilinear_law", "four_rods_with_couplings"])
+@pytest.mark.parametrize("make", [
+    pytest.param(lambda: crushing_scene(rock=BILINEAR, solver__end_time_s=0.1, **SHORT_METRICS), id="bilinear_law"),
+    pytest.param(four_rods_with_couplings, id="four_rods_with_couplings", marks=pytest.mark.slow)])
 def test_piecewise_laws_agree_with_the_ode_to_1e_9_in_the_bottom(make):
     """The exact formulation runs every declared law: the bilinear rock (two states, resets on entering
     loading and free) and compression-only couplings (modes of five links at once)."""

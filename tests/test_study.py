@@ -181,6 +181,7 @@ def test_batches_keep_every_point_once_in_order_and_even(count, workers):
     assert max(map(len, parts), default=0) - min(map(len, parts), default=0) <= 1
 
 
+@pytest.mark.slow
 def test_dask_local_cluster(tmp_path):
     study = write_study(tmp_path / "dask.yaml", scan={"impact.frequency_hz": [40, 60]}, plots=[])
     out = tmp_path / "out"
