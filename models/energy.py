@@ -6,7 +6,11 @@ with W_impact = int F_d v_shank dt, W_feed = sum_i F_i (x_i - x_i(0)) (+ (M_x - 
 E_elastic including what the rock stores, F_spring^2 / (2 k_unload) (rocklaw.base.RockLaw),
 D_damping = int of every damper's power (joints, shock absorber, the rock damper, c_x), and
 W_crushing the rock law's plastic work int F_spring d(x_n) (Jenkins: F_th (x_n - x_n(0))).
-The powers are integrated by the trapezoidal rule over every stored solver step.
+The powers are integrated by the trapezoidal rule over every stored solver step, unless the
+formulation integrated the works exactly (``SimulationResult.works_j``, the exact formulation): then
+W_impact is its impact work and D_damping what the links, the rock and the torsion line absorb less
+what they store and crush; the balance then states that the bodies' kinetic energy changes by the
+work of every force on them.
 """
 
 from __future__ import annotations
@@ -62,12 +66,13 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
         elastic = elastic + 0.5 * tor.stiffness_n_m_per_rad * phi**2
         damping_power = damping_power + tor.damping_n_m_s_per_rad * omega**2
         feed = feed + (tor.drive_torque_n_m - tor.resisting_torque_n_m) * (phi - phi[0])
-    return EnergyAccount(
-        time_s=t,
-        impact_work_j=cumulative_trapezoid(result.impact_force_n * v[:, chain.impact_body], t),
-        feed_work_j=feed,
-        kinetic_j=kinetic,
-        elastic_j=elastic,
-        damping_j=cumulative_trapezoid(damping_power, t),
-        crushing_work_j=rock.plastic_work_j(spring_force, result.bottom_m),
-    )
+    crushing = rock.plastic_work_j(spring_force, result.bottom_m)
+    if result.works_j is None:
+        impact, damping = cumulative_trapezoid(result.impact_force_n * v[:, chain.impact_body], t), \
+            cumulative_trapezoid(damping_power, t)
+    else:  # integrated exactly by the formulation: the dampers take what the internal forces absorb and
+        # neither store nor crush
+        impact = result.works_j["impact"]
+        damping = result.works_j["internal"] - (elastic - elastic[0]) - (crushing - crushing[0])
+    return EnergyAccount(time_s=t, impact_work_j=impact, feed_work_j=feed, kinetic_j=kinetic, elastic_j=elastic,
+                         damping_j=damping, crushing_work_j=crushing)

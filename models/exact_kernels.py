@@ -110,11 +110,13 @@ def diverged(rows: np.ndarray, row: int, bodies: int, position_limit_m: float) -
 
 
 @njit(cache=True)
-def record(time_out: np.ndarray, rows: np.ndarray, row: int, time_s: float, w: np.ndarray, rock_row: np.ndarray,
-           impact_row: np.ndarray) -> None:
-    """time_out[row] = t, rows[row, :m + 2] = (w, F_r = rock_row . w, F_d = impact_row . (1, u1, u2))."""
+def record(time_out: np.ndarray, rows: np.ndarray, row_keys: np.ndarray, row: int, time_s: float, w: np.ndarray,
+           rock_row: np.ndarray, impact_row: np.ndarray, key: int) -> None:
+    """time_out[row] = t, rows[row, :m + 2] = (w, F_r = rock_row . w, F_d = impact_row . (1, u1, u2)),
+    row_keys[row] = the key that propagates from this row on."""
     size = rock_row.shape[0]
     time_out[row] = time_s
+    row_keys[row] = key
     rock = 0.0
     for c in range(size):
         rows[row, c] = w[c]
@@ -159,7 +161,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                reset_rows: np.ndarray, monotone: int, step_s: float, per_anchor: int, per_sample: int,
                min_switch_interval_s: float, max_switches: int, bodies: int, position_limit_m: float,
                progress: np.ndarray, clock: np.ndarray, w: np.ndarray, time_out: np.ndarray, rows: np.ndarray,
-               switch_times_s: np.ndarray, switch_modes: np.ndarray) -> int:
+               row_keys: np.ndarray, switch_times_s: np.ndarray, switch_modes: np.ndarray) -> int:
     """The event loop of models.exact_model (its module doc), from pulse phase progress[0] on.
 
     Per key (rock mode, pulse phase), with R = (I_m, rock row, piston row, exit rows), r rows, and
@@ -168,7 +170,8 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
     [(R expm(A b h))^T]_b (m x B r); per exit e of a key the next mode id ``next_modes`` and the entry
     resets w[reset_targets[j]] = reset_rows[j] . w (j < reset_counts; the ``monotone`` entry keeps the
     larger of old and new value). Fills ``time_out``, ``rows`` (w, F_r, F_d; both sides of every
-    switch) and the switch log. The run's state is progress = (phase, mode id, rows filled, switches,
+    switch), ``row_keys`` (the key propagating from each row) and the switch log. The run's state is
+    progress = (phase, mode id, rows filled, switches,
     resume), clock = (t, mode start) and w: a key not built yet (key_of -1) returns MISSING_KEY with
     resume = 1, and the call after it is built goes on from there. Returns OK, TOO_MANY_SWITCHES,
     DIVERGED or MISSING_KEY.
@@ -202,7 +205,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
             return MISSING_KEY
         taylor_k, step_k, anchors_k, readout_k = taylor[key], one_step[key], anchors[key], readout[key]
         rock_k, impact_k, directions_k, exit_count = rock_rows[key], impact_rows[key], directions[key], exit_counts[key]
-        record(time_out, rows, row, t, w, rock_k, impact_k)
+        record(time_out, rows, row_keys, row, t, w, rock_k, impact_k, key)
         row += 1
         while True:
             # sub-grid points first + i, i < count <= J, after t and before end_s
@@ -263,6 +266,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                     w[c] = point[count - 1, c] if more else final[c]
             for i in range((-first) % per_sample, formed, per_sample):
                 time_out[row] = (first + i) * h
+                row_keys[row] = key
                 if per_sample > 1:
                     for c in range(width):
                         rows[row, c] = point[i, c]
@@ -272,7 +276,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                 return DIVERGED
             if crossed < 0:
                 if not more:
-                    record(time_out, rows, row, end_s, final, rock_k, impact_k)
+                    record(time_out, rows, row_keys, row, end_s, final, rock_k, impact_k, key)
                     row += 1
                     p += 1
                     break
@@ -287,7 +291,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
             low = max(0.0, min(mode_start_s + min_switch_interval_s, t_right) - t_left)
             root, e = locate(terms, exit_count, directions_k, low, t_right - t_left, coefficients, final)
             t = t_left + root
-            record(time_out, rows, row, t, final, rock_k, impact_k)
+            record(time_out, rows, row_keys, row, t, final, rock_k, impact_k, key)
             row += 1
             mode, mode_start_s = next_modes[key, e], t
             for c in range(size):
@@ -332,3 +336,52 @@ def assemble(one_step: np.ndarray, matrix: np.ndarray, readout_rows: np.ndarray,
         if k:
             term = np.dot(term, matrix) / k
         taylor[:, k * width:(k + 1) * width] = term.T
+
+
+@njit(cache=True)
+def quadratic(form: np.ndarray, w: np.ndarray) -> float:
+    """w^T Q w."""
+    total = 0.0
+    for r in range(w.shape[0]):
+        partial = 0.0
+        for c in range(w.shape[0]):
+            partial += form[r, c] * w[c]
+        total += w[r] * partial
+    return total
+
+
+@njit(cache=True)
+def integrate_powers(time_s: np.ndarray, rows: np.ndarray, row_keys: np.ndarray, one_step: np.ndarray,
+                     step_grams: np.ndarray, series: np.ndarray, step_s: float, sample_interval_s: float,
+                     out: np.ndarray) -> None:
+    """out[r, q] = int w^T Q_q w dt from row r - 1 to row r for every interval that is not a whole sample
+    interval (those are left as they are), for every quadratic form q of a key, exactly: between two
+    rows one key propagates w(t_(r-1) + s) = expm(A s) w_(r-1), so the integral is w_(r-1)^T G(s) w_(r-1),
+    G(s) = int_0^s expm(A^T u) Q expm(A u) du: whole sub-steps G(h) (``step_grams`` [key, q], the state
+    carried on by expm(A h), ``one_step``) and the rest s < h by the series G(s) = sum_k s^(k+1) C_k
+    (``series`` [key, q, k], summed by Horner's rule into one matrix)."""
+    size, count, terms = one_step.shape[1], step_grams.shape[1], series.shape[2]
+    w, carried, gram = np.empty(size), np.empty(size), np.empty((size, size))
+    for r in range(1, time_s.shape[0]):
+        rest = time_s[r] - time_s[r - 1]
+        if rest <= 0.0 or abs(rest - sample_interval_s) <= 1e-9 * sample_interval_s:
+            continue
+        key = row_keys[r - 1]
+        for q in range(count):
+            out[r, q] = 0.0
+        for c in range(size):
+            w[c] = rows[r - 1, c]
+        while rest > step_s * (1.0 + 1e-9):
+            for q in range(count):
+                out[r, q] += quadratic(step_grams[key, q], w)
+            matvec(one_step[key], w, carried)
+            for c in range(size):
+                w[c] = carried[c]
+            rest -= step_s
+        for q in range(count):
+            gram[:, :] = series[key, q, terms - 1]
+            for k in range(terms - 2, -1, -1):
+                for a in range(size):
+                    for b in range(size):
+                        gram[a, b] = gram[a, b] * rest + series[key, q, k, a, b]
+            out[r, q] += quadratic(gram, w) * rest

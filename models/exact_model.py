@@ -31,6 +31,11 @@ goes from its side to the crossed side brackets the switch, which Brent's method
 loop runs compiled (models.exact_kernels); the operators of a key are built when the run first
 reaches it.
 
+Works (with the energy outputs): the impact work and the work the links, the rock and the torsion
+line absorb are quadratic forms w^T Q w integrated exactly between the samples,
+int_0^s w^T Q w = w^T G(s) w with G(s) = int_0^s expm(A^T u) Q expm(A u) du per key (Operators.add_powers,
+models.exact_kernels.integrate_powers), so the samples stay at the output interval.
+
 Zero-length modes: a mode lasts at least ``min_switch_interval_s``. Its start is taken as not
 crossed for every exit function; if an exit function is on its crossed side already at
 t_start + min_switch_interval_s, the switch is placed there. More than ``max_switches_per_blow``
@@ -53,13 +58,22 @@ from scipy.linalg.lapack import dgebal
 from threadpoolctl import ThreadpoolController
 
 from rpdrill.models.chain import torsion_first_order_matrix
-from rpdrill.models.exact_kernels import DIVERGED, MISSING_KEY, TOO_MANY_SWITCHES, assemble, run_events
+from rpdrill.models.exact_kernels import (
+    DIVERGED,
+    MISSING_KEY,
+    TOO_MANY_SWITCHES,
+    assemble,
+    integrate_powers,
+    run_events,
+)
+from rpdrill.models.links import RATE
 from rpdrill.models.piecewise import Element, elements
 from rpdrill.models.pulse import PHASES, generator_states, phase_generator, phase_pieces, phase_row
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import Simulation, as_simulation
 from rpdrill.models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
+from rpdrill.rocklaw.base import VELOCITY
 from rpdrill.rocklaw.modes import Affine
 
 ANCHORS, PER_ANCHOR = 16, 16  # A, B: a batch is J = A B sub-grid points from one state (module doc)
@@ -112,6 +126,18 @@ def balance(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return balanced, scale
 
 
+def step_gram(matrix: np.ndarray, form: np.ndarray, step_s: float) -> np.ndarray:
+    """G(h) = int_0^h expm(A^T u) Q expm(A u) du by Van Loan's block exponential, expm([[-A^T, Q], [0, A]] h)
+    = [[., F12], [0, F22]], G = F22^T F12, on the balanced A = D A_b D^-1 (G = D^-1 G_b(D Q D) D^-1)."""
+    balanced, scale = balance(matrix)
+    size = len(matrix)
+    block = np.zeros((2 * size, 2 * size))
+    block[:size, :size], block[size:, size:] = -balanced.T, balanced
+    block[:size, size:] = scale[:, None] * form * scale[None, :]
+    exponential = expm(block * step_s)
+    return (exponential[size:, size:].T @ exponential[:size, size:]) / scale[:, None] / scale[None, :]
+
+
 class Model:
     """The generated matrices, rows and resets of one simulation (module doc)."""
 
@@ -157,6 +183,36 @@ class Model:
         matrix[one:, one:] = phase_generator(self.impact, phase)
         return matrix
 
+    def power_forms(self, modes: Modes, phase: str) -> np.ndarray:
+        """(Q_impact, Q_internal) with power = w^T Q w: the piston's F_d v_shank, and the power every link,
+        the rock and the torsion line absorb, sum of F u over them (F the force row of the element in its
+        mode, u its stretch rate: a link's delta', the rock's v_bit, the torsion line's omega)."""
+        layout, chain = self.layout, self.simulation.chain
+        n, size = layout.n, layout.size
+        pairs = []  # (force row, rate row) over w
+        for link in chain.linear_links():
+            stretch, rate = np.zeros(size), np.zeros(size)
+            stretch[link.body_b], rate[n + link.body_b] = 1.0, 1.0
+            if link.body_a is not None:
+                stretch[link.body_a], rate[n + link.body_a] = -1.0, -1.0
+            pairs.append((link.stiffness_n_per_m * stretch + link.damping_n_s_per_m * rate, rate))
+        for element, mode in zip(self.pieces, modes, strict=True):
+            velocity = element.variables[VELOCITY if element is self.pieces[0] else RATE]
+            pairs.append((self.row(element, element.table[mode].force), velocity))
+        if self.simulation.torsion is not None:
+            torsion, force, rate = self.simulation.torsion, np.zeros(size), np.zeros(size)
+            force[layout.angle] = torsion.stiffness_n_m_per_rad
+            force[layout.angle + 1], rate[layout.angle + 1] = torsion.damping_n_m_s_per_rad, 1.0
+            pairs.append((force, rate))
+        impact = np.zeros(size)
+        impact[layout.one:] = phase_row(self.impact, phase)
+        shank = np.zeros(size)
+        shank[n + chain.impact_body] = 1.0
+        forms = np.zeros((2, size, size))
+        for index, (force, rate) in [(0, (impact, shank))] + [(1, pair) for pair in pairs]:
+            forms[index] += 0.5 * (np.outer(force, rate) + np.outer(rate, force))
+        return forms
+
     def exits(self, modes: Modes) -> list[tuple[np.ndarray, int, Modes, list[tuple[int, np.ndarray]]]]:
         """(row, direction, next modes, entry resets (target index, row)) of every exit of ``modes``."""
         out = []
@@ -186,8 +242,8 @@ class Operators:
     first named, key_of[mode id, phase id] -> key (-1: not built), arrays growing as needed.
     R = (I, F_r row, F_d row, exit rows) gives a point's outputs."""
 
-    def __init__(self, model: Model, step_s: float, order: int, capacity: int) -> None:
-        self.model, self.step_s, self.order = model, step_s, order
+    def __init__(self, model: Model, step_s: float, per_sample: int, order: int, capacity: int, powers: bool) -> None:
+        self.model, self.step_s, self.per_sample, self.order = model, step_s, per_sample, order
         self.modes: list[Modes] = []
         self.mode_ids: dict[Modes, int] = {}
         size, exits = model.layout.size, model.max_exits
@@ -205,6 +261,12 @@ class Operators:
         self.rock_rows = np.zeros((capacity, size))  # F_r = row . w
         self.impact_rows = np.zeros((capacity, 3))  # F_d = row . (1, u1, u2)
         self.key_of = np.full((capacity, len(PHASES)), -1, dtype=np.int64)
+        # with the energy outputs, the integrals of the power forms Q (Model.power_forms) over a sub-step, a
+        # sample interval and as a series in the length (integrate_powers), [key, form]
+        form_capacity = capacity if powers else 0
+        self.step_grams = np.empty((form_capacity, 2, size, size))
+        self.sample_grams = np.empty((form_capacity, 2, size, size))
+        self.series = np.empty((form_capacity, 2, order + 1, size, size))
         self.built = 0
 
     def mode_id(self, modes: Modes) -> int:
@@ -219,9 +281,11 @@ class Operators:
     def _grow(self) -> None:
         """Double the capacity of the per-key arrays."""
         for name in ("taylor", "one_step", "anchors", "readout", "exit_counts", "directions", "next_modes",
-                     "reset_counts", "reset_targets", "reset_rows", "rock_rows", "impact_rows"):
+                     "reset_counts", "reset_targets", "reset_rows", "rock_rows", "impact_rows", "step_grams",
+                     "sample_grams", "series"):
             array = getattr(self, name)
-            setattr(self, name, np.concatenate([array, np.zeros_like(array)]))
+            if len(array):
+                setattr(self, name, np.concatenate([array, np.zeros_like(array)]))
 
     def add(self, modes: Modes, phase: str) -> None:
         """Build the arrays of (modes, phase): expm(A h) = D expm(D^-1 A D h) D^-1 (``scipy.linalg.expm``
@@ -250,8 +314,32 @@ class Operators:
         self.exit_counts[i] = len(exits)
         assemble(self.one_step[i], matrix, readout, ANCHORS, PER_ANCHOR, self.readout[i], self.anchors[i],
                  self.taylor[i])
+        if len(self.series):
+            self.add_powers(i, matrix, model.power_forms(modes, phase))
         self.key_of[self.mode_id(modes), PHASES.index(phase)] = i
         self.built += 1
+
+
+    def add_powers(self, i: int, matrix: np.ndarray, forms: np.ndarray) -> None:
+        """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of key ``i``'s power forms: G(h) by Van
+        Loan, G(p h) = sum_(j < p) (E^j)^T G(h) E^j (p sub-steps per sample, E = expm(A h)), and for s <= h
+        the series G(s) = sum_k s^(k+1) S_k / (k + 1) of the integrand's Taylor coefficients, S_0 = Q,
+        S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on the balanced matrix
+        (S_k = D^-1 S_k,b(D Q D) D^-1)."""
+        balanced, scale = balance(matrix)
+        unscale = 1.0 / scale[:, None] / scale[None, :]
+        for q, form in enumerate(forms):
+            gram = self.step_grams[i, q] = step_gram(matrix, form, self.step_s)
+            total, power = np.zeros_like(gram), np.eye(len(matrix))
+            for _ in range(self.per_sample):
+                total += power.T @ gram @ power
+                power = self.one_step[i] @ power
+            self.sample_grams[i, q] = total
+            coefficient = scale[:, None] * form * scale[None, :]
+            for k in range(self.order + 1):
+                if k:
+                    coefficient = (balanced.T @ coefficient + coefficient @ balanced) / k
+                self.series[i, q, k] = coefficient / (k + 1) * unscale
 
 
 class ExactSolver:
@@ -268,8 +356,29 @@ class ExactSolver:
         norm = max(np.linalg.norm(balance(matrix)[0], 1) for matrix in self.model.norm_candidates(self.phases))
         self.per_sample = max(1, math.ceil(settings.sample_interval_s * norm))
         self.step_s = settings.sample_interval_s / self.per_sample
-        self.operators = Operators(self.model, self.step_s, taylor_order(norm * self.step_s),
-                                   len(self.model.pieces[0].table) * len(set(self.phases)))
+        self.operators = Operators(self.model, self.step_s, self.per_sample, taylor_order(norm * self.step_s),
+                                   len(self.model.pieces[0].table) * len(set(self.phases)),
+                                   "energy" in simulation.needed_data)
+
+    def works_j(self, time_s: np.ndarray, rows: np.ndarray) -> dict[str, np.ndarray]:
+        """Cumulative impact work int F_d v_shank dt and internal work (what the links, the rock and the
+        torsion line absorb) at every row, integrated exactly from the propagators: a whole sample interval
+        as w^T G(sample interval) w, all of one key at once (BLAS), every other interval by
+        integrate_powers."""
+        ops, size = self.operators, self.layout.size
+        interval = self.step_s * self.per_sample
+        powers = np.zeros((len(time_s), 2))
+        integrate_powers(time_s, rows, self.row_keys, ops.one_step, ops.step_grams, ops.series, self.step_s,
+                         interval, powers)
+        whole = np.flatnonzero(np.abs(np.diff(time_s) - interval) <= 1e-9 * interval)
+        keys = self.row_keys[whole]
+        for key in np.unique(keys):
+            start = whole[keys == key]
+            states = rows[start, :size]
+            for q in range(2):
+                powers[start + 1, q] = np.einsum("ij,ij->i", states @ ops.sample_grams[key, q], states)
+        impact, internal = np.cumsum(powers, axis=0).T
+        return {"impact": impact, "internal": internal}
 
     def run(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Modes]]:
         """From the simulation's start (rest, off the bottom; or preloaded, in contact) through every
@@ -288,7 +397,7 @@ class ExactSolver:
         phase_ids = np.array([PHASES.index(p) for p in self.phases])
         capacity = (math.floor(simulation.settings.end_time_s / (self.step_s * self.per_sample)) + 4
                     + 2 * len(self.phases) + 2 * self.max_switches + ANCHORS * PER_ANCHOR)
-        time_s, rows = np.empty(capacity), np.empty((capacity, ops.width))
+        time_s, rows, row_keys = np.empty(capacity), np.empty((capacity, ops.width)), np.empty(capacity, dtype=np.int64)
         switch_times = np.empty(self.max_switches + 1)
         switch_modes = np.empty(self.max_switches + 1, dtype=np.int64)
         initial = tuple(element.initial_mode(w) for element in self.model.pieces)
@@ -300,12 +409,13 @@ class ExactSolver:
                 ops.rock_rows, ops.impact_rows, ops.key_of, self.phase_times, phase_ids, pulse, ops.reset_counts,
                 ops.reset_targets, ops.reset_rows, self.model.pieces[0].monotone, self.step_s, PER_ANCHOR,
                 self.per_sample, self.min_switch_interval_s, self.max_switches, n, POSITION_LIMIT_M, progress, clock,
-                w, time_s, rows, switch_times, switch_modes)
+                w, time_s, rows, row_keys, switch_times, switch_modes)
             if status != MISSING_KEY:
                 break
             ops.add(ops.modes[progress[1]], self.phases[progress[0]])
         filled, switches = progress[2], progress[3]
         time_s, rows, switch_times = time_s[:filled], rows[:filled], switch_times[:switches]
+        self.row_keys = row_keys[:filled]
         if status == TOO_MANY_SWITCHES:
             raise SimulationFailed(
                 f"scene '{simulation.name}': exact solver exceeded {self.max_switches} switches "
@@ -343,6 +453,7 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     with BLAS.limit(limits=1, user_api="blas"):
         solver = ExactSolver(simulation)
         time_s, rows, switch_times, entered = solver.run()
+        works = solver.works_j(time_s, rows) if "energy" in simulation.needed_data else None
     layout = solver.layout
     n, angle, states = layout.n, layout.angle, slice(2 * layout.n, 2 * layout.n + layout.rock_states)
     cpu = time.process_time() - start
@@ -362,6 +473,7 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
         torsion_angle_rad=rows[:, angle] if layout.torsion else None,
         torsion_rate_rad_per_s=rows[:, angle + 1] if layout.torsion else None,
         cpu_time_s=cpu,
+        works_j=works,
         info={
             "solver_success": True,
             "sub_step_s": solver.step_s,

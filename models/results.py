@@ -40,6 +40,10 @@ class SimulationResult:
     # the rock law's states (samples x states, rocklaw.base.RockLaw.state_names) at the stored
     # steps; None: the formulation stored only the bottom (enough for a one-state law, Jenkins)
     rock_state_m: np.ndarray | None = None
+    # cumulative works at the stored steps integrated exactly by the formulation (exact: "impact",
+    # int F_d v_shank dt, and "internal", what the links, the rock and the torsion line absorb); None:
+    # the energy account integrates the sampled powers
+    works_j: dict[str, np.ndarray] | None = None
 
     @property
     def scene(self) -> Scene:

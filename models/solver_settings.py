@@ -12,9 +12,9 @@ a preset and without explicit accuracy options the ``standard`` preset applies.
   (docs/stability.md); the suite checks them.
 * ode: DOP853 at the preset's tolerances (absolute tolerance in the state's SI units), dense
   output sampled every ``sample_interval_s`` (default 2e-6 s).
-* exact: exact to round-off at every preset; samples every ``output_interval_s`` (at most
-  ENERGY_SAMPLE_S when an energy output is asked for: the trapezoidal energy integrals then close
-  the balance to ~1e-4 of the impact work), every switch recorded.
+* exact: exact to round-off at every preset; samples every ``output_interval_s``, every switch
+  recorded (the energy outputs' works are integrated exactly from the propagators, whatever the
+  samples).
 """
 
 from __future__ import annotations
@@ -63,7 +63,6 @@ ODE_PRESETS: dict[str, dict[str, float]] = {
 }
 EXUDYN_ACCURACY_KEYS = ("type", "step_s", "spectral_radius", "relative_tolerance", "absolute_tolerance")
 ODE_SAMPLE_INTERVAL_S = 2e-6
-ENERGY_SAMPLE_S = 1e-5
 
 
 @dataclass(frozen=True)
@@ -117,10 +116,9 @@ def _given(solver: Solver, key: str, default: float) -> float:
     return default if value is None else value
 
 
-def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_per_s: Callable[[], float],
-                     energy: bool) -> Settings:
+def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_per_s: Callable[[], float]) -> Settings:
     """The settings of ``solver``'s formulation (module doc). ``spectral_radius_per_s`` is called only
-    when an Exudyn preset must choose the step; ``energy``: an energy output is asked for."""
+    when an Exudyn preset must choose the step."""
     common = {"formulation": solver.formulation, "end_time_s": solver.end_time_s,
               "output_interval_s": solver.output_interval_s}
     if solver.formulation == "exudyn":
@@ -141,8 +139,7 @@ def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_pe
                            absolute_tolerance=_given(solver, "absolute_tolerance", tier["absolute_tolerance"]),
                            sample_interval_s=_given(solver, "sample_interval_s", ODE_SAMPLE_INTERVAL_S),
                            preset=preset, **common)
-    automatic = min(solver.output_interval_s, ENERGY_SAMPLE_S) if energy else solver.output_interval_s
-    return ExactSettings(sample_interval_s=_given(solver, "sample_interval_s", automatic),
+    return ExactSettings(sample_interval_s=_given(solver, "sample_interval_s", solver.output_interval_s),
                          min_switch_interval_s=_given(solver, "min_switch_interval_s", 1e-12),
                          max_switches_per_blow=int(_given(solver, "max_switches_per_blow", 1000)),
                          preset=solver.preset, **common)
