@@ -1,8 +1,9 @@
 """Cost and x_n accuracy of the three formulations, measured in one run.
 
 For each scene: CPU seconds per simulated second and the x_n error of the exact event-driven
-solution (models.exact_model, default settings: every output asked for, so samples every 1e-5 s
-for the energy account; and with only the penetration rate asked for, samples every 1e-4 s), the
+solution (models.exact_model, default settings: every output asked for, its works integrated
+exactly from the propagators; and with only the penetration rate asked for; samples every 1e-4 s
+either way), with the CPU seconds of the metrics of the last exact result, the
 Exudyn model at the scene's solver setting and the SciPy ODE formulation (DOP853, rtol 1e-8), all
 against the exact solution on a finer grid (samples and sub-step 1e-6 s; the exact run's own
 difference to it is round-off). The error is max |x_n - x_n,ref| over the blow starts divided by

@@ -351,16 +351,18 @@ def quadratic(form: np.ndarray, w: np.ndarray) -> float:
 
 
 @njit(cache=True)
-def integrate_powers(time_s: np.ndarray, rows: np.ndarray, row_keys: np.ndarray, one_step: np.ndarray,
+def integrate_powers(time_s: np.ndarray, rows: np.ndarray, row_keys: np.ndarray, step_powers: np.ndarray,
                      step_grams: np.ndarray, series: np.ndarray, step_s: float, sample_interval_s: float,
                      out: np.ndarray) -> None:
     """out[r, q] = int w^T Q_q w dt from row r - 1 to row r for every interval that is not a whole sample
     interval (those are left as they are), for every quadratic form q of a key, exactly: between two
     rows one key propagates w(t_(r-1) + s) = expm(A s) w_(r-1), so the integral is w_(r-1)^T G(s) w_(r-1),
-    G(s) = int_0^s expm(A^T u) Q expm(A u) du: whole sub-steps G(h) (``step_grams`` [key, q], the state
-    carried on by expm(A h), ``one_step``) and the rest s < h by the series G(s) = sum_k s^(k+1) C_k
-    (``series`` [key, q, k], summed by Horner's rule into one matrix)."""
-    size, count, terms = one_step.shape[1], step_grams.shape[1], series.shape[2]
+    G(s) = int_0^s expm(A^T u) Q expm(A u) du: the j whole sub-steps first, G(j h) (``step_grams``
+    [key, q, j], j up to the sub-steps of a sample) with the state carried on by expm(A h)^j
+    (``step_powers`` [key, j]), then the rest s < h by the series G(s) = sum_k s^(k+1) C_k (``series``
+    [key, q, k]) summed by Horner's rule from the first k whose bound (2 s / h)^(k+1) / (k+1)! (||A|| h
+    <= 1 on the balanced matrix) is below 1e-17."""
+    size, count, terms, most = step_powers.shape[2], step_grams.shape[1], series.shape[2], step_powers.shape[1] - 1
     w, carried, gram = np.empty(size), np.empty(size), np.empty((size, size))
     for r in range(1, time_s.shape[0]):
         rest = time_s[r] - time_s[r - 1]
@@ -371,16 +373,25 @@ def integrate_powers(time_s: np.ndarray, rows: np.ndarray, row_keys: np.ndarray,
             out[r, q] = 0.0
         for c in range(size):
             w[c] = rows[r - 1, c]
+        whole = 0
         while rest > step_s * (1.0 + 1e-9):
+            whole += 1
+            rest -= step_s
+        while whole > 0:
+            j = min(whole, most)
             for q in range(count):
-                out[r, q] += quadratic(step_grams[key, q], w)
-            matvec(one_step[key], w, carried)
+                out[r, q] += quadratic(step_grams[key, q, j], w)
+            matvec(step_powers[key, j], w, carried)
             for c in range(size):
                 w[c] = carried[c]
-            rest -= step_s
+            whole -= j
+        last, bound, ratio = 0, 2.0 * rest / step_s, 2.0 * rest / step_s
+        while bound > 1e-17 and last < terms - 1:
+            last += 1
+            bound *= ratio / (last + 1)
         for q in range(count):
-            gram[:, :] = series[key, q, terms - 1]
-            for k in range(terms - 2, -1, -1):
+            gram[:, :] = series[key, q, last]
+            for k in range(last - 1, -1, -1):
                 for a in range(size):
                     for b in range(size):
                         gram[a, b] = gram[a, b] * rest + series[key, q, k, a, b]

@@ -261,11 +261,11 @@ class Operators:
         self.rock_rows = np.zeros((capacity, size))  # F_r = row . w
         self.impact_rows = np.zeros((capacity, 3))  # F_d = row . (1, u1, u2)
         self.key_of = np.full((capacity, len(PHASES)), -1, dtype=np.int64)
-        # with the energy outputs, the integrals of the power forms Q (Model.power_forms) over a sub-step, a
-        # sample interval and as a series in the length (integrate_powers), [key, form]
+        # with the energy outputs, the integrals of the power forms Q (Model.power_forms) over whole sub-steps
+        # and as a series in the length (integrate_powers), [key, form]
         form_capacity = capacity if powers else 0
-        self.step_grams = np.empty((form_capacity, 2, size, size))
-        self.sample_grams = np.empty((form_capacity, 2, size, size))
+        self.step_powers = np.empty((form_capacity, per_sample + 1, size, size))  # expm(A h)^j
+        self.step_grams = np.empty((form_capacity, 2, per_sample + 1, size, size))  # G(j h), j <= p
         self.series = np.empty((form_capacity, 2, order + 1, size, size))
         self.built = 0
 
@@ -281,8 +281,8 @@ class Operators:
     def _grow(self) -> None:
         """Double the capacity of the per-key arrays."""
         for name in ("taylor", "one_step", "anchors", "readout", "exit_counts", "directions", "next_modes",
-                     "reset_counts", "reset_targets", "reset_rows", "rock_rows", "impact_rows", "step_grams",
-                     "sample_grams", "series"):
+                     "reset_counts", "reset_targets", "reset_rows", "rock_rows", "impact_rows", "step_powers",
+                     "step_grams", "series"):
             array = getattr(self, name)
             if len(array):
                 setattr(self, name, np.concatenate([array, np.zeros_like(array)]))
@@ -322,19 +322,22 @@ class Operators:
 
     def add_powers(self, i: int, matrix: np.ndarray, forms: np.ndarray) -> None:
         """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of key ``i``'s power forms: G(h) by Van
-        Loan, G(p h) = sum_(j < p) (E^j)^T G(h) E^j (p sub-steps per sample, E = expm(A h)), and for s <= h
-        the series G(s) = sum_k s^(k+1) S_k / (k + 1) of the integrand's Taylor coefficients, S_0 = Q,
-        S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on the balanced matrix
-        (S_k = D^-1 S_k,b(D Q D) D^-1)."""
+        Loan, G(j h) = sum_(l < j) (E^l)^T G(h) E^l for j up to the sub-steps of a sample (E = expm(A h)),
+        and for s <= h the series G(s) = sum_k s^(k+1) S_k / (k + 1) of the integrand's Taylor
+        coefficients, S_0 = Q, S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on
+        the balanced matrix (S_k = D^-1 S_k,b(D Q D) D^-1)."""
         balanced, scale = balance(matrix)
         unscale = 1.0 / scale[:, None] / scale[None, :]
+        power = np.eye(len(matrix))
+        for j in range(self.per_sample + 1):
+            self.step_powers[i, j] = power
+            power = self.one_step[i] @ power
         for q, form in enumerate(forms):
-            gram = self.step_grams[i, q] = step_gram(matrix, form, self.step_s)
-            total, power = np.zeros_like(gram), np.eye(len(matrix))
-            for _ in range(self.per_sample):
-                total += power.T @ gram @ power
-                power = self.one_step[i] @ power
-            self.sample_grams[i, q] = total
+            gram = step_gram(matrix, form, self.step_s)
+            self.step_grams[i, q, 0] = 0.0
+            for j in range(1, self.per_sample + 1):
+                carried = self.step_powers[i, j - 1]
+                self.step_grams[i, q, j] = self.step_grams[i, q, j - 1] + carried.T @ gram @ carried
             coefficient = scale[:, None] * form * scale[None, :]
             for k in range(self.order + 1):
                 if k:
@@ -368,7 +371,7 @@ class ExactSolver:
         ops, size = self.operators, self.layout.size
         interval = self.step_s * self.per_sample
         powers = np.zeros((len(time_s), 2))
-        integrate_powers(time_s, rows, self.row_keys, ops.one_step, ops.step_grams, ops.series, self.step_s,
+        integrate_powers(time_s, rows, self.row_keys, ops.step_powers, ops.step_grams, ops.series, self.step_s,
                          interval, powers)
         whole = np.flatnonzero(np.abs(np.diff(time_s) - interval) <= 1e-9 * interval)
         keys = self.row_keys[whole]
@@ -376,7 +379,7 @@ class ExactSolver:
             start = whole[keys == key]
             states = rows[start, :size]
             for q in range(2):
-                powers[start + 1, q] = np.einsum("ij,ij->i", states @ ops.sample_grams[key, q], states)
+                powers[start + 1, q] = np.einsum("ij,ij->i", states @ ops.step_grams[key, q, -1], states)
         impact, internal = np.cumsum(powers, axis=0).T
         return {"impact": impact, "internal": internal}
 
