@@ -33,8 +33,9 @@ reaches it.
 
 Works (with the energy outputs): the impact work and the work the links, the rock and the torsion
 line absorb are quadratic forms w^T Q w integrated exactly between the samples,
-int_0^s w^T Q w = w^T G(s) w with G(s) = int_0^s expm(A^T u) Q expm(A u) du per key (Operators.add_powers,
-models.exact_kernels.integrate_powers), so the samples stay at the output interval.
+int_0^s w^T Q w = w^T G(s) w with G(s) = int_0^s expm(A^T u) Q expm(A u) du per key, a series in s
+(Operators.add_powers, models.exact_kernels.integrate_powers), so the samples stay at the output
+interval.
 
 Zero-length modes: a mode lasts at least ``min_switch_interval_s``. Its start is taken as not
 crossed for every exit function; if an exit function is on its crossed side already at
@@ -124,18 +125,6 @@ def balance(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if info < 0:
         raise ValueError(f"dgebal: illegal argument {-info}")
     return balanced, scale
-
-
-def step_gram(matrix: np.ndarray, form: np.ndarray, step_s: float) -> np.ndarray:
-    """G(h) = int_0^h expm(A^T u) Q expm(A u) du by Van Loan's block exponential, expm([[-A^T, Q], [0, A]] h)
-    = [[., F12], [0, F22]], G = F22^T F12, on the balanced A = D A_b D^-1 (G = D^-1 G_b(D Q D) D^-1)."""
-    balanced, scale = balance(matrix)
-    size = len(matrix)
-    block = np.zeros((2 * size, 2 * size))
-    block[:size, :size], block[size:, size:] = -balanced.T, balanced
-    block[:size, size:] = scale[:, None] * form * scale[None, :]
-    exponential = expm(block * step_s)
-    return (exponential[size:, size:].T @ exponential[:size, size:]) / scale[:, None] / scale[None, :]
 
 
 class Model:
@@ -321,11 +310,12 @@ class Operators:
 
 
     def add_powers(self, i: int, matrix: np.ndarray, forms: np.ndarray) -> None:
-        """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of key ``i``'s power forms: G(h) by Van
-        Loan, G(j h) = sum_(l < j) (E^l)^T G(h) E^l for j up to the sub-steps of a sample (E = expm(A h)),
-        and for s <= h the series G(s) = sum_k s^(k+1) S_k / (k + 1) of the integrand's Taylor
-        coefficients, S_0 = Q, S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on
-        the balanced matrix (S_k = D^-1 S_k,b(D Q D) D^-1)."""
+        """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of key ``i``'s power forms: for s <= h the
+        series G(s) = sum_k s^(k+1) S_k / (k + 1) of the integrand's Taylor coefficients, S_0 = Q,
+        S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on the balanced matrix
+        (S_k = D^-1 S_k,b(D Q D) D^-1; the truncation after the Taylor order of the sub-step leaves
+        2^(K+1) / (K+1)! of it, below 1e-14); then G(j h) = sum_(l < j) (E^l)^T G(h) E^l for j up to the
+        sub-steps of a sample (E = expm(A h))."""
         balanced, scale = balance(matrix)
         unscale = 1.0 / scale[:, None] / scale[None, :]
         power = np.eye(len(matrix))
@@ -333,16 +323,16 @@ class Operators:
             self.step_powers[i, j] = power
             power = self.one_step[i] @ power
         for q, form in enumerate(forms):
-            gram = step_gram(matrix, form, self.step_s)
-            self.step_grams[i, q, 0] = 0.0
-            for j in range(1, self.per_sample + 1):
-                carried = self.step_powers[i, j - 1]
-                self.step_grams[i, q, j] = self.step_grams[i, q, j - 1] + carried.T @ gram @ carried
-            coefficient = scale[:, None] * form * scale[None, :]
+            coefficient, gram = scale[:, None] * form * scale[None, :], np.zeros_like(matrix)
             for k in range(self.order + 1):
                 if k:
                     coefficient = (balanced.T @ coefficient + coefficient @ balanced) / k
                 self.series[i, q, k] = coefficient / (k + 1) * unscale
+                gram += self.series[i, q, k] * self.step_s ** (k + 1)
+            self.step_grams[i, q, 0] = 0.0
+            for j in range(1, self.per_sample + 1):
+                carried = self.step_powers[i, j - 1]
+                self.step_grams[i, q, j] = self.step_grams[i, q, j - 1] + carried.T @ gram @ carried
 
 
 class ExactSolver:
