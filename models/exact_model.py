@@ -308,7 +308,6 @@ class Operators:
         self.key_of[self.mode_id(modes), PHASES.index(phase)] = i
         self.built += 1
 
-
     def add_powers(self, i: int, matrix: np.ndarray, forms: np.ndarray) -> None:
         """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of key ``i``'s power forms: for s <= h the
         series G(s) = sum_k s^(k+1) S_k / (k + 1) of the integrand's Taylor coefficients, S_0 = Q,
@@ -375,8 +374,9 @@ class ExactSolver:
 
     def run(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Modes]]:
         """From the simulation's start (rest, off the bottom; or preloaded, in contact) through every
-        pulse phase to the end time: (sample times; rows w, F_r, F_d; switch times; modes entered). The
-        kernel returns when it reaches a key not built yet, and resumes once it is built."""
+        pulse phase to the end time: (sample times; rows w, F_r, F_d; switch times; modes entered); the
+        key propagating from each row in ``row_keys``. The kernel returns when it reaches a key not built
+        yet, and resumes once it is built."""
         layout, ops, period, simulation = self.layout, self.operators, self.impact.period_s, self.simulation
         n = layout.n
         w = np.zeros(layout.size)
