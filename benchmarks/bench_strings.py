@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 
-# one BLAS thread, as in a study's workers (studies.runners.SINGLE_THREAD): set before NumPy loads
+# one BLAS thread, as in a study's workers (studies.runners.WORKER_ENVIRONMENT): set before NumPy loads
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 

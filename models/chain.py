@@ -13,7 +13,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import root
 
 from rpdrill.models.links import LINK_TYPES, Link
 from rpdrill.models.scene import EVERY_BODY, GROUND, Body, Connector, Scene, Torsion
@@ -104,30 +103,31 @@ class AxialChain:
         matrix[n:, 2 * n] = inverse_mass * self.constant_forces()
         return matrix
 
+    def incidence(self, links: tuple[Link, ...] | None = None) -> np.ndarray:
+        """D (n_links x n_bodies) with delta = D x: +1 at each link's body_b, -1 at its body_a (none: ground)."""
+        links = self.links if links is None else links
+        matrix = np.zeros((len(links), self.size))
+        for row, link in enumerate(links):
+            matrix[row, link.body_b] = 1.0
+            if link.body_a is not None:
+                matrix[row, link.body_a] = -1.0
+        return matrix
+
     def link_stretch(self, positions: np.ndarray, links: tuple[Link, ...] | None = None) -> np.ndarray:
         """delta = x_b - x_a of every link (or of ``links``), for (..., n_bodies) positions."""
-        links = self.links if links is None else links
-        with_ground = np.concatenate([positions, np.zeros((*positions.shape[:-1], 1))], axis=-1)  # ground last
-        ends_a = [-1 if link.body_a is None else link.body_a for link in links]
-        return with_ground[..., [link.body_b for link in links]] - with_ground[..., ends_a]
+        return positions @ self.incidence(links).T
 
-    def link_forces_n(self, positions: np.ndarray, velocities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(spring, damper) force of every link, (..., n_links); damper = total - spring."""
-        stretch, rate = self.link_stretch(positions), self.link_stretch(velocities)
-        spring = np.stack([link.spring_force_n(stretch[..., i]) for i, link in enumerate(self.links)], axis=-1)
-        total = np.stack([link.force_n(stretch[..., i], rate[..., i]) for i, link in enumerate(self.links)], axis=-1)
-        return spring, total - spring
-
-    def elastic_energy_j(self, positions: np.ndarray) -> np.ndarray:
-        """sum over links of F_spring^2 / (2 k)."""
-        spring, _ = self.link_forces_n(positions, np.zeros_like(positions))
-        stiffness = np.array([link.stiffness_n_per_m for link in self.links])
-        return (spring**2) @ (0.5 / stiffness)
-
-    def damping_power_w(self, positions: np.ndarray, velocities: np.ndarray) -> np.ndarray:
-        """sum over links of F_damper delta' (>= 0: what the dampers dissipate)."""
-        _, damper = self.link_forces_n(positions, velocities)
-        return np.sum(damper * self.link_stretch(velocities), axis=-1)
+    def link_energy(self, positions: np.ndarray, velocities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(elastic energy sum F_spring^2 / (2 k) [J], damper power sum (F - F_spring) delta' [W]) of the
+        links, for (samples, n_bodies) positions and velocities (link by link on contiguous rows)."""
+        incidence = self.incidence()
+        stretch, rate = incidence @ positions.T, incidence @ velocities.T
+        elastic, damping = np.zeros(len(positions)), np.zeros(len(positions))
+        for link, delta, delta_rate in zip(self.links, stretch, rate, strict=True):
+            spring = link.spring_force_n(delta)
+            elastic += spring**2 * (0.5 / link.stiffness_n_per_m)
+            damping += (link.force_n(delta, delta_rate) - spring) * delta_rate
+        return elastic, damping
 
 
 def _derived_stiffness_n_per_m(ends: list[Body]) -> float:
@@ -201,6 +201,8 @@ def static_preload_m(chain: AxialChain, law: RockLaw) -> np.ndarray:
     positions = np.linalg.solve(stiffness, chain.constant_forces())
     feed_n = float(np.sum(chain.constant_forces()))
     if not chain.is_linear:
+        from scipy.optimize import root  # deferred: scipy.optimize takes ~0.4 s to import, only this needs it
+
         rest = np.zeros(chain.size)
 
         def residual(q: np.ndarray) -> np.ndarray:

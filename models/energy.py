@@ -6,7 +6,11 @@ with W_impact = int F_d v_shank dt, W_feed = sum_i F_i (x_i - x_i(0)) (+ (M_x - 
 E_elastic including what the rock stores, F_spring^2 / (2 k_unload) (rocklaw.base.RockLaw),
 D_damping = int of every damper's power (joints, shock absorber, the rock damper, c_x), and
 W_crushing the rock law's plastic work int F_spring d(x_n) (Jenkins: F_th (x_n - x_n(0))).
-The powers are integrated by the trapezoidal rule over every stored solver step.
+The powers are integrated by the trapezoidal rule over every stored solver step, unless the
+formulation integrated the works exactly (``SimulationResult.works_j``, the exact formulation): then
+W_impact is its impact work and D_damping what the links, the rock and the torsion line absorb less
+what they store and crush; the balance then states that the bodies' kinetic energy changes by the
+work of every force on them.
 """
 
 from __future__ import annotations
@@ -14,13 +18,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 
 from rpdrill.models.results import SimulationResult
-
-
-def _cumulative(power: np.ndarray, time_s: np.ndarray) -> np.ndarray:
-    return cumulative_trapezoid(power, time_s, initial=0.0)
+from rpdrill.rocklaw.base import cumulative_trapezoid
 
 
 @dataclass
@@ -47,8 +47,12 @@ class EnergyAccount:
 
 
 def impact_work_j(result: SimulationResult) -> np.ndarray:
-    """W_impact = int F_d v_impact dt, cumulative at every stored step (trapezoidal rule)."""
-    return _cumulative(result.impact_force_n * result.velocity_m_per_s[:, result.chain.impact_body], result.time_s)
+    """W_impact = int F_d v_impact dt, cumulative at every stored step: the formulation's exact work when
+    it has one, else the trapezoidal rule."""
+    if result.works_j is not None:
+        return result.works_j["impact"]
+    return cumulative_trapezoid(result.impact_force_n * result.velocity_m_per_s[:, result.chain.impact_body],
+                                result.time_s)
 
 
 def energy_account(result: SimulationResult) -> EnergyAccount:
@@ -59,10 +63,10 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
 
     kinetic = 0.5 * (v**2) @ masses
     spring_force = rock.spring_force(result.bit_position_m, result.rock_states())
-    elastic = chain.elastic_energy_j(x) + 0.5 * spring_force**2 / rock.unloading_stiffness_n_per_m
-    damping_power = chain.damping_power_w(x, v)
+    link_elastic, link_damping = chain.link_energy(x, v)
+    elastic = link_elastic + 0.5 * spring_force**2 / rock.unloading_stiffness_n_per_m
     # what the rock force does beyond its spring-slider part is dissipated in the rock damper
-    damping_power = damping_power + (result.rock_force_n - spring_force) * result.bit_velocity_m_per_s
+    damping_power = link_damping + (result.rock_force_n - spring_force) * result.bit_velocity_m_per_s
     feed = (x - x[0]) @ chain.constant_forces()
     if result.torsion_angle_rad is not None:
         tor = simulation.scene.torsion
@@ -71,12 +75,11 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
         elastic = elastic + 0.5 * tor.stiffness_n_m_per_rad * phi**2
         damping_power = damping_power + tor.damping_n_m_s_per_rad * omega**2
         feed = feed + (tor.drive_torque_n_m - tor.resisting_torque_n_m) * (phi - phi[0])
-    return EnergyAccount(
-        time_s=t,
-        impact_work_j=impact_work_j(result),
-        feed_work_j=feed,
-        kinetic_j=kinetic,
-        elastic_j=elastic,
-        damping_j=_cumulative(damping_power, t),
-        crushing_work_j=rock.plastic_work_j(spring_force, result.bottom_m),
-    )
+    crushing = rock.plastic_work_j(spring_force, result.bottom_m)
+    if result.works_j is None:
+        damping = cumulative_trapezoid(damping_power, t)
+    else:  # integrated exactly by the formulation: the dampers take what the internal forces absorb and
+        # neither store nor crush
+        damping = result.works_j["internal"] - (elastic - elastic[0]) - (crushing - crushing[0])
+    return EnergyAccount(time_s=t, impact_work_j=impact_work_j(result), feed_work_j=feed, kinetic_j=kinetic,
+                         elastic_j=elastic, damping_j=damping, crushing_work_j=crushing)

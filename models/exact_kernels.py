@@ -111,11 +111,13 @@ def diverged(rows: np.ndarray, row: int, bodies: int, position_limit_m: float) -
 
 
 @njit(cache=True)
-def record(time_out: np.ndarray, rows: np.ndarray, row: int, time_s: float, w: np.ndarray, rock_row: np.ndarray,
-           impact_row: np.ndarray) -> None:
-    """time_out[row] = t, rows[row, :m + 2] = (w, F_r = rock_row . w, F_d = impact_row . (1, u1, u2))."""
+def record(time_out: np.ndarray, rows: np.ndarray, row_keys: np.ndarray, row: int, time_s: float, w: np.ndarray,
+           rock_row: np.ndarray, impact_row: np.ndarray, key: int) -> None:
+    """time_out[row] = t, rows[row, :m + 2] = (w, F_r = rock_row . w, F_d = impact_row . (1, u1, u2)),
+    row_keys[row] = the key that propagates from this row on."""
     size = rock_row.shape[0]
     time_out[row] = time_s
+    row_keys[row] = key
     rock = 0.0
     for c in range(size):
         rows[row, c] = w[c]
@@ -125,31 +127,63 @@ def record(time_out: np.ndarray, rows: np.ndarray, row: int, time_s: float, w: n
 
 
 @njit(cache=True)
-def locate(terms: np.ndarray, exit_count: int, directions: np.ndarray, low: float, high: float,
-           coefficients: np.ndarray, outputs: np.ndarray) -> tuple[float, int]:
+def first_crossing(coefficients: np.ndarray, slopes: np.ndarray, low: float, high: float) -> float:
+    """Earliest s in [low, high] where p(s) = sum_k c_k s^k is on the crossed side (p > 0), inf if none:
+    the root of p before high where p(high) > 0 (low if p(low) >= 0 already); where p(high) <= 0 but p
+    rises at low and falls at high, the root before its maximum if that maximum is above 0 (a crossing
+    and its return within one interval of the sub-grid, which the signs at the points cannot see).
+    ``slopes`` is scratch for the coefficients of p'."""
+    last = coefficients.shape[0] - 1
+    for k in range(last):
+        slopes[k] = (k + 1) * coefficients[k + 1]
+    slopes[last] = 0.0
+    value_low = horner(coefficients, low)
+    if horner(coefficients, high) > 0.0:
+        return low if value_low >= 0.0 else brent(coefficients, low, high)
+    if horner(slopes, low) > 0.0 and horner(slopes, high) < 0.0:
+        peak = brent(slopes, low, high)
+        if horner(coefficients, peak) > 0.0:
+            return low if value_low >= 0.0 else brent(coefficients, low, peak)
+    return math.inf
+
+
+@njit(cache=True)
+def exit_polynomial(terms: np.ndarray, exits0: int, e: int, direction: float, coefficients: np.ndarray) -> None:
+    """coefficients_k = direction_e g_e,k: exit function e on its crossed side where positive."""
+    for k in range(terms.shape[0]):
+        coefficients[k] = direction * terms[k, exits0 + e]
+
+
+@njit(cache=True)
+def locate(terms: np.ndarray, exits0: int, exit_count: int, directions: np.ndarray, low: float, high: float,
+           coefficients: np.ndarray, slopes: np.ndarray, outputs: np.ndarray) -> tuple[float, int]:
     """Earliest switch s in [low, high] from the Taylor terms of the outputs (taylor_terms): the
-    smallest root of g_e(s) direction_e (s = low if g_e(low) >= 0 already); with no root, s = high and
+    earliest :func:`first_crossing` of the exit functions g_e direction_e; with none, s = high and
     the exit furthest on its crossed side there. outputs = outputs at s; returns (s, e)."""
-    first_exit = terms.shape[1] - directions.shape[0]
     root, exit_ = math.inf, -1
     for e in range(exit_count):
-        for k in range(terms.shape[0]):
-            coefficients[k] = directions[e] * terms[k, first_exit + e]
-        if horner(coefficients, high) <= 0.0:
-            continue
-        candidate = low if horner(coefficients, low) >= 0.0 else brent(coefficients, low, high)
+        exit_polynomial(terms, exits0, e, directions[e], coefficients)
+        candidate = first_crossing(coefficients, slopes, low, high)
         if candidate < root:
             root, exit_ = candidate, e
     if exit_ < 0:  # a crossing the sub-grid saw but the polynomial puts at round-off level
         root, largest = high, -math.inf
         for e in range(exit_count):
-            for k in range(terms.shape[0]):
-                coefficients[k] = directions[e] * terms[k, first_exit + e]
+            exit_polynomial(terms, exits0, e, directions[e], coefficients)
             value = horner(coefficients, high)
             if value > largest:
                 largest, exit_ = value, e
     taylor_sum(terms, root, outputs)
     return root, exit_
+
+
+@njit(cache=True)
+def turns_across(terms: np.ndarray, exits0: int, e: int, direction: float, low: float, high: float,
+                 coefficients: np.ndarray, slopes: np.ndarray) -> bool:
+    """Exit function e, on its uncrossed side at both ends of [low, high], crosses and returns in between
+    (:func:`first_crossing` from the terms of the interval's start)."""
+    exit_polynomial(terms, exits0, e, direction, coefficients)
+    return first_crossing(coefficients, slopes, low, high) < math.inf
 
 
 @njit(cache=True)
@@ -160,16 +194,18 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                reset_rows: np.ndarray, monotone: int, step_s: float, per_anchor: int, per_sample: int,
                min_switch_interval_s: float, max_switches: int, bodies: int, position_limit_m: float,
                progress: np.ndarray, clock: np.ndarray, w: np.ndarray, time_out: np.ndarray, rows: np.ndarray,
-               switch_times_s: np.ndarray, switch_modes: np.ndarray) -> int:
+               row_keys: np.ndarray, switch_times_s: np.ndarray, switch_modes: np.ndarray) -> int:
     """The event loop of models.exact_model (its module doc), from pulse phase progress[0] on.
 
-    Per key (rock mode, pulse phase), with R = (I_m, rock row, piston row, exit rows), r rows, and
+    Per key (rock mode, pulse phase), with R = (I_m, rock row, piston row, exit rows c_e, their slope
+    rows c_e A), r rows, and
     B = ``per_anchor``: ``taylor`` [(R A^k / k!)^T]_k, ``one_step`` expm(A h), ``anchors``
     [expm(A a B h)^T]_a (m x A m), ``readout``
     [(R expm(A b h))^T]_b (m x B r); per exit e of a key the next mode id ``next_modes`` and the entry
     resets w[reset_targets[j]] = reset_rows[j] . w (j < reset_counts; the ``monotone`` entry keeps the
     larger of old and new value). Fills ``time_out``, ``rows`` (w, F_r, F_d; both sides of every
-    switch) and the switch log. The run's state is progress = (phase, mode id, rows filled, switches,
+    switch), ``row_keys`` (the key propagating from each row) and the switch log. The run's state is
+    progress = (phase, mode id, rows filled, switches,
     resume), clock = (t, mode start) and w: a key not built yet (key_of -1) returns MISSING_KEY with
     resume = 1, and the call after it is built goes on from there. A phase that starts a blow
     (``blow_starts`` nonzero) returns BLOW_START first, with w at the blow start and resume = 2: the
@@ -178,6 +214,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
     """
     size, width = w.shape[0], readout.shape[2] // per_anchor  # m, r
     exits0 = size + 2  # first exit output
+    slopes0 = exits0 + directions.shape[1]  # first exit slope output
     anchor_count = anchors.shape[2] // size  # A
     batch = anchor_count * per_anchor  # J = A B
     h = step_s
@@ -189,7 +226,8 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
     anchor_flat = anchor_states.reshape(1, anchor_count * size)
     terms = np.empty((taylor.shape[2] // width, width))
     terms_flat = terms.reshape(1, terms.size)
-    coefficients = np.empty(terms.shape[0])
+    coefficients, slopes = np.empty(terms.shape[0]), np.empty(terms.shape[0])
+    start_slopes = np.empty(directions.shape[1])
     p, mode, row, switches, resume = progress[0], progress[1], progress[2], progress[3], progress[4]
     t, mode_start_s = clock[0], clock[1]
     while p < phase_ids.shape[0]:
@@ -209,7 +247,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
             return MISSING_KEY
         taylor_k, step_k, anchors_k, readout_k = taylor[key], one_step[key], anchors[key], readout[key]
         rock_k, impact_k, directions_k, exit_count = rock_rows[key], impact_rows[key], directions[key], exit_counts[key]
-        record(time_out, rows, row, t, w, rock_k, impact_k)
+        record(time_out, rows, row_keys, row, t, w, rock_k, impact_k, key)
         row += 1
         while True:
             # sub-grid points first + i, i < count <= J, after t and before end_s
@@ -220,6 +258,10 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
             while count < batch and (first + count) * h < end_s:
                 count += 1
             crossed, done = -1, 0  # first point on the crossed side of an exit function; points formed
+            for e in range(exit_count):  # the exit functions' slopes at w, for the turns in its interval
+                start_slopes[e] = 0.0
+                for c in range(size):
+                    start_slopes[e] += taylor_k[c, slopes0 + e] * w[c]
             # dense output (every sub-grid point a sample): the points are formed in place in ``rows``
             point = rows[row:row + batch] if per_sample == 1 else scratch
             if count:
@@ -243,9 +285,22 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                     np.dot(anchor_states[low_anchor:high_anchor], readout_k, points[low_anchor:high_anchor])
                     for i in range(done, min(count, high_anchor * per_anchor)):
                         for e in range(exit_count):
-                            if point[i, exits0 + e] * directions_k[e] > 0.0:
+                            direction = directions_k[e]
+                            if point[i, exits0 + e] * direction > 0.0:
                                 crossed = i
                                 break
+                            before = point[i - 1, slopes0 + e] if i else start_slopes[e]
+                            if before * direction > 0.0 and point[i, slopes0 + e] * direction < 0.0:
+                                # it turns back between the points: does it cross and return?
+                                t_before = (first + i - 1) * h if i else t
+                                for c in range(size):
+                                    base_row[c] = point[i - 1, c] if i else w[c]
+                                taylor_terms(taylor_k, base, terms_flat)
+                                low = max(0.0, min(mode_start_s + min_switch_interval_s, (first + i) * h) - t_before)
+                                if turns_across(terms, exits0, e, direction, low, (first + i) * h - t_before,
+                                                coefficients, slopes):
+                                    crossed = i
+                                    break
                         if crossed >= 0:
                             break
                     done = min(count, high_anchor * per_anchor)
@@ -254,9 +309,16 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                 for c in range(size):
                     base_row[c] = point[count - 1, c] if count else w[c]
                 taylor_terms(taylor_k, base, terms_flat)
-                taylor_sum(terms, end_s - ((first + count - 1) * h if count else t), final)
+                t_before = (first + count - 1) * h if count else t
+                taylor_sum(terms, end_s - t_before, final)
                 for e in range(exit_count):
-                    if final[exits0 + e] * directions_k[e] > 0.0:
+                    direction = directions_k[e]
+                    before = point[count - 1, slopes0 + e] if count else start_slopes[e]
+                    low = max(0.0, min(mode_start_s + min_switch_interval_s, end_s) - t_before)
+                    if final[exits0 + e] * direction > 0.0 or (
+                            before * direction > 0.0 and final[slopes0 + e] * direction < 0.0
+                            and turns_across(terms, exits0, e, direction, low, end_s - t_before, coefficients,
+                                             slopes)):
                         crossed = count
                         break
             formed = crossed if crossed >= 0 else count
@@ -270,6 +332,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                     w[c] = point[count - 1, c] if more else final[c]
             for i in range((-first) % per_sample, formed, per_sample):
                 time_out[row] = (first + i) * h
+                row_keys[row] = key
                 if per_sample > 1:
                     for c in range(width):
                         rows[row, c] = point[i, c]
@@ -279,7 +342,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                 return DIVERGED
             if crossed < 0:
                 if not more:
-                    record(time_out, rows, row, end_s, final, rock_k, impact_k)
+                    record(time_out, rows, row_keys, row, end_s, final, rock_k, impact_k, key)
                     row += 1
                     p += 1
                     break
@@ -292,9 +355,10 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                 taylor_terms(taylor_k, base, terms_flat)
             t_right = (first + crossed) * h if crossed < count else end_s
             low = max(0.0, min(mode_start_s + min_switch_interval_s, t_right) - t_left)
-            root, e = locate(terms, exit_count, directions_k, low, t_right - t_left, coefficients, final)
+            root, e = locate(terms, exits0, exit_count, directions_k, low, t_right - t_left, coefficients, slopes,
+                             final)
             t = t_left + root
-            record(time_out, rows, row, t, final, rock_k, impact_k)
+            record(time_out, rows, row_keys, row, t, final, rock_k, impact_k, key)
             row += 1
             mode, mode_start_s = next_modes[key, e], t
             for c in range(size):
@@ -339,3 +403,63 @@ def assemble(one_step: np.ndarray, matrix: np.ndarray, readout_rows: np.ndarray,
         if k:
             term = np.dot(term, matrix) / k
         taylor[:, k * width:(k + 1) * width] = term.T
+
+
+@njit(cache=True)
+def quadratic(form: np.ndarray, w: np.ndarray) -> float:
+    """w^T Q w."""
+    total = 0.0
+    for r in range(w.shape[0]):
+        partial = 0.0
+        for c in range(w.shape[0]):
+            partial += form[r, c] * w[c]
+        total += w[r] * partial
+    return total
+
+
+@njit(cache=True)
+def integrate_powers(time_s: np.ndarray, rows: np.ndarray, row_keys: np.ndarray, step_powers: np.ndarray,
+                     step_grams: np.ndarray, series: np.ndarray, step_s: float, sample_interval_s: float,
+                     out: np.ndarray) -> None:
+    """out[r, q] = int w^T Q_q w dt from row r - 1 to row r for every interval that is not a whole sample
+    interval (those are left as they are), for every quadratic form q of a key, exactly: between two
+    rows one key propagates w(t_(r-1) + s) = expm(A s) w_(r-1), so the integral is w_(r-1)^T G(s) w_(r-1),
+    G(s) = int_0^s expm(A^T u) Q expm(A u) du: the j whole sub-steps first, G(j h) (``step_grams``
+    [key, q, j], j up to the sub-steps of a sample) with the state carried on by expm(A h)^j
+    (``step_powers`` [key, j]), then the rest s < h by the series G(s) = sum_k s^(k+1) C_k (``series``
+    [key, q, k]) summed by Horner's rule from the first k whose bound (2 s / h)^(k+1) / (k+1)! (||A|| h
+    <= 1 on the balanced matrix) is below 1e-17."""
+    size, count, terms, most = step_powers.shape[2], step_grams.shape[1], series.shape[2], step_powers.shape[1] - 1
+    w, carried, gram = np.empty(size), np.empty(size), np.empty((size, size))
+    for r in range(1, time_s.shape[0]):
+        rest = time_s[r] - time_s[r - 1]
+        if rest <= 0.0 or abs(rest - sample_interval_s) <= 1e-9 * sample_interval_s:
+            continue
+        key = row_keys[r - 1]
+        for q in range(count):
+            out[r, q] = 0.0
+        for c in range(size):
+            w[c] = rows[r - 1, c]
+        whole = 0
+        while rest > step_s * (1.0 + 1e-9):
+            whole += 1
+            rest -= step_s
+        while whole > 0:
+            j = min(whole, most)
+            for q in range(count):
+                out[r, q] += quadratic(step_grams[key, q, j], w)
+            matvec(step_powers[key, j], w, carried)
+            for c in range(size):
+                w[c] = carried[c]
+            whole -= j
+        last, bound, ratio = 0, 2.0 * rest / step_s, 2.0 * rest / step_s
+        while bound > 1e-17 and last < terms - 1:
+            last += 1
+            bound *= ratio / (last + 1)
+        for q in range(count):
+            gram[:, :] = series[key, q, last]
+            for k in range(last - 1, -1, -1):
+                for a in range(size):
+                    for b in range(size):
+                        gram[a, b] = gram[a, b] * rest + series[key, q, k, a, b]
+            out[r, q] += quadratic(gram, w) * rest

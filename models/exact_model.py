@@ -25,11 +25,19 @@ the readout rows R = (I, F_r row, F_d row, exit rows) and the Taylor matrices A^
 and a batch is two matrix products. A piece shorter than h (to the first grid point after a switch,
 to a pulse switch, to a located switch) uses the Taylor series sum_k (A s)^k / k! w truncated where
 its remainder is below 1e-20 of the state (s <= h): the exact solution to round-off, without an
-expm per switch. Each exit function g = c . w comes with every point; the first interval where g
-goes from its side to the crossed side brackets the switch, which Brent's method (as
-``scipy.optimize.brentq``) locates on the Taylor polynomial g(s) of the exact solution. The event
+expm per switch. Each exit function g = c . w and its slope g' = c A w come with every point; the
+first interval where g goes from its side to the crossed side, or where g' turns from towards it to
+away from it and the maximum of g between the points is on the crossed side (a crossing and its
+return within one sub-step), brackets the switch, which Brent's method (as ``scipy.optimize.brentq``)
+locates on the Taylor polynomial g(s) of the exact solution. The event
 loop runs compiled (models.exact_kernels); the operators of a key are built when the run first
 reaches it.
+
+Works (with the energy outputs): the impact work and the work the links, the rock and the torsion
+line absorb are quadratic forms w^T Q w integrated exactly between the samples,
+int_0^s w^T Q w = w^T G(s) w with G(s) = int_0^s expm(A^T u) Q expm(A u) du per key, a series in s
+(Operators.add_powers, models.exact_kernels.integrate_powers), so the samples stay at the output
+interval.
 
 Zero-length modes: a mode lasts at least ``min_switch_interval_s``. Its start is taken as not
 crossed for every exit function; if an exit function is on its crossed side already at
@@ -64,8 +72,10 @@ from rpdrill.models.exact_kernels import (
     MISSING_KEY,
     TOO_MANY_SWITCHES,
     assemble,
+    integrate_powers,
     run_events,
 )
+from rpdrill.models.links import RATE
 from rpdrill.models.piecewise import Element, elements, undeclared
 from rpdrill.models.pulse import (
     PHASES,
@@ -79,6 +89,7 @@ from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import SceneError, Simulation, as_simulation
 from rpdrill.models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
+from rpdrill.rocklaw.base import VELOCITY
 from rpdrill.rocklaw.modes import Affine
 
 ANCHORS, PER_ANCHOR = 16, 16  # A, B: a batch is J = A B sub-grid points from one state (module doc)
@@ -176,6 +187,36 @@ class Model:
         matrix[one:, one:] = phase_generator(self.impact, phase)
         return matrix
 
+    def power_forms(self, modes: Modes, phase: str) -> np.ndarray:
+        """(Q_impact, Q_internal) with power = w^T Q w: the piston's F_d v_shank, and the power every link,
+        the rock and the torsion line absorb, sum of F u over them (F the force row of the element in its
+        mode, u its stretch rate: a link's delta', the rock's v_bit, the torsion line's omega)."""
+        layout, chain = self.layout, self.simulation.chain
+        n, size = layout.n, layout.size
+        pairs = []  # (force row, rate row) over w
+        for link in chain.linear_links():
+            stretch, rate = np.zeros(size), np.zeros(size)
+            stretch[link.body_b], rate[n + link.body_b] = 1.0, 1.0
+            if link.body_a is not None:
+                stretch[link.body_a], rate[n + link.body_a] = -1.0, -1.0
+            pairs.append((link.stiffness_n_per_m * stretch + link.damping_n_s_per_m * rate, rate))
+        for element, mode in zip(self.pieces, modes, strict=True):
+            velocity = element.variables[VELOCITY if element is self.pieces[0] else RATE]
+            pairs.append((self.row(element, element.table[mode].force), velocity))
+        if self.simulation.torsion is not None:
+            torsion, force, rate = self.simulation.torsion, np.zeros(size), np.zeros(size)
+            force[layout.angle] = torsion.stiffness_n_m_per_rad
+            force[layout.angle + 1], rate[layout.angle + 1] = torsion.damping_n_m_s_per_rad, 1.0
+            pairs.append((force, rate))
+        impact = np.zeros(size)
+        impact[layout.one:] = phase_row(self.impact, phase)
+        shank = np.zeros(size)
+        shank[n + chain.impact_body] = 1.0
+        forms = np.zeros((2, size, size))
+        for index, (force, rate) in [(0, (impact, shank))] + [(1, pair) for pair in pairs]:
+            forms[index] += 0.5 * (np.outer(force, rate) + np.outer(rate, force))
+        return forms
+
     def exits(self, modes: Modes) -> list[tuple[np.ndarray, int, Modes, list[tuple[int, np.ndarray]]]]:
         """(row, direction, next modes, entry resets (target index, row)) of every exit of ``modes``."""
         out = []
@@ -203,14 +244,14 @@ class Operators:
     """The per-key (modes, phase) arrays of models.exact_kernels.run_events, stacked over the keys and
     filled when the kernel first reaches a key (``add``); mode combinations get ids as they are
     first named, key_of[mode id, phase id] -> key (-1: not built), arrays growing as needed.
-    R = (I, F_r row, F_d row, exit rows) gives a point's outputs."""
+    R = (I, F_r row, F_d row, exit rows c_e, their slopes c_e A) gives a point's outputs."""
 
-    def __init__(self, model: Model, step_s: float, order: int, capacity: int) -> None:
-        self.model, self.step_s, self.order = model, step_s, order
+    def __init__(self, model: Model, step_s: float, per_sample: int, order: int, capacity: int, powers: bool) -> None:
+        self.model, self.step_s, self.per_sample, self.order = model, step_s, per_sample, order
         self.modes: list[Modes] = []
         self.mode_ids: dict[Modes, int] = {}
         size, exits = model.layout.size, model.max_exits
-        self.width = size + 2 + exits
+        self.width = size + 2 + 2 * exits
         self.taylor = np.empty((capacity, size, (order + 1) * self.width))  # [(R A^k / k!)^T]_k
         self.one_step = np.empty((capacity, size, size))  # expm(A h)
         self.anchors = np.empty((capacity, size, ANCHORS * size))  # [expm(A a B h)^T]_a
@@ -224,6 +265,12 @@ class Operators:
         self.rock_rows = np.zeros((capacity, size))  # F_r = row . w
         self.impact_rows = np.zeros((capacity, 3))  # F_d = row . (1, u1, u2)
         self.key_of = np.full((capacity, len(PHASES)), -1, dtype=np.int64)
+        # with the energy outputs, the integrals of the power forms Q (Model.power_forms) over whole sub-steps
+        # and as a series in the length (integrate_powers), [key, form]
+        form_capacity = capacity if powers else 0
+        self.step_powers = np.empty((form_capacity, per_sample + 1, size, size))  # expm(A h)^j
+        self.step_grams = np.empty((form_capacity, 2, per_sample + 1, size, size))  # G(j h), j <= p
+        self.series = np.empty((form_capacity, 2, order + 1, size, size))
         self.built = 0
 
     def mode_id(self, modes: Modes) -> int:
@@ -238,9 +285,11 @@ class Operators:
     def _grow(self) -> None:
         """Double the capacity of the per-key arrays."""
         for name in ("taylor", "one_step", "anchors", "readout", "exit_counts", "directions", "next_modes",
-                     "reset_counts", "reset_targets", "reset_rows", "rock_rows", "impact_rows"):
+                     "reset_counts", "reset_targets", "reset_rows", "rock_rows", "impact_rows", "step_powers",
+                     "step_grams", "series"):
             array = getattr(self, name)
-            setattr(self, name, np.concatenate([array, np.zeros_like(array)]))
+            if len(array):
+                setattr(self, name, np.concatenate([array, np.zeros_like(array)]))
 
     def add(self, modes: Modes, phase: str) -> None:
         """Build the arrays of (modes, phase): expm(A h) = D expm(D^-1 A D h) D^-1 (``scipy.linalg.expm``
@@ -261,6 +310,7 @@ class Operators:
         readout[size + 1, model.layout.one:] = self.impact_rows[i] = phase_row(model.impact, phase)
         for e, (row, direction, following, resets) in enumerate(exits):
             readout[size + 2 + e] = row
+            readout[size + 2 + model.max_exits + e] = row @ matrix
             self.directions[i, e] = direction
             self.next_modes[i, e] = self.mode_id(following)
             self.reset_counts[i, e] = len(resets)
@@ -269,8 +319,35 @@ class Operators:
         self.exit_counts[i] = len(exits)
         assemble(self.one_step[i], matrix, readout, ANCHORS, PER_ANCHOR, self.readout[i], self.anchors[i],
                  self.taylor[i])
+        if len(self.series):
+            self.add_powers(i, matrix, model.power_forms(modes, phase))
         self.key_of[self.mode_id(modes), PHASES.index(phase)] = i
         self.built += 1
+
+    def add_powers(self, i: int, matrix: np.ndarray, forms: np.ndarray) -> None:
+        """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of key ``i``'s power forms: for s <= h the
+        series G(s) = sum_k s^(k+1) S_k / (k + 1) of the integrand's Taylor coefficients, S_0 = Q,
+        S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on the balanced matrix
+        (S_k = D^-1 S_k,b(D Q D) D^-1; the truncation after the Taylor order of the sub-step leaves
+        2^(K+1) / (K+1)! of it, below 1e-14); then G(j h) = sum_(l < j) (E^l)^T G(h) E^l for j up to the
+        sub-steps of a sample (E = expm(A h))."""
+        balanced, scale = balance(matrix)
+        unscale = 1.0 / scale[:, None] / scale[None, :]
+        power = np.eye(len(matrix))
+        for j in range(self.per_sample + 1):
+            self.step_powers[i, j] = power
+            power = self.one_step[i] @ power
+        for q, form in enumerate(forms):
+            coefficient, gram = scale[:, None] * form * scale[None, :], np.zeros_like(matrix)
+            for k in range(self.order + 1):
+                if k:
+                    coefficient = (balanced.T @ coefficient + coefficient @ balanced) / k
+                self.series[i, q, k] = coefficient / (k + 1) * unscale
+                gram += self.series[i, q, k] * self.step_s ** (k + 1)
+            self.step_grams[i, q, 0] = 0.0
+            for j in range(1, self.per_sample + 1):
+                carried = self.step_powers[i, j - 1]
+                self.step_grams[i, q, j] = self.step_grams[i, q, j - 1] + carried.T @ gram @ carried
 
 
 class ExactSolver:
@@ -287,8 +364,9 @@ class ExactSolver:
         norm = max(np.linalg.norm(balance(matrix)[0], 1) for matrix in self.model.norm_candidates(self.phases))
         self.per_sample = max(1, math.ceil(settings.sample_interval_s * norm))
         self.step_s = settings.sample_interval_s / self.per_sample
-        self.operators = Operators(self.model, self.step_s, taylor_order(norm * self.step_s),
-                                   len(self.model.pieces[0].table) * len(set(self.phases)))
+        self.operators = Operators(self.model, self.step_s, self.per_sample, taylor_order(norm * self.step_s),
+                                   len(self.model.pieces[0].table) * len(set(self.phases)),
+                                   "energy" in simulation.needed_data)
         self.blows = simulation.blow_starts()
         blows = blow_start_times(self.impact, settings.end_time_s) if self.blows else np.empty(0)
         self.blow_phases = np.isin(self.phase_times[:, 0], blows).astype(np.int64)
@@ -304,10 +382,31 @@ class ExactSolver:
         modes = self.operators.modes[mode_id]
         return self.operators.mode_id((rock.initial_mode(w), *modes[1:]))
 
+    def works_j(self, time_s: np.ndarray, rows: np.ndarray) -> dict[str, np.ndarray]:
+        """Cumulative impact work int F_d v_shank dt and internal work (what the links, the rock and the
+        torsion line absorb) at every row, integrated exactly from the propagators: a whole sample interval
+        as w^T G(sample interval) w, all of one key at once (BLAS), every other interval by
+        integrate_powers."""
+        ops, size = self.operators, self.layout.size
+        interval = self.step_s * self.per_sample
+        powers = np.zeros((len(time_s), 2))
+        integrate_powers(time_s, rows, self.row_keys, ops.step_powers, ops.step_grams, ops.series, self.step_s,
+                         interval, powers)
+        whole = np.flatnonzero(np.abs(np.diff(time_s) - interval) <= 1e-9 * interval)
+        keys = self.row_keys[whole]
+        for key in np.unique(keys):
+            start = whole[keys == key]
+            states = rows[start, :size]
+            for q in range(2):
+                powers[start + 1, q] = np.einsum("ij,ij->i", states @ ops.step_grams[key, q, -1], states)
+        impact, internal = np.cumsum(powers, axis=0).T
+        return {"impact": impact, "internal": internal}
+
     def run(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Modes]]:
         """From the simulation's start (rest, off the bottom; or preloaded, in contact) through every
-        pulse phase to the end time: (sample times; rows w, F_r, F_d; switch times; modes entered). The
-        kernel returns when it reaches a key not built yet, and resumes once it is built."""
+        pulse phase to the end time: (sample times; rows w, F_r, F_d; switch times; modes entered); the
+        key propagating from each row in ``row_keys``. The kernel returns when it reaches a key not built
+        yet, and resumes once it is built."""
         layout, ops, period, simulation = self.layout, self.operators, self.impact.period_s, self.simulation
         n = layout.n
         w = np.zeros(layout.size)
@@ -321,7 +420,7 @@ class ExactSolver:
         phase_ids = np.array([PHASES.index(p) for p in self.phases])
         capacity = (math.floor(simulation.settings.end_time_s / (self.step_s * self.per_sample)) + 4
                     + 2 * len(self.phases) + 2 * self.max_switches + ANCHORS * PER_ANCHOR)
-        time_s, rows = np.empty(capacity), np.empty((capacity, ops.width))
+        time_s, rows, row_keys = np.empty(capacity), np.empty((capacity, ops.width)), np.empty(capacity, dtype=np.int64)
         switch_times = np.empty(self.max_switches + 1)
         switch_modes = np.empty(self.max_switches + 1, dtype=np.int64)
         initial = tuple(element.initial_mode(w) for element in self.model.pieces)
@@ -334,7 +433,7 @@ class ExactSolver:
                 ops.reset_counts,
                 ops.reset_targets, ops.reset_rows, self.model.pieces[0].monotone, self.step_s, PER_ANCHOR,
                 self.per_sample, self.min_switch_interval_s, self.max_switches, n, POSITION_LIMIT_M, progress, clock,
-                w, time_s, rows, switch_times, switch_modes)
+                w, time_s, rows, row_keys, switch_times, switch_modes)
             if status == BLOW_START:
                 progress[1] = self.start_blow(w, progress[1])
             elif status == MISSING_KEY:
@@ -343,6 +442,7 @@ class ExactSolver:
                 break
         filled, switches = progress[2], progress[3]
         time_s, rows, switch_times = time_s[:filled], rows[:filled], switch_times[:switches]
+        self.row_keys = row_keys[:filled]
         if status == TOO_MANY_SWITCHES:
             raise SimulationFailed(
                 f"scene '{simulation.name}': exact solver exceeded {self.max_switches} switches "
@@ -398,6 +498,7 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     with BLAS.limit(limits=1, user_api="blas"):
         solver = ExactSolver(simulation)
         time_s, rows, switch_times, entered = solver.run()
+        works = solver.works_j(time_s, rows) if "energy" in simulation.needed_data else None
     layout = solver.layout
     n, angle, states = layout.n, layout.angle, slice(2 * layout.n, 2 * layout.n + layout.rock_states)
     cpu = time.process_time() - start
@@ -417,6 +518,7 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
         torsion_angle_rad=rows[:, angle] if layout.torsion else None,
         torsion_rate_rad_per_s=rows[:, angle + 1] if layout.torsion else None,
         cpu_time_s=cpu,
+        works_j=works,
         info={
             "solver_success": True,
             "sub_step_s": solver.step_s,

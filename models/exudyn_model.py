@@ -12,9 +12,11 @@ unless an output asks for them.
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -45,6 +47,7 @@ from rpdrill.rocklaw.backends import SCALAR, SymbolicBackend
 from rpdrill.rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 
 SOLVER_TYPES = {
+    "rk67": exu.DynamicSolverType.RK67,
     "rk44": exu.DynamicSolverType.RK44,
     "rk33": exu.DynamicSolverType.RK33,
     "explicit_midpoint": exu.DynamicSolverType.ExplicitMidpoint,
@@ -104,6 +107,9 @@ def _simulation_settings(simulation: Simulation) -> Any:
     else:
         integration.automaticStepSize = False
         integration.adaptiveStep = False
+    # the explicit solvers' extra right-hand side per step computes accelerations for output only (none
+    # is stored; the states are bitwise the same without it, and a rk44 step costs ~12 % less)
+    integration.explicit.computeEndOfStepAccelerations = False
     settings.show.statistics = False
     settings.solution.file.write = False
     # energies are integrated over every step; otherwise store only at the output interval
@@ -243,6 +249,19 @@ def _pre_step(actions: list[Callable[[Any, float], bool]]) -> Callable[[Any, flo
     return pre_step
 
 
+@contextlib.contextmanager
+def _no_cyclic_gc() -> Iterator[None]:
+    """Python's cyclic garbage collector paused: the per-step hooks allocate small objects without
+    cycles (freed by reference counting), and the collections they would trigger cost ~5 % of a run."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
 def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
     return mbs.GetSensorStoredData(sensor)
 
@@ -267,9 +286,10 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     pre_step = _pre_step(actions)
     if pre_step is not None:
         mbs.SetPreStepUserFunction(pre_step)
-    start = time.process_time()
-    ok = mbs.SolveDynamic(drill.settings, solverType=SOLVER_TYPES[settings.type])
-    cpu = time.process_time() - start
+    with _no_cyclic_gc():
+        start = time.process_time()
+        ok = mbs.SolveDynamic(drill.settings, solverType=SOLVER_TYPES[settings.type])
+        cpu = time.process_time() - start
     reached_s = mbs.systemData.GetTime()
     data = {name: _sensor(mbs, sensor) for name, sensor in drill.sensors.items()}
     time_s = data["x0"][:, 0]

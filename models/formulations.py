@@ -26,7 +26,7 @@ if TYPE_CHECKING:
 # accuracy tiers that every formulation resolves into its own settings (models.solver_settings)
 PRESETS = ("fast", "standard", "reference")
 DEFAULT_PRESET = "standard"
-EXUDYN_SOLVERS = ("rk44", "rk33", "explicit_midpoint", "explicit_euler", "generalized_alpha",
+EXUDYN_SOLVERS = ("rk67", "rk44", "rk33", "explicit_midpoint", "explicit_euler", "generalized_alpha",
                   "trapezoidal_index2", "dopri5", "ode23")
 AUTOMATIC_STEP_SOLVERS = ("dopri5", "ode23")
 ODE_METHODS = ("DOP853", "Radau", "LSODA")

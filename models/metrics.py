@@ -15,7 +15,6 @@ from collections.abc import Callable
 from functools import cached_property
 
 import numpy as np
-from scipy.integrate import trapezoid
 
 from rpdrill.models.energy import EnergyAccount, energy_account, impact_work_j
 from rpdrill.models.results import SimulationResult
@@ -66,7 +65,7 @@ class _Window:
         return float(np.max(np.abs(values[self.mask])))
 
     def rms(self, values: np.ndarray) -> float:
-        return float(math.sqrt(trapezoid(values[self.mask] ** 2, self.result.time_s[self.mask]) / self.duration))
+        return float(math.sqrt(np.trapezoid(values[self.mask] ** 2, self.result.time_s[self.mask]) / self.duration))
 
     def efficiency(self) -> float:
         """Crushing work / work put in by the impacts and the feed over the window."""
@@ -86,7 +85,7 @@ METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
     "penetration_per_impact_energy_m_per_j": lambda w: w.advance_per_impact_work(),
     "advance_per_blow_m": lambda w: float(w.per_blow.mean()),
     "advance_per_blow_std_m": lambda w: _spread(w.per_blow),
-    "borehole_bottom_final_m": lambda w: float(w.result.bottom_m[-1]),
+    "borehole_bottom_final_m": lambda w: float(w.result.bottom_at(w.result.time_s[-1:])[0]),
     "bit_velocity_peak_m_per_s": lambda w: w.peak(w.result.bit_velocity_m_per_s),
     "bit_velocity_rms_m_per_s": lambda w: w.rms(w.result.bit_velocity_m_per_s),
     "collar_velocity_peak_m_per_s": lambda w: w.peak(w.result.body_velocity_m_per_s("collar")),

@@ -2,7 +2,8 @@
 
 Each metric and time history names the effects it depends on (``torsion``, ``rock_plasticity``),
 the bodies of the drill string it reads (``collar``) and the data it needs recorded: ``forces`` (rock and impact force sensors) or ``energy``
-(every solver step stored and the energy account integrated). Asking for an output pulls in
+(the works integrated: Exudyn stores every solver step, the exact formulation integrates them from
+its propagators). Asking for an output pulls in
 what it needs; asking for nothing more builds nothing more.
 """
 

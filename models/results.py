@@ -40,6 +40,10 @@ class SimulationResult:
     # the rock law's states (samples x states, rocklaw.base.RockLaw.state_names) at the stored
     # steps; None: the formulation stored only the bottom (enough for a one-state law, Jenkins)
     rock_state_m: np.ndarray | None = None
+    # cumulative works at the stored steps integrated exactly by the formulation (exact: "impact",
+    # int F_d v_shank dt, and "internal", what the links, the rock and the torsion line absorb); None:
+    # the energy account integrates the sampled powers
+    works_j: dict[str, np.ndarray] | None = None
 
     @property
     def scene(self) -> Scene:
@@ -58,10 +62,20 @@ class SimulationResult:
         return (self.bottom_m,)
 
     def bottom_at(self, times_s: np.ndarray) -> np.ndarray:
-        """Borehole bottom x_n at the given times (held between its changes)."""
+        """Borehole bottom x_n at the given times: the rock state held since its last recorded change,
+        taken on by the law's return map to the bit position there (linear between stored samples). A
+        crushing bit carries the bottom on between the formulation's records (Exudyn: its steps); at a
+        recorded time the return map leaves the state as it is."""
+        times = np.asarray(times_s, dtype=float)
         event_t, event_x = self.bottom_events or (self.time_s, self.bottom_m)
-        index = np.searchsorted(event_t, np.asarray(times_s) + 1e-12, side="right") - 1
-        return event_x[np.clip(index, 0, len(event_x) - 1)]
+        held = event_x[np.clip(np.searchsorted(event_t, times + 1e-12, side="right") - 1, 0, len(event_x) - 1)]
+        sample = np.clip(np.searchsorted(self.time_s, times + 1e-12, side="right") - 1, 0, len(self.time_s) - 1)
+        law = self.simulation.rock
+        states = np.column_stack(self.rock_states())[sample]
+        states[:, law.bottom_index] = held
+        bit = np.interp(times, self.time_s, self.bit_position_m)
+        return np.array([law.return_map(float(x), tuple(map(float, state)))[law.bottom_index]
+                         for x, state in zip(bit, states, strict=True)])
 
     @property
     def bit_position_m(self) -> np.ndarray:

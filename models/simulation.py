@@ -124,8 +124,7 @@ def prepare(scene: Scene) -> Simulation:
     rock = scene.rock.build(damping=effects.rock_damping, plasticity=effects.rock_plasticity,
                             indexed=effects.indexing)
     radius = spectral_radius_per_s(chain, rock) if scene.solver.formulation == "exudyn" else None
-    settings = resolve_settings(scene.solver, scene.impact.duration_s, lambda: radius,
-                                "energy" in needs(outputs.metrics, outputs.timeseries).data)
+    settings = resolve_settings(scene.solver, scene.impact.duration_s, lambda: radius)
     positions, angle = np.zeros(chain.size), 0.0
     if scene.start == "preloaded":
         try:

@@ -3,16 +3,18 @@
 An accuracy preset (fast, standard, reference) fills the options the scene does not give; without
 a preset and without explicit accuracy options the ``standard`` preset applies.
 
-* exudyn: RK44 at a fixed step, the smallest of a cap, a fraction of the pulse duration (a step
-  must resolve the pulse) and a multiple of 1/|lambda|_max (the stiffest or fastest mode,
-  models.stability.spectral_radius_per_s). The stated errors (relative to the reference preset,
-  and of the energy balance relative to the impact work) are the largest measured on the hard
-  scenes of tests/stability, rounded up (docs/stability.md); the suite checks them.
+* exudyn: the preset's fixed-step solver (fast: RK44, standard and reference: RK67) at the smallest of
+  a cap, a fraction of the pulse duration (a step must resolve the pulse) and a multiple of
+  1/|lambda|_max (the stiffest or fastest mode, models.stability.spectral_radius_per_s); explicit
+  ``type`` or ``step_s`` win (a step or tolerances without a preset and without a type: RK44). The
+  stated errors (penetration rate relative to the exact formulation, energy balance relative to the
+  impact work) are the largest measured on the hard scenes of tests/stability, rounded up
+  (docs/stability.md); the suite checks them.
 * ode: DOP853 at the preset's tolerances (absolute tolerance in the state's SI units), dense
   output sampled every ``sample_interval_s`` (default 2e-6 s).
-* exact: exact to round-off at every preset; samples every ``output_interval_s`` (at most
-  ENERGY_SAMPLE_S when an energy output is asked for: the trapezoidal energy integrals then close
-  the balance to ~1e-4 of the impact work), every switch recorded.
+* exact: exact to round-off at every preset; samples every ``output_interval_s``, every switch
+  recorded (the energy outputs' works are integrated exactly from the propagators, whatever the
+  samples).
 """
 
 from __future__ import annotations
@@ -23,14 +25,37 @@ from dataclasses import dataclass
 from rpdrill.models.formulations import DEFAULT_PRESET
 from rpdrill.models.scene import Solver
 
-EXUDYN_PRESETS: dict[str, dict[str, float]] = {
-    "fast": {"step_s": 1e-4, "steps_per_pulse": 10, "step_times_radius": 0.8,
-             "penetration_rate_error": 0.03, "energy_balance_error": 0.03},
-    "standard": {"step_s": 4e-5, "steps_per_pulse": 25, "step_times_radius": 0.4,
-                 "penetration_rate_error": 0.003, "energy_balance_error": 0.003},
-    "reference": {"step_s": 5e-6, "steps_per_pulse": 200, "step_times_radius": 0.05,
-                  "penetration_rate_error": 1e-4, "energy_balance_error": 1e-4},
+
+@dataclass(frozen=True)
+class ExudynPreset:
+    """An Exudyn accuracy preset: a fixed-step solver and its step rule, step = min(step_s,
+    pulse duration / steps_per_pulse, step_times_radius / |lambda|_max), and the errors it is stated to
+    keep on every hard scene of tests/stability (penetration rate relative to the exact formulation,
+    energy balance relative to the impact work), checked by that suite."""
+
+    type: str
+    step_s: float
+    steps_per_pulse: int
+    step_times_radius: float
+    penetration_rate_error: float
+    energy_balance_error: float
+
+    def step(self, pulse_duration_s: float, spectral_radius_per_s: float) -> float:
+        """The step of this preset for a pulse of ``pulse_duration_s`` and |lambda|_max ``spectral_radius_per_s``."""
+        return min(self.step_s, pulse_duration_s / self.steps_per_pulse, self.step_times_radius / spectral_radius_per_s)
+
+
+# Picked from the measured work-precision fronts (docs/stability.md, python benchmarks/bench_presets.py):
+# fast: rk44 near its stability limit (2.4 / |lambda|_max), the step capped at 1e-4 s; standard and
+# reference: rk67, whose sixth order makes a step of the same cost ~10 times more accurate than rk44's
+# on the paper scene (its stability limit is ~1.0 / |lambda|_max).
+EXUDYN_PRESETS: dict[str, ExudynPreset] = {
+    "fast": ExudynPreset("rk44", 1e-4, 10, 1.9, penetration_rate_error=0.04, energy_balance_error=0.12),
+    "standard": ExudynPreset("rk67", 5e-5, 20, 0.8, penetration_rate_error=5e-4, energy_balance_error=5e-3),
+    "reference": ExudynPreset("rk67", 1e-5, 100, 0.2, penetration_rate_error=1e-4, energy_balance_error=3e-4),
 }
+# the solver of a scene that gives its own step or tolerances, neither a preset nor a type
+UNPRESET_TYPE = "rk44"
 ODE_PRESETS: dict[str, dict[str, float]] = {
     "fast": {"relative_tolerance": 1e-6, "absolute_tolerance": 1e-9},
     "standard": {"relative_tolerance": 1e-8, "absolute_tolerance": 1e-11},
@@ -38,7 +63,6 @@ ODE_PRESETS: dict[str, dict[str, float]] = {
 }
 EXUDYN_ACCURACY_KEYS = ("type", "step_s", "spectral_radius", "relative_tolerance", "absolute_tolerance")
 ODE_SAMPLE_INTERVAL_S = 2e-6
-ENERGY_SAMPLE_S = 1e-5
 
 
 @dataclass(frozen=True)
@@ -92,20 +116,19 @@ def _given(solver: Solver, key: str, default: float) -> float:
     return default if value is None else value
 
 
-def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_per_s: Callable[[], float],
-                     energy: bool) -> Settings:
+def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_per_s: Callable[[], float]) -> Settings:
     """The settings of ``solver``'s formulation (module doc). ``spectral_radius_per_s`` is called only
-    when an Exudyn preset must choose the step; ``energy``: an energy output is asked for."""
+    when an Exudyn preset must choose the step."""
     common = {"formulation": solver.formulation, "end_time_s": solver.end_time_s,
               "output_interval_s": solver.output_interval_s}
     if solver.formulation == "exudyn":
         preset = _preset(solver, EXUDYN_ACCURACY_KEYS)
+        tier = EXUDYN_PRESETS[preset or DEFAULT_PRESET]
         step = solver.step_s
         if step is None:
-            tier = EXUDYN_PRESETS[preset or DEFAULT_PRESET]
-            step = min(tier["step_s"], pulse_duration_s / tier["steps_per_pulse"],
-                       tier["step_times_radius"] / spectral_radius_per_s())
-        return ExudynSettings(type=solver.type or "rk44", step_s=step, spectral_radius=_given(solver, "spectral_radius", 1.0),
+            step = tier.step(pulse_duration_s, spectral_radius_per_s())
+        return ExudynSettings(type=solver.type or (tier.type if preset else UNPRESET_TYPE), step_s=step,
+                              spectral_radius=_given(solver, "spectral_radius", 1.0),
                               relative_tolerance=_given(solver, "relative_tolerance", 1e-8),
                               absolute_tolerance=_given(solver, "absolute_tolerance", 1e-12), preset=preset, **common)
     if solver.formulation == "ode":
@@ -116,8 +139,7 @@ def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_pe
                            absolute_tolerance=_given(solver, "absolute_tolerance", tier["absolute_tolerance"]),
                            sample_interval_s=_given(solver, "sample_interval_s", ODE_SAMPLE_INTERVAL_S),
                            preset=preset, **common)
-    automatic = min(solver.output_interval_s, ENERGY_SAMPLE_S) if energy else solver.output_interval_s
-    return ExactSettings(sample_interval_s=_given(solver, "sample_interval_s", automatic),
+    return ExactSettings(sample_interval_s=_given(solver, "sample_interval_s", solver.output_interval_s),
                          min_switch_interval_s=_given(solver, "min_switch_interval_s", 1e-12),
                          max_switches_per_blow=int(_given(solver, "max_switches_per_blow", 1000)),
                          preset=solver.preset, **common)

@@ -29,6 +29,7 @@ POSITION_LIMIT_M = 1e3
 # Largest stable h * |lambda|_max measured on the hard scenes (docs/stability.md); None: no step
 # is stable on the undamped modes (explicit Euler amplifies every oscillation).
 STABLE_STEP_FACTOR: dict[str, float | None] = {
+    "rk67": 1.0,
     "rk44": 2.4,
     "rk33": 1.6,
     "explicit_midpoint": 0.2,

@@ -33,7 +33,6 @@ from collections.abc import Mapping, Sequence
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 
 from rpdrill.rocklaw.backends import NUMERIC, Backend
 from rpdrill.rocklaw.modes import ModeTable
@@ -130,6 +129,13 @@ def force_and_state(law: RockLaw, bit_position_m: float, bit_velocity_m_per_s: f
     return law.force(bit_position_m, bit_velocity_m_per_s, new_state, backend), new_state
 
 
+def cumulative_trapezoid(values: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """int values dx from x[0] to every x[i] by the trapezoidal rule (0 at the start), as SciPy's
+    ``cumulative_trapezoid(..., initial=0)``; NumPy only, so that a worker does not import
+    scipy.integrate (half a second) for it."""
+    return np.concatenate(([0.0], np.cumsum(0.5 * (values[1:] + values[:-1]) * np.diff(x))))
+
+
 def trapezoidal_plastic_work_j(spring_force_n: np.ndarray, bottom_m: np.ndarray) -> np.ndarray:
     """W_p = int F_spring d(x_n), trapezoidal over the samples (exact where F is linear in x_n)."""
-    return cumulative_trapezoid(spring_force_n, bottom_m, initial=0.0)
+    return cumulative_trapezoid(spring_force_n, bottom_m)

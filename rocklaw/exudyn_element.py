@@ -23,6 +23,8 @@ from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
 from rpdrill.rocklaw.backends import SCALAR, SymbolicBackend
 from rpdrill.rocklaw.base import RockLaw, State
 
+COORDINATE = exu.OutputVariableType.Coordinates
+
 
 def attach_user_function(mbs: Any, item: Any, parameter: str, function: Any, symbolic: bool) -> Any:
     """Set ``function`` as the item's user function: recorded as symbolic (compiled) or as a
@@ -60,10 +62,11 @@ class ExudynRockContact:
         self.rock = rock
         self._start_blow, self._blow_period_s, self._blows = start_blow, blow_period_s, 0
         self._bit_node = bit_node
+        self._return_map = rock.return_map
         if initial_state is None:
             initial_position = mbs.GetNodeParameter(bit_node, "initialCoordinates")[0]
             initial_state = rock.return_map(initial_position, rock.initial_state())
-        self.state: State = tuple(initial_state)
+        self.state: State = tuple(float(value) for value in initial_state)  # floats: the hook compares them every step
         # (time, state) each time the state changed; the state at t is the step function through these
         self.state_history: list[tuple[float, State]] = [(0.0, self.state)]
         self._step_start_s = 0.0
@@ -92,7 +95,6 @@ class ExudynRockContact:
         self._user_function = attach_user_function(
             mbs, self.object, "springForceUserFunction", rock_force, symbolic
         )
-        self._coordinate = exu.OutputVariableType.Coordinates
 
     @property
     def bottom_history(self) -> list[tuple[float, float]]:
@@ -111,7 +113,7 @@ class ExudynRockContact:
         """Go on with ``rock`` (the same law with another eta: models.indexing), in the expression too."""
         if self._fresh_fraction is not None and rock.fresh_fraction != self.rock.fresh_fraction:
             self._fresh_fraction.SetValue(rock.fresh_fraction)
-        self.rock = rock
+        self.rock, self._return_map = rock, rock.return_map
 
     def state_at(self, times_s: np.ndarray) -> np.ndarray:
         """The state (samples x states) at ``times_s``: the last change at or before each time."""
@@ -125,8 +127,8 @@ class ExudynRockContact:
         Exudyn passes the pre-step function the time at the *end* of the coming step while the
         state is still that of its start; the history is stamped with the start time.
         """
-        position = mbs.GetNodeOutput(self._bit_node, self._coordinate)
-        state = self.rock.return_map(position, self.state)
+        position = mbs.GetNodeOutput(self._bit_node, COORDINATE)
+        state = self._return_map(position, self.state)
         # a step start a round-off before a blow start is that blow start
         if self._start_blow is not None and self._step_start_s >= (self._blows - 1e-9) * self._blow_period_s:
             state = self._start_blow(position, state)

@@ -52,6 +52,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any, Literal
 
 import numpy as np
@@ -92,9 +93,10 @@ class JenkinsRock:
     def unloading_stiffness_n_per_m(self) -> float:
         return self.stiffness_n_per_m
 
-    @property
+    @cached_property
     def crushing_penetration_m(self) -> float:
-        """Penetration F_th / k_n at which the rock starts to crush."""
+        """Penetration F_th / k_n at which the rock starts to crush (cached: the Exudyn element's return
+        map reads it at every step)."""
         return self.threshold_n / self.stiffness_n_per_m
 
     @property

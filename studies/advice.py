@@ -216,7 +216,7 @@ class Evaluator:
         tasks = [(i, scene, [self.request.metric], [scene["impact"]["frequency_hz"]])
                  for i, scene in enumerate(scenes) if ratios[i] < self.request.max_thrust_ratio]
         values = np.full(len(points), np.nan)
-        for scan in self.runner(scan_target, tasks) if tasks else ():
+        for scan in (scan for batch in self.runner(scan_target, tasks) for scan in batch) if tasks else ():
             values[scan["key"]] = scan["values"][self.request.metric][0]
             self.failed += scan["failed_runs"]
             self.first_error = self.first_error or scan["error"]

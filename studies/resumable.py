@@ -1,8 +1,9 @@
-"""Resumable runs of many points into an output directory: a results table appended point by point,
+"""Resumable runs of many points into an output directory: a results table appended batch by batch,
 and the provenance beside it.
 
 ``DIR/study.json`` records what produced the results (the study's hash, versions, the resolved
-study, every session); ``DIR/<table>.csv`` gets one row per finished point as it finishes. A rerun
+study, every session); ``DIR/<table>.csv`` gets the rows of each batch of points as it finishes
+(studies.runners). A rerun
 into the same directory keeps the complete rows (a row cut by a kill is dropped), runs only the
 points without one, and refuses a study whose hash differs. Failed points count as finished
 (their errors are in the table; delete their rows to retry them).
@@ -127,10 +128,10 @@ def run_points(study: ResumableStudy, out: Path, table: str, columns: list[str],
     with path.open("a", newline="", encoding="utf-8") as handle, \
             tqdm(total=len(study.points), initial=len(done), desc=name, unit="point", disable=quiet) as bar:
         writer = csv.DictWriter(handle, columns)
-        for outcome in run(worker, [task(p) for p in todo]) if todo else ():
-            writer.writerow(to_row(outcome))
+        for batch in run(worker, [task(p) for p in todo]) if todo else ():  # a batch's rows, then one flush
+            writer.writerows(to_row(outcome) for outcome in batch)
             handle.flush()
-            bar.update(1)
+            bar.update(len(batch))
     rows = read_rows(path)
     record["sessions"].append({"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"),
                                "runner": label, "points_run": len(todo),

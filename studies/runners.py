@@ -1,55 +1,85 @@
-"""Runners: plug-ins that map a top-level function over arguments, yielding results as they complete.
+"""Runners: plug-ins that map a top-level function over arguments in batches, yielding each batch's
+results as it completes.
 
-Each runner is ``runner(function, arguments) -> Iterator[result]``: :func:`sequential` (in this
-process), or one bound to a pool that lives for many calls, :func:`process_pool` (spawned
-single-thread workers, all cores by default) and :func:`dask_pool` (a Dask cluster or a
-LocalCluster); :func:`pool` picks one for the command line options. Results come in completion
-order, so the function's result must say which argument it belongs to. Workers run one BLAS
-thread each (OMP/OpenBLAS/MKL set to 1). A worker's warnings come back with its result and are
-issued again in this process (its filters and formatting apply; each distinct warning once per
-pool), so that workers print nothing themselves.
+Each runner is ``runner(function, arguments) -> Iterator[list[result]]``: :func:`sequential` (in this
+process, one argument per batch), or one bound to a pool that lives for many calls,
+:func:`process_pool` (spawned workers, all cores by default) and :func:`dask_pool` (a Dask cluster or
+a LocalCluster); :func:`pool` picks one for the command line options. A pool's workers start and
+import rpdrill once (a process pool's with its first call, so that a study refused before it runs
+starts none) and take batches of arguments (:func:`batches`): a run pays the process machinery once
+per pool and once per batch, not per argument. A pool's call submits its work at once and returns
+the iterator of results, so work submitted earlier (plots) goes on while the caller waits for later
+work. Results come in completion order, so the function's result must say which argument it belongs
+to. Workers run one BLAS thread each and keep freed memory (WORKER_ENVIRONMENT). A worker's
+warnings come back with its batch and are issued again in this process (its filters and formatting
+apply; each distinct warning once per pool), so that workers print nothing themselves.
 """
 
 from __future__ import annotations
 
 import contextlib
-import functools
+import itertools
 import logging
+import math
 import os
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from multiprocessing import get_context
+from pathlib import Path
 from typing import Any, TypeVar
 
 Arg = TypeVar("Arg")
 Result = TypeVar("Result")
-Runner = Callable[[Callable[[Arg], Result], Sequence[Arg]], Iterator[Result]]
-
-SINGLE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+Runner = Callable[[Callable[[Arg], Result], Sequence[Arg]], Iterator[list[Result]]]
 Caught = list[tuple[str, type[Warning], str, int]]
 
+# A worker's environment: one BLAS thread, and glibc keeping freed memory for reuse (arrays up to 64 MB
+# from the heap, kept up to 256 MB): a run's sample arrays, a few MB each, would otherwise be fresh pages
+# every time, and on this machine their page faults cost more than an exact solution and half its
+# metrics (docs/performance.md).
+WORKER_ENVIRONMENT = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+                      "MALLOC_MMAP_THRESHOLD_": str(64 << 20), "MALLOC_TRIM_THRESHOLD_": str(256 << 20)}
+BATCHES_PER_WORKER = 4  # enough to even out unequal points; few enough that a batch costs ~nothing to send
+PAPER_SCENE = Path(__file__).resolve().parent / "scenes" / "paper_base.yaml"
 
-def _caught(function: Callable[[Arg], Result], argument: Arg) -> tuple[Result, Caught]:
-    """Worker side: ``function(argument)`` and the warnings it issued (text, category, file, line)."""
+def batches(arguments: Sequence[Arg], workers: int) -> list[list[Arg]]:
+    """``arguments`` in order, cut into at most BATCHES_PER_WORKER batches per worker of equal size
+    (+-1): each worker takes several, so one slow batch does not leave the others idle."""
+    count = min(len(arguments), workers * BATCHES_PER_WORKER)
+    if count == 0:
+        return []
+    size, extra = divmod(len(arguments), count)
+    bounds = [i * size + min(i, extra) for i in range(count + 1)]
+    return [list(arguments[a:b]) for a, b in itertools.pairwise(bounds)]
+
+
+def run_batch(task: tuple[Callable[[Arg], Result], list[Arg]]) -> tuple[list[Result], Caught]:
+    """Worker: ``function`` over one batch of arguments, and the warnings it issued (text, category,
+    file, line)."""
+    function, arguments = task
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result = function(argument)
-    return result, [(str(w.message), w.category, w.filename, w.lineno) for w in caught]
+        results = [function(argument) for argument in arguments]
+    return results, [(str(w.message), w.category, w.filename, w.lineno) for w in caught]
 
 
-def _reissued(outcome: tuple[Result, Caught], registry: dict[Any, Any]) -> Result:
-    """The worker's result, after issuing its warnings here (``registry``: those issued already)."""
-    result, caught = outcome
-    for text, category, filename, lineno in caught:
-        warnings.warn_explicit(text, category, filename, lineno, registry=registry)
-    return result
+def warm_up() -> None:
+    """Worker initializer: import the study machinery and both formulations, and load the exact solver's
+    compiled kernels from numba's cache (one blow of the shipped paper scene), once per worker."""
+    import rpdrill.models.exudyn_model  # noqa: F401 - imported for what it loads (Exudyn)
+    from rpdrill.models.scene import Scene
+    from rpdrill.models.simulation import prepare
+    from rpdrill.studies.loading import read_yaml
+    from rpdrill.studies.points import run_point  # noqa: F401 - the study machinery
 
+    one_blow = {**read_yaml(PAPER_SCENE), "metrics": {"transient_blows": 0, "block_blows": 1},
+                "solver": {"formulation": "exact", "end_time_s": 0.02}}
+    prepare(Scene.model_validate(one_blow)).run()
 
-def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
-    """In this process, one after the other."""
-    for argument in arguments:
-        yield function(argument)
+def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
+    """In this process, one after the other (each result its own batch)."""
+    return ([function(argument)] for argument in arguments)
 
 
 @contextlib.contextmanager
@@ -67,29 +97,43 @@ def _environment(values: dict[str, str]) -> Iterator[None]:
                 os.environ[key] = value
 
 
+def _completed(futures: list[Any], as_done: Callable[[list[Any]], Iterator[Any]],
+               cancel: Callable[[list[Any]], None], registry: dict[Any, Any]) -> Iterator[list[Any]]:
+    """Each future's batch of results as it completes, after issuing its warnings here (``registry``:
+    those issued already); the rest cancelled when the caller stops early."""
+    try:
+        for future in as_done(futures):
+            results, caught = future.result()
+            for text, category, filename, lineno in caught:
+                warnings.warn_explicit(text, category, filename, lineno, registry=registry)
+            yield results
+    finally:
+        cancel(futures)
+
+
 @contextlib.contextmanager
 def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
-    """A runner bound to one pool of spawned single-thread workers, kept for many calls
-    (calibration evaluates many scans; starting workers costs seconds)."""
+    """A runner bound to one pool of spawned workers (WORKER_ENVIRONMENT), kept for many calls; every
+    worker starts (and imports, :func:`warm_up`) with the first call, none when nothing is run."""
     workers = workers or os.cpu_count() or 1
-    with _environment(SINGLE_THREAD):  # workers start on demand: the setting lasts the pool's life
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+    executors: list[ProcessPoolExecutor] = []
+    registry: dict[Any, Any] = {}
 
-        registry: dict[Any, Any] = {}
+    def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
+        if not executors:
+            with _environment(WORKER_ENVIRONMENT):  # the workers start inside: the setting reaches them
+                executors.append(ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
+                                                     initializer=warm_up))
+                for _ in range(workers):  # a new worker per task pending when submitted: all start now
+                    executors[0].submit(math.sqrt, 0.0)
+        futures = [executors[0].submit(run_batch, (function, batch)) for batch in batches(arguments, workers)]
+        return _completed(futures, as_completed, lambda pending: [f.cancel() for f in pending], registry)
 
-        def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
-            futures = [pool.submit(_caught, function, argument) for argument in arguments]
-            try:
-                for future in as_completed(futures):
-                    yield _reissued(future.result(), registry)
-            finally:
-                for future in futures:
-                    future.cancel()
-
-        try:
-            yield run
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+    try:
+        yield run
+    finally:
+        for executor in executors:
+            executor.shutdown(wait=True, cancel_futures=True)
 
 
 @contextlib.contextmanager
@@ -105,18 +149,15 @@ def dask_pool(address: str | None = None, workers: int | None = None) -> Iterato
         else:
             cluster = stack.enter_context(LocalCluster(
                 n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                dashboard_address=":0", silence_logs=logging.ERROR, env=SINGLE_THREAD))
+                dashboard_address=":0", silence_logs=logging.ERROR, env=WORKER_ENVIRONMENT))
             client = stack.enter_context(Client(cluster))
-
+        client.run(warm_up)
+        slots = sum(client.nthreads().values()) or 1
         registry: dict[Any, Any] = {}
 
-        def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
-            futures = client.map(functools.partial(_caught, function), list(arguments), pure=False)
-            try:
-                for future in dask_completed(futures):
-                    yield _reissued(future.result(), registry)
-            finally:
-                client.cancel(futures)
+        def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
+            futures = client.map(run_batch, [(function, batch) for batch in batches(arguments, slots)], pure=False)
+            return _completed(futures, dask_completed, client.cancel, registry)
 
         yield run
 

@@ -83,8 +83,9 @@ def run_scans(runner: Runner, tasks: list[ScanTask]) -> Iterator[tuple[list[Any]
         keys.setdefault(signature, []).append(task[0])
         first.setdefault(signature, task)
     served = {task[0]: keys[signature] for signature, task in first.items()}
-    for scan in runner(scan_target, list(first.values())) if first else ():
-        yield served[scan["key"]], scan
+    for batch in runner(scan_target, list(first.values())) if first else ():
+        for scan in batch:
+            yield served[scan["key"]], scan
 
 
 def scan_all(runner: Runner, tasks: list[ScanTask]) -> tuple[dict[Any, dict[str, Any]], dict[str, Any]]:

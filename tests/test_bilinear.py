@@ -1,5 +1,5 @@
 """The bilinear loading/unloading rock law: the pure law, its scene keys, and the Exudyn model
-against the ODE formulation with it (both closing the energy balance)."""
+against the exact formulation with it (both closing the energy balance)."""
 
 from __future__ import annotations
 
@@ -165,22 +165,24 @@ def window(**overrides: object):
 
 @pytest.fixture(scope="module", params=["rest", "preloaded"])
 def runs(request):
+    """(the exact formulation, the Exudyn model) of the window; the exact formulation against the ODE on
+    this law: tests/test_exact_model.py."""
     s = window(start=request.param)
-    return simulate(s, "ode", preset="reference"), simulate(s)
+    return simulate(s, "exact", sample_interval_s=DEFAULT_STEP_S), simulate(s)  # both on the same grid
 
 
-def test_exudyn_agrees_with_ode(runs):
-    ode, exudyn = runs
-    report = compare_runs(ode, exudyn, ode.scene.solver.end_time_s)
+def test_exudyn_agrees_with_exact(runs):
+    exact, exudyn = runs
+    report = compare_runs(exact, exudyn, exact.scene.solver.end_time_s)
     checks = verdict(report)
     assert all(c["passed"] for c in checks.values()), checks
     rate = report["metrics"]["penetration_rate_m_per_s"]
     assert rate["reference"] > 0 and rate["rel"] < 1e-4
-    for r in (ode, exudyn):
-        surface, bottom = r.rock_state_m.T  # never backwards (the ODE's to round-off of its events)
+    for r in (exact, exudyn):
+        surface, bottom = r.rock_state_m.T  # never backwards (the exact solution's to round-off of its events)
         assert np.all(np.diff(bottom) >= -1e-15) and np.all(surface <= bottom)
         assert np.min(r.bit_position_m - r.bottom_m) < -1e-6  # the bit lifts off between blows
-    assert {"loading", "unloading", "lifted"} <= set(ode.info["switches_into"])
+    assert {"loading", "unloading", "lifted"} <= set(exact.info["switches_into"])
 
 
 BOUNCING = {**ROCK, "unloading_stiffness_n_per_m": 5e9}  # a stiff unloading: the bit rings off and comes back
@@ -196,7 +198,7 @@ def test_bouncing_bit_remembers_its_crater_within_a_blow(bouncing):
     """The bit rings off the rock and comes back within a blow: from the regain until the force passes
     the blow's earlier peak, the bottom stays and F = k_u (x - p) (no soft re-indentation from a reset
     surface), in every formulation; exact and ODE agree on the penetration rate (the Exudyn cross-check
-    is test_exudyn_agrees_with_ode: its per-step return map on this 5e9 N/m unloading is 8e-4 off)."""
+    is test_exudyn_agrees_with_exact: its per-step return map on this 5e9 N/m unloading is 8e-4 off)."""
     for r in bouncing:
         period, t, x, force = r.scene.impact.period_s, r.time_s, r.bit_position_m, r.rock_force_n
         bottom = r.rock_state_m[:, 1]
@@ -222,14 +224,14 @@ def test_bouncing_bit_remembers_its_crater_within_a_blow(bouncing):
 
 
 def test_start_state_is_consistent_with_the_preload(runs):
-    ode, exudyn = runs
-    x0 = ode.bit_position_m[0]
+    exact, exudyn = runs
+    x0 = exact.bit_position_m[0]
     expected = LAW.return_map(x0, LAW.initial_state())  # (0, 0) from rest
-    for r in (ode, exudyn):
+    for r in (exact, exudyn):
         np.testing.assert_allclose(r.rock_state_m[0], expected, rtol=1e-12, atol=0)
         assert r.rock_force_n[0] == pytest.approx(K_LOAD * x0, abs=1e-6)
-    if ode.scene.start == "preloaded":
-        assert K_LOAD * x0 == pytest.approx(ode.scene.feed.force_n)  # the carriage's feed rests on the rock
+    if exact.scene.start == "preloaded":
+        assert K_LOAD * x0 == pytest.approx(exact.scene.feed.force_n)  # the carriage's feed rests on the rock
 
 
 def test_energy_balance_closes_in_both_formulations(runs):

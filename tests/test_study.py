@@ -3,6 +3,7 @@ Dask, and bad input."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import os
@@ -10,6 +11,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -21,6 +23,7 @@ from rpdrill.models.scene import Scene
 from rpdrill.models.stability import StepLimitWarning
 from rpdrill.studies.cli import main
 from rpdrill.studies.points import run_point
+from rpdrill.studies.runners import BATCHES_PER_WORKER, WORKER_ENVIRONMENT, batches
 from rpdrill.studies.specs import METRIC_NAMES
 from rpdrill.studies.study import load_study
 
@@ -172,12 +175,67 @@ def test_resume_after_kill(tmp_path, capsys):
     assert all(r == before[r["point"]] for r in after if r["point"] in before)
 
 
+@pytest.mark.parametrize("count, workers", [(0, 2), (1, 2), (7, 2), (92, 2), (207, 3)])
+def test_batches_keep_every_point_once_in_order_and_even(count, workers):
+    parts = batches(list(range(count)), workers)
+    assert [p for part in parts for p in part] == list(range(count))
+    assert len(parts) <= workers * BATCHES_PER_WORKER and all(parts)
+    assert max(map(len, parts), default=0) - min(map(len, parts), default=0) <= 1
+
+
+@pytest.mark.slow
 def test_dask_local_cluster(tmp_path):
     study = write_study(tmp_path / "dask.yaml", scan={"impact.frequency_hz": [40, 60]}, plots=[])
     out = tmp_path / "out"
     assert main(["study", str(study), "--out", str(out), "--dask", "--workers", "2", "--quiet"]) == 0
     assert sorted(r["point"] for r in rows(out)) == ["0", "1"]
     assert json.loads((out / "study.json").read_text())["sessions"][0]["runner"] == "dask (LocalCluster)"
+
+
+@contextlib.contextmanager
+def dask_cluster(folder: Path, workers: int) -> Iterator[str]:
+    """A real Dask cluster on this machine, as a user starts one: ``dask scheduler`` and ``dask worker``
+    processes (one thread each); yields the scheduler's address once every worker has joined."""
+    from dask.distributed import Client
+
+    scheduler_file = folder / "scheduler.json"
+    environment = {**os.environ, **WORKER_ENVIRONMENT}
+    command = [sys.executable, "-m", "dask"]
+    processes = [subprocess.Popen([*command, "scheduler", "--scheduler-file", str(scheduler_file), "--port", "0",
+                                   "--no-dashboard"], env=environment, stderr=subprocess.DEVNULL)]
+    try:
+        deadline = time.monotonic() + 60
+        while not scheduler_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        address = json.loads(scheduler_file.read_text())["address"]
+        processes.append(subprocess.Popen([*command, "worker", address, "--nworkers", str(workers), "--nthreads", "1",
+                                           "--no-dashboard"], env=environment, stderr=subprocess.DEVNULL))
+        with Client(address) as client:
+            client.wait_for_workers(workers, timeout=60)
+        yield address
+    finally:
+        for process in reversed(processes):
+            process.terminate()
+            process.wait(timeout=30)
+
+
+@pytest.mark.slow
+def test_study_on_a_real_dask_cluster_gives_the_local_results(tmp_path):
+    """``rpdrill study --dask ADDRESS`` on a scheduler and two worker processes started with the dask
+    command line: the same table as a run in this process (every column but the wall time)."""
+    study = write_study(tmp_path / "cluster.yaml", plots=[])
+    with dask_cluster(tmp_path, workers=2) as address:
+        assert main(["study", str(study), "--out", str(tmp_path / "cluster"), "--dask", address, "--quiet"]) == 0
+    assert main(["study", str(study), "--out", str(tmp_path / "local"), "--workers", "1", "--quiet"]) == 0
+    sessions = json.loads((tmp_path / "cluster" / "study.json").read_text())["sessions"]
+    assert sessions[0]["runner"] == f"dask ({address})"
+
+    def table(out: Path) -> list[dict[str, str]]:
+        return sorted(({k: v for k, v in row.items() if k != "wall_time_s"} for row in rows(out)),
+                      key=lambda row: int(row["point"]))
+
+    assert len(table(tmp_path / "cluster")) == 4
+    assert table(tmp_path / "cluster") == table(tmp_path / "local")
 
 
 @pytest.mark.parametrize("changes, expected", [

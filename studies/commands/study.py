@@ -13,13 +13,12 @@ from pathlib import Path
 
 from rpdrill.models.formulations import FORMULATIONS
 from rpdrill.studies.commands import add_runner_arguments
-from rpdrill.studies.plots.scans import draw_plots
 from rpdrill.studies.points import run_point
-from rpdrill.studies.resumable import STATUS_COLUMNS, run_points
+from rpdrill.studies.resumable import STATUS_COLUMNS, Row, run_points
 from rpdrill.studies.run_files import write_json, write_rows_csv
-from rpdrill.studies.runners import pool
-from rpdrill.studies.study import load_study
-from rpdrill.studies.study_optima import csv_rows, optima_table, study_optima
+from rpdrill.studies.runners import Runner, pool
+from rpdrill.studies.study import Study, load_study
+from rpdrill.studies.study_optima import Record, csv_rows, optima_table, study_optima
 
 FILES = """files written to DIR:
   results.csv    one row per point (scan values, status, error, wall time, metrics in SI units),
@@ -41,17 +40,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_runner_arguments(parser)
 
 
-def run(args: argparse.Namespace) -> int:
-    study = load_study(args.study, args.formulation)
-    out = Path(args.out)
+def run_study(study: Study, out: Path, runner: tuple[str, Runner], quiet: bool) -> tuple[list[Row], list[Record]]:
+    """Run the study's points into ``out`` (resumable), then write its optima (optima.csv, study.json):
+    (all rows, the optima)."""
     columns = ["point", *study.axes, *STATUS_COLUMNS, *study.spec.metrics]
-    with pool(args.dask, args.workers) as runner:
-        rows = run_points(study, out, "results.csv", columns, lambda p: (p.index, p.simulation), run_point, runner,
-                          args.quiet)
+    rows = run_points(study, out, "results.csv", columns, lambda p: (p.index, p.simulation), run_point, runner, quiet)
     optima = study_optima(study, rows)
     write_rows_csv(out / "optima.csv", csv_rows(optima))
     record = json.loads((out / "study.json").read_text(encoding="utf-8"))
     write_json(out / "study.json", {**record, "optima": optima})
+    return rows, optima
+
+
+def run(args: argparse.Namespace) -> int:
+    study = load_study(args.study, args.formulation)
+    out = Path(args.out)
+    with pool(args.dask, args.workers) as runner:
+        rows, optima = run_study(study, out, runner, args.quiet)
+    from rpdrill.studies.plots.scans import draw_plots  # matplotlib once the points have run, not at start
+
     written, skipped = draw_plots(study, rows, optima, out)
     failed = [row for row in rows if row["status"] != "ok"]
     print(f"{study.spec.name}: {len(rows) - len(failed)} points ok, {len(failed)} failed; wrote "

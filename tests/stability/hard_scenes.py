@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from scenes import CRUSHING
+from scenes import CRUSHING, scene_dict
+
+from rpdrill.models.scene import Scene
 
 
 def _links(stiffness: tuple[float, float, float], damping: tuple[float, float, float]) -> dict[str, Any]:
@@ -39,3 +41,11 @@ HARD_SCENES: dict[str, dict[str, Any]] = {
 }
 LONG_RUN = {**CRUSHING, "impact.frequency_hz": 65.0, "solver.end_time_s": 10.0, "metrics.transient_blows": 50,
             "metrics.block_blows": 50}
+
+
+def hard_scene(overrides: dict[str, Any], solver: dict[str, Any] | None = None) -> Scene:
+    """The test drill with a hard scene's ``overrides``, short unless they say otherwise, with the
+    ``solver`` options (default: the scene's default, the standard preset)."""
+    data = scene_dict(**(SHORT | overrides))
+    data["solver"] = {"end_time_s": data["solver"]["end_time_s"]} | (solver or {})
+    return Scene.model_validate(data)

@@ -1,5 +1,6 @@
 """Hard scenes stay numerically stable with every preset and with the fixed-step explicit
-solvers at the largest step the docs allow; a too-large step is reported, never returned."""
+solvers at the largest step the docs allow, and every preset keeps its stated errors against the
+exact formulation; a too-large step is reported, never returned."""
 
 from __future__ import annotations
 
@@ -7,11 +8,10 @@ import functools
 
 import numpy as np
 import pytest
-from scenes import scene_dict, simulate
+from scenes import simulate
 
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
 from rpdrill.models.solver_settings import EXUDYN_PRESETS
 from rpdrill.models.stability import (
@@ -20,19 +20,19 @@ from rpdrill.models.stability import (
     StepLimitWarning,
     largest_stable_step_s,
 )
-from stability.hard_scenes import HARD_SCENES, LONG_RUN, SHORT
-
-
-def make(overrides: dict, solver: dict) -> Scene:
-    data = scene_dict(**(SHORT | overrides))
-    data["solver"] = {"end_time_s": data["solver"]["end_time_s"]} | solver
-    return Scene.model_validate(data)
+from stability.hard_scenes import HARD_SCENES, LONG_RUN, hard_scene
 
 
 @functools.cache
 def run(name: str, preset: str) -> tuple[SimulationResult, dict]:
-    result = simulate(make(HARD_SCENES[name], {"preset": preset}))
+    result = simulate(hard_scene(HARD_SCENES[name], {"preset": preset}))
     return result, summary_metrics(result)
+
+
+@functools.cache
+def exact(name: str) -> dict:
+    """The exact formulation's metrics of a hard scene: the reference of every preset's error."""
+    return summary_metrics(simulate(hard_scene(HARD_SCENES[name], {"formulation": "exact"})))
 
 
 def assert_physical(result: SimulationResult) -> None:
@@ -52,17 +52,16 @@ def test_preset_is_stable_and_within_its_stated_errors(name, preset):
     result, metrics = run(name, preset)
     assert_physical(result)
     stated = EXUDYN_PRESETS[preset]
-    assert metrics["energy_balance_relative_error"] <= stated["energy_balance_error"]
-    if preset != "reference":
-        assert rate_error(metrics, run(name, "reference")[1]) <= stated["penetration_rate_error"]
+    assert metrics["energy_balance_relative_error"] <= stated.energy_balance_error
+    assert rate_error(metrics, exact(name)) <= stated.penetration_rate_error
 
 
 @pytest.mark.parametrize("solver", [s for s, f in STABLE_STEP_FACTOR.items() if f is not None])
 @pytest.mark.parametrize("name", list(HARD_SCENES))
 def test_fixed_step_at_documented_limit_stays_stable(name, solver):
-    base = make(HARD_SCENES[name], {"preset": "standard"})
+    base = hard_scene(HARD_SCENES[name])
     step = min(largest_stable_step_s(prepare(base), solver), base.impact.duration_s / 5, base.impact.period_s / 20)
-    result = simulate(make(HARD_SCENES[name], {"type": solver, "step_s": step}))
+    result = simulate(hard_scene(HARD_SCENES[name], {"type": solver, "step_s": step}))
     assert_physical(result)
 
 
@@ -80,18 +79,19 @@ def test_crushing_scenes_do_crush(name):
 
 @pytest.mark.slow
 def test_long_run_650_blows():
-    results = {p: simulate(make(LONG_RUN, {"preset": p})) for p in ("fast", "standard")}
-    for result in results.values():
+    reference = summary_metrics(simulate(hard_scene(LONG_RUN, {"formulation": "exact"})))
+    for preset in ("fast", "standard"):
+        result = simulate(hard_scene(LONG_RUN, {"preset": preset}))
         assert_physical(result)
         assert result.time_s[-1] * result.scene.impact.frequency_hz >= 650
-    fast, standard = (summary_metrics(results[p]) for p in ("fast", "standard"))
-    assert standard["energy_balance_relative_error"] <= EXUDYN_PRESETS["standard"]["energy_balance_error"]
-    assert rate_error(fast, standard) <= EXUDYN_PRESETS["fast"]["penetration_rate_error"]
+        metrics, stated = summary_metrics(result), EXUDYN_PRESETS[preset]
+        assert metrics["energy_balance_relative_error"] <= stated.energy_balance_error
+        assert rate_error(metrics, reference) <= stated.penetration_rate_error
 
 
 def test_unstable_step_is_reported_with_time_and_remedy():
-    limit = largest_stable_step_s(prepare(make(HARD_SCENES["no_damping"], {"preset": "standard"})), "rk44")
-    scene = make(HARD_SCENES["no_damping"], {"type": "rk44", "step_s": 1.5 * limit})
+    limit = largest_stable_step_s(prepare(hard_scene(HARD_SCENES["no_damping"])), "rk44")
+    scene = hard_scene(HARD_SCENES["no_damping"], {"type": "rk44", "step_s": 1.5 * limit})
     with pytest.warns(StepLimitWarning, match="exceeds the stability limit"), \
             pytest.raises(SimulationFailed) as failure:
         simulate(scene)
@@ -102,8 +102,8 @@ def test_unstable_step_is_reported_with_time_and_remedy():
 def test_automatic_step_at_its_minimum_is_reported_not_returned():
     """DOPRI5 at a tolerance the rock's kinks cannot meet: Exudyn would go on at its minimum step
     (inaccurate, or for hours); the run is stopped and reported with a remedy."""
-    scene = make(HARD_SCENES["stiffest_rock_stiff_joints"],
-                 {"type": "dopri5", "step_s": 1e-4, "relative_tolerance": 1e-9, "absolute_tolerance": 1e-12})
+    scene = hard_scene(HARD_SCENES["stiffest_rock_stiff_joints"],
+                       {"type": "dopri5", "step_s": 1e-4, "relative_tolerance": 1e-9, "absolute_tolerance": 1e-12})
     with pytest.raises(SimulationFailed, match="reached the minimum step") as failure:
         simulate(scene)
     assert "try relative_tolerance" in str(failure.value)

@@ -1,0 +1,132 @@
+"""The Exudyn accuracy presets against their targets, measured in one run.
+
+Usage: python benchmarks/bench_presets.py [--repeats N] [--presets fast,standard,reference] [--front]
+With ``--front``: the work-precision front the presets are picked from. Every candidate step rule
+(rk44, rk67 and generalized-alpha at step = min(1e-4 s, pulse / 10, c / |lambda|_max) over a range of
+c) runs on the paper scene and on every hard scene; printed per candidate: its CPU seconds per
+simulated second on the paper scene and its largest penetration-rate and energy-balance errors over
+the scenes (the damped scenes and the undamped one apart: its errors grow blow by blow), the
+candidates on the front (no other both cheaper and more accurate over the damped scenes) marked.
+Otherwise prints, for each preset of models.solver_settings: its solver and step on the shipped paper scene,
+the CPU seconds per simulated second there (1 s simulated, every output, median of N runs after a
+warm-up, results dropped between runs), and on the paper scene and every hard scene of
+tests/stability/hard_scenes.py (the frozen test drill varied) the penetration-rate error against the
+exact formulation and the energy-balance error; then the largest errors over the scenes against
+what the preset states, and the cost against the issue's targets (fast 0.05, standard 0.1).
+"""
+
+from __future__ import annotations
+
+import os
+
+# one BLAS thread, as in a study's workers (studies.runners.WORKER_ENVIRONMENT): set before NumPy loads
+for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_variable, "1")
+
+import argparse
+import statistics
+import sys
+import warnings
+from pathlib import Path
+
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.scene import Scene
+from rpdrill.models.simulation import prepare
+from rpdrill.models.solver_settings import EXUDYN_PRESETS
+from rpdrill.models.workprecision import pareto_front
+from rpdrill.studies.loading import load_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))  # the hard scenes of the stability suite
+from stability.hard_scenes import HARD_SCENES, hard_scene
+
+COST_TARGETS = {"fast": 0.05, "standard": 0.1}
+
+
+def rate_error(metrics: dict[str, float], exact: dict[str, float]) -> float:
+    reference = exact["penetration_rate_m_per_s"]
+    return abs(metrics["penetration_rate_m_per_s"] - reference) / max(abs(reference), 1e-9)
+
+
+def cost(scene: Scene, repeats: int) -> float:
+    simulation = prepare(scene)
+    simulation.run()  # warm-up
+    runs = []
+    for _ in range(repeats):
+        runs.append(simulation.run().cpu_time_s)  # the result is dropped at once
+    return statistics.median(runs) / scene.solver.end_time_s
+
+
+FRONT_CANDIDATES = [("rk44", c) for c in (2.2, 1.9, 1.5, 1.0, 0.7, 0.5)] + \
+    [("rk67", c) for c in (1.0, 0.8, 0.6, 0.4, 0.2)] + [("generalized_alpha", c) for c in (2.0, 1.0, 0.5, 0.25)]
+UNDAMPED = "no_damping"
+
+
+def front(scenes: dict[str, Scene], exact: dict[str, dict[str, float]]) -> None:
+    """The candidates' cost on the paper scene and largest errors over the scenes (module doc)."""
+    print(f"{'solver':<20}{'c':<6}{'CPU s / sim s':<15}{'rate, damped':<14}{'rate, undamped':<16}"
+          f"{'energy, damped':<16}front")
+    rows = []
+    for solver, factor in FRONT_CANDIDATES:
+        rate, energy, undamped, per_second = 0.0, 0.0, 0.0, float("nan")
+        for name, scene in scenes.items():
+            radius = prepare(scene).spectral_radius_per_s
+            step = min(1e-4, scene.impact.duration_s / 10, factor / radius)
+            try:
+                result = prepare(scene.with_solver("exudyn", type=solver, step_s=step)).run()
+            except Exception:  # noqa: BLE001 - a diverged candidate is off the front
+                rate = energy = float("inf")
+                break
+            metrics = summary_metrics(result)
+            if name == "paper_base":
+                per_second = result.cpu_time_s / scene.solver.end_time_s
+            if name == UNDAMPED:
+                undamped = rate_error(metrics, exact[name])
+            else:
+                rate = max(rate, rate_error(metrics, exact[name]))
+                energy = max(energy, metrics["energy_balance_relative_error"])
+        rows.append((solver, factor, per_second, rate, undamped, energy))
+    on_front = set(pareto_front([r[2] for r in rows], [r[3] for r in rows]))
+    for i, (solver, factor, per_second, rate, undamped, energy) in enumerate(rows):
+        print(f"{solver:<20}{factor:<6g}{per_second:<15.4f}{rate:<14.2e}{undamped:<16.2e}{energy:<16.2e}"
+              f"{'*' if i in on_front else ''}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--presets", default=",".join(EXUDYN_PRESETS))
+    parser.add_argument("--front", action="store_true", help="measure the candidates' front instead")
+    args = parser.parse_args()
+    warnings.simplefilter("ignore")  # step-limit warnings of the explicit solvers: errors are measured
+    scenes = {"paper_base": load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml")}
+    scenes.update({name: hard_scene(overrides) for name, overrides in HARD_SCENES.items()})
+    exact = {name: summary_metrics(prepare(scene.with_solver("exact")).run()) for name, scene in scenes.items()}
+    if args.front:
+        front(scenes, exact)
+        return
+    for preset in args.presets.split(","):
+        stated = EXUDYN_PRESETS[preset]
+        paper = scenes["paper_base"].with_solver("exudyn", preset=preset)
+        settings = prepare(paper).settings
+        per_second = cost(paper, args.repeats)
+        print(f"\npreset {preset}: {settings.type}, step {settings.step_s:.3g} s on paper_base; "
+              f"{per_second:.4f} CPU s per simulated s (median of {args.repeats})"
+              + (f", target {COST_TARGETS[preset]}: ratio {per_second / COST_TARGETS[preset]:.2f}"
+                 if preset in COST_TARGETS else ""))
+        print(f"  {'scene':<28}{'step [s]':<12}{'rate error':<14}{'energy error':<14}CPU s / sim s")
+        worst = {"rate": 0.0, "energy": 0.0}
+        for name, scene in scenes.items():
+            simulation = prepare(scene.with_solver("exudyn", preset=preset))
+            result = simulation.run()
+            metrics = summary_metrics(result)
+            error, energy = rate_error(metrics, exact[name]), metrics["energy_balance_relative_error"]
+            worst = {"rate": max(worst["rate"], error), "energy": max(worst["energy"], energy)}
+            print(f"  {name:<28}{simulation.settings.step_s:<12.3g}{error:<14.2e}{energy:<14.2e}"
+                  f"{result.cpu_time_s / scene.solver.end_time_s:.4f}")
+        print(f"  largest: rate {worst['rate']:.2e} (stated {stated.penetration_rate_error:g}), energy "
+              f"{worst['energy']:.2e} (stated {stated.energy_balance_error:g})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,98 @@
+"""What the study machinery costs beside the simulations: the three paper scans, measured in one run.
+
+Usage: python benchmarks/bench_studies.py [--workers N] [--formulations exact,fast]
+For each formulation (``exact``: the exact formulation; ``fast``/``standard``: Exudyn at that preset),
+the three paper scans (studies/paper/{frequency,impulse,stiffness}_scan.yaml, 207 points of 1.5 s)
+run through the study command's own code (studies.commands.study.run_study: load, resumable results,
+optima; then studies.plots.scans.draw_plots) on one process pool opened for the three, into a scratch
+directory.
+Prints the wall time from opening the pool to the last plot, the CPU seconds of this process and its
+workers over the same span (on a shared machine the wall time depends on the other load; the CPU
+time is what the run needs: on N idle cores the wall time is about CPU / N), the CPU seconds the
+simulations reported (``cpu_time_s`` of every point) and their share of all CPU.
+Then one ``rpdrill study`` command of the frequency scan as a user runs it (a new process: imports,
+pool start, plots), its wall time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import yaml
+
+from rpdrill.studies.commands.study import run_study
+from rpdrill.studies.plots.scans import draw_plots
+from rpdrill.studies.runners import pool
+from rpdrill.studies.study import load_study
+
+ROOT = Path(__file__).resolve().parents[1]
+SCANS = ("frequency_scan", "impulse_scan", "stiffness_scan")
+SOLVERS = {"exact": {"solver.formulation": "exact"}, "fast": {"solver.preset": "fast"},
+           "standard": {"solver.preset": "standard"}}
+
+
+def study_file(scan: str, solver: str, folder: Path) -> Path:
+    """The paper scan with the solver's overrides, as a study file in ``folder``."""
+    data = yaml.safe_load((ROOT / "studies" / "paper" / f"{scan}.yaml").read_text(encoding="utf-8"))
+    data["base_scene"] = str(ROOT / "studies" / "scenes" / "paper_base.yaml")
+    data["base_overrides"] = {**data.get("base_overrides", {}), **SOLVERS[solver]}
+    path = folder / f"{scan}_{solver}.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def cpu_s() -> float:
+    """CPU seconds of this process and of its finished children (the pool's workers once it closed)."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def three_scans(solver: str, workers: int, folder: Path) -> None:
+    start, cpu_start = time.perf_counter(), cpu_s()
+    simulated_cpu, points, plots_written = 0.0, 0, 0
+    with pool(None, workers) as runner:
+        for scan in SCANS:
+            study = load_study(study_file(scan, solver, folder))
+            rows, optima = run_study(study, folder / f"{scan}_{solver}", runner, quiet=True)
+            plots_written += len(draw_plots(study, rows, optima, folder / f"{scan}_{solver}")[0])
+            simulated_cpu += sum(float(row["cpu_time_s"]) for row in rows if row["status"] == "ok")
+            points += len(rows)
+    wall, cpu = time.perf_counter() - start, cpu_s() - cpu_start
+    print(f"{solver:<10}{points:<8}{wall:<10.2f}{cpu:<18.2f}{simulated_cpu:<22.2f}{simulated_cpu / cpu:<24.2f}"
+          f"{plots_written}")
+
+
+def one_command(solver: str, workers: int, folder: Path) -> float:
+    study = study_file("frequency_scan", solver, folder)
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "rpdrill.studies.cli", "study", str(study), "--out",
+                    str(folder / f"command_{solver}"), "--workers", str(workers), "--quiet"], check=True)
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--formulations", default="exact,fast")
+    args = parser.parse_args()
+    solvers = args.formulations.split(",")
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = Path(scratch)
+        print(f"three paper scans on one pool of {args.workers} workers")
+        print(f"{'solver':<10}{'points':<8}{'wall s':<10}{'all CPU s':<18}{'simulation CPU s':<22}"
+              f"{'simulation / all':<24}plots")
+        for solver in solvers:
+            three_scans(solver, args.workers, folder)
+        for solver in solvers:
+            print(f"one command (rpdrill study frequency_scan, 23 points, {solver}): "
+                  f"{one_command(solver, args.workers, folder):.2f} s wall")
+
+
+if __name__ == "__main__":
+    main()
