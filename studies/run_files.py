@@ -18,7 +18,8 @@ import yaml
 
 @contextlib.contextmanager
 def staged_directory(out_dir: str | Path) -> Iterator[Path]:
-    """Yield a scratch directory; its files move into ``out_dir`` only if the block succeeds."""
+    """Yield a scratch directory; its files and folders move into ``out_dir`` only if the block succeeds
+    (replacing those of the same name there)."""
     out_dir = Path(out_dir)
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}-", dir=out_dir.parent))
@@ -26,6 +27,8 @@ def staged_directory(out_dir: str | Path) -> Iterator[Path]:
         yield stage
         out_dir.mkdir(exist_ok=True)
         for item in stage.iterdir():
+            if (out_dir / item.name).is_dir():
+                shutil.rmtree(out_dir / item.name)
             os.replace(item, out_dir / item.name)
     finally:
         shutil.rmtree(stage, ignore_errors=True)

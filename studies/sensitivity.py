@@ -295,7 +295,8 @@ def trends(study: SensitivityStudy, rows: list[Row]) -> list[dict[str, Any]]:
 
 def global_indices(study: SensitivityStudy, rows: list[Row]) -> list[dict[str, Any]]:
     """SALib indices per scan, metric and quantity (optimum frequency, peak); a sample without an optimum
-    takes the nominal value (counted in ``missing``)."""
+    takes the nominal value (counted in ``missing``); where the nominal scan has none either, the indices
+    are NaN (not computed)."""
     analysis = study.spec.global_analysis
     if analysis is None:
         return []
@@ -312,12 +313,14 @@ def global_indices(study: SensitivityStudy, rows: list[Row]) -> list[dict[str, A
                 values = np.array([_number(r[column]) for r in samples])
                 missing = int(np.sum(~np.isfinite(values)))
                 values[~np.isfinite(values)] = _number(nominal[label][column])
-                if analysis.method == "morris":
+                names = ("mu_star", "sigma") if analysis.method == "morris" else ("S1", "ST")
+                if not np.isfinite(values).all():
+                    found = {k: np.full(len(analysis.parameters), np.nan) for k in names}
+                elif analysis.method == "morris":
                     found = morris.analyze(problem, study.samples, values, num_levels=4, seed=analysis.seed)
-                    indices = {"mu_star": found["mu_star"], "sigma": found["sigma"]}
                 else:
                     found = sobol.analyze(problem, values, seed=analysis.seed)
-                    indices = {"S1": found["S1"], "ST": found["ST"]}
+                indices = {k: found[k] for k in names}
                 for i, name in enumerate(analysis.parameters):
                     out.append({"scan": label, "metric": metric, "quantity": quantity, "parameter": name,
                                 "missing": missing, **{k: float(v[i]) for k, v in indices.items()}})

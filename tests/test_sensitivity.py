@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+import warnings
 from pathlib import Path
 
 import pytest
@@ -96,6 +97,23 @@ def test_morris_screening_ranks_the_parameters(tmp_path):
     optimum = {i["parameter"]: float(i["mu_star"]) for i in indices
                if i["quantity"] == "optimum_hz" and i["metric"] == "collar_velocity_peak_m_per_s"}
     assert all(value > 0 for value in optimum.values())  # both move the rock mode
+
+
+def test_morris_indices_without_any_optimum_are_not_computed(tmp_path, capsys):
+    """A scan that never crushes has no penetration optimum, nominal or sampled: its indices are NaN,
+    not a masked SALib result (no warning), and the collar velocity's are computed."""
+    never = [{"label": "never crushes", "overrides": {"impact.amplitude_n": 160e3, "rock.threshold_n": 1e9}}]
+    study = write(tmp_path / "g.yaml", spec(parameters=[COLLAR], scans=never,
+                                            **{"global": {"method": "morris", "parameters": [COLLAR, ROCK],
+                                                          "samples": 2, "seed": 3}}))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert main(["sensitivity", str(study), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"]) == 0
+    assert not [str(w.message) for w in caught] and "warning" not in capsys.readouterr().err.lower()
+    indices = [i for i in table(tmp_path / "out" / "global.csv") if i["quantity"] == "optimum_hz"]
+    rate = [i for i in indices if i["metric"] == "penetration_rate_m_per_s"]
+    assert rate and all(i["mu_star"] == "nan" and int(i["missing"]) == 6 for i in rate)
+    assert all(float(i["mu_star"]) >= 0 for i in indices if i["metric"] == "collar_velocity_peak_m_per_s")
 
 
 def test_all_parameters_are_the_numbers_the_scene_sets():
