@@ -32,6 +32,7 @@ SPEED, FREQUENCY, ROCK = "rotation.speed_rpm", "impact.frequency_hz", "rock.name
 MANUAL_RPM_FACTOR, MANUAL_BLOWS_PER_MINUTE = 1600.0, 2160.0
 MANUAL_INDEX_PER_BUTTON = MANUAL_RPM_FACTOR / MANUAL_BLOWS_PER_MINUTE
 CHALK_SPIRAL_MM = (10.0, 19.0)  # the manual's field check: penetration per turn
+TIE = 1e-6  # relative: rates closer than this are equal (aliased speeds give the same rate to round-off)
 DRILLED = 0.01  # a frequency counts as drilled where its best rate reaches 1 % of the rock's best on the map
 
 
@@ -67,9 +68,10 @@ def dth_rows(run: Path) -> tuple[list[str], float, float]:
     manual, best = manual_speed_rpm(bit, frequency), Indexing(bit, None, frequency).best_speed_rpm()
     lines = []
     for rock, members in _by_rock(rows).items():
+        members = sorted(members, key=lambda r: float(r[SPEED]))
         speeds = np.array([float(r[SPEED]) for r in members])
         rates = np.array([float(r[RATE]) for r in members])
-        top = int(np.argmax(rates))
+        top = int(np.argmax(rates >= rates.max() - TIE * abs(rates.max())))  # the slowest of equal rates
         if rates[top] <= 0:
             lines.append(f"| {rock} | no penetration at any speed | 0 | 0 | - |")
             continue
@@ -86,9 +88,10 @@ def ridge(run: Path) -> list[tuple[str, float, float, float, float]]:
     bit, found = _bit(run), []
     for rock, members in _by_rock(_rows(run / "results.csv")).items():
         best: dict[float, tuple[float, float]] = {}
-        for row in members:
+        for row in sorted(members, key=lambda r: float(r[SPEED])):
             frequency, rate = float(row[FREQUENCY]), float(row[RATE])
-            if rate > best.get(frequency, (0.0, -1.0))[1]:
+            # the slowest of equal rates: speeds whose index per blow differ by a button pitch are aliases
+            if frequency not in best or rate > best[frequency][1] + TIE * abs(best[frequency][1]):
                 best[frequency] = (float(row[SPEED]), rate)
         peak = max(rate for _, rate in best.values())
         found += [(rock, frequency, speed, rate, Indexing(bit, None, frequency).best_speed_rpm())
