@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 from scenes import PER_BODY, crushing_scene, scene, simulate
 
 import rpdrill.models.exact_model
@@ -29,6 +28,7 @@ from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.stability import SimulationFailed
+from rpdrill.studies.loading import read_yaml
 
 BLOWS = 12
 SHORT_METRICS = {"metrics__transient_blows": 2, "metrics__block_blows": 2}
@@ -228,7 +228,7 @@ FOUR_ROD = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "four_ro
 def four_rods_with_couplings() -> Scene:
     """The four-rod string with compression-only couplings on soft limestone, 400 kN blows: it crushes
     in its first blow; one blow (the rattle of loose couplings is chaotic over many blows)."""
-    data = yaml.safe_load(FOUR_ROD.read_text())
+    data = read_yaml(FOUR_ROD)
     for name in ("shank_coupling", "coupling1", "coupling2", "coupling3", "bit_coupling"):
         data["drill_string"]["connectors"][name]["type"] = "coupling"
     data["rock"], data["impact"]["amplitude_n"] = {"name": "soft_limestone"}, 400e3
