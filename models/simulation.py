@@ -10,6 +10,8 @@ the energy account and the stability checks read these fields; nothing derives t
 
 from __future__ import annotations
 
+import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -29,7 +31,7 @@ from rpdrill.models.scene import (
     requested_outputs,
 )
 from rpdrill.models.solver_settings import Settings, resolve_settings
-from rpdrill.models.stability import spectral_radius_per_s
+from rpdrill.models.stability import FastestElement, fastest_element, spectral_radius_per_s
 from rpdrill.rocklaw import RockLaw, State
 
 if TYPE_CHECKING:
@@ -58,6 +60,7 @@ class Simulation:
     initial_rock_state: State
     initial_torsion_angle_rad: float
     spectral_radius_per_s: float | None  # |lambda|_max with the bit on the rock (Exudyn runs only)
+    fastest: FastestElement  # the element of the highest rate and the keys that set it
 
     @property
     def name(self) -> str:
@@ -98,8 +101,14 @@ def prepare(scene: Scene) -> Simulation:
     outputs = requested_outputs(scene, effects)
     chain = axial_chain(scene, joint_damping=effects.joint_damping)
     rock = scene.rock.build(damping=effects.rock_damping, plasticity=effects.rock_plasticity)
-    radius = spectral_radius_per_s(chain, rock) if scene.solver.formulation == "exudyn" else None
-    settings = resolve_settings(scene.solver, scene.impact.duration_s, lambda: radius,
+    torsion = scene.torsion if effects.torsion else None
+    fastest = fastest_element(scene, chain, rock, torsion)
+    radius = spectral_radius_per_s(chain, rock, torsion) if scene.solver.formulation == "exudyn" else None
+    if not math.isfinite(fastest.rate_per_s) or not math.isfinite(radius or 0.0):
+        raise SceneError(tuple(fastest.key.split(".")), fastest.value,
+                         f"with {fastest.other_key} {fastest.other_value:g} the model's fastest rate overflows "
+                         f"(k/m or c/m beyond {sys.float_info.max:.3g}); give values of a physical drill")
+    settings = resolve_settings(scene.solver, scene.impact.duration_s, radius,
                                 "energy" in needs(outputs.metrics, outputs.timeseries).data)
     positions, angle = np.zeros(chain.size), 0.0
     if scene.start == "preloaded":
@@ -110,7 +119,7 @@ def prepare(scene: Scene) -> Simulation:
         if effects.torsion:
             angle = static_torsion_angle_rad(scene.torsion)
     state = rock.return_map(float(positions[chain.bit_body]), rock.initial_state())
-    return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, radius)
+    return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, radius, fastest)
 
 
 def as_simulation(run: Scene | Simulation) -> Simulation:

@@ -17,7 +17,6 @@ a preset and without explicit accuracy options the ``standard`` preset applies.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 from rpdrill.models.formulations import DEFAULT_PRESET
@@ -92,10 +91,11 @@ def _given(solver: Solver, key: str, default: float) -> float:
     return default if value is None else value
 
 
-def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_per_s: Callable[[], float],
+def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_per_s: float | None,
                      energy: bool) -> Settings:
-    """The settings of ``solver``'s formulation (module doc). ``spectral_radius_per_s`` is called only
-    when an Exudyn preset must choose the step; ``energy``: an energy output is asked for."""
+    """The settings of ``solver``'s formulation (module doc): ``spectral_radius_per_s`` is |lambda|_max
+    (an Exudyn preset's step follows it; None for the other formulations); ``energy``: an energy output
+    is asked for."""
     common = {"formulation": solver.formulation, "end_time_s": solver.end_time_s,
               "output_interval_s": solver.output_interval_s}
     if solver.formulation == "exudyn":
@@ -104,7 +104,7 @@ def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_pe
         if step is None:
             tier = EXUDYN_PRESETS[preset or DEFAULT_PRESET]
             step = min(tier["step_s"], pulse_duration_s / tier["steps_per_pulse"],
-                       tier["step_times_radius"] / spectral_radius_per_s())
+                       tier["step_times_radius"] / spectral_radius_per_s)
         return ExudynSettings(type=solver.type or "rk44", step_s=step, spectral_radius=_given(solver, "spectral_radius", 1.0),
                               relative_tolerance=_given(solver, "relative_tolerance", 1e-8),
                               absolute_tolerance=_given(solver, "absolute_tolerance", 1e-12), preset=preset, **common)

@@ -5,7 +5,8 @@ process), or one bound to a pool that lives for many calls, :func:`process_pool`
 single-thread workers, all cores by default) and :func:`dask_pool` (a Dask cluster or a
 LocalCluster); :func:`pool` picks one for the command line options. Results come in completion
 order, so the function's result must say which argument it belongs to. Workers run one BLAS
-thread each (OMP/OpenBLAS/MKL set to 1).
+thread each (OMP/OpenBLAS/MKL set to 1); pool workers stop on SIGTERM as on Ctrl-C
+(studies.interrupts).
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from multiprocessing import get_context
 from typing import Any, TypeVar
+
+from rpdrill.studies.interrupts import worker_stops_like_ctrl_c
 
 Arg = TypeVar("Arg")
 Result = TypeVar("Result")
@@ -52,7 +55,8 @@ def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
     (calibration evaluates many scans; starting workers costs seconds)."""
     workers = workers or os.cpu_count() or 1
     with _environment(SINGLE_THREAD):  # workers start on demand: the setting lasts the pool's life
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
+                                   initializer=worker_stops_like_ctrl_c)
 
         def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[Result]:
             futures = [pool.submit(function, argument) for argument in arguments]

@@ -1,8 +1,9 @@
 """The corpus of malformed inputs (tests/bad_inputs/cases.yaml): every case is rejected cleanly.
 
 Clean: the declared exit status (2 bad input, 1 a budget exceeded or a run that diverged), one
-message on standard error that names the file and contains the declared word, no traceback, and
-nothing written to ``--out`` (absent before: absent after; holding something: unchanged). Each
+message on standard error that names the file (the ``--out`` folder, or the command-line argument,
+where that is what is wrong) and contains the declared word, no traceback, and nothing written to
+``--out`` (absent before: absent after; holding something: unchanged). Each
 case runs in this process through ``rpdrill.studies.cli.main``; they are refused before anything
 heavy runs, so the corpus is fast.
 """
@@ -24,6 +25,7 @@ FOLDERS = ("scenes", "studies", "calibrations", "accuracy", "outputs", "cli")
 HOLDINGS = {
     "other_run": {"timeseries.csv": "time_s,bit_position_m\n0,0\n", "summary.json": "{}\n"},
     "other_study": {"study.json": json.dumps({"hash": "0" * 64, "sessions": []}), "results.csv": "point,status\n"},
+    "broken_record": {"study.json": "{\"hash\": ", "checkpoint.json": "[1, 2]\n"},
 }
 
 
@@ -62,8 +64,8 @@ def problems(path: str, case: dict, status: int, message: str, out: Path, before
     found = []
     if status != case["status"]:
         found.append(f"exit status {status}, expected {case['status']}")
-    if "Traceback" in message:
-        found.append("a traceback")
+    if "Traceback" in message or "internal error" in message:
+        found.append("a traceback or an internal error")
     if str(case["word"]) not in message:
         found.append(f"no {case['word']!r} in the message")
     if named not in message:
