@@ -60,7 +60,7 @@ from rpdrill.models.workprecision import (
     uniform_grid_s,
 )
 from rpdrill.studies.budgets import DEFAULT_BUDGET, Budget, check_size
-from rpdrill.studies.loading import parse, prepare_scene, read_yaml
+from rpdrill.studies.loading import InputError, parse, prepare_scene, read_yaml
 from rpdrill.studies.resumable import STATUS_COLUMNS, result_row
 from rpdrill.studies.specs import Axis, SceneSpec, StrictSpec
 from rpdrill.studies.study import Point
@@ -69,6 +69,7 @@ from rpdrill.studies.study import Point
 # linear interpolation of its own steps onto the grid, not that of a coarser storage interval.
 EVERY_STEP_S = 1e-9
 ODE_SAMPLE_INTERVAL_S = 2e-7
+GRID_POINTS_PER_PULSE = 10  # the bit-velocity comparison grid resolves the impact pulse
 MAX_TIME_LIMIT_S = 86400.0  # a day of CPU per run (the timer of cpu_time_limit takes no more than a time_t)
 # What the windowed scenes compute: only what the errors need (no energy account, no force sensors).
 OUTPUTS = {"metrics": ["penetration_rate_m_per_s"], "timeseries": ["borehole_bottom_m"]}
@@ -188,7 +189,11 @@ def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Ac
     spec = parse(AccuracySpec, read_yaml(path), source)
     base = spec.base_scene_dict(path)
     scene = windowed_scene(base, spec.blows)
-    parse(Scene, scene, f"{path} (base scene over blows: {spec.blows})")
+    pulse_s = parse(Scene, scene, f"{path} (base scene over blows: {spec.blows})").impact.duration_s
+    if spec.grid_interval_s > pulse_s / GRID_POINTS_PER_PULSE:
+        raise InputError(f"{source}: grid_interval_s: {spec.grid_interval_s:g}: the comparison grid must resolve "
+                         f"the pulse: at most impact.duration_s / {GRID_POINTS_PER_PULSE} = "
+                         f"{pulse_s / GRID_POINTS_PER_PULSE:.3g} s")
     count = sum(axis.count for family in spec.families for axis in family.sweep.values())
     what = f"families: {count:.6g} settings x repeats, over blows: {spec.blows}"
     check_size(budget, source, what, count, 0.0)

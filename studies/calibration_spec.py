@@ -232,6 +232,8 @@ def _labels(spec: CalibrationSpec, source: str) -> tuple[str, ...]:
             if label not in labels:
                 raise InputError(f"{source}: rising.{i}.{j}: {label!r}: not a target label; labels: "
                                  f"{', '.join(labels)}")
+            if chain.index(label) != j:
+                raise InputError(f"{source}: rising.{i}.{j}: {label!r}: already in this order; each label once")
     return labels
 
 
@@ -268,7 +270,10 @@ def _check_parameters(spec: CalibrationSpec, base: dict[str, Any], source: str) 
         check_scene_path(source, "parameters", name, base)
         if not _takes_numbers(field_at(Scene, tuple(name.split("."))).annotation):
             raise InputError(f"{source}: parameters.{name}: {_get(base, name)!r} in the base scene: a scene key "
-                             "that does not take a number; a fitted parameter is a key that does")
+                             "that does not take a real number; a fitted parameter is a key that does")
+        if name == FREQUENCY or all(name in target.overrides for target in spec.targets):
+            raise InputError(f"{source}: parameters.{name}: every target sets it (the scanned frequency or "
+                             "its overrides), so no scan depends on it; fit a key the targets leave free")
     for i, target in enumerate(spec.targets):
         for key in target.overrides:
             check_scene_path(source, f"targets.{i}.overrides", key, base)

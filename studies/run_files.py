@@ -61,8 +61,15 @@ def write_columns_csv(path: Path, columns: dict[str, np.ndarray]) -> None:
     np.savetxt(path, table, delimiter=",", header=",".join(columns), comments="", fmt="%.12g")
 
 
+def _plain(value: Any) -> Any:
+    """NumPy arrays and scalars as JSON lists and numbers (a run's info holds both)."""
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serializable")
+
+
 def write_json(path: Path, data: Any) -> None:
-    path.write_text(json.dumps(data, indent=2, sort_keys=False) + "\n", encoding="utf-8")
+    path.write_text(json.dumps(data, indent=2, sort_keys=False, default=_plain) + "\n", encoding="utf-8")
 
 
 def write_resolved(path: Path, data: dict[str, Any]) -> None:

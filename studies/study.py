@@ -36,7 +36,7 @@ import itertools
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
@@ -63,7 +63,7 @@ class Plot(StrictSpec):
 
     kind: Literal["curves", "map"] = "curves"
     x: str
-    y: str | list[str]
+    y: str | Annotated[list[str], Field(min_length=1)]
     z: MetricName | None = None
     curves: str | None = None
 
@@ -88,7 +88,7 @@ class StudySpec(SceneSpec):
     """The study file as written."""
 
     scan: dict[str, Axis] = Field(min_length=1)
-    combine: Literal["grid", "zip"] | list[list[str]] = "grid"
+    combine: Literal["grid", "zip"] | list[Annotated[list[str], Field(min_length=1)]] = "grid"
     metrics: list[MetricName] = Field(list(METRIC_NAMES), min_length=1)
     plots: list[Plot] = Field(default_factory=list)
     format: Literal["png", "svg", "pdf"] = "png"

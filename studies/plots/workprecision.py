@@ -27,11 +27,13 @@ def plot_workprecision(study: AccuracyStudy, rows: list[Row], front: list[dict[s
     markers = "osD^v<>ph*X"
     colors = plt.cm.tab20(range(20))
     for ax, measure in zip(axes, ERROR_MEASURES):
+        positive = False  # log axes need a positive value to show (settings equal to the reference have none)
         for k, (label, members) in enumerate(families.items()):
             pairs = [(number(r["cpu_time_s"]), number(r[measure])) for r in members if r["status"] == "ok"]
             pairs = [(c, e) for c, e in pairs if c > 0 and e > 0 and math.isfinite(e)]
             failed = sum(r["status"] != "ok" for r in members)
             name = label + (f" ({failed} failed)" if failed else "")
+            positive |= bool(pairs)
             if pairs:
                 ax.loglog(*zip(*pairs), marker=markers[k % len(markers)], ms=4, lw=1, label=name,
                           color=colors[(2 * k) % 20 + (k // 10) % 2])
@@ -45,8 +47,11 @@ def plot_workprecision(study: AccuracyStudy, rows: list[Row], front: list[dict[s
         agreement = report.get("agreement", {}).get(measure)
         if agreement and agreement > 0:
             ax.axhline(agreement, color="gray", ls=":", lw=1, label="references' agreement")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
+        if positive:
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+        else:
+            ax.text(0.5, 0.5, "no error above 0", transform=ax.transAxes, ha="center")
         ax.set_xlabel("CPU time [s] (median of repeats)")
         ax.set_ylabel(ERROR_LABELS[measure])
         ax.grid(alpha=0.3, which="both")
