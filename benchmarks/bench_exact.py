@@ -24,6 +24,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import argparse
+import copy
 import math
 import statistics
 import subprocess
@@ -34,12 +35,12 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
+from rpdrill.studies.loading import read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = ROOT / "studies" / "scenes" / "paper_base.yaml"
@@ -62,12 +63,12 @@ print(time.process_time() - start)
 def scenes(end_time_s: float, outputs: dict | None = None) -> dict[str, Scene]:
     """paper_base and its crushing variant (400 kN at 45 Hz), ``end_time_s`` long, with ``outputs``
     (None: the scene file's, every output)."""
-    base = yaml.safe_load(BASE.read_text(encoding="utf-8"))
+    base = read_yaml(BASE)
     base["solver"]["end_time_s"] = end_time_s
     base["metrics"] = {"transient_blows": 0, "block_blows": 1}
     if outputs is not None:
         base["outputs"] = outputs
-    crushing = yaml.safe_load(yaml.safe_dump(base)) | {"name": "paper_base_crushing"}
+    crushing = copy.deepcopy(base) | {"name": "paper_base_crushing"}
     crushing["impact"].update(CRUSHING)
     return {data["name"]: Scene.model_validate(data) for data in (base, crushing)}
 

@@ -27,6 +27,7 @@ from pathlib import Path
 import yaml
 
 from rpdrill.studies.commands.study import run_study
+from rpdrill.studies.loading import read_yaml
 from rpdrill.studies.plots.scans import draw_plots
 from rpdrill.studies.runners import pool
 from rpdrill.studies.study import load_study
@@ -39,7 +40,7 @@ SOLVERS = {"exact": {"solver.formulation": "exact"}, "fast": {"solver.preset": "
 
 def study_file(scan: str, solver: str, folder: Path) -> Path:
     """The paper scan with the solver's overrides, as a study file in ``folder``."""
-    data = yaml.safe_load((ROOT / "studies" / "paper" / f"{scan}.yaml").read_text(encoding="utf-8"))
+    data = read_yaml(ROOT / "studies" / "paper" / f"{scan}.yaml")
     data["base_scene"] = str(ROOT / "studies" / "scenes" / "paper_base.yaml")
     data["base_overrides"] = {**data.get("base_overrides", {}), **SOLVERS[solver]}
     path = folder / f"{scan}_{solver}.yaml"

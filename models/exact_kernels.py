@@ -60,10 +60,12 @@ def horner(coefficients: np.ndarray, s: float) -> float:
     return value
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def brent(coefficients: np.ndarray, low: float, high: float) -> float:
     """Root of the polynomial sum_k c_k s^k in [low, high] (signs differ at the ends) by Brent's
-    method, as scipy.optimize.brentq: |error| < (BRENT_XTOL + BRENT_RTOL |root|) / 2."""
+    method, as scipy.optimize.brentq: |error| < (BRENT_XTOL + BRENT_RTOL |root|) / 2. An interpolation
+    step that divides by zero (two equal values) is inf or nan, fails the acceptance test and bisects,
+    as in SciPy's C code (error_model="numpy": IEEE division, no ZeroDivisionError)."""
     x_pre, x_cur = low, high
     f_pre, f_cur = horner(coefficients, x_pre), horner(coefficients, x_cur)
     if f_pre == 0.0:

@@ -350,6 +350,16 @@ class Operators:
                 self.step_grams[i, q, j] = self.step_grams[i, q, j - 1] + carried.T @ gram @ carried
 
 
+def sub_step(simulation: Simulation, phases: list[str], model: Model | None = None) -> tuple[float, int, float]:
+    """(||A_bal||_1, sub-steps per sample, sub-step h) of the global sub-grid (module doc): the
+    largest balanced 1-norm over the modes and the pulse ``phases``, and h = sample interval / ceil(
+    sample interval x norm)."""
+    model = model or Model(simulation)
+    norm = max(np.linalg.norm(balance(matrix)[0], 1) for matrix in model.norm_candidates(phases))
+    per_sample = max(1, math.ceil(simulation.settings.sample_interval_s * norm))
+    return norm, per_sample, simulation.settings.sample_interval_s / per_sample
+
+
 class ExactSolver:
     """The event-driven exact solution of one simulation (module doc)."""
 
@@ -361,9 +371,7 @@ class ExactSolver:
         self.min_switch_interval_s = settings.min_switch_interval_s
         self.max_switches = settings.max_switches_per_blow * math.ceil(settings.end_time_s * self.impact.frequency_hz)
         self.phase_times, self.phases = phase_pieces(self.impact, settings.end_time_s)
-        norm = max(np.linalg.norm(balance(matrix)[0], 1) for matrix in self.model.norm_candidates(self.phases))
-        self.per_sample = max(1, math.ceil(settings.sample_interval_s * norm))
-        self.step_s = settings.sample_interval_s / self.per_sample
+        norm, self.per_sample, self.step_s = sub_step(simulation, self.phases, self.model)
         self.operators = Operators(self.model, self.step_s, self.per_sample, taylor_order(norm * self.step_s),
                                    len(self.model.pieces[0].table) * len(set(self.phases)),
                                    "energy" in simulation.needed_data)

@@ -10,11 +10,12 @@ the rock law, the initial state) is resolved once per run by :mod:`rpdrill.model
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
 from rpdrill.models.formulations import (
@@ -29,17 +30,36 @@ from rpdrill.models.outputs import METRICS, SERIES, Need, needs
 from rpdrill.rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
 from rpdrill.rocklaw.catalog import TABLE_1
 
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0)]
+NonNegative = Annotated[float, Field(ge=0)]
+# Counts are bounded so that no count makes a float overflow or an array beyond memory.
+MAX_COUNT = 10**6
+# A body or connector name: an identifier, so that no name collides with a generated one (the
+# segments ``rod[0]`` of a segmented rod, its links ``rod[0-1]``).
+NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+
+
+def _name(value: str) -> str:
+    if not NAME.fullmatch(value):
+        raise ValueError(f"{value!r} is not a name: letters, digits and _, starting with a letter or _, at most 64 "
+                         "characters (generated names such as rod[0] are reserved)")
+    return value
+
+
+Name = Annotated[str, AfterValidator(_name)]
 
 
 class Strict(BaseModel):
-    """Unknown keys are errors (a unit typo such as ``force_kn`` must not pass silently)."""
+    """Unknown keys are errors (a unit typo such as ``force_kn`` must not pass silently); numbers
+    are numbers (strict: no true/false, text or null where a number is required; an integer is
+    a number) and finite."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
 
+# The formulations assemble dense matrices of the whole chain (models.chain): 1000 lumped bodies is
+# a 2000 x 2000 first-order matrix.
+MAX_CHAIN_BODIES = 1000
 STEEL_YOUNGS_MODULUS_PA = 210e9
 STEEL_DENSITY_KG_PER_M3 = 7800.0  # with 210 GPa: bar wave speed sqrt(E / rho) = 5189 m/s
 GROUND = "ground"
@@ -66,7 +86,7 @@ class Body(Strict):
     mass_per_length_kg_per_m: Positive | None = Field(None, description="weight per metre of a pipe, kg/m")
     youngs_modulus_pa: Positive = STEEL_YOUNGS_MODULUS_PA
     density_kg_per_m3: Positive = STEEL_DENSITY_KG_PER_M3
-    segments: Annotated[int, Field(ge=1)] = 1
+    segments: Annotated[int, Field(ge=1, le=MAX_CHAIN_BODIES)] = 1
 
     @model_validator(mode="after")
     def _mass_or_geometry(self) -> Body:
@@ -121,11 +141,11 @@ class Connector(Strict):
     stiffness follows from the rods it joins (:class:`Body`).
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+    model_config = ConfigDict(populate_by_name=True)
 
     type: str = "spring_damper"
-    from_body: str = Field(alias="from")
-    to_body: str = Field(alias="to")
+    from_body: Name = Field(alias="from")
+    to_body: Name = Field(alias="to")
     stiffness_n_per_m: Positive | None = None
     damping_n_s_per_m: NonNegative = 0.0
     gap_m: NonNegative | None = Field(None, description="coupling gap, m (type coupling; default 0)")
@@ -145,16 +165,18 @@ class Connector(Strict):
 class DrillString(Strict):
     """The axial chain: bodies and connectors by name, in order from the hammer to the rock."""
 
-    bodies: Annotated[dict[str, Body], Field(min_length=1)]
-    connectors: dict[str, Connector] = Field(default_factory=dict)
-    impact_body: str = Field(description="the body the piston strikes")
-    rock_body: str = Field(description="the body that touches the rock (the bit)")
+    bodies: Annotated[dict[Name, Body], Field(min_length=1)]
+    connectors: dict[Name, Connector] = Field(default_factory=dict)
+    impact_body: Name = Field(description="the body the piston strikes")
+    rock_body: Name = Field(description="the body that touches the rock (the bit)")
 
     @model_validator(mode="after")
     def _consistent(self) -> DrillString:
         names = list(self.bodies)
-        if GROUND in names or EVERY_BODY in names:
-            raise ValueError(f"'{GROUND}' and '{EVERY_BODY}' are reserved, not body names")
+        for reserved in (GROUND, EVERY_BODY):
+            if reserved in names:
+                raise _key_error("DrillString", ("bodies", reserved), reserved, "a reserved word, not a body name "
+                                 "('{ground}' and '{every}' name the ground and every body)", ground=GROUND, every=EVERY_BODY)
         for role in ("impact_body", "rock_body"):
             if getattr(self, role) not in names:
                 raise ValueError(f"{role} {getattr(self, role)!r} is not a body; bodies: {', '.join(names)}")
@@ -168,19 +190,83 @@ class DrillString(Strict):
             ends = [self.bodies[b] for b in (connector.from_body, connector.to_body) if b != GROUND]
             if connector.stiffness_n_per_m is None and not any(b.is_rod for b in ends):
                 raise ValueError(f"connectors.{name} needs stiffness_n_per_m: neither end is a rod with a geometry")
-        self._check_connected(names)
+        total = sum(body.segments for body in self.bodies.values())
+        if total > MAX_CHAIN_BODIES:
+            largest = max(self.bodies, key=lambda name: self.bodies[name].segments)
+            raise _key_error("DrillString", ("bodies", largest, "segments"), self.bodies[largest].segments,
+                             "the chain would have {total} lumped bodies; at most {most} (the formulations assemble "
+                             "dense matrices of the whole chain)", total=total, most=MAX_CHAIN_BODIES)
+        self._check_graph()
         return self
 
-    def _check_connected(self, names: list[str]) -> None:
-        """Every body must be held: linked through connectors to ground or to the rock body."""
-        reached, frontier = {GROUND}, {GROUND, self.rock_body}
+    def _check_graph(self) -> None:
+        """The connectors form a chain: no loop (a connector joining two bodies that are joined
+        already, through ground too), and every body joined to the rock body. One problem per loop,
+        loose body and separate part (a ValidationError naming them)."""
+        problems = []
+        joined: dict[str, list[tuple[str, str]]] = {name: [] for name in (GROUND, *self.bodies)}  # -> (connector, end)
+        for name, connector in self.connectors.items():
+            ends = (connector.from_body, connector.to_body)
+            route = _route(joined, *ends)
+            if route is not None:
+                loop = [*route, name]
+                problems.append(_problem(("connectors", name), name, "connectors {loop} form a loop; a drill string "
+                                         "is a chain from ground or the hammer to the rock, without loops",
+                                         loop=", ".join(loop)))
+                continue
+            joined[ends[0]].append((name, ends[1]))
+            joined[ends[1]].append((name, ends[0]))
+        for part in _parts(joined):
+            bodies = [b for b in self.bodies if b in part]
+            if self.rock_body in part or not bodies:
+                continue
+            if len(bodies) == 1 and not joined[bodies[0]]:
+                problems.append(_problem(("bodies", bodies[0]), bodies[0], "no connector joins this body to the drill "
+                                         "string; every body is joined to rock_body '{rock}'", rock=self.rock_body))
+            else:
+                to = " and ".join(["each other"] * (len(bodies) > 1) + [GROUND] * (GROUND in part))
+                problems.append(_problem(("bodies", bodies[0]), bodies, "a separate part: joined to {to} but not to "
+                                         "rock_body '{rock}'; every body is joined to the rock body through connectors",
+                                         to=to, rock=self.rock_body))
+        if problems:
+            raise ValidationError.from_exception_data("DrillString", problems)
+
+
+def _route(joined: dict[str, list[tuple[str, str]]], start: str, end: str) -> list[str] | None:
+    """The connectors on the path from body ``start`` to ``end`` through ``joined`` (a forest), None
+    if they are not joined."""
+    came: dict[str, tuple[str, str] | None] = {start: None}  # body -> (connector, previous body)
+    frontier = [start]
+    while frontier and end not in came:
+        body = frontier.pop()
+        for connector, other in joined[body]:
+            if other not in came:
+                came[other] = (connector, body)
+                frontier.append(other)
+    if end not in came:
+        return None
+    route, body = [], end
+    while came[body] is not None:
+        connector, body = came[body]
+        route.append(connector)
+    return route[::-1]
+
+
+def _parts(joined: dict[str, list[tuple[str, str]]]) -> list[set[str]]:
+    """The connected parts of the graph ``joined`` (bodies and ground)."""
+    parts, seen = [], set()
+    for start in joined:
+        if start in seen:
+            continue
+        part, frontier = {start}, [start]
         while frontier:
-            reached |= frontier
-            frontier = {b for c in self.connectors.values() for a, b in ((c.from_body, c.to_body), (c.to_body, c.from_body))
-                        if a in reached and b not in reached}
-        loose = [n for n in names if n not in reached]
-        if loose:
-            raise ValueError(f"bodies {', '.join(loose)} are not connected to the rock body or ground by any connector")
+            for _, other in joined[frontier.pop()]:
+                if other not in part:
+                    part.add(other)
+                    frontier.append(other)
+        seen |= part
+        parts.append(part)
+    return parts
 
 
 class Torsion(Strict):
@@ -189,8 +275,8 @@ class Torsion(Strict):
     inertia_kg_m2: Positive = Field(description="J_x of collar and bit")
     stiffness_n_m_per_rad: NonNegative = Field(description="k_x")
     damping_n_m_s_per_rad: NonNegative = Field(description="c_x")
-    drive_torque_n_m: Finite = Field(description="M_x")
-    resisting_torque_n_m: Finite = Field(description="M_c")
+    drive_torque_n_m: float = Field(description="M_x")
+    resisting_torque_n_m: float = Field(description="M_c")
 
 
 class Bit(Strict):
@@ -230,7 +316,7 @@ class Feed(Strict):
     segments)."""
 
     force_n: NonNegative
-    acts_on: str = EVERY_BODY
+    acts_on: Name = EVERY_BODY
 
 
 class Impact(Strict):
@@ -373,7 +459,7 @@ class Solver(Strict):
     method: Literal[ODE_METHODS] | None = None  # type: ignore[valid-type]
     sample_interval_s: Positive | None = None
     min_switch_interval_s: Positive | None = None
-    max_switches_per_blow: Annotated[int, Field(ge=1)] | None = None
+    max_switches_per_blow: Annotated[int, Field(ge=1, le=MAX_COUNT)] | None = None
 
     @model_validator(mode="after")
     def _options_of_the_formulation(self) -> Solver:
@@ -427,8 +513,8 @@ class Outputs(Strict):
 class Metrics(Strict):
     """Averaging window: skip ``transient_blows`` blows, then whole blocks of ``block_blows`` blows."""
 
-    transient_blows: Annotated[int, Field(ge=0)] = 10
-    block_blows: Annotated[int, Field(ge=1)] = 5
+    transient_blows: Annotated[int, Field(ge=0, le=MAX_COUNT)] = 10
+    block_blows: Annotated[int, Field(ge=1, le=MAX_COUNT)] = 5
 
 
 class Scene(Strict):

@@ -11,6 +11,8 @@ the energy account and the stability checks read these fields; nothing derives t
 
 from __future__ import annotations
 
+import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
@@ -32,7 +34,7 @@ from rpdrill.models.scene import (
     requested_outputs,
 )
 from rpdrill.models.solver_settings import Settings, resolve_settings
-from rpdrill.models.stability import spectral_radius_per_s
+from rpdrill.models.stability import FastestElement, fastest_element, spectral_radius_per_s
 from rpdrill.rocklaw import RockLaw, State
 
 if TYPE_CHECKING:
@@ -61,6 +63,7 @@ class Simulation:
     initial_rock_state: State
     initial_torsion_angle_rad: float
     spectral_radius_per_s: float | None  # |lambda|_max with the bit on the rock (Exudyn runs only)
+    fastest: FastestElement  # the element of the highest rate and the keys that set it
     indexing: Indexing | None = None
 
     @property
@@ -123,8 +126,14 @@ def prepare(scene: Scene) -> Simulation:
     chain = axial_chain(scene, joint_damping=effects.joint_damping)
     rock = scene.rock.build(damping=effects.rock_damping, plasticity=effects.rock_plasticity,
                             indexed=effects.indexing)
-    radius = spectral_radius_per_s(chain, rock) if scene.solver.formulation == "exudyn" else None
-    settings = resolve_settings(scene.solver, scene.impact.duration_s, lambda: radius)
+    torsion = scene.torsion if effects.torsion else None
+    fastest = fastest_element(scene, chain, rock, torsion)
+    radius = spectral_radius_per_s(chain, rock, torsion) if scene.solver.formulation == "exudyn" else None
+    if not math.isfinite(fastest.rate_per_s) or not math.isfinite(radius or 0.0):
+        raise SceneError(tuple(fastest.key.split(".")), fastest.value,
+                         f"with {fastest.other_key} {fastest.other_value:g} the model's fastest rate overflows "
+                         f"(k/m or c/m beyond {sys.float_info.max:.3g}); give values of a physical drill")
+    settings = resolve_settings(scene.solver, scene.impact.duration_s, radius)
     positions, angle = np.zeros(chain.size), 0.0
     if scene.start == "preloaded":
         try:
@@ -139,7 +148,8 @@ def prepare(scene: Scene) -> Simulation:
         indexing = Indexing(scene.bit, scene.rotation.speed_rpm if scene.rotation else None, scene.impact.frequency_hz)
         if indexing.speed_rpm is not None:  # the same share every blow: the law has it from the start
             rock = replace(rock, fresh_fraction=indexing.fresh_fraction(indexing.prescribed_angle_rad))
-    return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, radius, indexing)
+    return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, radius, fastest,
+                      indexing)
 
 
 def as_simulation(run: Scene | Simulation) -> Simulation:

@@ -19,7 +19,6 @@ a preset and without explicit accuracy options the ``standard`` preset applies.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 from rpdrill.models.formulations import DEFAULT_PRESET
@@ -116,9 +115,9 @@ def _given(solver: Solver, key: str, default: float) -> float:
     return default if value is None else value
 
 
-def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_per_s: Callable[[], float]) -> Settings:
-    """The settings of ``solver``'s formulation (module doc). ``spectral_radius_per_s`` is called only
-    when an Exudyn preset must choose the step."""
+def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_per_s: float | None) -> Settings:
+    """The settings of ``solver``'s formulation (module doc): ``spectral_radius_per_s`` is |lambda|_max
+    (an Exudyn preset's step follows it; None for the other formulations)."""
     common = {"formulation": solver.formulation, "end_time_s": solver.end_time_s,
               "output_interval_s": solver.output_interval_s}
     if solver.formulation == "exudyn":
@@ -126,7 +125,7 @@ def resolve_settings(solver: Solver, pulse_duration_s: float, spectral_radius_pe
         tier = EXUDYN_PRESETS[preset or DEFAULT_PRESET]
         step = solver.step_s
         if step is None:
-            step = tier.step(pulse_duration_s, spectral_radius_per_s())
+            step = tier.step(pulse_duration_s, spectral_radius_per_s)
         return ExudynSettings(type=solver.type or (tier.type if preset else UNPRESET_TYPE), step_s=step,
                               spectral_radius=_given(solver, "spectral_radius", 1.0),
                               relative_tolerance=_given(solver, "relative_tolerance", 1e-8),

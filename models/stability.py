@@ -9,13 +9,18 @@ the factors were measured on the hard scenes (docs/stability.md).
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+from statistics import median
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.linalg import block_diag
 
-from rpdrill.models.chain import AxialChain
+from rpdrill.models.chain import AxialChain, torsion_first_order_matrix
 from rpdrill.models.energy import energy_account
 from rpdrill.models.pulse import impulse_per_blow_n_s
+from rpdrill.models.scene import Scene, Torsion
 from rpdrill.rocklaw import RockLaw
 
 if TYPE_CHECKING:
@@ -46,14 +51,86 @@ class StepLimitWarning(UserWarning):
     """A fixed explicit step beyond the measured stability limit of the scene's stiffest mode."""
 
 
-def spectral_radius_per_s(chain: AxialChain, law: RockLaw) -> float:
+def spectral_radius_per_s(chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> float:
     """|lambda|_max of the first-order system z' = A z, A = [[0, I], [-M^-1 K, -M^-1 C]] of every link
     at its full stiffness, with the bit on the rock (its stiffest slope and its damper added on the
-    bit): what limits an explicit solver's step, the stiffest mode for light damping and the fastest
-    decay for heavy damping."""
+    bit), and the torsion line when given: what limits an explicit solver's step, the stiffest mode
+    for light damping and the fastest decay for heavy damping. Infinite when an entry of A overflows
+    (:func:`fastest_element` names the scene key)."""
     stiffest = max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m)
-    system = chain.first_order_matrix(chain.links, stiffest, law.damping_n_s_per_m)[:, :-1]
+    with np.errstate(over="ignore"):
+        system = chain.first_order_matrix(chain.links, stiffest, law.damping_n_s_per_m)[:, :-1]
+        if torsion is not None:
+            system = block_diag(system, torsion_first_order_matrix(torsion)[:, :-1])
+    if not np.isfinite(system).all():
+        return math.inf
     return float(np.abs(np.linalg.eigvals(system)).max())
+
+
+@dataclass(frozen=True)
+class FastestElement:
+    """The element of the highest rate, sqrt(k (1/m_a + 1/m_b)) of a spring or c (1/m_a + 1/m_b) of a
+    damper, in 1/s (|lambda|_max is of that order), with the two scene keys that set it: ``key`` the
+    one that departs more from the drill's other values (the stiffness or damping against the median
+    of all stiffnesses or dampers, the mass against the median mass), ``other_key`` the other."""
+
+    rate_per_s: float
+    key: str
+    value: float
+    other_key: str
+    other_value: float
+
+
+# Torsion has one element: its values are compared with those of studies/scenes/paper_base.yaml.
+TORSION_REFERENCE = {"inertia_kg_m2": 2.0, "stiffness_n_m_per_rad": 1e5, "damping_n_m_s_per_rad": 200.0}
+
+
+def _mass_key(scene: Scene, body: str) -> tuple[str, float]:
+    """The key that sets a drill-string body's (segment) mass: mass_kg, segments, or the rod's density."""
+    values = scene.drill_string.bodies[body]
+    key = "mass_kg" if values.mass_kg is not None else "segments" if values.segments > 1 else \
+        "mass_per_length_kg_per_m" if values.mass_per_length_kg_per_m is not None else "density_kg_per_m3"
+    return f"drill_string.bodies.{body}.{key}", getattr(values, key)
+
+
+def fastest_element(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> FastestElement:
+    """The element of the highest rate (:class:`FastestElement`): every link, the rock under the bit,
+    the torsion line when given."""
+    owner = {i: name for name, (first, last) in chain.groups.items() for i in range(first, last + 1)}
+    masses = [body.mass_kg for body in chain.bodies]
+    connectors = scene.drill_string.connectors
+    rock_stiffness = max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m)
+    rock_key = "rock.unloading_stiffness_n_per_m" if scene.rock.law == "bilinear" else "rock.stiffness_n_per_m"
+    # (stiffness or damping, its key, the bodies it moves, spring or damper)
+    elements = [(rock_stiffness, rock_key, [chain.bit_body], True),
+                (law.damping_n_s_per_m, "rock.damping_n_s_per_m", [chain.bit_body], False)]
+    for link in chain.links:
+        path = f"drill_string.connectors.{link.name}" if link.name in connectors else \
+            f"drill_string.bodies.{owner[link.body_b]}"
+        moved = [i for i in (link.body_a, link.body_b) if i is not None]
+        elements += [(link.stiffness_n_per_m, f"{path}.stiffness_n_per_m" if link.name in connectors
+                      else f"{path}.youngs_modulus_pa", moved, True),
+                     (link.damping_n_s_per_m, f"{path}.damping_n_s_per_m", moved, False)]
+    typical = {spring: median([e[0] for e in elements if e[3] == spring and e[0] > 0] or [1.0]) for spring in (True, False)}
+    typical_mass = median(masses)
+    candidates = []
+    for value, key, moved, spring in elements:
+        inverse_mass = sum(1.0 / masses[i] for i in moved)
+        rate = math.sqrt(value * inverse_mass) if spring else value * inverse_mass
+        lightest = min(moved, key=lambda i: masses[i])
+        departs = math.log10(value / typical[spring]) if value > 0 else -math.inf
+        pair = ((key, value), _mass_key(scene, owner[lightest]))
+        first, second = pair if departs >= math.log10(typical_mass / masses[lightest]) else pair[::-1]
+        candidates.append(FastestElement(rate, *first, *second))
+    if torsion is not None:
+        for key, spring in (("stiffness_n_m_per_rad", True), ("damping_n_m_s_per_rad", False)):
+            value, inertia = getattr(torsion, key), torsion.inertia_kg_m2
+            rate = math.sqrt(value / inertia) if spring else value / inertia
+            pair = ((f"torsion.{key}", value), ("torsion.inertia_kg_m2", inertia))
+            departs = math.log10(value / TORSION_REFERENCE[key]) if value > 0 else -math.inf
+            first, second = pair if departs >= math.log10(TORSION_REFERENCE["inertia_kg_m2"] / inertia) else pair[::-1]
+            candidates.append(FastestElement(rate, *first, *second))
+    return max(candidates, key=lambda element: element.rate_per_s)
 
 
 def largest_stable_step_s(simulation: Simulation, solver_type: str | None = None) -> float | None:
@@ -63,7 +140,8 @@ def largest_stable_step_s(simulation: Simulation, solver_type: str | None = None
     if solver_type not in STABLE_STEP_FACTOR:
         return None
     factor = STABLE_STEP_FACTOR[solver_type]
-    radius = simulation.spectral_radius_per_s or spectral_radius_per_s(simulation.chain, simulation.rock)
+    radius = simulation.spectral_radius_per_s or spectral_radius_per_s(simulation.chain, simulation.rock,
+                                                                        simulation.torsion)
     return 0.0 if factor is None else factor / radius
 
 

@@ -48,8 +48,9 @@ from typing import Any, Literal
 
 from pydantic import Field
 
+from rpdrill.models.cost import Cause
 from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Scene
+from rpdrill.models.scene import MAX_COUNT, Scene
 from rpdrill.models.workprecision import (
     ERROR_MEASURES,
     Signature,
@@ -58,7 +59,8 @@ from rpdrill.models.workprecision import (
     signature,
     uniform_grid_s,
 )
-from rpdrill.studies.loading import parse, prepare_scene, read_yaml
+from rpdrill.studies.budgets import DEFAULT_BUDGET, Budget, check_size
+from rpdrill.studies.loading import InputError, parse, prepare_scene, read_yaml
 from rpdrill.studies.resumable import STATUS_COLUMNS, result_row
 from rpdrill.studies.specs import Axis, SceneSpec, StrictSpec
 from rpdrill.studies.study import Point
@@ -67,6 +69,8 @@ from rpdrill.studies.study import Point
 # linear interpolation of its own steps onto the grid, not that of a coarser storage interval.
 EVERY_STEP_S = 1e-9
 ODE_SAMPLE_INTERVAL_S = 2e-7
+GRID_POINTS_PER_PULSE = 10  # the bit-velocity comparison grid resolves the impact pulse
+MAX_TIME_LIMIT_S = 86400.0  # a day of CPU per run (the timer of cpu_time_limit takes no more than a time_t)
 # What the windowed scenes compute: only what the errors need (no energy account, no force sensors).
 OUTPUTS = {"metrics": ["penetration_rate_m_per_s"], "timeseries": ["borehole_bottom_m"]}
 
@@ -85,16 +89,16 @@ class Family(StrictSpec):
     solver: dict[str, Any]
     sweep: dict[str, Axis] = Field(min_length=1, max_length=1)
     atol_ratio: float = Field(1e-3, gt=0)
-    repeats: int | None = Field(None, ge=1)
+    repeats: int | None = Field(None, ge=1, le=MAX_COUNT)
 
 
 class AccuracySpec(SceneSpec):
     """The study file as written."""
 
-    blows: int = Field(ge=1)
-    repeats: int = Field(3, ge=1)
+    blows: int = Field(ge=1, le=MAX_COUNT)
+    repeats: int = Field(3, ge=1, le=MAX_COUNT)
     grid_interval_s: float = Field(1e-5, gt=0)
-    time_limit_s: float = Field(60.0, gt=0)
+    time_limit_s: float = Field(60.0, gt=0, le=MAX_TIME_LIMIT_S)
     reference: Run = Run()
     reference_check: Run | None = None
     families: list[Family] = Field(min_length=1)
@@ -160,42 +164,56 @@ def scene_for(study: AccuracyStudy | dict[str, Any], setting: Setting, grid_inte
 
 def _setting(fixed: dict[str, Any], key: str | None, value: Any, atol_ratio: float, repeats: int) -> Setting:
     solver = {**fixed, **({key: value} if key else {})}
-    if key == "relative_tolerance" and "absolute_tolerance" not in fixed:
+    if key == "relative_tolerance" and "absolute_tolerance" not in fixed and type(value) in (int, float):
         solver["absolute_tolerance"] = float(f"{value * atol_ratio:.6g}")
     return Setting(solver, repeats)
 
 
-def _checked(setting: Setting, scene: dict[str, Any], grid_interval_s: float, where: str) -> Setting:
-    """The setting if its windowed scene validates and prepares; InputError naming ``where`` otherwise."""
-    prepare_scene(parse(Scene, scene_for(scene, setting, grid_interval_s), where, ()), where)
-    return setting
+def _checked(setting: Setting, scene: dict[str, Any], spec: AccuracySpec, source: str, key: str,
+             budget: Budget) -> float:
+    """The estimated CPU seconds of the setting's runs (each at most ``time_limit_s``); InputError naming
+    ``source`` and ``key`` unless its windowed scene validates and prepares, BudgetError beyond the run
+    budget."""
+    grid, where = spec.grid_interval_s, f"{source}: {key}"
+    simulation = prepare_scene(parse(Scene, scene_for(scene, setting, grid), where, ()), where)
+    cost = budget.check_run(simulation, source, f"{key}, over blows: {spec.blows}: ",
+                            resampled=Cause("grid_interval_s", grid))
+    return setting.repeats * min(cost.cpu_s, spec.time_limit_s)
 
 
-def load_accuracy_study(path: str | Path) -> AccuracyStudy:
-    """Read, validate and expand a work-precision study; InputError naming file and key otherwise."""
+def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> AccuracyStudy:
+    """Read, validate and expand a work-precision study, every run checked against the ``budget``;
+    InputError naming file and key, BudgetError naming the cost, otherwise."""
     path = Path(path)
-    spec = parse(AccuracySpec, read_yaml(path), str(path))
+    source = str(path)
+    spec = parse(AccuracySpec, read_yaml(path), source)
     base = spec.base_scene_dict(path)
     scene = windowed_scene(base, spec.blows)
-    parse(Scene, scene, f"{path} (base scene over blows: {spec.blows})")
-    grid = spec.grid_interval_s
+    pulse_s = parse(Scene, scene, f"{path} (base scene over blows: {spec.blows})").impact.duration_s
+    if spec.grid_interval_s > pulse_s / GRID_POINTS_PER_PULSE:
+        raise InputError(f"{source}: grid_interval_s: {spec.grid_interval_s:g}: the comparison grid must resolve "
+                         f"the pulse: at most impact.duration_s / {GRID_POINTS_PER_PULSE} = "
+                         f"{pulse_s / GRID_POINTS_PER_PULSE:.3g} s")
+    count = sum(axis.count for family in spec.families for axis in family.sweep.values())
+    what = f"families: {count:.6g} settings x repeats, over blows: {spec.blows}"
+    check_size(budget, source, what, count, 0.0)
     points, runs = [], []
     for i, family in enumerate(spec.families):
         (key, axis), = family.sweep.items()
         for value in axis.expand():
-            setting = _checked(_setting(family.solver, key, value, family.atol_ratio, family.repeats or spec.repeats),
-                               scene, grid, f"{path}: families.{i}.sweep.{key}: {value!r}")
+            setting = _setting(family.solver, key, value, family.atol_ratio, family.repeats or spec.repeats)
+            cpu = _checked(setting, scene, spec, source, f"families.{i}.sweep.{key}: {value!r}", budget)
             solver = setting.solver.get("type", "rk44") if setting.formulation == "exudyn" \
                 else setting.solver.get("method", setting.formulation)
             points.append(Point(len(points), {"family": family.label, "formulation": setting.formulation,
-                                              "solver": solver, "setting": key, "value": value}, None))
+                                              "solver": solver, "setting": key, "value": value}, None, cpu))
             runs.append(setting)
-    reference = _checked(_setting(spec.reference.solver, None, None, spec.reference.atol_ratio, 1), scene, grid,
-                         f"{path}: reference")
-    check = None if spec.reference_check is None else _checked(
-        _setting(spec.reference_check.solver, None, None, spec.reference_check.atol_ratio, 1), scene, grid,
-        f"{path}: reference_check")
-    return AccuracyStudy(path, spec, base, scene, points, runs, reference, check)
+    references = [None if run is None else _setting(run.solver, None, None, run.atol_ratio, 1)
+                  for run in (spec.reference, spec.reference_check)]
+    cpu = [_checked(setting, scene, spec, source, key, budget)
+           for setting, key in zip(references, ("reference", "reference_check")) if setting is not None]
+    budget.check_total(source, what, sum(r.repeats for r in runs) + len(cpu), sum(p.cpu_s for p in points) + sum(cpu))
+    return AccuracyStudy(path, spec, base, scene, points, runs, *references)
 
 
 def simulate_setting(scene: dict[str, Any], setting: Setting, grid_interval_s: float) -> SimulationResult:

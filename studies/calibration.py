@@ -29,6 +29,7 @@ from scipy import optimize
 
 from rpdrill.studies.calibration_log import EvaluationLog, Record, unit_key
 from rpdrill.studies.calibration_spec import Calibration
+from rpdrill.studies.interrupts import raise_if_stopped
 from rpdrill.studies.runners import Runner
 from rpdrill.studies.targets import ScanTask, rising_shortfalls, run_scans, scan_all, scan_cost, scan_optimum
 
@@ -107,6 +108,7 @@ class Evaluator:
                 cost: dict[str, Any]) -> None:
         results = [target_result(self.calibration, t, list(self.calibration.frequencies_hz), scan)
                    for t, scan in enumerate(scans)]
+        raise_if_stopped()  # scans cut by an interrupt are not an evaluation
         total, penalty = objective(self.calibration, results)
         record = {"unit": list(key), "parameters": values, "targets": results, "rising_penalty": penalty,
                   "objective": total, **cost}
@@ -117,15 +119,6 @@ class Evaluator:
         self.cpu_time_s += cost["cpu_time_s"]
         if self.progress:
             self.progress(record, False)
-
-
-def planned_evaluations(calibration: Calibration) -> int:
-    """The search's budget in evaluations (DE: a population of popsize x n, at least 5, per
-    generation and for the initial population)."""
-    search = calibration.spec.search
-    if search.method == "nelder-mead":
-        return search.max_evaluations
-    return max(5, search.popsize * len(calibration.names)) * (search.max_generations + 1)
 
 
 def search(calibration: Calibration, evaluate: Callable[[np.ndarray], np.ndarray]) -> None:
@@ -185,28 +178,48 @@ def final_scan(calibration: Calibration, best: Record, runner: Runner) -> FinalS
 
 @dataclass(frozen=True)
 class CalibrationResult:
-    """Every recorded evaluation, the best one (None if every simulation of every evaluation
-    failed), its final scan, and what this session cost."""
+    """Every recorded evaluation, the best one (None if every simulation of every evaluation failed,
+    or every run of a target did: ``failed_targets``), its final scan, and what this session cost."""
 
     records: list[Record]
     best: Record | None
     final: FinalScan | None
     session: dict[str, Any]
+    failed_targets: list[str]
+
+
+def failed_targets(calibration: Calibration, records: list[Record]) -> list[str]:
+    """The labels of the targets whose every run failed in every evaluation."""
+    count = len(calibration.frequencies_hz)
+    return [label for t, label in enumerate(calibration.labels)
+            if all(record["targets"][t]["failed_runs"] >= count for record in records)]
+
+
+def _session(evaluator: Evaluator, final: FinalScan | None, runner_label: str, start_wall: float,
+             interrupted: bool) -> dict[str, Any]:
+    return {"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"), "runner": runner_label,
+            "interrupted": interrupted, "evaluations_run": evaluator.evaluated,
+            "evaluations_replayed": evaluator.replayed,
+            "simulations": evaluator.simulations + (final.cost["simulations"] if final else 0),
+            "simulation_cpu_time_s": evaluator.cpu_time_s + (final.cost["cpu_time_s"] if final else 0.0),
+            "wall_time_s": time.perf_counter() - start_wall}
 
 
 def calibrate(calibration: Calibration, runner: Runner, log: EvaluationLog,
               progress: Progress | None = None, runner_label: str = "") -> CalibrationResult:
-    """Search (replaying what ``log`` holds), then scan the best parameter set for the report."""
+    """Search (replaying what ``log`` holds), then scan the best parameter set for the report. An
+    interrupted search (Ctrl-C, SIGTERM) records its session before it stops."""
     start_wall = time.perf_counter()
     evaluator = Evaluator(calibration, runner, log, progress)
-    search(calibration, evaluator)
-    usable = [r for r in log.records if r["failed_runs"] < r["simulations"]]
-    best = min(usable, key=lambda r: r["objective"]) if usable else None
-    final = final_scan(calibration, best, runner) if best else None
-    session = {"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"), "runner": runner_label,
-               "evaluations_run": evaluator.evaluated, "evaluations_replayed": evaluator.replayed,
-               "simulations": evaluator.simulations + (final.cost["simulations"] if final else 0),
-               "simulation_cpu_time_s": evaluator.cpu_time_s + (final.cost["cpu_time_s"] if final else 0.0),
-               "wall_time_s": time.perf_counter() - start_wall}
+    try:
+        search(calibration, evaluator)
+        failed = failed_targets(calibration, log.records)
+        usable = [r for r in log.records if r["failed_runs"] < r["simulations"]]
+        best = min(usable, key=lambda r: r["objective"]) if usable and not failed else None
+        final = final_scan(calibration, best, runner) if best else None
+    except KeyboardInterrupt:
+        log.add_session(_session(evaluator, None, runner_label, start_wall, interrupted=True))
+        raise
+    session = _session(evaluator, final, runner_label, start_wall, interrupted=False)
     log.add_session(session)
-    return CalibrationResult(list(log.records), best, final, session)
+    return CalibrationResult(list(log.records), best, final, session, failed)

@@ -4,7 +4,8 @@
 objective, cost); ``OUT/checkpoint.json`` the calibration's hash and one entry per session. A
 rerun into the same OUT replays the recorded evaluations (by their exact unit point) instead of
 recomputing them, so a seeded search retraces its path and continues where it stopped; a
-different calibration is refused (InputError). A line cut by a kill is dropped.
+different calibration is refused (InputError; with ``overwrite`` it starts afresh). A line cut by a
+kill is dropped.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from rpdrill.studies.calibration_spec import Calibration
+from rpdrill.studies.loading import InputError
 from rpdrill.studies.resumable import checked_record
 from rpdrill.studies.run_files import write_json
 
@@ -29,37 +31,44 @@ def unit_key(unit: Any) -> tuple[float, ...]:
 
 
 def _complete_records(path: Path) -> list[Record]:
-    """The records of whole lines (a last line cut by a kill is left out)."""
+    """The records of whole lines (a last line cut by a kill is left out); InputError naming the file
+    and line when a whole line is not a record."""
     records = []
-    for line in path.read_text(encoding="utf-8").splitlines(keepends=True) if path.exists() else ():
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines(keepends=True) if path.exists() else []
+    except UnicodeDecodeError:
+        raise InputError(f"--out: {path}: not evaluations rpdrill wrote (not UTF-8 text)") from None
+    for number, line in enumerate(lines, 1):
         try:
             records.append(json.loads(line))
         except json.JSONDecodeError:
             if line.endswith("\n"):
-                raise
+                raise InputError(f"--out: {path}: line {number} is not an evaluation rpdrill wrote") from None
     return records
 
 
 class EvaluationLog:
     """The recorded evaluations of one calibration in one output directory (close it when done)."""
 
-    def __init__(self, out: Path, calibration: Calibration) -> None:
+    def __init__(self, out: Path, calibration: Calibration, overwrite: bool = False) -> None:
         self.out = out
-        self.checkpoint = self._checkpoint(calibration)
+        self.checkpoint, resumed = self._checkpoint(calibration, overwrite)
         path = out / EVALUATIONS
-        self.records = _complete_records(path)
+        self.records = _complete_records(path) if resumed else []
         temporary = path.with_suffix(".jsonl.tmp")
         temporary.write_text("".join(json.dumps(r) + "\n" for r in self.records), encoding="utf-8")
         os.replace(temporary, path)
         self._handle: TextIO = path.open("a", encoding="utf-8")
 
-    def _checkpoint(self, calibration: Calibration) -> dict[str, Any]:
+    def _checkpoint(self, calibration: Calibration, overwrite: bool) -> tuple[dict[str, Any], bool]:
+        """The checkpoint (this calibration's, or a fresh one) and whether it resumes an earlier run."""
         self.out.mkdir(parents=True, exist_ok=True)
         fresh = {"calibration": calibration.spec.name, "calibration_file": str(calibration.source),
                  "hash": calibration.hash, "sessions": []}
-        checkpoint = checked_record(self.out / CHECKPOINT, fresh, calibration.source, [self.out / EVALUATIONS])
+        checkpoint = checked_record(self.out / CHECKPOINT, fresh, calibration.source, [self.out / EVALUATIONS],
+                                    overwrite)
         write_json(self.out / CHECKPOINT, checkpoint)
-        return checkpoint
+        return checkpoint, checkpoint is not fresh
 
     def append(self, record: Record) -> None:
         """Record an evaluation now (one line, flushed)."""

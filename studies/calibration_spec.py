@@ -22,25 +22,32 @@ a log scale. Example: ``studies/paper/calibration.yaml``.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import hashlib
 import itertools
 import json
 import math
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from types import UnionType
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from rpdrill.models.scene import Scene
-from rpdrill.studies.loading import InputError, parse, read_yaml
+from rpdrill.studies.budgets import (
+    AXIS_VALUE_BYTES,
+    DEFAULT_BUDGET,
+    EVALUATION_BYTES,
+    Budget,
+    base_estimate_s,
+)
+from rpdrill.studies.loading import InputError, field_at, parse, read_yaml
 from rpdrill.studies.points import prepare_point
-from rpdrill.studies.specs import NUMBER, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
+from rpdrill.studies.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
 from rpdrill.studies.targets import FREQUENCY, Scan
 
-FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+PositiveFloat = Annotated[float, Field(gt=0)]
 # keys that do not change what an evaluation gives: a rerun may change them and continue
 BUDGET_KEYS = ("max_generations", "max_evaluations")
 
@@ -49,7 +56,7 @@ class Parameter(StrictSpec):
     """One fitted scene value: its bounds, how the search scales them, and the physical reason."""
 
     scale: Literal["linear", "log"] = "linear"
-    bounds: tuple[FiniteFloat, FiniteFloat]
+    bounds: tuple[float, float] = Field(strict=False)  # a YAML list; its numbers stay strict
     reason: str = Field(min_length=1)
 
     @field_validator("bounds")
@@ -58,6 +65,8 @@ class Parameter(StrictSpec):
         lower, upper = bounds
         if not lower < upper:
             raise ValueError(f"{list(bounds)}: the lower bound must be below the upper bound")
+        if not math.isfinite(upper - lower):
+            raise ValueError(f"{list(bounds)}: the bounds span more than a float holds")
         if info.data.get("scale") == "log" and lower <= 0:
             raise ValueError(f"{list(bounds)}: scale log needs a positive lower bound")
         return bounds
@@ -80,7 +89,7 @@ class Target(Scan):
     """A scan (studies.targets) and where the paper puts its optimum."""
 
     optimum_hz: PositiveFloat
-    band_hz: tuple[PositiveFloat, PositiveFloat] | None = None
+    band_hz: tuple[PositiveFloat, PositiveFloat] | None = Field(None, strict=False)  # as Parameter.bounds
     weight: PositiveFloat = 1.0
     tolerance: PositiveFloat = 0.15
 
@@ -96,10 +105,10 @@ class Search(StrictSpec):
     """How the objective is minimised over the unit cube."""
 
     method: Literal["differential-evolution", "nelder-mead"] = "differential-evolution"
-    popsize: int = Field(8, ge=1, description="DE: population = popsize x number of parameters")
-    max_generations: int = Field(15, ge=0, description="DE: generations after the initial population")
-    seed: int = 1
-    max_evaluations: int = Field(100, ge=1, description="Nelder-Mead: evaluation budget")
+    popsize: int = Field(8, ge=1, le=MAX_NUM, description="DE: population = popsize x number of parameters")
+    max_generations: int = Field(15, ge=0, le=MAX_NUM, description="DE: generations after the initial population")
+    seed: int = Field(1, ge=0, le=2**63 - 1)
+    max_evaluations: int = Field(100, ge=1, le=MAX_NUM, description="Nelder-Mead: evaluation budget")
 
     @model_validator(mode="after")
     def _keys_of_method(self) -> Search:
@@ -115,6 +124,13 @@ class Search(StrictSpec):
     def population(self) -> int:
         return 1 if self.method == "nelder-mead" else self.popsize
 
+    def evaluations(self, parameters: int) -> int:
+        """The search's budget in evaluations (DE: a population of popsize x n, at least 5, per
+        generation and for the initial population)."""
+        if self.method == "nelder-mead":
+            return self.max_evaluations
+        return max(5, self.popsize * parameters) * (self.max_generations + 1)
+
 
 class CalibrationSpec(SceneSpec):
     """The calibration file as written (module docstring)."""
@@ -125,11 +141,11 @@ class CalibrationSpec(SceneSpec):
     parameters: dict[str, Parameter] = Field(min_length=1)
     targets: list[Target] = Field(min_length=1)
     rising: list[Annotated[list[str], Field(min_length=2)]] = Field(default_factory=list)
-    rising_weight: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1.0
+    rising_weight: Annotated[float, Field(ge=0)] = 1.0
     search: Search = Search()
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Calibration:
     """A validated calibration: the base scene (overrides set), scan frequencies and target labels."""
 
@@ -138,10 +154,16 @@ class Calibration:
     base: dict[str, Any]
     frequencies_hz: tuple[float, ...]
     labels: tuple[str, ...]
+    cpu_s: float = 0.0  # estimated for the whole calibration (models.cost)
 
     @property
     def names(self) -> list[str]:
         return list(self.spec.parameters)
+
+    @property
+    def evaluations(self) -> int:
+        """The search's budget in evaluations (Search.evaluations)."""
+        return self.spec.search.evaluations(len(self.spec.parameters))
 
     def metric(self, index: int) -> str:
         return self.spec.targets[index].metric or self.spec.metric
@@ -163,11 +185,9 @@ class Calibration:
 
     def start_unit(self) -> np.ndarray:
         """The base scene's values in unit coordinates (0.5 where the base scene gives none)."""
-        units = []
-        for name, parameter in self.spec.parameters.items():
-            value = _number(_get(self.base, name))
-            units.append(0.5 if value is None else parameter.unit(value))
-        return np.array(units)
+        values = {name: _get(self.base, name) for name in self.spec.parameters}
+        return np.array([0.5 if values[name] is None else parameter.unit(values[name])
+                         for name, parameter in self.spec.parameters.items()])
 
     @property
     def hash(self) -> str:
@@ -188,15 +208,14 @@ def _get(data: Any, path: str) -> Any:
     return data
 
 
-def _number(value: Any) -> float | None:
-    """A number of a scene file (YAML 1.1 reads ``1.7e6`` as a string), None if absent; ValueError
-    if something else."""
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, float, str)) or \
-            (isinstance(value, str) and not NUMBER.fullmatch(value)):
-        raise ValueError(f"{value!r} is not a number")
-    return float(value)
+def _takes_numbers(annotation: Any) -> bool:
+    """Whether a scene field's annotation is a real number (``float``, perhaps constrained or optional)."""
+    if get_origin(annotation) is Annotated:
+        return _takes_numbers(get_args(annotation)[0])
+    if get_origin(annotation) in (Union, UnionType):
+        kinds = [a for a in get_args(annotation) if a is not type(None)]
+        return bool(kinds) and all(_takes_numbers(a) for a in kinds)
+    return annotation is float
 
 
 def _labels(spec: CalibrationSpec, source: str) -> tuple[str, ...]:
@@ -210,53 +229,91 @@ def _labels(spec: CalibrationSpec, source: str) -> tuple[str, ...]:
             if label not in labels:
                 raise InputError(f"{source}: rising.{i}.{j}: {label!r}: not a target label; labels: "
                                  f"{', '.join(labels)}")
+            if chain.index(label) != j:
+                raise InputError(f"{source}: rising.{i}.{j}: {label!r}: already in this order; each label once")
     return labels
 
 
-def _check_scene(source: str, key: str, scene: dict[str, Any], where: str) -> None:
-    """InputError unless ``scene`` validates and prepares (its formulation able to run it)."""
+def _check_scene(source: str, key: str, scene: dict[str, Any], where: str, budget: Budget) -> float:
+    """The estimated CPU seconds of a run of ``scene``; InputError unless it validates and prepares (its
+    formulation able to run it), BudgetError beyond the budget of a run."""
     try:
-        prepare_point(source, scene, {})
+        simulation = prepare_point(source, scene, {})
     except InputError as error:
         first = str(error).splitlines()[0].removeprefix(f"{source}: ")
         raise InputError(f"{source}: {key}: {where} is not a valid scene: {first}") from None
+    return budget.check_run(simulation, source, f"{key}: {where}: ").cpu_s
 
 
-def _check_scenes(calibration: Calibration) -> None:
-    """Every target at both ends of the scan must be a valid scene at the start values and with
-    each parameter at each bound (the others at their start values)."""
+def _check_scenes(calibration: Calibration, budget: Budget) -> float:
+    """Every target at both ends of the scan must be a valid scene within the run budget at the start
+    values and with each parameter at each bound (the others at their start values); the mean
+    estimated CPU seconds of a run at the start values."""
     source, spec = str(calibration.source), calibration.spec
     start = calibration.values(calibration.start_unit())
     ends = (calibration.frequencies_hz[0], calibration.frequencies_hz[-1])
     cases = [("targets.{i}.overrides", start, "")] + [
         (f"parameters.{name}.bounds", start | {name: bound}, f" with {name} = {bound:g} ({side} bound)")
         for name, parameter in spec.parameters.items() for side, bound in zip(("lower", "upper"), parameter.bounds)]
-    for key, values, note in cases:
-        for i, label in enumerate(calibration.labels):
-            for frequency in ends:
-                _check_scene(source, key.format(i=i), calibration.scene(values, i, frequency),
-                             f"target {label!r} at {frequency:g} Hz{note}")
+    cpu = [[_check_scene(source, key.format(i=i), calibration.scene(values, i, frequency),
+                         f"target {label!r} at {frequency:g} Hz{note}", budget)
+            for i, label in enumerate(calibration.labels) for frequency in ends] for key, values, note in cases]
+    return float(np.mean(cpu[0]))
 
 
-def load_calibration(path: str | Path) -> Calibration:
-    """Read and validate a calibration file; InputError naming the file, key path and value otherwise."""
-    path = Path(path)
-    spec = parse(CalibrationSpec, read_yaml(path), str(path))
-    base = spec.base_scene_dict(path)
+def _check_parameters(spec: CalibrationSpec, base: dict[str, Any], source: str) -> None:
+    """A parameter names a scene key that takes a number; a target's overrides name scene keys."""
     for name in spec.parameters:
-        check_scene_path(str(path), "parameters", name, base)
-        try:
-            _number(_get(base, name))
-        except ValueError as error:
-            raise InputError(f"{path}: parameters.{name}: the base scene holds {error}; "
-                             "a fitted parameter must be a number") from None
+        check_scene_path(source, "parameters", name, base)
+        if not _takes_numbers(field_at(Scene, tuple(name.split("."))).annotation):
+            raise InputError(f"{source}: parameters.{name}: {_get(base, name)!r} in the base scene: a scene key "
+                             "that does not take a real number; a fitted parameter is a key that does")
+        if name == FREQUENCY or all(name in target.overrides for target in spec.targets):
+            raise InputError(f"{source}: parameters.{name}: every target sets it (the scanned frequency or "
+                             "its overrides), so no scan depends on it; fit a key the targets leave free")
     for i, target in enumerate(spec.targets):
         for key in target.overrides:
-            check_scene_path(str(path), f"targets.{i}.overrides", key, base)
-    frequencies = spec.frequency_hz.expand()
+            check_scene_path(source, f"targets.{i}.overrides", key, base)
+
+
+def _check_frequencies(spec: CalibrationSpec, frequencies: list[Any], source: str) -> None:
+    """At least 3 increasing positive frequencies, every target's optimum and band inside the scan."""
     if len(frequencies) < 3 or any(not isinstance(f, (int, float)) or f <= 0 for f in frequencies) \
             or any(b <= a for a, b in itertools.pairwise(frequencies)):
-        raise InputError(f"{path}: frequency_hz: {frequencies}: need at least 3 increasing positive frequencies")
-    calibration = Calibration(path, spec, base, tuple(float(f) for f in frequencies), _labels(spec, str(path)))
-    _check_scenes(calibration)
-    return calibration
+        raise InputError(f"{source}: frequency_hz: {frequencies}: need at least 3 increasing positive frequencies")
+    for i, target in enumerate(spec.targets):
+        for key, values in (("optimum_hz", [target.optimum_hz]), ("band_hz", target.band_hz or [])):
+            if any(not frequencies[0] <= f <= frequencies[-1] for f in values):
+                raise InputError(f"{source}: targets.{i}.{key}: {values if key == 'band_hz' else values[0]}: outside "
+                                 f"the scanned frequency_hz {frequencies[0]:g} .. {frequencies[-1]:g} Hz")
+
+
+def scans_per_evaluation(spec: CalibrationSpec) -> int:
+    """The distinct scans of an evaluation: targets with the same overrides and metric share one."""
+    return len({json.dumps([t.overrides, t.metric or spec.metric], sort_keys=True) for t in spec.targets})
+
+
+def load_calibration(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Calibration:
+    """Read and validate a calibration file, its runs checked against the ``budget``; InputError naming
+    the file, key path and value, BudgetError naming the cost, otherwise."""
+    path = Path(path)
+    source = str(path)
+    spec = parse(CalibrationSpec, read_yaml(path), source)
+    base = spec.base_scene_dict(path)
+    _check_parameters(spec, base, source)
+    evaluations = spec.search.evaluations(len(spec.parameters))
+    scans, count = scans_per_evaluation(spec), spec.frequency_hz.count
+    what = (f"search: {evaluations:.6g} evaluations (search.popsize, search.max_generations, search.max_evaluations) "
+            f"x {scans} scans x frequency_hz: {count:.6g} frequencies")
+    runs = evaluations * scans * count
+    budget.check_total(source, what, runs, runs * base_estimate_s(source, base),
+                       evaluations * EVALUATION_BYTES + count * AXIS_VALUE_BYTES)
+    frequencies = spec.frequency_hz.expand()
+    _check_frequencies(spec, frequencies, source)
+    calibration = Calibration(path, spec, base, tuple(float(f) for f in frequencies), _labels(spec, source))
+    run_s = _check_scenes(calibration, budget)
+    spacing = max(b - a for a, b in itertools.pairwise(frequencies))
+    report = len(spec.targets) * (count + (4 * spacing / spec.refine_hz + 2 if spec.refine_hz else 0))
+    runs += report
+    budget.check_total(source, f"{what} + refine_hz: {report:.6g} runs of the report", runs, runs * run_s)
+    return dataclasses.replace(calibration, cpu_s=runs * run_s)

@@ -1,8 +1,11 @@
 """The ``rpdrill`` command line: one subcommand per module, each with ``add_arguments`` and ``run``.
 
-Exit status: 0 success, 1 a run failed or a check did not pass, 2 bad input. While a command runs,
-a warning prints as one line, ``rpdrill: warning: ...`` (warnings of worker processes come back
-to this process and print here, once each: studies.runners).
+Exit status: 0 success, 1 a run failed, a check did not pass or a budget was exceeded
+(studies.budgets), 2 bad input, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM: stopped as for
+Ctrl-C, finished results kept). An unexpected exception is a bug: one line naming the input and
+where it was raised, exit status 1, no traceback. While a command runs, a warning prints as one
+line, ``rpdrill: warning: ...`` (warnings of worker processes come back to this process and print
+here, once each: studies.runners).
 """
 
 from __future__ import annotations
@@ -12,9 +15,13 @@ import contextlib
 import importlib
 import importlib.metadata
 import sys
+import traceback
 import warnings
 from collections.abc import Iterator
+from pathlib import Path
 
+from rpdrill.studies.budgets import BudgetError
+from rpdrill.studies.interrupts import Terminated, raise_if_stopped, stops_handled
 from rpdrill.studies.loading import InputError
 
 # name: (module, one-line help); a module is imported only when its command runs
@@ -72,15 +79,28 @@ def main(argv: list[str] | None = None) -> int:
             module = importlib.import_module(module_name)
             module.add_arguments(command_parser)
     args = parser.parse_args(argv)
-    with one_line_warnings():
-        try:
-            return int(module.run(args))
-        except InputError as err:
-            print(str(err), file=sys.stderr)
-            return 2
-        except KeyboardInterrupt:
-            print("rpdrill: interrupted", file=sys.stderr)
-            return 130
+    try:
+        with one_line_warnings(), stops_handled():
+            status = int(module.run(args))
+            raise_if_stopped()
+            return status
+    except InputError as err:
+        print(str(err), file=sys.stderr)
+        return 2
+    except BudgetError as err:
+        print(str(err), file=sys.stderr)
+        return 1
+    except KeyboardInterrupt as stop:
+        terminated = isinstance(stop, Terminated)
+        print(f"rpdrill: {'terminated (SIGTERM)' if terminated else 'interrupted'}; finished results are kept",
+              file=sys.stderr)
+        return 143 if terminated else 130
+    except Exception as err:  # noqa: BLE001 - a bug, not bad input: one line naming the input, no traceback
+        where = traceback.extract_tb(err.__traceback__)[-1]
+        source = next((getattr(args, key) for key in ("scene", "study", "calibration") if hasattr(args, key)), "")
+        print(f"{source}: rpdrill internal error: {type(err).__name__}: {err} (at {Path(where.filename).name}:"
+              f"{where.lineno}); please report it with this input", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

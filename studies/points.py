@@ -17,7 +17,7 @@ from rpdrill.models.formulations import unsupported
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import SceneError, Simulation, prepare
-from rpdrill.studies.loading import InputError
+from rpdrill.studies.loading import InputError, problem
 
 
 def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]) -> list[str]:
@@ -26,7 +26,7 @@ def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]
     for item in error.errors():
         loc = ".".join(str(p) for p in item["loc"] if p != "function-after")
         related = [a for a in parameters if a == loc or a.startswith(loc + ".") or loc.startswith(a + ".")]
-        message = item["msg"].removeprefix("Value error, ")
+        message = problem(item)
         if len(related) == 1:
             lines.append(f"{source}: scan.{related[0]}: {parameters[related[0]]!r}: {message}")
         else:

@@ -36,7 +36,7 @@ class PaperResult(StrictSpec):
     """What the paper reports for a case: its optimum (the centre of its band), its band, its words."""
 
     optimum_hz: float | None = Field(None, gt=0, allow_inf_nan=False)
-    band_hz: tuple[float, float] | None = None
+    band_hz: tuple[float, float] | None = Field(None, strict=False)  # a YAML list; its numbers stay strict
     says: str
 
 

@@ -1,4 +1,5 @@
-"""Writing run outputs: CSV with unit-carrying headers, JSON, the resolved scene; all or nothing."""
+"""Writing run outputs: the output folder checked before any work, CSV with unit-carrying headers,
+JSON, the resolved scene; all or nothing."""
 
 from __future__ import annotations
 
@@ -14,6 +15,29 @@ from typing import Any
 
 import numpy as np
 import yaml
+
+from rpdrill.studies.loading import InputError
+
+
+def check_out(out: str | Path, overwrite: bool | None = False, record: str | None = None) -> Path:
+    """``--out`` as a folder that can take a run's files, checked before any work; InputError if it
+    is a file, lies below a file, cannot be written, or is a folder that holds another run's files
+    (anything but names starting with '.') unless ``overwrite`` (None: the command has no
+    ``--overwrite``), or unless it holds ``record`` (a resumable command's own record, which the
+    command checks itself)."""
+    out = Path(out)
+    existing = next(p for p in (out, *out.parents) if p.exists())
+    if not existing.is_dir():
+        where = "is a file" if existing == out else f"lies below the file {existing}"
+        raise InputError(f"--out: {out}: {where}; give a folder")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise InputError(f"--out: {out}: cannot write in {existing}; give a folder you can write")
+    held = sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) if existing == out else []
+    if held and not overwrite and (record is None or record not in held):
+        shown = ", ".join(held[:6]) + (f" and {len(held) - 6} more" if len(held) > 6 else "")
+        hint = "give a new folder" + ("" if overwrite is None else ", or --overwrite to write over them")
+        raise InputError(f"--out: {out}: holds {shown} (another run's files); {hint}")
+    return out
 
 
 @contextlib.contextmanager

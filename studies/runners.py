@@ -7,12 +7,11 @@ process, one argument per batch), or one bound to a pool that lives for many cal
 a LocalCluster); :func:`pool` picks one for the command line options. A pool's workers start and
 import rpdrill once (a process pool's with its first call, so that a study refused before it runs
 starts none) and take batches of arguments (:func:`batches`): a run pays the process machinery once
-per pool and once per batch, not per argument. A pool's call submits its work at once and returns
-the iterator of results, so work submitted earlier (plots) goes on while the caller waits for later
-work. Results come in completion order, so the function's result must say which argument it belongs
-to. Workers run one BLAS thread each and keep freed memory (WORKER_ENVIRONMENT). A worker's
-warnings come back with its batch and are issued again in this process (its filters and formatting
-apply; each distinct warning once per pool), so that workers print nothing themselves.
+per pool and once per batch, not per argument. Results come in completion order, so the function's
+result must say which argument it belongs to. Workers run one BLAS thread each and keep freed memory
+(WORKER_ENVIRONMENT); process-pool workers stop on SIGTERM as on Ctrl-C (studies.interrupts). A
+worker's warnings come back with its batch and are issued again in this process (its filters and
+formatting apply; each distinct warning once per pool), so that workers print nothing themselves.
 """
 
 from __future__ import annotations
@@ -28,6 +27,8 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from multiprocessing import get_context
 from pathlib import Path
 from typing import Any, TypeVar
+
+from rpdrill.studies.interrupts import worker_stops_like_ctrl_c
 
 Arg = TypeVar("Arg")
 Result = TypeVar("Result")
@@ -77,6 +78,13 @@ def warm_up() -> None:
                 "solver": {"formulation": "exact", "end_time_s": 0.02}}
     prepare(Scene.model_validate(one_blow)).run()
 
+
+def start_process_worker() -> None:
+    """Process-pool worker initializer: SIGTERM stops it as Ctrl-C does (studies.interrupts), then
+    :func:`warm_up`."""
+    worker_stops_like_ctrl_c()
+    warm_up()
+
 def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
     """In this process, one after the other (each result its own batch)."""
     return ([function(argument)] for argument in arguments)
@@ -123,7 +131,7 @@ def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
         if not executors:
             with _environment(WORKER_ENVIRONMENT):  # the workers start inside: the setting reaches them
                 executors.append(ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
-                                                     initializer=warm_up))
+                                                     initializer=start_process_worker))
                 for _ in range(workers):  # a new worker per task pending when submitted: all start now
                     executors[0].submit(math.sqrt, 0.0)
         futures = [executors[0].submit(run_batch, (function, batch)) for batch in batches(arguments, workers)]

@@ -33,6 +33,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from rpdrill.models.scene import Scene
+from rpdrill.studies.budgets import base_estimate_s
 from rpdrill.studies.loading import InputError, parse, read_yaml
 from rpdrill.studies.specs import Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
 from rpdrill.studies.targets import (
@@ -94,6 +95,7 @@ class Point:
     parameters: dict[str, Any]
     scan: int
     scene: dict[str, Any]
+    cpu_s: float  # estimated: the scan's frequencies, each a run of the base scene with its overrides
 
 
 @dataclass(frozen=True)
@@ -206,12 +208,15 @@ def load_sensitivity(path: str | Path) -> SensitivityStudy:
         samples = _global_samples(spec.global_analysis)
         variations += [({"kind": "global", "sample": i}, dict(zip(spec.global_analysis.parameters, row.tolist())))
                        for i, row in enumerate(samples)]
+    scan_cpu_s = [len(frequencies) * base_estimate_s(str(path), set_frequency(varied_scene(base, scan.overrides, {}),
+                                                                                  frequencies[0]))
+                  for scan in spec.scans]
     points = []
     for labels, factors in variations:
         for s, scan in enumerate(spec.scans):
             scene = varied_scene(base, scan.overrides, factors)
             parse(Scene, set_frequency(scene, frequencies[0]), f"{path} (scan {scan.label!r}, {labels})")
-            points.append(Point(len(points), {**labels, "scan": scan.label}, s, scene))
+            points.append(Point(len(points), {**labels, "scan": scan.label}, s, scene, scan_cpu_s[s]))
     return SensitivityStudy(path, spec, base, frequencies, varied, samples, points)
 
 

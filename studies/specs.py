@@ -10,23 +10,26 @@ from __future__ import annotations
 
 import copy
 import math
-import re
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from rpdrill.models.outputs import METRICS
 from rpdrill.models.scene import Scene
 from rpdrill.studies.loading import InputError, allowed_keys, parse, read_yaml
 
 METRIC_NAMES = tuple(METRICS)
-NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 MetricName = Literal[METRIC_NAMES]  # type: ignore[valid-type]
+# a range's num is bounded so that its count stays a float; a study of so many points is refused by
+# its budget long before (studies.budgets)
+MAX_NUM = 10**15
 
 
 class StrictSpec(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+    """Unknown keys are errors; numbers are numbers and finite (as in the scene, models.scene.Strict)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True, strict=True, allow_inf_nan=False)
 
 
 class SceneSpec(StrictSpec):
@@ -42,9 +45,10 @@ class SceneSpec(StrictSpec):
         must still supply the rock values); InputError naming ``source`` otherwise."""
         if isinstance(self.base_scene, str):
             path = source.parent / self.base_scene
-            if not path.is_file():
-                raise InputError(f"{source}: base_scene: {self.base_scene!r}: no scene file {path}")
-            data = read_yaml(path)
+            try:
+                data = read_yaml(path)
+            except InputError as error:
+                raise InputError(f"{source}: base_scene: {self.base_scene!r}: {error}") from None
             parse(Scene, data, str(path))
         else:
             data = copy.deepcopy(self.base_scene)
@@ -60,23 +64,16 @@ class Axis(StrictSpec):
     """Values of one scan axis: a list ``[..]``, ``{from, to, step}`` or ``{from, to, num, spacing}``."""
 
     values: list[Any] | None = Field(None, min_length=1)
-    start: float | None = Field(None, alias="from", allow_inf_nan=False)
-    to: float | None = Field(None, allow_inf_nan=False)
-    step: float | None = Field(None, allow_inf_nan=False)
-    num: int | None = Field(None, ge=2)
+    start: float | None = Field(None, alias="from")
+    to: float | None = None
+    step: float | None = None
+    num: int | None = Field(None, ge=2, le=MAX_NUM)
     spacing: Literal["linear", "log"] = "linear"
 
     @model_validator(mode="before")
     @classmethod
     def _list_is_values(cls, data: Any) -> Any:
         return {"values": data} if isinstance(data, list) else data
-
-    @field_validator("values")
-    @classmethod
-    def _numbers(cls, values: list[Any] | None) -> list[Any] | None:
-        """YAML 1.1 reads ``1.2e5`` (no exponent sign) as a string: make such strings numbers."""
-        return None if values is None else [float(v) if isinstance(v, str) and NUMBER.fullmatch(v) else v
-                                            for v in values]
 
     @model_validator(mode="after")
     def _one_form(self) -> Axis:
@@ -91,6 +88,16 @@ class Axis(StrictSpec):
         if self.spacing == "log" and (self.num is None or self.start <= 0 or self.to <= 0):
             raise ValueError("spacing: log needs num and positive from and to")
         return self
+
+    @property
+    def count(self) -> float:
+        """How many values :meth:`expand` gives, known before expanding (inf beyond any float)."""
+        if self.values is not None:
+            return float(len(self.values))
+        if self.step is not None:
+            span = (self.to - self.start) / self.step
+            return float(math.floor(span + 1e-9) + 1) if math.isfinite(span) else math.inf
+        return float(self.num)
 
     def expand(self) -> list[Any]:
         """The axis values; ranges include ``to`` and are rounded to 12 significant digits."""

@@ -36,12 +36,13 @@ import itertools
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
 from rpdrill.models.scene import Scene, switch_formulation
 from rpdrill.models.simulation import Simulation
+from rpdrill.studies.budgets import DEFAULT_BUDGET, Budget, BudgetError, base_estimate_s, check_size
 from rpdrill.studies.loading import InputError, parse, read_yaml
 from rpdrill.studies.points import prepare_point
 from rpdrill.studies.specs import (
@@ -63,7 +64,7 @@ class Plot(StrictSpec):
 
     kind: Literal["curves", "map"] = "curves"
     x: str
-    y: str | list[str]
+    y: str | Annotated[list[str], Field(min_length=1)]
     z: MetricName | None = None
     curves: str | None = None
 
@@ -88,7 +89,7 @@ class StudySpec(SceneSpec):
     """The study file as written."""
 
     scan: dict[str, Axis] = Field(min_length=1)
-    combine: Literal["grid", "zip"] | list[list[str]] = "grid"
+    combine: Literal["grid", "zip"] | list[Annotated[list[str], Field(min_length=1)]] = "grid"
     metrics: list[MetricName] = Field(list(METRIC_NAMES), min_length=1)
     plots: list[Plot] = Field(default_factory=list)
     format: Literal["png", "svg", "pdf"] = "png"  # an SVG is written beside a PNG or PDF
@@ -96,11 +97,13 @@ class StudySpec(SceneSpec):
 
 @dataclass(frozen=True)
 class Point:
-    """One scene of a study: its index, its scan parameters and the prepared simulation."""
+    """One scene of a study: its index, its scan parameters, the prepared simulation and its
+    estimated CPU seconds (models.cost)."""
 
     index: int
     parameters: dict[str, Any]
-    simulation: Simulation
+    simulation: Simulation | None
+    cpu_s: float
 
 
 @dataclass(frozen=True)
@@ -141,14 +144,21 @@ def _groups(spec: StudySpec, source: str) -> list[list[str]]:
     return list(spec.combine) + [[n] for n in names if n not in listed]
 
 
-def _combine(groups: list[list[str]], axes: dict[str, list[Any]], source: str) -> list[dict[str, Any]]:
-    zipped = []
+def _point_count(groups: list[list[str]], spec: StudySpec, source: str) -> float:
+    """The number of points, from the axes' counts (before any is expanded); InputError when a
+    zipped group's axes differ in length."""
+    count = 1.0
     for group in groups:
-        lengths = {n: len(axes[n]) for n in group}
+        lengths = {n: spec.scan[n].count for n in group}
         if len(set(lengths.values())) > 1:
             raise InputError(f"{source}: combine: zipped axes need equal lengths, got "
-                             + ", ".join(f"scan.{n}: {k}" for n, k in lengths.items()))
-        zipped.append([dict(zip(group, values)) for values in zip(*(axes[n] for n in group))])
+                             + ", ".join(f"scan.{n}: {k:.6g}" for n, k in lengths.items()))
+        count *= next(iter(lengths.values()))
+    return count
+
+
+def _combine(groups: list[list[str]], axes: dict[str, list[Any]]) -> list[dict[str, Any]]:
+    zipped = [[dict(zip(group, values)) for values in zip(*(axes[n] for n in group))] for group in groups]
     return [{k: v for part in combo for k, v in part.items()} for combo in itertools.product(*zipped)]
 
 
@@ -167,33 +177,42 @@ def _check_plots(spec: StudySpec, axes: dict[str, list[Any]], source: str) -> No
                                  f"metrics: {', '.join(spec.metrics)}")
 
 
-def load_study(path: str | Path, formulation: str | None = None) -> Study:
+def load_study(path: str | Path, formulation: str | None = None, budget: Budget = DEFAULT_BUDGET) -> Study:
     """Read, validate and expand a study file, every point with ``formulation`` when given (the base
-    scene's solver options of another formulation dropped); InputError naming the file and key path
-    otherwise."""
+    scene's solver options of another formulation dropped) and checked against the ``budget`` before it
+    runs; InputError naming the file and key path, BudgetError naming the cost, otherwise."""
     path = Path(path)
-    spec = parse(StudySpec, read_yaml(path), str(path))
+    source = str(path)
+    spec = parse(StudySpec, read_yaml(path), source)
     base = spec.base_scene_dict(path)
     if formulation is not None:
         base["solver"] = switch_formulation(base.get("solver", {}), formulation)
     for axis in spec.scan:
-        check_scene_path(str(path), "scan", axis, base)
+        check_scene_path(source, "scan", axis, base)
+    _check_rock_name_axis(spec, base, source)
+    groups = _groups(spec, source)
+    count = _point_count(groups, spec, source)
+    outputs = {"outputs": {"metrics": list(spec.metrics)}}  # the model records only what these need
+    what = f"scan: {count:.6g} points (" + ", ".join(f"scan.{n}: {a.count:.6g} values" for n, a in spec.scan.items()) + ")"
+    check_size(budget, source, what, count, base_estimate_s(source, {**base, **outputs}))
     axes = {name: axis.expand() for name, axis in spec.scan.items()}
-    _check_plots(spec, axes, str(path))
-    _check_rock_name_axis(spec, base, str(path))
-    points, problems = [], []
-    for index, parameters in enumerate(_combine(_groups(spec, str(path)), axes, str(path))):
+    points, problems, bad_input = [], [], False
+    for index, parameters in enumerate(_combine(groups, axes)):
         scene = copy.deepcopy(base)
         for name, value in parameters.items():
             set_path(scene, name, value)
-        scene["outputs"] = {"metrics": list(spec.metrics)}  # the model records only what these need
         try:
-            points.append(Point(index, parameters, prepare_point(str(path), scene, parameters)))
-        except InputError as error:
+            simulation = prepare_point(source, {**scene, **outputs}, parameters)
+            cost = budget.check_run(simulation, source, f"scan point {parameters}: ")
+            points.append(Point(index, parameters, simulation, cost.cpu_s))
+        except (InputError, BudgetError) as error:
+            bad_input |= isinstance(error, InputError)
             problems += [line for line in str(error).splitlines() if line not in problems]
     if problems:
         more = f"\n... and {len(problems) - 5} more" if len(problems) > 5 else ""
-        raise InputError("\n".join(problems[:5]) + more)
+        raise (InputError if bad_input else BudgetError)("\n".join(problems[:5]) + more)
+    _check_plots(spec, axes, source)
+    budget.check_total(source, what, count, sum(p.cpu_s for p in points))
     return Study(path, spec, base, axes, points)
 
 

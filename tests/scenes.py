@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-import copy
 from pathlib import Path
 from typing import Any
-
-import yaml
 
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
+from rpdrill.studies.loading import read_yaml
 
 PAPER_BASE = Path(__file__).resolve().parent / "test_drill.yaml"
 
@@ -23,7 +21,7 @@ PER_BODY = {"drill_string.bodies.carriage": None, "drill_string.connectors.shock
 
 def scene_dict(path: Path = PAPER_BASE, **overrides: Any) -> dict:
     """The scene file as a dict with ``{"a.b.c": value}`` overrides (use ``None`` to delete a key)."""
-    data = copy.deepcopy(yaml.safe_load(path.read_text()))
+    data = read_yaml(path)
     for dotted, value in overrides.items():
         *parents, key = dotted.split(".")
         node = data

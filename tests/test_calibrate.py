@@ -180,6 +180,17 @@ def test_another_calibration_into_the_same_out_is_refused(tiny, tmp_path, capsys
     assert evaluations(out) == evaluations(first)
 
 
+def test_overwrite_starts_another_calibration_afresh(tiny, tmp_path):
+    _, first = tiny
+    out = tmp_path / "out"
+    shutil.copytree(first, out)
+    other = write(tmp_path / "other.yaml", spec(search={"method": "nelder-mead", "max_evaluations": 2}))
+    assert main(["calibrate", str(other), "--out", str(out), "--workers", "1", "--quiet", "--overwrite"]) == 0
+    checkpoint = json.loads((out / "checkpoint.json").read_text())
+    assert checkpoint["calibration_file"] == str(other) and len(checkpoint["sessions"]) == 1
+    assert checkpoint["sessions"][0]["evaluations_replayed"] == 0 and len(evaluations(out)) <= 3
+
+
 def test_nelder_mead_stays_within_its_budget(tmp_path):
     path = write(tmp_path / "nm.yaml", spec(search={"method": "nelder-mead", "max_evaluations": 3}))
     assert calibrate(path, tmp_path / "out") == 0

@@ -67,7 +67,7 @@ def test_bad_scene_one_message_exit_2(tmp_path, capsys, label, overrides, expect
     assert not out.exists()  # nothing half-written
 
 
-@pytest.mark.parametrize("content, expected", [(None, "cannot read"), ("a: [1, 2", "not valid YAML"),
+@pytest.mark.parametrize("content, expected", [(None, "no such file"), ("a: [1, 2", "not valid YAML"),
                                                ("- 1\n- 2\n", "mapping")])
 def test_unreadable_files(tmp_path, capsys, content, expected):
     path = tmp_path / "scene.yaml"
@@ -95,3 +95,24 @@ def test_diverged_run_is_an_error_not_a_result(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "diverged" in err and "explicit_euler" in err and "step_s" in err
     assert not out.exists()
+
+
+def test_an_out_folder_holding_another_run_is_refused_unless_overwrite(tmp_path, capsys):
+    path = write(tmp_path, scene_dict(**QUICK))
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "results.csv").write_text("point,status\n")  # a study's results
+    assert main(["simulate", str(path), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"--out: {out}: holds results.csv" in err and "--overwrite" in err
+    assert [p.name for p in out.iterdir()] == ["results.csv"]
+    assert main(["simulate", str(path), "--out", str(out), "--quiet", "--overwrite"]) == 0
+    assert {p.name for p in out.iterdir()} >= {"results.csv", "timeseries.csv", "summary.json"}
+
+
+def test_simulate_with_the_exact_formulation_writes_its_run_info(tmp_path):
+    """The exact run's info holds arrays (switch times): summary.json writes them as lists."""
+    path = write(tmp_path, scene_dict(**QUICK, solver={"formulation": "exact", "end_time_s": 0.1}))
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    run = json.loads((tmp_path / "out" / "summary.json").read_text())["run"]
+    assert run["mode_switches"] == len(run["switch_times_s"]) > 0

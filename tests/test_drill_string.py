@@ -77,7 +77,7 @@ def test_segments_split_mass_and_keep_total_compliance():
     ({"drill_string.connectors.collar_bit_joint.stiffness_n_per_m": None}, "neither end is a rod"),
     ({"drill_string.connectors.collar_bit_joint.gap_m": 1e-4}, "does not apply to type 'spring_damper'"),
     ({"drill_string.connectors.collar_bit_joint.type": "weld"}, "'weld' is not one of spring_damper, coupling"),
-    ({"drill_string.connectors.shank_collar_joint": None}, "not connected"),
+    ({"drill_string.connectors.shank_collar_joint": None}, "a separate part"),
     ({"drill_string.rock_body": "collar_bit"}, "rock_body 'collar_bit' is not a body"),
     ({"drill_string.bodies.ground": {"mass_kg": 1.0}}, "reserved"),
 ])

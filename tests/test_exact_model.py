@@ -19,17 +19,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 from scenes import PER_BODY, crushing_scene, scene, simulate
 
 import rpdrill.models.exact_model
 import rpdrill.models.stability
 from rpdrill.models.energy import energy_account
-from rpdrill.models.exact_kernels import first_crossing, run_events
+from rpdrill.models.exact_kernels import BRENT_RTOL, BRENT_XTOL, brent, first_crossing, horner, run_events
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.stability import SimulationFailed
+from rpdrill.studies.loading import read_yaml
 
 BLOWS = 12
 SHORT_METRICS = {"metrics__transient_blows": 2, "metrics__block_blows": 2}
@@ -177,6 +177,24 @@ def test_a_crossing_and_its_return_between_two_points_is_found(peak: float, expe
     assert found == pytest.approx(expected, rel=1e-14)
 
 
+# An exit function of the 64-segment wave rod (studies/scenes/wave_rod.yaml) far from the wave, at 1e-290:
+# Brent's inverse quadratic step divides by a product that underflows to 0 (once a ZeroDivisionError).
+UNDERFLOWING_EXIT = [7.788371615881117e-290, 4.124835374249013e-283, -2.862719303340617e-276, -4.17270827535055e-269,
+                     -1.633151127953158e-262, -3.438384844349407e-256, -3.138989670558964e-250, -9.993503771441705e-245,
+                     -2.233829228423664e-238, 1.030536368331734e-235, 1.3117665095211989e-225, 3.920775038924378e-219,
+                     3.3944288107501604e-213, 1.9913821534458496e-207, 1.0146212589486395e-201,
+                     -2.1784445545650176e-195, -1.4468496034364281e-189, -1.2690657502050154e-183,
+                     -4.169700916125896e-178, 3.0114328558827614e-172, -3.184844854080616e-166, 0.0]
+
+
+def test_a_root_of_an_exit_function_near_underflow_is_found() -> None:
+    """Brent's method returns the sign change of p (within its tolerance), not an exception."""
+    coefficients = np.array(UNDERFLOWING_EXIT)
+    root = brent(coefficients, 0.0, 2.5e-7)
+    tolerance = BRENT_XTOL + BRENT_RTOL * root
+    assert horner(coefficients, root - tolerance) > 0.0 > horner(coefficients, root + tolerance)
+
+
 def test_switches_do_not_depend_on_the_sample_interval() -> None:
     """The bilinear rock's brief loading episodes (one of 8 us on this drill, within a 14 us sub-step at
     1e-4 s samples) are found whatever the sub-grid: the same switches as on a 2 us sub-grid."""
@@ -244,13 +262,36 @@ def test_divergence_is_reported_at_the_first_bad_sample(monkeypatch: pytest.Monk
         simulate(short, "exact")
 
 
-FOUR_ROD = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "four_rod_string.yaml"
+SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
+FOUR_ROD = SCENES / "four_rod_string.yaml"
+
+
+@pytest.mark.parametrize("path", sorted(SCENES.glob("*.yaml")), ids=lambda path: path.stem)
+def test_every_shipped_scene_runs_exact_and_agrees_with_the_ode(path: Path) -> None:
+    """The exact formulation takes every shipped scene (its laws, couplings, torsion, rods of many
+    segments); over its first two blows (at most the scene's end time) every body's velocity and the
+    borehole bottom agree with the tight ODE at the pulse switches and the end, which both store."""
+    data = read_yaml(path)
+    scene_ = Scene.model_validate(data)
+    period_s, end_s = scene_.impact.period_s, min(scene_.solver.end_time_s, 2 * scene_.impact.period_s)
+    data["solver"] = {"end_time_s": end_s, "output_interval_s": min(1e-5, scene_.impact.duration_s / 20)}
+    data["metrics"] = {"transient_blows": 0, "block_blows": 1}
+    short = Scene.model_validate(data)
+    exact_run = simulate(short, "exact")
+    ode = simulate(short, "ode", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
+    switches_s = np.concatenate([np.arange(1, 2) * period_s, np.arange(2) * period_s + scene_.impact.duration_s])
+    stored_s = np.append(switches_s[switches_s < end_s - 1e-9], exact_run.time_s[-1])
+    assert ode.time_s[-1] == exact_run.time_s[-1] == pytest.approx(end_s)
+    for column in ("velocity_m_per_s", "bottom_m"):
+        reference = held_at(ode, getattr(ode, column), stored_s)
+        difference = held_at(exact_run, getattr(exact_run, column), stored_s) - reference
+        assert np.max(np.abs(difference)) <= AGREEMENT * max(np.max(np.abs(getattr(ode, column))), 1e-9), column  # measured <= 8e-12
 
 
 def four_rods_with_couplings() -> Scene:
     """The four-rod string with compression-only couplings on soft limestone, 400 kN blows: it crushes
     in its first blow; one blow (the rattle of loose couplings is chaotic over many blows)."""
-    data = yaml.safe_load(FOUR_ROD.read_text())
+    data = read_yaml(FOUR_ROD)
     for name in ("shank_coupling", "coupling1", "coupling2", "coupling3", "bit_coupling"):
         data["drill_string"]["connectors"][name]["type"] = "coupling"
     data["rock"], data["impact"]["amplitude_n"] = {"name": "soft_limestone"}, 400e3

@@ -6,7 +6,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 from scenes import scene_dict, simulate
 
 from rpdrill.models.compare import compare_bottom_at, compare_histories
@@ -14,6 +13,7 @@ from rpdrill.models.energy import energy_account
 from rpdrill.models.links import LINK_TYPES, RATE, STRETCH, Link
 from rpdrill.models.scene import Scene
 from rpdrill.rocklaw.modes import check_mode_forces
+from rpdrill.studies.loading import parse_yaml
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "extending.md"
 SHORT = {"solver.end_time_s": 0.2, "metrics.transient_blows": 3, "metrics.block_blows": 3,
@@ -33,7 +33,7 @@ def joint_type():
 
 
 def _scene(joint_type, **joint) -> Scene:
-    connector = yaml.safe_load(next(b for b in _blocks("yaml") if b.startswith("collar_bit_joint:")))
+    connector = parse_yaml(next(b for b in _blocks("yaml") if b.startswith("collar_bit_joint:")), "docs/extending.md")
     connector["collar_bit_joint"].update(joint)
     return Scene.model_validate(scene_dict(**SHORT, **{"drill_string.connectors.collar_bit_joint":
                                                        connector["collar_bit_joint"]}))

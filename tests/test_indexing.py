@@ -19,7 +19,7 @@ from rpdrill.models.scene import Bit, Scene
 from rpdrill.models.simulation import prepare
 from rpdrill.studies.cli import main
 from rpdrill.studies.crosscheck import DEFAULT_STEP_S
-from rpdrill.studies.loading import InputError, prepare_scene
+from rpdrill.studies.loading import InputError, prepare_scene, read_yaml
 from rpdrill.studies.study import load_study
 
 BIT = {"diameter_m": 0.216, "gauge_button_diameter_m": 0.019, "gauge_buttons": 12}  # the issue's DTH bit
@@ -203,7 +203,7 @@ def test_rotation_report_from_two_small_studies(tmp_path):
     figure; the note's manual and model speeds are the rule's and the model's formulas."""
     for name, scan in (("rpm_frequency_map", {"impact.frequency_hz": [36.0, 45.0], "rotation.speed_rpm": [45.0, 60.0]}),
                        ("dth_example", {"rotation.speed_rpm": [45.0, 60.0, 75.0]})):
-        spec = yaml.safe_load((ROTATION_STUDIES / f"{name}.yaml").read_text())
+        spec = read_yaml(ROTATION_STUDIES / f"{name}.yaml")
         spec.update(base_scene=str(ROTATION_STUDIES.parent / "scenes" / "dth_drill.yaml"),
                     scan={"rock.name": ["conglomerate"], **scan}, plots=[])
         spec["base_overrides"]["solver"]["end_time_s"] = 0.5

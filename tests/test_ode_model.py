@@ -2,25 +2,24 @@
 
 from __future__ import annotations
 
-import copy
 import functools
 import subprocess
 import sys
 
 import numpy as np
 import pytest
-import yaml
 from scenes import PAPER_BASE, simulate
 
 from rpdrill.models import ode_model
 from rpdrill.models.energy import energy_account
 from rpdrill.models.scene import Scene
 from rpdrill.models.stability import SimulationFailed
+from rpdrill.studies.loading import read_yaml
 
 
 def scene_from_base(blows: float = 15, **changes: object) -> Scene:
     """The test drill ending after ``blows`` periods, with ``changes`` given as 'section.key' -> value."""
-    data = copy.deepcopy(yaml.safe_load(PAPER_BASE.read_text(encoding="utf-8")))
+    data = read_yaml(PAPER_BASE)
     for path, value in changes.items():
         section, key = path.split(".")
         data.setdefault(section, {})[key] = value

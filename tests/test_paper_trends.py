@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
 from rpdrill.models.compare import compare_runs, verdict
 from rpdrill.models.energy import energy_account
@@ -16,6 +15,7 @@ from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.modal import rock_mode_frequency_hz
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
+from rpdrill.studies.loading import read_yaml
 from rpdrill.studies.optima import curve_optimum
 from rpdrill.studies.specs import set_path
 
@@ -24,7 +24,7 @@ SOFT_ROCK = {"rock.stiffness_n_per_m": 8.93e7, "rock.damping_n_s_per_m": 683.0, 
 
 
 def pipe_drill(**overrides: object) -> Scene:
-    data = yaml.safe_load(PIPE_DRILL.read_text(encoding="utf-8"))
+    data = read_yaml(PIPE_DRILL)
     for path, value in overrides.items():
         set_path(data, path, value)
     return Scene.model_validate(data)

@@ -22,6 +22,7 @@ from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.models.stability import StepLimitWarning
 from rpdrill.studies.cli import main
+from rpdrill.studies.loading import read_yaml
 from rpdrill.studies.points import run_point
 from rpdrill.studies.runners import BATCHES_PER_WORKER, WORKER_ENVIRONMENT, batches
 from rpdrill.studies.specs import METRIC_NAMES
@@ -37,7 +38,7 @@ def write_study(path: Path, **changes) -> Path:
         "name": "small",
         "base_scene": str(PAPER_BASE),
         "base_overrides": SHORT,
-        "scan": {"impact.frequency_hz": [40, 60], "impact.amplitude_n": ["160.0e3", 220e3]},
+        "scan": {"impact.frequency_hz": [40, 60], "impact.amplitude_n": [160.0e3, 220e3]},
         "metrics": ["penetration_rate_m_per_s", "bit_velocity_peak_m_per_s"],
         "plots": [
             {"x": "impact.frequency_hz", "y": "bit_velocity_peak_m_per_s", "curves": "impact.amplitude_n"},
@@ -92,7 +93,7 @@ def test_rock_name_axis_supplies_rock_values():
 
 
 def test_points_run_on_a_base_scene_with_default_solver(tmp_path):
-    base = {key: value for key, value in yaml.safe_load(PAPER_BASE.read_text()).items() if key != "solver"}
+    base = {key: value for key, value in read_yaml(PAPER_BASE).items() if key != "solver"}
     study = load_study(write_study(tmp_path / "s.yaml", base_scene=base, scan={"impact.frequency_hz": [40]},
                                    base_overrides=SHORT, plots=[]))
     outcome = run_point((0, study.points[0].simulation))
@@ -100,7 +101,7 @@ def test_points_run_on_a_base_scene_with_default_solver(tmp_path):
 
 
 def test_metric_names_are_those_of_summary_metrics():
-    scene = Scene.model_validate({**yaml.safe_load(PAPER_BASE.read_text()), "metrics": SHORT["metrics"],
+    scene = Scene.model_validate({**read_yaml(PAPER_BASE), "metrics": SHORT["metrics"],
                                   "solver": {"end_time_s": 0.1}})
     assert set(summary_metrics(simulate(scene))) == set(METRIC_NAMES)
 
@@ -184,6 +185,34 @@ def test_batches_keep_every_point_once_in_order_and_even(count, workers):
 
 
 @pytest.mark.slow
+def test_sigterm_stops_like_ctrl_c(tmp_path):
+    """SIGTERM to the command (its pool workers busy): a message, exit 143, the finished rows kept, the
+    interrupted session recorded in study.json, no traceback and no leaked semaphores."""
+    study = write_study(tmp_path / "term.yaml", base_overrides={"solver.end_time_s": 3.0}, plots=[],
+                        scan={"impact.frequency_hz": [40, 42, 44, 46, 48, 50, 52, 54, 56, 58]})
+    out = tmp_path / "out"
+    process = subprocess.Popen([sys.executable, "-m", "rpdrill.studies.cli", "study", str(study), "--out", str(out),
+                                "--workers", "2", "--quiet"], cwd=ROOT, start_new_session=True,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and process.poll() is None:
+            if (out / "results.csv").exists() and len(rows(out)) >= 1:
+                break
+            time.sleep(0.05)
+        process.send_signal(signal.SIGTERM)  # the command only, not its workers
+        _, err = process.communicate(timeout=120)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+    assert process.returncode == 143, err
+    assert "terminated" in err and "Traceback" not in err and "leaked" not in err
+    kept = rows(out)
+    assert 1 <= len(kept) < 10 and all(r["status"] == "ok" for r in kept)
+    session = json.loads((out / "study.json").read_text())["sessions"][-1]
+    assert session["interrupted"] is True and session["points_run"] == len(kept)
+
+
 def test_dask_local_cluster(tmp_path):
     study = write_study(tmp_path / "dask.yaml", scan={"impact.frequency_hz": [40, 60]}, plots=[])
     out = tmp_path / "out"
@@ -241,11 +270,12 @@ def test_study_on_a_real_dask_cluster_gives_the_local_results(tmp_path):
 @pytest.mark.parametrize("changes, expected", [
     ({"scna": {}}, "scna: {}: unknown key; allowed keys here: name, description, base_scene"),
     ({"scan": {"impact.freq": [40]}, "plots": []}, "scan.impact.freq: unknown scene key path; allowed keys here: amplitude_n"),
-    ({"scan": {"impact.frequency_hz": [40, "fast"]}, "plots": []}, "scan.impact.frequency_hz: 'fast': Input should be a valid"),
+    ({"scan": {"impact.frequency_hz": [40, "fast"]}, "plots": []}, "scan.impact.frequency_hz: 'fast': a number is required"),
     ({"scan": {"impact.frequency_hz": [40, 2000]}, "plots": []}, "scan.impact.frequency_hz: 2000"),
     ({"scan": {"impact.frequency_hz": {"from": 40, "to": 50}}, "plots": []}, "scan.impact.frequency_hz: give a list"),
     ({"scan": {"rock.name": ["sandstone", "conglomerate"]}, "plots": []}, "scan.rock.name: the base rock sets stiffness_n_per_m"),
-    ({"base_scene": "missing.yaml"}, "base_scene: 'missing.yaml': no scene file"),
+    ({"base_scene": "missing.yaml"}, "base_scene: 'missing.yaml': "),
+    ({"base_scene": "missing.yaml"}, "missing.yaml: no such file"),
     ({"metrics": ["penetration_rate"]}, "metrics.0: 'penetration_rate': Input should be"),
     ({"plots": [{"x": "rock.threshold_n", "y": "penetration_rate_m_per_s"}]},
      "plots.0.x: 'rock.threshold_n': not a scan axis"),

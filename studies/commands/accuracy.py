@@ -23,7 +23,6 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from pathlib import Path
 
 from rpdrill.models.workprecision import Signature
 from rpdrill.studies.accuracy import (
@@ -38,17 +37,19 @@ from rpdrill.studies.accuracy import (
     reference_signature,
     run_setting,
 )
-from rpdrill.studies.commands import add_runner_arguments
+from rpdrill.studies.commands import add_budget_arguments, add_runner_arguments, budget
+from rpdrill.studies.interrupts import raise_if_stopped
 from rpdrill.studies.plots.workprecision import plot_workprecision
-from rpdrill.studies.resumable import run_points
-from rpdrill.studies.run_files import write_json, write_rows_csv
+from rpdrill.studies.resumable import RECORD, run_points
+from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
 from rpdrill.studies.runners import pool
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("study", help="work-precision study YAML file (studies/accuracy_studies/*.yaml)")
-    parser.add_argument("--out", required=True, help="output directory (reused to resume)")
+    parser.add_argument("--out", required=True, help="output directory: new, empty, or this study's (to resume)")
     add_runner_arguments(parser)
+    add_budget_arguments(parser)
 
 
 def _reference(study: AccuracyStudy, setting: Setting | None, what: str) -> Signature | None:
@@ -62,13 +63,14 @@ def _reference(study: AccuracyStudy, setting: Setting | None, what: str) -> Sign
 
 
 def run(args: argparse.Namespace) -> int:
-    study = load_accuracy_study(args.study)
-    out = Path(args.out)
+    out = check_out(args.out, None, RECORD)
+    study = load_accuracy_study(args.study, budget(args))
     try:
         reference = _reference(study, study.reference, "reference")
         check = _reference(study, study.reference_check, "reference check")
     except Exception as err:  # noqa: BLE001 - no reference, no study
-        print(f"{study.spec.name}: the reference failed: {type(err).__name__}: {err}", file=sys.stderr)
+        raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
+        print(f"{args.study}: the reference failed: {type(err).__name__}: {err}", file=sys.stderr)
         return 1
     spec = study.spec
     with pool(args.dask, args.workers) as runner:

@@ -3,43 +3,55 @@ put their main-lobe optima where the paper does (studies.calibration, file forma
 studies.calibration_spec).
 
 Every evaluation is appended to DIR/evaluations.jsonl as it finishes; a rerun into the same DIR
-replays them and continues (a different calibration is refused). At the end DIR holds
-calibrated_scene.yaml, targets.csv, targets.md, pareto.csv, best_curves.csv and calibration.json
-(studies.calibration_report). Exit status 1, and no scene, when every simulation failed.
+replays them and continues (a different calibration, and a DIR holding anything else, are refused
+unless ``--overwrite``, which starts afresh there). Every run's budget, and the search's, are
+checked before it starts (studies.budgets). At the end DIR holds calibrated_scene.yaml,
+targets.csv, targets.md, pareto.csv, best_curves.csv and calibration.json
+(studies.calibration_report). Exit status 1, and no scene, when every simulation failed or every
+run of a target did.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import shutil
 import sys
-from pathlib import Path
 
 from tqdm import tqdm
 
-from rpdrill.studies.calibration import calibrate, planned_evaluations
-from rpdrill.studies.calibration_log import EvaluationLog, Record
+from rpdrill.studies.budgets import duration
+from rpdrill.studies.calibration import calibrate
+from rpdrill.studies.calibration_log import CHECKPOINT, EvaluationLog, Record
 from rpdrill.studies.calibration_report import write_report
 from rpdrill.studies.calibration_spec import load_calibration
-from rpdrill.studies.commands import add_runner_arguments
-from rpdrill.studies.run_files import staged_directory
+from rpdrill.studies.commands import add_budget_arguments, add_runner_arguments, budget
+from rpdrill.studies.run_files import check_out, staged_directory
 from rpdrill.studies.runners import pool
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("calibration", help="calibration YAML file")
-    parser.add_argument("--out", required=True, help="output directory (reused to resume)")
+    parser.add_argument("--out", required=True,
+                        help="output directory: new, empty, or this calibration's (to resume)")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="start afresh in --out although it holds other files or another calibration")
     add_runner_arguments(parser)
+    add_budget_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
-    calibration = load_calibration(args.calibration)
-    spec, out = calibration.spec, Path(args.out)
-    with contextlib.closing(EvaluationLog(out, calibration)) as log, pool(args.dask, args.workers) as (label, runner), \
-            tqdm(total=planned_evaluations(calibration), desc=spec.name, unit="eval", disable=args.quiet) as bar:
+    out = check_out(args.out, args.overwrite, CHECKPOINT)
+    calibration = load_calibration(args.calibration, budget(args))
+    new = not out.exists()
+    spec = calibration.spec
+    with contextlib.closing(EvaluationLog(out, calibration, args.overwrite)) as log, \
+            pool(args.dask, args.workers) as (label, runner), \
+            tqdm(total=calibration.evaluations, desc=spec.name, unit="eval", disable=args.quiet) as bar:
         print(f"{spec.name}: {len(calibration.names)} parameters, {len(spec.targets)} targets x "
-              f"{len(calibration.frequencies_hz)} frequencies, {len(log.records)} evaluations recorded earlier, "
-              f"on {label}", file=sys.stderr)
+              f"{len(calibration.frequencies_hz)} frequencies, {len(log.records)} of {calibration.evaluations} "
+              f"evaluations recorded earlier (estimated {duration(calibration.cpu_s)} of CPU for all), on {label}",
+              file=sys.stderr)
         best = [float("inf")]
 
         def progress(record: Record, replayed: bool) -> None:
@@ -49,10 +61,14 @@ def run(args: argparse.Namespace) -> int:
 
         result = calibrate(calibration, runner, log, progress, label)
     if result.best is None:
-        print(f"{spec.name}: every simulation of all {len(result.records)} evaluations failed; first error: "
-              f"{next((t['error'] for r in result.records for t in r['targets'] if t['error']), 'none')}; "
-              "no scene written",
-              file=sys.stderr)
+        failed = [i for i, label in enumerate(calibration.labels) if label in result.failed_targets]
+        which = f"targets {', '.join(result.failed_targets)}: every run" if result.failed_targets else "every simulation"
+        error = next((r["targets"][i]["error"] for r in result.records for i in failed or range(len(spec.targets))
+                      if r["targets"][i]["error"]), "none")
+        print(f"{args.calibration}: {which} of all {len(result.records)} evaluations failed; first error: {error}; "
+              "no scene written", file=sys.stderr)
+        if new:  # nothing worth keeping: a rerun would replay the failures
+            shutil.rmtree(out)
         return 1
     with staged_directory(out) as stage:
         write_report(stage, calibration, result, log.checkpoint["sessions"])

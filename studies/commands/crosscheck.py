@@ -9,32 +9,40 @@ import sys
 from rpdrill.models.compare import compare_runs, verdict
 from rpdrill.models.formulations import ODE_METHODS
 from rpdrill.models.stability import SimulationFailed
-from rpdrill.studies.commands import positive_number
+from rpdrill.studies.commands import add_budget_arguments, budget, positive_count, positive_number
 from rpdrill.studies.crosscheck import DEFAULT_STEP_S, comparison_table, window_scenes
+from rpdrill.studies.interrupts import raise_if_stopped
 from rpdrill.studies.loading import load_scene, prepare_scene
 from rpdrill.studies.plots.crosscheck import plot_overlay
-from rpdrill.studies.run_files import staged_directory, write_json
+from rpdrill.studies.run_files import check_out, staged_directory, write_json
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="scene YAML file")
-    parser.add_argument("--out", help="output directory for crosscheck.json and crosscheck.png (and .svg)")
-    parser.add_argument("--blows", type=int, default=20, help="compared window in impact periods (default 20)")
+    parser.add_argument("--out", help="output directory for crosscheck.json and crosscheck.png and .svg (new or empty)")
+    parser.add_argument("--overwrite", action="store_true", help="write into --out although it holds other files")
+    parser.add_argument("--blows", type=positive_count, default=20, help="compared window in impact periods (default 20)")
     parser.add_argument("--step", type=positive_number, default=DEFAULT_STEP_S,
                         help=f"Exudyn step [s] (default {DEFAULT_STEP_S:g}; solver type from the scene)")
     parser.add_argument("--method", choices=ODE_METHODS, default="DOP853", help="ODE method (default DOP853)")
     parser.add_argument("--rtol", type=positive_number, default=1e-10, help="ODE relative tolerance (default 1e-10)")
+    add_budget_arguments(parser, many_runs=False)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.out:
+        check_out(args.out, args.overwrite)
     exudyn_scene, ode_scene = window_scenes(load_scene(args.scene), args.blows, args.step, args.method, args.rtol,
                                             args.scene)
     scene = exudyn_scene
+    simulations = [prepare_scene(window, args.scene) for window in (exudyn_scene, ode_scene)]
+    for simulation in simulations:
+        budget(args).check_run(simulation, args.scene, f"{simulation.settings.formulation} window: ")
     try:
-        exudyn = prepare_scene(exudyn_scene, args.scene).run()
-        ode = prepare_scene(ode_scene, args.scene).run()
+        exudyn, ode = (simulation.run() for simulation in simulations)
     except SimulationFailed as err:
-        print(f"rpdrill: {err}", file=sys.stderr)
+        raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
+        print(f"{args.scene}: {err}", file=sys.stderr)
         return 1
     report = compare_runs(ode, exudyn, scene.solver.end_time_s)
     checks = verdict(report)

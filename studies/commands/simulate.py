@@ -1,7 +1,9 @@
 """Run one scene: time histories, summary figures and a plot.
 
 Writes DIR/timeseries.csv, DIR/summary.json, DIR/scene.resolved.yaml and DIR/timeseries.png (and
-.svg): the whole run beside its last blows.
+.svg): the whole run beside its last blows. DIR must be new or empty (``--overwrite``: write over
+what it holds). The run's steps and memory are checked against the budgets (studies.budgets)
+before it starts.
 """
 
 from __future__ import annotations
@@ -9,14 +11,23 @@ from __future__ import annotations
 import argparse
 import sys
 
+from rpdrill.models.cost import Cause
 from rpdrill.models.formulations import FORMULATIONS
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.stability import SimulationFailed
 from rpdrill.studies.catalogue import metric
+from rpdrill.studies.commands import add_budget_arguments, budget
+from rpdrill.studies.interrupts import raise_if_stopped
 from rpdrill.studies.loading import load_scene, prepare_scene
 from rpdrill.studies.plots.timeseries import plot_timeseries
 from rpdrill.studies.progress import time_progress
-from rpdrill.studies.run_files import staged_directory, write_columns_csv, write_json, write_resolved
+from rpdrill.studies.run_files import (
+    check_out,
+    staged_directory,
+    write_columns_csv,
+    write_json,
+    write_resolved,
+)
 
 HEADLINE = ("penetration_rate_m_per_s", "advance_per_blow_m", "energy_transfer_efficiency",
             "energy_balance_relative_error")
@@ -24,23 +35,28 @@ HEADLINE = ("penetration_rate_m_per_s", "advance_per_blow_m", "energy_transfer_e
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="scene YAML file")
-    parser.add_argument("--out", required=True, help="output directory")
+    parser.add_argument("--out", required=True, help="output directory (new or empty)")
+    parser.add_argument("--overwrite", action="store_true", help="write into --out although it holds other files")
     parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
                         help="run with this formulation (default: the scene's solver.formulation; the scene's "
                              "options of another formulation are dropped)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_budget_arguments(parser, many_runs=False)
 
 
 def run(args: argparse.Namespace) -> int:
+    check_out(args.out, args.overwrite)
     scene = load_scene(args.scene)
     if args.formulation:
         scene = scene.with_solver(args.formulation)
     simulation = prepare_scene(scene, args.scene)
+    budget(args).check_run(simulation, args.scene, resampled=Cause("solver.output_interval_s", scene.solver.output_interval_s))
     try:
         with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
             result = simulation.run(progress)
     except SimulationFailed as err:
-        print(f"rpdrill: {err}", file=sys.stderr)
+        raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
+        print(f"{args.scene}: {err}", file=sys.stderr)
         return 1
     summary = summary_metrics(result)
     columns = result.resampled(scene.solver.output_interval_s)

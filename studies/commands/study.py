@@ -1,7 +1,9 @@
 """``rpdrill study STUDY.yaml --out DIR``: run a YAML study (a scan of scenes) on all cores or a Dask cluster.
 
-Running again into the same DIR skips finished points; a changed study is refused
-(studies.resumable). The exit status is 1 when some point failed. What DIR holds: FILES below.
+Running again into the same DIR skips finished points; a changed study, and a DIR holding anything
+else, are refused (studies.resumable). Every point and the whole study are checked against the
+budgets before any runs (studies.budgets). The exit status is 1 when some point failed. What DIR
+holds: FILES below.
 """
 
 from __future__ import annotations
@@ -12,10 +14,10 @@ import sys
 from pathlib import Path
 
 from rpdrill.models.formulations import FORMULATIONS
-from rpdrill.studies.commands import add_runner_arguments
+from rpdrill.studies.commands import add_budget_arguments, add_runner_arguments, budget
 from rpdrill.studies.points import run_point
-from rpdrill.studies.resumable import STATUS_COLUMNS, Row, run_points
-from rpdrill.studies.run_files import write_json, write_rows_csv
+from rpdrill.studies.resumable import RECORD, STATUS_COLUMNS, Row, run_points
+from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
 from rpdrill.studies.runners import Runner, pool
 from rpdrill.studies.study import Study, load_study
 from rpdrill.studies.study_optima import Record, csv_rows, optima_table, study_optima
@@ -34,10 +36,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.epilog = FILES
     parser.add_argument("study", help="study YAML file")
-    parser.add_argument("--out", required=True, help="output directory (reused to resume)")
+    parser.add_argument("--out", required=True, help="output directory: new, empty, or this study's (to resume)")
     parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
                         help="run every point with this formulation (default: the scene's solver.formulation)")
     add_runner_arguments(parser)
+    add_budget_arguments(parser)
 
 
 def run_study(study: Study, out: Path, runner: tuple[str, Runner], quiet: bool) -> tuple[list[Row], list[Record]]:
@@ -53,8 +56,8 @@ def run_study(study: Study, out: Path, runner: tuple[str, Runner], quiet: bool) 
 
 
 def run(args: argparse.Namespace) -> int:
-    study = load_study(args.study, args.formulation)
-    out = Path(args.out)
+    out = check_out(args.out, None, RECORD)
+    study = load_study(args.study, args.formulation, budget(args))
     with pool(args.dask, args.workers) as runner:
         rows, optima = run_study(study, out, runner, args.quiet)
     from rpdrill.studies.plots.scans import draw_plots  # matplotlib once the points have run, not at start

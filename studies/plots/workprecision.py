@@ -23,12 +23,14 @@ def plot_workprecision(study: AccuracyStudy, rows: list[Row], front: list[dict[s
         families[row["family"]].append(row)
     styles = line_styles(len(families))
     for ax, measure in zip(axes, ERROR_MEASURES):
+        positive = False  # log axes need a positive value to show (settings equal to the reference have none)
         for style, (label, members) in zip(styles, families.items()):
             pairs = [(number(r["cpu_time_s"]), number(r[measure])) for r in members if r["status"] == "ok"]
             pairs = [(c, e) for c, e in pairs if c > 0 and e > 0 and math.isfinite(e)]
             failed = sum(r["status"] != "ok" for r in members)
             name = label + (f" ({failed} failed)" if failed else "")
-            ax.loglog(*(zip(*pairs) if pairs else ([], [])), ms=4, lw=1, label=name, **style.kwargs())
+            positive |= bool(pairs)
+            ax.plot(*(zip(*pairs) if pairs else ([], [])), ms=4, lw=1, label=name, **style.kwargs())
         points = [(number(p["cpu_time_s"]), number(p["error"])) for p in front if p["measure"] == measure]
         points = [(c, e) for c, e in points if c > 0 and e > 0]
         if points:
@@ -37,8 +39,11 @@ def plot_workprecision(study: AccuracyStudy, rows: list[Row], front: list[dict[s
         agreement = report.get("agreement", {}).get(measure)
         if agreement and agreement > 0:
             ax.axhline(agreement, color="gray", ls=":", lw=1, label="references' agreement")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
+        if positive:
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+        else:
+            ax.text(0.5, 0.5, "no error above 0", transform=ax.transAxes, ha="center")
         ax.set_xlabel("CPU time [s] (median of repeats)")
         ax.set_ylabel(f"{ERROR_LABELS[measure]} [-]")
         ax.grid(alpha=0.3, which="both")

@@ -1,0 +1,148 @@
+"""What a prepared run will cost, estimated before it runs: steps, memory and CPU time, and the
+scene key that makes it cost that much.
+
+With T = ``solver.end_time_s``, r the rate of the fastest element (models.stability.fastest_element,
+of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2 n + rock states
++ 2 (torsion) + 3 (the constant and the pulse generator) values:
+
+* exudyn: T / ``step_s`` steps (for dopri5 and ode23 ``step_s`` is the largest step: a lower
+  bound); it stores every step when an energy output is asked for, else every
+  ``output_interval_s``, two values (time, value) per sensor of 2 n + 4;
+* exact: T / h sub-grid points, h the exact solver's own sub-step (models.exact_model.sub_step:
+  the sample interval over ceil(sample interval x ||A_bal||_1)); it stores m + 2 values per
+  sample and per allowed switch, and about OPERATOR_VALUES m^2 values per (mode, pulse phase) of
+  the rock law;
+* ode: T r ODE_STEPS_PER_RADIAN steps (measured), DOP853's dense output (ODE_STAGES
+  states per step) and m values per sample.
+
+Histories resampled after the run (``rpdrill simulate``: every ``output_interval_s``) add 2 n + 8
+columns. Memory is 8 bytes per value times the copies held at the peak (MEMORY_COPIES,
+OUTPUT_COPIES); CPU time is steps x the measured cost of a step, a + b n seconds.
+``python benchmarks/bench_budgets.py`` measures the constants and prints estimate against
+measurement on the shipped scenes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rpdrill.models.formulations import DEFAULT_PRESET, FORMULATIONS
+from rpdrill.models.pulse import phase_pieces
+from rpdrill.models.simulation import Simulation
+from rpdrill.models.solver_settings import EXUDYN_PRESETS
+
+# Measured by benchmarks/bench_budgets.py (one BLAS thread, shared 2-core machine):
+CPU_S_PER_STEP = {"exudyn": (3e-6, 6e-7), "exact": (0.0, 2.5e-8), "ode": (4.5e-4, 0.0)}  # a + b n
+ODE_STEPS_PER_RADIAN = 2.0  # DOP853 steps per unit of r T
+ODE_STAGES = 10  # state vectors per step kept by DOP853's dense output
+OPERATOR_VALUES = 55  # values per state^2 of one exact propagator key (expm, anchors, read-outs, Taylor)
+# stored values held at once at the peak of a run (its storage, the result's arrays and their copies),
+# and of the histories resampled at the output interval (the columns and the table written)
+MEMORY_COPIES = {"exudyn": 4, "exact": 2, "ode": 3}
+OUTPUT_COPIES = 2
+BYTES_PER_VALUE = 8
+# What a run usually is: the key that departs most from these is named as the cause.
+USUAL_END_TIME_S, USUAL_STEP_S, USUAL_INTERVAL_S = 1.0, 1e-5, 1e-4
+
+
+@dataclass(frozen=True)
+class Cause:
+    """The scene key (dotted path) and value that make a run cost what it does."""
+
+    key: str
+    value: float | str
+
+
+@dataclass(frozen=True)
+class RunCost:
+    """A run's estimated steps (and the step), memory and CPU time, and the keys that set them."""
+
+    steps: float
+    step_s: float
+    steps_cause: Cause
+    memory_bytes: float
+    memory_cause: Cause
+    cpu_s: float
+
+
+def _named(cause: Cause, interval_s: float | None, usual_s: float, end_time_s: float) -> Cause:
+    """The key that makes T / interval large: ``cause`` (which sets the step or storage interval),
+    or the end time when it departs more from a usual run (log scale)."""
+    if interval_s is not None and math.log10(end_time_s / USUAL_END_TIME_S) > math.log10(usual_s / interval_s):
+        return Cause("solver.end_time_s", end_time_s)
+    return cause
+
+
+def _fastest(simulation: Simulation) -> Cause:
+    return Cause(simulation.fastest.key, simulation.fastest.value)
+
+
+def _interval(simulation: Simulation) -> Cause:
+    """The key of the sample interval of the exact and ODE formulations (given, or the output interval)."""
+    key = "sample_interval_s" if simulation.scene.solver.sample_interval_s is not None else "output_interval_s"
+    return Cause(f"solver.{key}", simulation.settings.sample_interval_s)
+
+
+# A part of the memory: what sets it, values, and the interval it stores at (None: not per time)
+Part = tuple[Cause, float, float | None]
+
+
+def _exudyn(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
+    settings, scene, n = simulation.settings, simulation.scene, simulation.chain.size
+    step = settings.step_s
+    if scene.solver.step_s is not None:
+        cause = Cause("solver.step_s", step)
+    elif math.isclose(step, scene.impact.duration_s / EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].steps_per_pulse):
+        cause = Cause("impact.duration_s", scene.impact.duration_s)
+    else:
+        cause = _fastest(simulation)
+    every_step = "energy" in simulation.needed_data or settings.output_interval_s < step
+    storage = (cause, step) if every_step else (Cause("solver.output_interval_s", settings.output_interval_s),
+                                                settings.output_interval_s)
+    return step, cause, [(storage[0], settings.end_time_s / storage[1] * 2 * (2 * n + 4), storage[1])]
+
+
+def _state_size(simulation: Simulation) -> int:
+    return 2 * simulation.chain.size + len(simulation.rock.state_names) + 2 * (simulation.torsion is not None) + 3
+
+
+def _exact(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
+    settings, m, sampled = simulation.settings, _state_size(simulation), _interval(simulation)
+    one_period = phase_pieces(simulation.impact, simulation.impact.period_s)[1]  # every pulse phase of the run
+    _, _, step = FORMULATIONS["exact"].implementation().sub_step(simulation, one_period)
+    switches = settings.max_switches_per_blow * math.ceil(settings.end_time_s * simulation.impact.frequency_hz)
+    keys = len(simulation.rock.modes()) * len(set(one_period))
+    return step, sampled if step == settings.sample_interval_s else _fastest(simulation), [
+        (sampled, settings.end_time_s / settings.sample_interval_s * (m + 2), settings.sample_interval_s),
+        (Cause("solver.max_switches_per_blow", settings.max_switches_per_blow), 2 * switches * (m + 3), None),
+        (Cause("drill_string.bodies", f"{simulation.chain.size} lumped bodies"), keys * OPERATOR_VALUES * m**2, None)]
+
+
+def _ode(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
+    settings, m, sampled = simulation.settings, _state_size(simulation), _interval(simulation)
+    steps = max(1.0, settings.end_time_s * simulation.fastest.rate_per_s * ODE_STEPS_PER_RADIAN)
+    fastest = _fastest(simulation)
+    return settings.end_time_s / steps, fastest, [
+        (sampled, settings.end_time_s / settings.sample_interval_s * m, settings.sample_interval_s),
+        (fastest, steps * ODE_STAGES * m, settings.end_time_s / steps)]
+
+
+ESTIMATES = {"exudyn": _exudyn, "exact": _exact, "ode": _ode}
+
+
+def run_cost(simulation: Simulation, resampled: Cause | None = None) -> RunCost:
+    """The estimated cost of running ``simulation`` (module doc), its histories then resampled at the
+    interval ``resampled`` names (``rpdrill simulate``: ``solver.output_interval_s``) or not (None)."""
+    settings, n = simulation.settings, simulation.chain.size
+    end = settings.end_time_s
+    step, cause, parts = ESTIMATES[settings.formulation](simulation)
+    values = sum(part[1] for part in parts) * MEMORY_COPIES[settings.formulation]
+    if resampled is not None:
+        parts.append((resampled, end / resampled.value * (2 * n + 8), resampled.value))
+        values += parts[-1][1] * OUTPUT_COPIES
+    largest, _, interval = max(parts, key=lambda part: part[1])
+    a, b = CPU_S_PER_STEP[settings.formulation]
+    return RunCost(steps=end / step, step_s=step, steps_cause=_named(cause, step, USUAL_STEP_S, end),
+                   memory_bytes=values * BYTES_PER_VALUE, memory_cause=_named(largest, interval, USUAL_INTERVAL_S, end),
+                   cpu_s=end / step * (a + b * n))
