@@ -308,15 +308,16 @@ def load_scene(path: str | Path) -> Scene:
     return parse(Scene, read_yaml(path), str(path))
 
 
-def prepare_scene(scene: Scene, source: str) -> Simulation:
-    """Prepare a validated scene for a run; InputError naming ``source``, the key path and the value
-    where it cannot run as given (models.simulation.SceneError, or a formulation that cannot run it)."""
+def prepare_scene(scene: Scene, source: str, where: str = "") -> Simulation:
+    """Prepare a validated scene for a run; InputError naming ``source``, ``where`` (a scan point),
+    the key path and the value where it cannot run as given (models.simulation.SceneError, or a
+    formulation that cannot run it)."""
     try:
         simulation = prepare(scene)
     except SceneError as err:
-        raise InputError(f"{source}: {'.'.join(err.location)}: {_short(err.value)}: {err}") from None
+        raise InputError(f"{source}: {where}{'.'.join(err.location)}: {_short(err.value)}: {err}") from None
     formulation = simulation.settings.formulation
     why = unsupported(formulation, simulation)
     if why:
-        raise InputError(f"{source}: solver.formulation: {formulation!r} cannot run this scene: {why}")
+        raise InputError(f"{source}: {where}solver.formulation: {formulation!r} cannot run this scene: {why}")
     return simulation

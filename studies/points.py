@@ -13,11 +13,10 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from rpdrill.models.formulations import unsupported
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import SceneError, Simulation, prepare
-from rpdrill.studies.loading import InputError, problem
+from rpdrill.models.simulation import Simulation
+from rpdrill.studies.loading import InputError, prepare_scene, problem
 
 
 def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]) -> list[str]:
@@ -40,19 +39,12 @@ def _point(parameters: dict[str, Any]) -> str:
 
 def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]) -> Simulation:
     """Validate and prepare one point's scene; InputError naming the scan axis that made it invalid
-    (or the point), and when its formulation cannot run it."""
+    (or the point), and when its formulation cannot run it (studies.loading.prepare_scene)."""
     try:
-        simulation = prepare(Scene.model_validate(scene))
+        validated = Scene.model_validate(scene)
     except ValidationError as error:
         raise InputError("\n".join(_point_error(source, error, parameters))) from None
-    except SceneError as error:
-        where = ".".join(error.location)
-        raise InputError(f"{source}: {_point(parameters)}{where}: {error.value!r}: {error}") from None
-    formulation = simulation.settings.formulation
-    why = unsupported(formulation, simulation)
-    if why:
-        raise InputError(f"{source}: solver.formulation: {formulation!r} cannot run scan point {parameters}: {why}")
-    return simulation
+    return prepare_scene(validated, source, _point(parameters))
 
 
 def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:

@@ -33,9 +33,9 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from rpdrill.models.scene import Scene
-from rpdrill.studies.budgets import base_estimate_s
+from rpdrill.studies.budgets import DEFAULT_BUDGET, Budget, base_estimate_s
 from rpdrill.studies.loading import InputError, parse, read_yaml
-from rpdrill.studies.specs import Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
+from rpdrill.studies.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
 from rpdrill.studies.targets import (
     FREQUENCY,
     Scan,
@@ -59,7 +59,7 @@ class GlobalAnalysis(StrictSpec):
     method: Literal["morris", "sobol"] = "morris"
     parameters: list[str] = Field(min_length=2)
     relative_span: float = Field(0.1, gt=0, lt=1)
-    samples: int = Field(8, ge=2, description="Morris: trajectories; Sobol: base samples (a power of 2)")
+    samples: int = Field(8, ge=2, le=MAX_NUM, description="Morris: trajectories; Sobol: base samples (a power of 2)")
     seed: int = 1
 
 
@@ -182,13 +182,22 @@ def _global_samples(spec: GlobalAnalysis) -> np.ndarray:
     return sobol.sample(problem, spec.samples, seed=spec.seed)
 
 
+def _global_count(spec: GlobalAnalysis | None) -> int:
+    """How many samples :func:`_global_samples` draws: Morris r (k + 1), Sobol (Saltelli) N (2 k + 2)."""
+    if spec is None:
+        return 0
+    k = len(spec.parameters)
+    return spec.samples * (k + 1 if spec.method == "morris" else 2 * k + 2)
+
+
 def _problem(spec: GlobalAnalysis) -> dict[str, Any]:
     return {"num_vars": len(spec.parameters), "names": spec.parameters,
             "bounds": [[1 - spec.relative_span, 1 + spec.relative_span]] * len(spec.parameters)}
 
 
-def load_sensitivity(path: str | Path) -> SensitivityStudy:
-    """Read, validate and expand a sensitivity file; InputError naming the file and key otherwise."""
+def load_sensitivity(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> SensitivityStudy:
+    """Read, validate and expand a sensitivity file; InputError naming the file and key otherwise,
+    BudgetError when its runs together are beyond ``budget``."""
     path = Path(path)
     spec = parse(SensitivitySpec, read_yaml(path), str(path))
     base = spec.base_scene_dict(path)
@@ -196,27 +205,33 @@ def load_sensitivity(path: str | Path) -> SensitivityStudy:
         for key in scan.overrides:
             check_scene_path(str(path), f"scans.{i}.overrides", key, base)
     varied = _one_at_a_time(spec, base, path)
+    if spec.global_analysis is not None:
+        for name in spec.global_analysis.parameters:
+            if name not in scene_values(base):
+                raise InputError(f"{path}: global.parameters: {name!r}: the base scene sets no number there")
+    first_hz = spec.frequency_hz.start if spec.frequency_hz.values is None else spec.frequency_hz.values[0]
+    scan_run_s = [base_estimate_s(str(path), set_frequency(varied_scene(base, scan.overrides, {}), first_hz))
+                  for scan in spec.scans]
+    count = 1 + 2 * len(varied) + _global_count(spec.global_analysis)
+    budget.check_total(str(path), f"{count:.6g} variations x {len(spec.scans)} scans x frequency_hz: "
+                       f"{spec.frequency_hz.count:.6g} values", count * len(spec.scans) * spec.frequency_hz.count,
+                       count * spec.frequency_hz.count * sum(scan_run_s))
     frequencies = spec.frequency_hz.expand()
     variations: list[tuple[dict[str, Any], dict[str, float]]] = [({"kind": NOMINAL}, {})]
     variations += [({"kind": "one_at_a_time", "parameter": p, "change": f"{sign * spec.relative_step:+.3g}"},
                     {p: 1 + sign * spec.relative_step}) for p in varied for sign in (-1, 1)]
     samples = None
     if spec.global_analysis is not None:
-        for name in spec.global_analysis.parameters:
-            if name not in scene_values(base):
-                raise InputError(f"{path}: global.parameters: {name!r}: the base scene sets no number there")
         samples = _global_samples(spec.global_analysis)
         variations += [({"kind": "global", "sample": i}, dict(zip(spec.global_analysis.parameters, row.tolist())))
                        for i, row in enumerate(samples)]
-    scan_cpu_s = [len(frequencies) * base_estimate_s(str(path), set_frequency(varied_scene(base, scan.overrides, {}),
-                                                                                  frequencies[0]))
-                  for scan in spec.scans]
     points = []
     for labels, factors in variations:
         for s, scan in enumerate(spec.scans):
             scene = varied_scene(base, scan.overrides, factors)
             parse(Scene, set_frequency(scene, frequencies[0]), f"{path} (scan {scan.label!r}, {labels})")
-            points.append(Point(len(points), {**labels, "scan": scan.label}, s, scene, scan_cpu_s[s]))
+            points.append(Point(len(points), {**labels, "scan": scan.label}, s, scene,
+                                len(frequencies) * scan_run_s[s]))
     return SensitivityStudy(path, spec, base, frequencies, varied, samples, points)
 
 

@@ -20,7 +20,7 @@ from rpdrill.studies.cli import main
 
 CORPUS = Path(__file__).resolve().parent / "bad_inputs"
 CASES: dict[str, dict] = yaml.safe_load((CORPUS / "cases.yaml").read_text(encoding="utf-8"))
-FOLDERS = ("scenes", "studies", "calibrations", "accuracy", "outputs", "cli")
+FOLDERS = ("scenes", "studies", "calibrations", "accuracy", "sensitivity", "outputs", "cli")
 # what --out holds before a run (the files of another run)
 HOLDINGS = {
     "other_run": {"timeseries.csv": "time_s,bit_position_m\n0,0\n", "summary.json": "{}\n"},

@@ -37,7 +37,7 @@ from rpdrill.studies.accuracy import (
     reference_signature,
     run_setting,
 )
-from rpdrill.studies.commands import add_budget_arguments, add_runner_arguments, budget
+from rpdrill.studies.commands import add_resumable_arguments, budget
 from rpdrill.studies.interrupts import raise_if_stopped
 from rpdrill.studies.plots.workprecision import plot_workprecision
 from rpdrill.studies.resumable import RECORD, run_points
@@ -46,10 +46,7 @@ from rpdrill.studies.runners import pool
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("study", help="work-precision study YAML file (studies/accuracy_studies/*.yaml)")
-    parser.add_argument("--out", required=True, help="output directory: new, empty, or this study's (to resume)")
-    add_runner_arguments(parser)
-    add_budget_arguments(parser)
+    add_resumable_arguments(parser, "study", "work-precision study YAML file (studies/accuracy_studies/*.yaml)")
 
 
 def _reference(study: AccuracyStudy, setting: Setting | None, what: str) -> Signature | None:

@@ -25,19 +25,15 @@ from rpdrill.studies.calibration import calibrate
 from rpdrill.studies.calibration_log import CHECKPOINT, EvaluationLog, Record
 from rpdrill.studies.calibration_report import write_report
 from rpdrill.studies.calibration_spec import load_calibration
-from rpdrill.studies.commands import add_budget_arguments, add_runner_arguments, budget
+from rpdrill.studies.commands import add_resumable_arguments, budget
 from rpdrill.studies.run_files import check_out, staged_directory
 from rpdrill.studies.runners import pool
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("calibration", help="calibration YAML file")
-    parser.add_argument("--out", required=True,
-                        help="output directory: new, empty, or this calibration's (to resume)")
+    add_resumable_arguments(parser, "calibration", "calibration YAML file")
     parser.add_argument("--overwrite", action="store_true",
                         help="start afresh in --out although it holds other files or another calibration")
-    add_runner_arguments(parser)
-    add_budget_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -11,12 +11,11 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
-from rpdrill.studies.commands import add_runner_arguments
+from rpdrill.studies.commands import add_resumable_arguments, budget
 from rpdrill.studies.plots.tornado import draw_tornados
-from rpdrill.studies.resumable import run_points
-from rpdrill.studies.run_files import write_json, write_rows_csv
+from rpdrill.studies.resumable import RECORD, run_points
+from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
 from rpdrill.studies.runners import pool
 from rpdrill.studies.sensitivity import (
     ONE_AT_A_TIME_COLUMNS,
@@ -34,14 +33,12 @@ from rpdrill.studies.sensitivity import (
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("sensitivity", help="sensitivity YAML file (studies/paper/sensitivity.yaml)")
-    parser.add_argument("--out", required=True, help="output directory (reused to resume)")
-    add_runner_arguments(parser)
+    add_resumable_arguments(parser, "sensitivity", "sensitivity YAML file (studies/paper/sensitivity.yaml)")
 
 
 def run(args: argparse.Namespace) -> int:
-    study = load_sensitivity(args.sensitivity)
-    out = Path(args.out)
+    out = check_out(args.out, None, RECORD)
+    study = load_sensitivity(args.sensitivity, budget(args))
     with pool(args.dask, args.workers) as runner:
         rows = run_points(study, out, "results.csv", columns(study), lambda p: task(study, p), run_variation,
                           runner, args.quiet, lambda outcome: row_of(study, outcome))

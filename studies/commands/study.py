@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from rpdrill.models.formulations import FORMULATIONS
-from rpdrill.studies.commands import add_budget_arguments, add_runner_arguments, budget
+from rpdrill.studies.commands import add_resumable_arguments, budget
 from rpdrill.studies.points import run_point
 from rpdrill.studies.resumable import RECORD, STATUS_COLUMNS, Row, run_points
 from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
@@ -35,12 +35,9 @@ FILES = """files written to DIR:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.epilog = FILES
-    parser.add_argument("study", help="study YAML file")
-    parser.add_argument("--out", required=True, help="output directory: new, empty, or this study's (to resume)")
+    add_resumable_arguments(parser, "study", "study YAML file")
     parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
                         help="run every point with this formulation (default: the scene's solver.formulation)")
-    add_runner_arguments(parser)
-    add_budget_arguments(parser)
 
 
 def run_study(study: Study, out: Path, runner: tuple[str, Runner], quiet: bool) -> tuple[list[Row], list[Record]]:
