@@ -23,6 +23,7 @@ import numpy as np
 from rpdrill.models.indexing import Indexing
 from rpdrill.models.scene import Bit
 from rpdrill.studies.catalogue import metric
+from rpdrill.studies.loading import InputError
 from rpdrill.studies.plots.rotation import draw_rotation_map
 
 RATE, ADVANCE = "penetration_rate_m_per_s", "advance_per_blow_m"
@@ -100,7 +101,7 @@ def ridge(run: Path) -> list[tuple[str, float, float, float, float]]:
 
 
 def render(runs: Path, figure: Path, rock: str) -> str:
-    map_run, dth_run = runs / "rpm_frequency_map", runs / "dth_example"
+    map_run, dth_run = (runs / name for name in STUDIES)
     bit = _bit(dth_run)
     dth, frequency, best = dth_rows(dth_run)
     manual = manual_speed_rpm(bit, frequency)
@@ -180,10 +181,25 @@ off the geometric one{furthest}.
 """
 
 
+STUDIES = ("rpm_frequency_map", "dth_example")  # studies/rotation/<name>.yaml, run into RUNS_DIR/<name>
+
+
+def check_runs(runs: Path, rock: str) -> None:
+    """InputError unless ``runs`` holds both studies' results and the map has rows of ``rock``."""
+    for name in STUDIES:
+        for file in ("results.csv", "study.json"):
+            if not (runs / name / file).is_file():
+                raise InputError(f"{runs}: {name}/{file}: missing; run `rpdrill study studies/rotation/{name}.yaml "
+                                 f"--out {runs / name}` first")
+    rocks = sorted(_by_rock(_rows(runs / STUDIES[0] / "results.csv")))
+    if rock not in rocks:
+        raise InputError(f"--rock: {rock!r}: not on the map in {runs / STUDIES[0]}; rocks there: {', '.join(rocks)}")
+
+
 def write_report(runs: Path, out: Path, rock: str) -> list[Path]:
     """rotation.md and the map of ``rock`` (PNG and SVG) into ``out``; the files written."""
     figure = out / f"rotation_map_{rock}.png"
-    run = runs / "rpm_frequency_map"
+    run = runs / STUDIES[0]
     rows = [r for r in _rows(run / "results.csv") if r[ROCK] == rock]
     bit = _bit(run)
     draw_rotation_map(rows, figure, f"{rock}: {metric(RATE).label()}",

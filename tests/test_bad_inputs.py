@@ -54,7 +54,8 @@ def snapshot(path: Path) -> dict[str, bytes] | bytes | None:
 
 
 def command_line(path: str, case: dict, out: Path) -> list[str]:
-    return [case["command"], str(CORPUS / path), "--out", str(out), "--quiet", *map(str, case.get("args", []))]
+    quiet = ["--quiet"] if case.get("quiet", True) else []  # a command with no progress has no --quiet
+    return [case["command"], str(CORPUS / path), "--out", str(out), *quiet, *map(str, case.get("args", []))]
 
 
 def problems(path: str, case: dict, status: int, message: str, out: Path, before: object) -> list[str]:

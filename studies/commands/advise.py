@@ -26,10 +26,10 @@ from rpdrill.studies.advice import (
 )
 from rpdrill.studies.advice_report import advice_markdown, advice_record, advice_text, best_table
 from rpdrill.studies.catalogue import metric, parameter
-from rpdrill.studies.commands import add_runner_arguments, positive_number
+from rpdrill.studies.commands import add_runner_arguments, positive_count, positive_number
 from rpdrill.studies.loading import load_scene
 from rpdrill.studies.plots.advice import plot_curves, plot_feed_map
-from rpdrill.studies.run_files import staged_directory, write_json
+from rpdrill.studies.run_files import check_out, staged_directory, write_json
 from rpdrill.studies.runners import pool
 
 FILES = """files written to DIR:
@@ -50,7 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.epilog = FILES
     parser.add_argument("scene", help="scene YAML file")
-    parser.add_argument("--out", required=True, help="output directory")
+    parser.add_argument("--out", required=True, help="output directory: new, empty, or earlier advice's")
+    parser.add_argument("--overwrite", action="store_true", help="write into --out although it holds other files")
     for entry in PARAMETERS:
         q = parameter(entry.path)
         parser.add_argument(entry.option, nargs=2, type=float, metavar=("LOW", "HIGH"),
@@ -65,9 +66,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="run only points whose mean thrust (feed + frequency x impulse per blow) is below this "
                              "fraction of the rock's threshold F_th (default 1: the static limit, beyond which the "
                              "rock yields under the mean load)")
-    parser.add_argument("--popsize", type=int, default=Search.popsize,
+    parser.add_argument("--popsize", type=positive_count, default=Search.popsize,
                         help=f"differential evolution: population per parameter (default {Search.popsize})")
-    parser.add_argument("--generations", type=int, default=Search.max_generations,
+    parser.add_argument("--generations", type=positive_count, default=Search.max_generations,
                         help=f"differential evolution: at most this many generations (default {Search.max_generations})")
     parser.add_argument("--seed", type=int, default=Search.seed, help=f"random seed (default {Search.seed})")
     parser.add_argument("--markdown", type=Path, help="also write advice.md to this file (e.g. docs/advice.md)")
@@ -88,6 +89,7 @@ def command_line(args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_out(args.out, args.overwrite, "advice.json")
     scene = load_scene(args.scene).model_dump(by_alias=True, exclude_none=True)
     bounds = {e.path: e.si_bounds(_given(args, e)) for e in PARAMETERS if _given(args, e) is not None}
     request = Request(args.metric, bounds, args.max_thrust_ratio,

@@ -23,10 +23,11 @@ from pathlib import Path
 import rpdrill.studies
 from rpdrill.studies.calibration_spec import load_calibration
 from rpdrill.studies.commands import add_runner_arguments
+from rpdrill.studies.loading import InputError
 from rpdrill.studies.paper_pages import figures_page, parameters_page, reproduction_page, sensitivity_page
 from rpdrill.studies.plots.paper_figures import draw_figure
 from rpdrill.studies.reproduction import load_reproduction, reproduce, trend_checks, within
-from rpdrill.studies.run_files import staged_directory, write_json, write_rows_csv
+from rpdrill.studies.run_files import check_out, staged_directory, write_json, write_rows_csv
 from rpdrill.studies.runners import pool
 
 PAPER = Path(rpdrill.studies.__file__).parent / "paper"
@@ -35,7 +36,8 @@ PAPER = Path(rpdrill.studies.__file__).parent / "paper"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("reproduction", nargs="?", default=str(PAPER / "reproduction.yaml"),
                         help="reproduction YAML file (default: the paper's, studies/paper/reproduction.yaml)")
-    parser.add_argument("--out", required=True, help="output directory")
+    parser.add_argument("--out", required=True, help="output directory: new, empty, or an earlier reproduction's")
+    parser.add_argument("--overwrite", action="store_true", help="write into --out although it holds other files")
     parser.add_argument("--calibration", type=Path, help="output directory of `rpdrill calibrate` for parameters.md")
     parser.add_argument("--sensitivity", type=Path, help="output directory of `rpdrill sensitivity` for sensitivity.md")
     parser.add_argument("--docs", type=Path, help="also copy the pages and figures into this folder (e.g. docs)")
@@ -43,6 +45,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_out(args.out, args.overwrite, "reproduction.json")
+    for option, command in (("calibration", "calibrate"), ("sensitivity", "sensitivity")):
+        folder = getattr(args, option)
+        if folder is not None and not folder.is_dir():
+            raise InputError(f"--{option}: {folder}: not a folder; give the --out of `rpdrill {command}`")
     reproduction = load_reproduction(args.reproduction)
     calibration = None if reproduction.calibration_file is None else load_calibration(reproduction.calibration_file)
     with pool(args.dask, args.workers) as (label, runner):

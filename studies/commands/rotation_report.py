@@ -10,18 +10,21 @@ import shutil
 import sys
 from pathlib import Path
 
-from rpdrill.studies.rotation_report import write_report
-from rpdrill.studies.run_files import staged_directory
+from rpdrill.studies.rotation_report import check_runs, write_report
+from rpdrill.studies.run_files import check_out, staged_directory
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("runs", type=Path, help="directory with rpm_frequency_map/ and dth_example/")
-    parser.add_argument("--out", required=True, type=Path, help="output directory")
+    parser.add_argument("--out", required=True, type=Path, help="output directory: new, empty, or an earlier report's")
+    parser.add_argument("--overwrite", action="store_true", help="write into --out although it holds other files")
     parser.add_argument("--rock", default="sandstone", help="the rock whose map goes into the note")
     parser.add_argument("--docs", type=Path, help="also copy the note and its figure into this folder (e.g. docs)")
 
 
 def run(args: argparse.Namespace) -> int:
+    check_out(args.out, args.overwrite, "rotation.md")
+    check_runs(args.runs, args.rock)
     with staged_directory(args.out) as stage:
         written = [args.out / p.name for p in write_report(args.runs, stage, args.rock)]
     if args.docs is not None:
