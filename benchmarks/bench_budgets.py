@@ -4,7 +4,7 @@ Usage: python benchmarks/bench_budgets.py [--repeats N]
 
 Prints (1) for the shipped scenes (paper_base 4 bodies, four_rod_string 19, wave_rod 64) with every
 formulation that runs them: steps and CPU seconds, estimated and measured (the median of N runs
-after a warm-up, one BLAS thread), and their ratio; the CPU cost per step a + b n fitted to the
+after a warm-up, one BLAS thread), and their ratio; the CPU cost per step a + b n^p (models.cost.CPU_S_PER_STEP) fitted to the
 measurements of each formulation, and DOP853's steps per radian (steps / (r T), r the fastest
 element's rate), the constants of models.cost; (2) for runs that store much (every step, or fine samples), the memory
 estimate against the growth of the peak resident set during the run, each in a fresh process;
@@ -32,18 +32,21 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.models.cost import Cause, run_cost
+from rpdrill.models.cost import CPU_S_PER_STEP, Cause, cost_key, run_cost
 from rpdrill.models.formulations import unsupported
+from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
 from rpdrill.studies.calibration import target_result
 from rpdrill.studies.calibration_spec import load_calibration
-from rpdrill.studies.loading import load_scene, read_yaml
+from rpdrill.studies.loading import read_yaml
 from rpdrill.studies.points import prepare_point
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "studies" / "scenes"
-RUNS = [(scene, formulation) for scene in ("paper_base", "four_rod_string", "wave_rod")
-        for formulation in ("exudyn", "exact", "ode")]
+RATE_ONLY = {"metrics": ["penetration_rate_m_per_s"]}  # a scan's outputs: no energy works
+# (scene, formulation, outputs): every output, and the exact formulation also as a scan runs it
+RUNS = [(scene, formulation, outputs) for scene in ("paper_base", "four_rod_string", "wave_rod")
+        for formulation, outputs in (("exudyn", None), ("exact", None), ("exact", RATE_ONLY), ("ode", None))]
 # (scene, formulation, solver options): runs whose stored histories dominate their memory
 MEMORY_RUNS = [
     ("paper_base", "exudyn", {"end_time_s": 8.0, "output_interval_s": 1e-5}),
@@ -52,8 +55,9 @@ MEMORY_RUNS = [
 ]
 
 
-def simulation(scene: str, formulation: str, options: dict | None = None):
-    return prepare(load_scene(SCENES / f"{scene}.yaml").with_solver(formulation, **(options or {})))
+def simulation(scene: str, formulation: str, options: dict | None = None, outputs: dict | None = None):
+    data = read_yaml(SCENES / f"{scene}.yaml") | ({"outputs": outputs} if outputs else {})
+    return prepare(Scene.model_validate(data).with_solver(formulation, **(options or {})))
 
 
 def measured_steps(result) -> float:
@@ -67,31 +71,35 @@ def measured_steps(result) -> float:
 
 
 def cpu_table(repeats: int) -> None:
-    print("scene            formulation  bodies  steps est / run       CPU s est / run")
+    print("scene            formulation           bodies  steps est / run       CPU s est / run")
     fits: dict[str, list[tuple[int, float]]] = {}
     radians = []
-    for scene, formulation in RUNS:
-        run = simulation(scene, formulation)
-        if unsupported(formulation, run):
+    measured = set()
+    for scene, formulation, outputs in RUNS:
+        run = simulation(scene, formulation, outputs=outputs if (scene, "exact without energy") not in measured else None)
+        key = cost_key(run)
+        if unsupported(formulation, run) or (scene, key) in measured:  # a scene whose outputs need no energy
             continue
+        measured.add((scene, key))
         try:
             first = run.run()  # warm-up: the exact kernels compile, Exudyn loads
         except Exception as err:  # noqa: BLE001 - a formulation that fails on a scene is reported, not measured
-            print(f"{scene:<17}{formulation:<13}{run.chain.size:<8}failed: {type(err).__name__}: {err}")
+            print(f"{scene:<17}{key:<22}{run.chain.size:<8}failed: {type(err).__name__}: {err}")
             continue
         steps = measured_steps(first)
         del first  # each result is dropped before the next run, as in a study
         cpu = statistics.median(run.run().cpu_time_s for _ in range(repeats))
         cost, n = run_cost(run), run.chain.size
-        fits.setdefault(formulation, []).append((n, cpu / steps))
+        fits.setdefault(key, []).append((n, cpu / steps))
         if formulation == "ode":
             radians.append(steps / (run.fastest.rate_per_s * run.settings.end_time_s))
-        print(f"{scene:<17}{formulation:<13}{n:<8}{cost.steps:<9.3g}/ {steps:<9.3g}({cost.steps / steps:<5.2f})"
+        print(f"{scene:<17}{key:<22}{n:<8}{cost.steps:<9.3g}/ {steps:<9.3g}({cost.steps / steps:<5.2f})"
               f"{cost.cpu_s:<9.3g}/ {cpu:<9.3g}({cost.cpu_s / cpu:.2f})")
     for formulation, points in fits.items():
         bodies, per_step = np.array(points, dtype=float).T
-        slope, intercept = np.polyfit(bodies, per_step, 1) if len(points) > 1 else (0.0, per_step[0])
-        print(f"{formulation}: CPU s per step = {intercept:.3g} + {slope:.3g} n")
+        power = CPU_S_PER_STEP[formulation][2]
+        slope, intercept = np.polyfit(bodies**power, per_step, 1) if len(points) > 1 else (0.0, per_step[0])
+        print(f"{formulation}: CPU s per step = {intercept:.3g} + {slope:.3g} n" + (f"^{power}" if power != 1 else ""))
     if radians:
         print(f"ode: DOP853 steps per radian (r T) = {statistics.median(radians):.3g} "
               f"(range {min(radians):.3g} .. {max(radians):.3g})")
@@ -159,7 +167,8 @@ def held_table(count: int = 200) -> None:
 
     def record(i: int) -> dict:
         unit = np.full(len(calibration.names), 0.5 + 1e-4 * i)
-        scan = {"values": curve, "resonance_hz": 60.0, "failed_runs": 0, "error": ""}
+        metrics = {calibration.metric(t) for t in range(len(calibration.labels))}
+        scan = {"values": dict.fromkeys(metrics, curve), "resonance_hz": 60.0, "failed_runs": 0, "error": ""}
         return {"unit": list(unit), "parameters": calibration.values(unit),
                 "targets": [target_result(calibration, t, frequencies, scan) for t in range(len(calibration.labels))]}
 

@@ -17,7 +17,9 @@ of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2
 
 Histories resampled after the run (``rpdrill simulate``: every ``output_interval_s``) add 2 n + 8
 columns. Memory is 8 bytes per value times the copies held at the peak (MEMORY_COPIES,
-OUTPUT_COPIES); CPU time is steps x the measured cost of a step, a + b n seconds.
+OUTPUT_COPIES); CPU time is steps x the measured cost of a step, a + b n^p seconds (p = 2 for the
+exact formulation, whose sub-step is a product with a dense m x m propagator, with and without its
+energy works; 1 otherwise).
 ``python benchmarks/bench_budgets.py`` measures the constants and prints estimate against
 measurement on the shipped scenes.
 """
@@ -33,7 +35,10 @@ from rpdrill.models.simulation import Simulation
 from rpdrill.models.solver_settings import EXUDYN_PRESETS
 
 # Measured by benchmarks/bench_budgets.py (one BLAS thread, shared 2-core machine):
-CPU_S_PER_STEP = {"exudyn": (3e-6, 6e-7), "exact": (0.0, 2.5e-8), "ode": (4.5e-4, 0.0)}  # a + b n
+# (a, b, p) of a + b n^p; the exact formulation with its energy works (an energy output asked for), and
+# without (a scan of the penetration rate)
+CPU_S_PER_STEP = {"exudyn": (3e-6, 6e-7, 1), "exact": (2.6e-7, 3.2e-9, 2), "exact without energy": (1e-7, 2.9e-9, 2),
+                  "ode": (4.5e-4, 0.0, 1)}
 ODE_STEPS_PER_RADIAN = 2.0  # DOP853 steps per unit of r T
 ODE_STAGES = 10  # state vectors per step kept by DOP853's dense output
 OPERATOR_VALUES = 55  # values per state^2 of one exact propagator key (expm, anchors, read-outs, Taylor)
@@ -131,6 +136,15 @@ def _ode(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
 ESTIMATES = {"exudyn": _exudyn, "exact": _exact, "ode": _ode}
 
 
+def cost_key(simulation: Simulation) -> str:
+    """The key of CPU_S_PER_STEP for ``simulation``: its formulation (the exact one with or without
+    the energy works its outputs need)."""
+    formulation = simulation.settings.formulation
+    if formulation == "exact" and "energy" not in simulation.needed_data:
+        return "exact without energy"
+    return formulation
+
+
 def run_cost(simulation: Simulation, resampled: Cause | None = None) -> RunCost:
     """The estimated cost of running ``simulation`` (module doc), its histories then resampled at the
     interval ``resampled`` names (``rpdrill simulate``: ``solver.output_interval_s``) or not (None)."""
@@ -142,7 +156,7 @@ def run_cost(simulation: Simulation, resampled: Cause | None = None) -> RunCost:
         parts.append((resampled, end / resampled.value * (2 * n + 8), resampled.value))
         values += parts[-1][1] * OUTPUT_COPIES
     largest, _, interval = max(parts, key=lambda part: part[1])
-    a, b = CPU_S_PER_STEP[settings.formulation]
+    a, b, power = CPU_S_PER_STEP[cost_key(simulation)]
     return RunCost(steps=end / step, step_s=step, steps_cause=_named(cause, step, USUAL_STEP_S, end),
                    memory_bytes=values * BYTES_PER_VALUE, memory_cause=_named(largest, interval, USUAL_INTERVAL_S, end),
-                   cpu_s=end / step * (a + b * n))
+                   cpu_s=end / step * (a + b * n**power))

@@ -45,7 +45,7 @@ from rpdrill.studies.budgets import (
 from rpdrill.studies.loading import InputError, field_at, parse, read_yaml
 from rpdrill.studies.points import prepare_point
 from rpdrill.studies.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
-from rpdrill.studies.targets import FREQUENCY, Scan
+from rpdrill.studies.targets import FREQUENCY, Scan, scan_scene
 
 PositiveFloat = Annotated[float, Field(gt=0)]
 # keys that do not change what an evaluation gives: a rerun may change them and continue
@@ -255,7 +255,8 @@ def _check_scenes(calibration: Calibration, budget: Budget) -> float:
     cases = [("targets.{i}.overrides", start, "")] + [
         (f"parameters.{name}.bounds", start | {name: bound}, f" with {name} = {bound:g} ({side} bound)")
         for name, parameter in spec.parameters.items() for side, bound in zip(("lower", "upper"), parameter.bounds)]
-    cpu = [[_check_scene(source, key.format(i=i), calibration.scene(values, i, frequency),
+    cpu = [[_check_scene(source, key.format(i=i), scan_scene(calibration.scene(values, i), frequency,
+                                                             [calibration.metric(i)]),
                          f"target {label!r} at {frequency:g} Hz{note}", budget)
             for i, label in enumerate(calibration.labels) for frequency in ends] for key, values, note in cases]
     return float(np.mean(cpu[0]))
@@ -306,7 +307,8 @@ def load_calibration(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Calib
     what = (f"search: {evaluations:.6g} evaluations (search.popsize, search.max_generations, search.max_evaluations) "
             f"x {scans} scans x frequency_hz: {count:.6g} frequencies")
     runs = evaluations * scans * count
-    budget.check_total(source, what, runs, runs * base_estimate_s(source, base),
+    metrics = {target.metric or spec.metric for target in spec.targets}
+    budget.check_total(source, what, runs, runs * base_estimate_s(source, {**base, "outputs": {"metrics": sorted(metrics)}}),
                        evaluations * EVALUATION_BYTES + count * AXIS_VALUE_BYTES)
     frequencies = spec.frequency_hz.expand()
     _check_frequencies(spec, frequencies, source)

@@ -34,7 +34,7 @@ COMMANDS = {
     "reproduce": ("rpdrill.studies.commands.reproduce",
                   "the paper's headline cases and figures on the shipped scene, and the generated docs"),
     "sensitivity": ("rpdrill.studies.commands.sensitivity",
-                    "how the frequency optima move with each scene parameter (+-10 %, SALib global indices)"),
+                    "how the frequency optima move with each scene parameter (+-10 %%, SALib global indices)"),
     "rotation-report": ("rpdrill.studies.commands.rotation_report",
                         "the rotation-speed note (rpm x frequency map, best speed against the manual's rule)"),
     "advise": ("rpdrill.studies.commands.advise", "the operating point that maximises a metric within bounds"),

@@ -1,9 +1,9 @@
 """Cross-check the Exudyn model against the plain ODE of the paper's Eq. 4 over the first blows.
 
-Both formulations run the scene over a window of ``--blows`` impact periods from rest (default
-20): the Exudyn model with the scene's solver type at ``--step`` (default 5e-6 s; measured on
-paper_base, the rk44 bit velocity differs from the ODE by 1.1e-3 of its range at 2e-5 s, 9.5e-5 at
-1e-5 s, 6.0e-5 at 5e-6 s; see docs/crosscheck.md), the ODE (models.ode_model) with event-located
+Both formulations run the scene over a window of ``--blows`` impact periods from the scene's start
+(default 20): the Exudyn model with the scene's solver type at ``--step`` (default 5e-6 s; the
+differences against the step on the shipped and test drills: docs/crosscheck.md), the ODE
+(models.ode_model) with event-located
 rock switches at a tight tolerance. Only a window of early blows is compared: the rock law switches
 (contact, crushing) amplify tiny differences from blow to blow, so after many blows two correct
 solutions drift apart in phase and a pointwise comparison stops measuring accuracy.

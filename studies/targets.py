@@ -16,7 +16,7 @@ import itertools
 import json
 import math
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from typing import Any
 
 from pydantic import Field
@@ -49,6 +49,12 @@ def set_frequency(scene: dict[str, Any], frequency_hz: float) -> dict[str, Any]:
     return point
 
 
+def scan_scene(scene: dict[str, Any], frequency_hz: float, metrics: Sequence[str]) -> dict[str, Any]:
+    """One point of a scan: ``scene`` at ``frequency_hz``, asked for ``metrics`` only (the model then
+    records only what they need)."""
+    return {**set_frequency(scene, frequency_hz), "outputs": {"metrics": list(metrics)}}
+
+
 def scan_target(task: ScanTask) -> dict[str, Any]:
     """Worker: one scan, each metric at every frequency (NaN where a run failed; failures are counted,
     not raised), the scene's rock-mode frequency (None if it has none) and CPU seconds."""
@@ -58,8 +64,7 @@ def scan_target(task: ScanTask) -> dict[str, Any]:
     errors, resonance = [], None
     for frequency in frequencies:
         try:
-            simulation = prepare_point("frequency scan", {**set_frequency(scene, frequency),
-                                                          "outputs": {"metrics": list(metrics)}}, {})
+            simulation = prepare_point("frequency scan", scan_scene(scene, frequency, metrics), {})
         except InputError as error:
             outcome = {"status": "failed", "error": str(error), "metrics": {}}
         else:

@@ -14,7 +14,7 @@ import pytest
 import yaml
 from scenes import PAPER_BASE, scene_dict
 
-from rpdrill.studies.cli import main
+from rpdrill.studies.cli import COMMANDS, main
 
 ROOT = Path(__file__).resolve().parents[1]
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}
@@ -26,6 +26,16 @@ def test_version(capsys):
     assert done.value.code == 0
     assert capsys.readouterr().out.strip() == \
         f"rpdrill {importlib.metadata.version('rpdrill')} (Exudyn {importlib.metadata.version('exudyn')})"
+
+
+@pytest.mark.parametrize("words", [[]] + [[name] for name in COMMANDS], ids=lambda words: " ".join(words) or "rpdrill")
+def test_every_help_prints(words, capsys):
+    """``rpdrill --help`` and every command's ``--help`` print and exit 0 (a stray '%' in a help text
+    is a format error of argparse's)."""
+    with pytest.raises(SystemExit) as done:
+        main([*words, "--help"])
+    assert done.value.code == 0
+    assert "usage: rpdrill" in capsys.readouterr().out
 
 
 def test_study_help_lists_the_files_it_writes(capsys):

@@ -66,7 +66,7 @@ def test_best_speed_is_a_constant_index_per_blow():
     assert wider.best_speed_rpm() == pytest.approx(36.0 * 60 * 0.025 / (math.pi * DIAMETER))
 
 
-@pytest.mark.parametrize("formulation", ["exact", "ode", "exudyn"])
+@pytest.mark.parametrize("formulation", ["exact", pytest.param("ode", marks=pytest.mark.slow), "exudyn"])
 def test_effect_off_leaves_eq_4_bit_identical(formulation):
     """A bit and a rotation speed in the scene with indexing off run the paper's Eq. 4 exactly as a
     scene without them: the same states to the last bit."""
