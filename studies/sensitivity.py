@@ -41,6 +41,7 @@ from rpdrill.studies.targets import (
     Scan,
     rising_shortfalls,
     scan_optimum,
+    scan_scene,
     scan_target,
     set_frequency,
 )
@@ -74,6 +75,10 @@ class SensitivitySpec(SceneSpec):
     parameters: Literal["all"] | list[str] = "all"
     relative_step: float = Field(0.1, gt=0, lt=1)
     global_analysis: GlobalAnalysis | None = Field(None, alias="global")
+
+    def reported_metrics(self) -> list[str]:
+        """The listed metrics, or every scan's metric."""
+        return self.metrics or list(dict.fromkeys(scan.metric or self.metric for scan in self.scans))
 
     @model_validator(mode="after")
     def _labelled(self) -> SensitivitySpec:
@@ -116,7 +121,7 @@ class SensitivityStudy:
 
     def metrics(self) -> list[str]:
         """Reported metrics: the listed ones, or every scan's metric."""
-        return self.spec.metrics or list(dict.fromkeys(scan.metric or self.spec.metric for scan in self.spec.scans))
+        return self.spec.reported_metrics()
 
     def resolved(self) -> dict[str, Any]:
         return {**self.spec.model_dump(mode="json", by_alias=True), "base_scene": self.base,
@@ -210,7 +215,8 @@ def load_sensitivity(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Sensi
             if name not in scene_values(base):
                 raise InputError(f"{path}: global.parameters: {name!r}: the base scene sets no number there")
     first_hz = spec.frequency_hz.start if spec.frequency_hz.values is None else spec.frequency_hz.values[0]
-    scan_run_s = [base_estimate_s(str(path), set_frequency(varied_scene(base, scan.overrides, {}), first_hz))
+    metrics = spec.reported_metrics()
+    scan_run_s = [base_estimate_s(str(path), scan_scene(varied_scene(base, scan.overrides, {}), first_hz, metrics))
                   for scan in spec.scans]
     count = 1 + 2 * len(varied) + _global_count(spec.global_analysis)
     budget.check_total(str(path), f"{count:.6g} variations x {len(spec.scans)} scans x frequency_hz: "
