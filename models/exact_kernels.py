@@ -408,6 +408,41 @@ def assemble(one_step: np.ndarray, matrix: np.ndarray, readout_rows: np.ndarray,
 
 
 @njit(cache=True)
+def power_integrals(one_step: np.ndarray, balanced: np.ndarray, scale: np.ndarray, forms: np.ndarray, step_s: float,
+                    step_powers: np.ndarray, step_grams: np.ndarray, series: np.ndarray) -> None:
+    """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of one key's power forms Q_q (models.exact_model
+    .Operators.add_powers): ``step_powers`` [j] = E^j (E = expm(A h), j <= p, the sub-steps of a sample);
+    ``series`` [q, k] = S_k / (k + 1) with S_0 = Q, S_k = (A^T S_(k-1) + S_(k-1) A) / k, formed on the balanced
+    matrix A_b = D^-1 A D (S_k = D^-1 S_k,b(D Q D) D^-1), so that G(s) = sum_k s^(k+1) series[q, k] for s <= h;
+    ``step_grams`` [q, j] = G(j h) = sum_(l < j) (E^l)^T G(h) E^l."""
+    size, steps, terms = one_step.shape[0], step_powers.shape[0], series.shape[1]
+    step_powers[0] = np.eye(size)
+    for j in range(1, steps):
+        step_powers[j] = np.dot(one_step, step_powers[j - 1])
+    unscale = np.empty((size, size))
+    for a in range(size):
+        for b in range(size):
+            unscale[a, b] = 1.0 / (scale[a] * scale[b])
+    balanced_t = balanced.T.copy()
+    for q in range(forms.shape[0]):
+        coefficient, gram = np.empty((size, size)), np.zeros((size, size))
+        for a in range(size):
+            for b in range(size):
+                coefficient[a, b] = scale[a] * forms[q, a, b] * scale[b]
+        power = step_s
+        for k in range(terms):
+            if k:
+                coefficient = (np.dot(balanced_t, coefficient) + np.dot(coefficient, balanced)) / k
+            series[q, k] = coefficient / (k + 1) * unscale
+            gram += series[q, k] * power
+            power *= step_s
+        step_grams[q, 0] = 0.0
+        for j in range(1, steps):
+            carried = step_powers[j - 1]
+            step_grams[q, j] = step_grams[q, j - 1] + np.dot(np.dot(carried.T, gram), carried)
+
+
+@njit(cache=True)
 def quadratic(form: np.ndarray, w: np.ndarray) -> float:
     """w^T Q w."""
     total = 0.0
@@ -417,6 +452,19 @@ def quadratic(form: np.ndarray, w: np.ndarray) -> float:
             partial += form[r, c] * w[c]
         total += w[r] * partial
     return total
+
+
+@njit(cache=True, fastmath=True)
+def series_value(series: np.ndarray, outer: np.ndarray, last: int, s: float) -> float:
+    """sum_(k <= last) s^k <C_k, w w^T> (Frobenius products with the flattened C_k = series[k] and
+    outer = w w^T, summed by Horner's rule): w^T (sum_k s^k C_k) w."""
+    value = 0.0
+    for k in range(last, -1, -1):
+        product = 0.0
+        for e in range(outer.shape[0]):
+            product += series[k, e] * outer[e]
+        value = value * s + product
+    return value
 
 
 @njit(cache=True)
@@ -429,10 +477,10 @@ def integrate_powers(time_s: np.ndarray, rows: np.ndarray, row_keys: np.ndarray,
     G(s) = int_0^s expm(A^T u) Q expm(A u) du: the j whole sub-steps first, G(j h) (``step_grams``
     [key, q, j], j up to the sub-steps of a sample) with the state carried on by expm(A h)^j
     (``step_powers`` [key, j]), then the rest s < h by the series G(s) = sum_k s^(k+1) C_k (``series``
-    [key, q, k]) summed by Horner's rule from the first k whose bound (2 s / h)^(k+1) / (k+1)! (||A|| h
+    [key, q, k], each C_k flattened) from the first k whose bound (2 s / h)^(k+1) / (k+1)! (||A|| h
     <= 1 on the balanced matrix) is below 1e-17."""
     size, count, terms, most = step_powers.shape[2], step_grams.shape[1], series.shape[2], step_powers.shape[1] - 1
-    w, carried, gram = np.empty(size), np.empty(size), np.empty((size, size))
+    w, carried, outer = np.empty(size), np.empty(size), np.empty(size * size)
     for r in range(1, time_s.shape[0]):
         rest = time_s[r] - time_s[r - 1]
         if rest <= 0.0 or abs(rest - sample_interval_s) <= 1e-9 * sample_interval_s:
@@ -458,10 +506,8 @@ def integrate_powers(time_s: np.ndarray, rows: np.ndarray, row_keys: np.ndarray,
         while bound > 1e-17 and last < terms - 1:
             last += 1
             bound *= ratio / (last + 1)
+        for a in range(size):
+            for b in range(size):
+                outer[a * size + b] = w[a] * w[b]
         for q in range(count):
-            gram[:, :] = series[key, q, last]
-            for k in range(last - 1, -1, -1):
-                for a in range(size):
-                    for b in range(size):
-                        gram[a, b] = gram[a, b] * rest + series[key, q, k, a, b]
-            out[r, q] += quadratic(gram, w) * rest
+            out[r, q] += series_value(series[key, q], outer, last, rest) * rest

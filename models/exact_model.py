@@ -73,6 +73,7 @@ from rpdrill.models.exact_kernels import (
     TOO_MANY_SWITCHES,
     assemble,
     integrate_powers,
+    power_integrals,
     run_events,
 )
 from rpdrill.models.links import RATE
@@ -212,10 +213,9 @@ class Model:
         impact[layout.one:] = phase_row(self.impact, phase)
         shank = np.zeros(size)
         shank[n + chain.impact_body] = 1.0
-        forms = np.zeros((2, size, size))
-        for index, (force, rate) in [(0, (impact, shank))] + [(1, pair) for pair in pairs]:
-            forms[index] += 0.5 * (np.outer(force, rate) + np.outer(rate, force))
-        return forms
+        forces, rates = (np.array(rows) for rows in zip(*pairs, strict=True))
+        internal = forces.T @ rates  # sum over the pairs of F u^T
+        return 0.5 * np.stack([np.outer(impact, shank) + np.outer(shank, impact), internal + internal.T])
 
     def exits(self, modes: Modes) -> list[tuple[np.ndarray, int, Modes, list[tuple[int, np.ndarray]]]]:
         """(row, direction, next modes, entry resets (target index, row)) of every exit of ``modes``."""
@@ -320,35 +320,19 @@ class Operators:
         assemble(self.one_step[i], matrix, readout, ANCHORS, PER_ANCHOR, self.readout[i], self.anchors[i],
                  self.taylor[i])
         if len(self.series):
-            self.add_powers(i, matrix, model.power_forms(modes, phase))
+            self.add_powers(i, balanced, scale, model.power_forms(modes, phase))
         self.key_of[self.mode_id(modes), PHASES.index(phase)] = i
         self.built += 1
 
-    def add_powers(self, i: int, matrix: np.ndarray, forms: np.ndarray) -> None:
-        """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of key ``i``'s power forms: for s <= h the
-        series G(s) = sum_k s^(k+1) S_k / (k + 1) of the integrand's Taylor coefficients, S_0 = Q,
-        S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on the balanced matrix
-        (S_k = D^-1 S_k,b(D Q D) D^-1; the truncation after the Taylor order of the sub-step leaves
-        2^(K+1) / (K+1)! of it, below 1e-14); then G(j h) = sum_(l < j) (E^l)^T G(h) E^l for j up to the
-        sub-steps of a sample (E = expm(A h))."""
-        balanced, scale = balance(matrix)
-        unscale = 1.0 / scale[:, None] / scale[None, :]
-        power = np.eye(len(matrix))
-        for j in range(self.per_sample + 1):
-            self.step_powers[i, j] = power
-            power = self.one_step[i] @ power
-        for q, form in enumerate(forms):
-            coefficient, gram = scale[:, None] * form * scale[None, :], np.zeros_like(matrix)
-            for k in range(self.order + 1):
-                if k:
-                    coefficient = (balanced.T @ coefficient + coefficient @ balanced) / k
-                self.series[i, q, k] = coefficient / (k + 1) * unscale
-                gram += self.series[i, q, k] * self.step_s ** (k + 1)
-            self.step_grams[i, q, 0] = 0.0
-            for j in range(1, self.per_sample + 1):
-                carried = self.step_powers[i, j - 1]
-                self.step_grams[i, q, j] = self.step_grams[i, q, j - 1] + carried.T @ gram @ carried
-
+    def add_powers(self, i: int, balanced: np.ndarray, scale: np.ndarray, forms: np.ndarray) -> None:
+        """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of key ``i``'s power forms (compiled:
+        models.exact_kernels.power_integrals): for s <= h the series G(s) = sum_k s^(k+1) S_k / (k + 1) of the
+        integrand's Taylor coefficients, S_0 = Q, S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves
+        F' = A^T F + F A), formed on the balanced matrix (the truncation after the Taylor order of the
+        sub-step leaves 2^(K+1) / (K+1)! of it, below 1e-14); then G(j h) = sum_(l < j) (E^l)^T G(h) E^l for j
+        up to the sub-steps of a sample (E = expm(A h)). ``balanced``, ``scale``: balance(A)."""
+        power_integrals(self.one_step[i], balanced, scale, forms, self.step_s, self.step_powers[i],
+                        self.step_grams[i], self.series[i])
 
 def sub_step(simulation: Simulation, phases: list[str], model: Model | None = None) -> tuple[float, int, float]:
     """(||A_bal||_1, sub-steps per sample, sub-step h) of the global sub-grid (module doc): the
@@ -398,7 +382,8 @@ class ExactSolver:
         ops, size = self.operators, self.layout.size
         interval = self.step_s * self.per_sample
         powers = np.zeros((len(time_s), 2))
-        integrate_powers(time_s, rows, self.row_keys, ops.step_powers, ops.step_grams, ops.series, self.step_s,
+        flat_series = ops.series.reshape(*ops.series.shape[:3], size * size)
+        integrate_powers(time_s, rows, self.row_keys, ops.step_powers, ops.step_grams, flat_series, self.step_s,
                          interval, powers)
         whole = np.flatnonzero(np.abs(np.diff(time_s) - interval) <= 1e-9 * interval)
         keys = self.row_keys[whole]
@@ -460,7 +445,7 @@ class ExactSolver:
             first = diverged_index(rows[:, :n], rows[:, n:2 * n])
             raise SimulationFailed(f"scene '{simulation.name}': exact solution diverged at "
                                    f"t = {time_s[-1 if first is None else first]:.6g} s (an unstable chain?)")
-        return time_s, rows, switch_times, [ops.modes[m] for m in switch_modes[:switches]]
+        return time_s, rows, switch_times, [ops.modes[m] for m in switch_modes[:switches].tolist()]
 
 
 def _switch_counts(model: Model, before: Modes, entered: list[Modes]) -> dict[str, int]:
