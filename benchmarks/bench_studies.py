@@ -61,7 +61,7 @@ def three_scans(solver: str, workers: int, folder: Path) -> None:
         for scan in SCANS:
             study = load_study(study_file(scan, solver, folder))
             rows, optima = run_study(study, folder / f"{scan}_{solver}", runner, quiet=True)
-            plots_written += len(draw_plots(study, rows, optima, folder / f"{scan}_{solver}")[0])
+            plots_written += len(draw_plots(study, rows, optima, folder / f"{scan}_{solver}", runner[1])[0])
             simulated_cpu += sum(float(row["cpu_time_s"]) for row in rows if row["status"] == "ok")
             points += len(rows)
     wall, cpu = time.perf_counter() - start, cpu_s() - cpu_start

@@ -57,9 +57,9 @@ def run(args: argparse.Namespace) -> int:
     study = load_study(args.study, args.formulation, budget(args))
     with pool(args.dask, args.workers) as runner:
         rows, optima = run_study(study, out, runner, args.quiet)
-    from rpdrill.studies.plots.scans import draw_plots  # matplotlib once the points have run, not at start
+        from rpdrill.studies.plots.scans import draw_plots  # matplotlib once the points have run, not at start
 
-    written, skipped = draw_plots(study, rows, optima, out)
+        written, skipped = draw_plots(study, rows, optima, out, runner[1])  # by the workers, side by side
     failed = [row for row in rows if row["status"] != "ok"]
     print(f"{study.spec.name}: {len(rows) - len(failed)} points ok, {len(failed)} failed; wrote "
           f"{out / 'results.csv'}, {out / 'study.json'}, {out / 'optima.csv'}" + "".join(f", {p}" for p in written),

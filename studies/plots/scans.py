@@ -24,6 +24,7 @@ from rpdrill.models.scene import Scene
 from rpdrill.studies.catalogue import Quantity, describe_scene, metric, quantity
 from rpdrill.studies.plots.cells import cell_map, no_result_patch
 from rpdrill.studies.plots.style import line_styles, plt, save
+from rpdrill.studies.runners import Runner, sequential
 from rpdrill.studies.study import Plot, Study
 from rpdrill.studies.study_optima import Record, Row, curves, metric_value, number_or_text
 
@@ -142,15 +143,23 @@ def plot_name(plot: Plot) -> str:
     return f"{'_'.join(plot.metrics) if len(plot.metrics) == 1 else 'metrics'}_vs_{plot.x}".replace(".", "_")
 
 
-def draw_plots(study: Study, rows: list[Row], optima: list[Record], out: Path) -> tuple[list[Path], list[str]]:
-    """Draw every plot of the study that has a result into ``out``: (the files written, the names of
-    the plots left out because none of their metrics has a finite value)."""
-    written, skipped = [], []
+def draw_plot(task: tuple[Plot, Study, list[Row], list[Record], Path]) -> list[Path]:
+    """Worker: draw one plot of a study into its path; the files written."""
+    plot, study, rows, optima, path = task
+    return (_map if plot.kind == "map" else _curves)(plot, study, rows, optima, path)
+
+
+def draw_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
+               runner: Runner = sequential) -> tuple[list[Path], list[str]]:
+    """Draw every plot of the study that has a result into ``out``, one plot per task of ``runner`` (a
+    pool's workers draw them side by side): (the files written, the names of the plots left out because
+    none of their metrics has a finite value)."""
+    tasks, skipped = [], []
     for i, plot in enumerate(study.spec.plots):
         name = f"{i:02d}_{plot_name(plot)}"
-        if not any(np.isfinite(metric_value(row, m)) for row in rows for m in plot.metrics):
+        if any(np.isfinite(metric_value(row, m)) for row in rows for m in plot.metrics):
+            tasks.append((plot, study, rows, optima, out / f"{name}.{study.spec.format}"))
+        else:
             skipped.append(name)
-            continue
-        draw = _map if plot.kind == "map" else _curves
-        written += draw(plot, study, rows, optima, out / f"{name}.{study.spec.format}")
-    return written, skipped
+    written = [path for batch in (runner(draw_plot, tasks) if tasks else ()) for paths in batch for path in paths]
+    return sorted(written), skipped

@@ -17,6 +17,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
+from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 OKABE_ITO = ("#000000", "#E69F00", "#56B4E9", "#009E73", "#0072B2", "#D55E00", "#CC79A7")
 LINE_STYLES = ("-", "--", ":", "-.")
@@ -43,9 +44,12 @@ def line_styles(count: int) -> list[LineStyle]:
 
 
 def save(fig: Figure, path: Path, dpi: int = 120) -> list[Path]:
-    """Write ``fig`` to ``path`` and, unless ``path`` is an SVG, to an SVG beside it; close it."""
+    """Write ``fig`` to ``path`` and, unless ``path`` is an SVG, to an SVG beside it; close it. A figure
+    with the constrained layout fits its legends and labels already; any other is cropped to what it
+    draws (``bbox_inches="tight"``, one more draw per file)."""
     paths = [path] + ([path.with_suffix(".svg")] if path.suffix != ".svg" else [])
+    crop = None if isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine) else "tight"
     for target in paths:
-        fig.savefig(target, dpi=dpi, bbox_inches="tight")
+        fig.savefig(target, dpi=dpi, bbox_inches=crop)
     plt.close(fig)
     return paths
