@@ -1,6 +1,10 @@
 """The Exudyn accuracy presets against their targets, measured in one run.
 
-Usage: python benchmarks/bench_presets.py [--repeats N] [--presets fast,standard,reference] [--front]
+Usage: python benchmarks/bench_presets.py [--repeats N] [--presets fast,standard,reference] [--front | --modules]
+With ``--modules``: each preset's CPU seconds per simulated second on the paper scene with Exudyn's
+regular compiled module (``EXUDYN_MODULE=regular``) and with the fast one rpdrill loads
+(rocklaw.exudyn_module), each in its own child process, alternated three times; the medians, their
+ratio and the largest relative difference of the penetration rate between the two.
 With ``--front``: the work-precision front the presets are picked from. Every candidate step rule
 (rk44, rk67 and generalized-alpha at step = min(1e-4 s, pulse / 10, c / |lambda|_max) over a range of
 c) runs on the paper scene and on every hard scene; printed per candidate: its CPU seconds per
@@ -24,7 +28,9 @@ for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
 import argparse
+import json
 import statistics
+import subprocess
 import sys
 import warnings
 from pathlib import Path
@@ -92,13 +98,49 @@ def front(scenes: dict[str, Scene], exact: dict[str, dict[str, float]]) -> None:
               f"{'*' if i in on_front else ''}")
 
 
+def paper_costs(presets: list[str], repeats: int) -> dict[str, tuple[float, float]]:
+    """(CPU s per simulated s, penetration rate) of each preset on the paper scene, in this process."""
+    paper = load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml")
+    return {preset: (cost(paper.with_solver("exudyn", preset=preset), repeats), summary_metrics(
+        prepare(paper.with_solver("exudyn", preset=preset)).run())["penetration_rate_m_per_s"]) for preset in presets}
+
+
+def modules(presets: list[str], repeats: int, rounds: int = 3) -> None:
+    """The presets' cost with Exudyn's regular and fast modules (module doc), a child process each."""
+    measured: dict[str, list[dict[str, list[float]]]] = {"regular": [], "fast": []}
+    for _ in range(rounds):
+        for module, runs in measured.items():
+            environment = {k: v for k, v in os.environ.items() if k != "EXUDYN_MODULE"}
+            if module == "regular":
+                environment["EXUDYN_MODULE"] = "regular"
+            child = subprocess.run([sys.executable, __file__, "--presets", ",".join(presets), "--repeats",
+                                    str(repeats), "--one-module"], env=environment, check=True,
+                                   capture_output=True, text=True)
+            runs.append(json.loads(child.stdout.splitlines()[-1]))
+    print(f"{'preset':<12}{'regular CPU s / sim s':<24}{'fast CPU s / sim s':<22}{'fast / regular':<17}"
+          "rate difference")
+    for preset in presets:
+        regular, fast = (statistics.median(run[preset][0] for run in measured[m]) for m in ("regular", "fast"))
+        rates = [run[preset][1] for m in measured for run in measured[m]]
+        spread = (max(rates) - min(rates)) / abs(statistics.median(rates))
+        print(f"{preset:<12}{regular:<24.4f}{fast:<22.4f}{fast / regular:<17.3f}{spread:.1e}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--presets", default=",".join(EXUDYN_PRESETS))
     parser.add_argument("--front", action="store_true", help="measure the candidates' front instead")
+    parser.add_argument("--modules", action="store_true", help="the regular against the fast Exudyn module")
+    parser.add_argument("--one-module", action="store_true", help=argparse.SUPPRESS)  # a child of --modules
     args = parser.parse_args()
     warnings.simplefilter("ignore")  # step-limit warnings of the explicit solvers: errors are measured
+    if args.one_module:
+        print(json.dumps(paper_costs(args.presets.split(","), args.repeats)))
+        return
+    if args.modules:
+        modules(args.presets.split(","), args.repeats)
+        return
     scenes = {"paper_base": load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml")}
     scenes.update({name: hard_scene(overrides) for name, overrides in HARD_SCENES.items()})
     exact = {name: summary_metrics(prepare(scene.with_solver("exact")).run()) for name, scene in scenes.items()}

@@ -20,8 +20,11 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-import exudyn as exu
 import numpy as np
+
+from rpdrill.rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled module
+
+# isort: split
 from exudyn.itemInterface import (
     LoadCoordinate,
     MarkerNodeCoordinate,

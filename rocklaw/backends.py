@@ -76,9 +76,9 @@ class SymbolicBackend:
     """``exudyn.symbolic`` evaluation: every constant is wrapped as a symbolic ``Real``."""
 
     def __init__(self) -> None:
-        import exudyn
+        from rpdrill.rocklaw.exudyn_module import exu
 
-        self._sym = exudyn.symbolic
+        self._sym = exu.symbolic
 
     def _real(self, value: Any) -> Any:
         return self._sym.Real(float(value)) if isinstance(value, (int, float, np.floating)) else value

@@ -15,8 +15,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-import exudyn as exu
 import numpy as np
+
+from rpdrill.rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled module
+
+# isort: split
 from exudyn.advancedUtilities import CreateSymbolicUserFunction
 from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
 

@@ -136,3 +136,45 @@ def test_preloaded_start_is_the_static_equilibrium_and_all_formulations_use_it()
 def test_preload_that_would_crush_is_refused():
     with pytest.raises(ValueError, match="static feed alone crushes the rock"):
         prepare(scene(start="preloaded", feed__force_n=200e3))
+
+
+MODULE_PROBE = """
+import json, sys
+from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.simulation import prepare
+from rpdrill.rocklaw.exudyn_module import FAST
+from rpdrill.studies.loading import load_scene
+scene = load_scene(sys.argv[1]).with_solver("exudyn", preset="fast", end_time_s=0.3)
+rate = summary_metrics(prepare(scene).run())["penetration_rate_m_per_s"]
+print(json.dumps({"fast": FAST, "loaded": sorted(m for m in sys.modules if m.startswith("exudyn.exudynCPP")),
+                  "rate": rate}))
+"""
+
+
+def _probe(environment: dict[str, str]) -> tuple[list[str], dict]:
+    """The lines a process importing rpdrill's Exudyn model prints, and what it reports last."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    paper = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
+    env = {k: v for k, v in os.environ.items() if k != "EXUDYN_MODULE"} | environment
+    lines = subprocess.run([sys.executable, "-c", MODULE_PROBE, str(paper)], env=env, check=True,
+                           capture_output=True, text=True).stdout.splitlines()
+    return lines, json.loads(lines[-1])
+
+
+def test_exudyn_fast_module_is_loaded_quietly_and_agrees_with_the_regular_one():
+    """rocklaw.exudyn_module: the build without range checks where the CPU has AVX2 (Exudyn's own
+    condition), nothing printed on standard output; EXUDYN_MODULE=regular keeps the regular module, and
+    the two give the same penetration rate to round-off."""
+    with open("/proc/cpuinfo", encoding="utf-8") as info:
+        avx2 = any(line.startswith("flags") and "avx2" in line.split() for line in info)
+    lines, fast = _probe({})
+    assert lines == lines[-1:], lines  # only the probe's own line
+    assert fast["fast"] is avx2 and fast["loaded"][0] == ("exudyn.exudynCPPfast" if avx2 else "exudyn.exudynCPP")
+    _, regular = _probe({"EXUDYN_MODULE": "regular"})
+    assert regular["fast"] is False and regular["loaded"][0] == "exudyn.exudynCPP"
+    assert fast["rate"] > 0 and abs(fast["rate"] - regular["rate"]) <= 1e-12 * abs(regular["rate"])
