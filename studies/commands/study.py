@@ -18,7 +18,7 @@ from rpdrill.studies.commands import add_resumable_arguments, budget
 from rpdrill.studies.points import run_point
 from rpdrill.studies.resumable import RECORD, STATUS_COLUMNS, Row, run_points
 from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
-from rpdrill.studies.runners import Runner, pool
+from rpdrill.studies.runners import Runner, pool, sequential
 from rpdrill.studies.study import Study, load_study
 from rpdrill.studies.study_optima import Record, csv_rows, optima_table, study_optima
 
@@ -57,9 +57,11 @@ def run(args: argparse.Namespace) -> int:
     study = load_study(args.study, args.formulation, budget(args))
     with pool(args.dask, args.workers) as runner:
         rows, optima = run_study(study, out, runner, args.quiet)
-        from rpdrill.studies.plots.scans import draw_plots  # matplotlib once the points have run, not at start
+        # matplotlib once the points have run, not at start
+        from rpdrill.studies.plots.scans import draw_plots
 
-        written, skipped = draw_plots(study, rows, optima, out, runner[1])  # by the workers, side by side
+        # by the pool's workers, side by side; here with Dask, whose workers may write on another machine
+        written, skipped = draw_plots(study, rows, optima, out, sequential if args.dask is not None else runner[1])
     failed = [row for row in rows if row["status"] != "ok"]
     print(f"{study.spec.name}: {len(rows) - len(failed)} points ok, {len(failed)} failed; wrote "
           f"{out / 'results.csv'}, {out / 'study.json'}, {out / 'optima.csv'}" + "".join(f", {p}" for p in written),
