@@ -3,13 +3,15 @@ results as it completes.
 
 Each runner is ``runner(function, arguments) -> Iterator[list[result]]``: :func:`sequential` (in this
 process, one argument per batch), or one bound to a pool that lives for many calls,
-:func:`process_pool` (spawned workers, all cores by default) and :func:`dask_pool` (a Dask cluster or
+:func:`process_pool` (local worker processes, all cores by default) and :func:`dask_pool` (a Dask cluster or
 a LocalCluster); :func:`pool` picks one for the command line options. A pool's workers start and
 import rpdrill once (a process pool's with its first call, so that a study refused before it runs
 starts none) and take batches of arguments (:func:`batches`): a run pays the process machinery once
 per pool and once per batch, not per argument. Results come in completion order, so the function's
 result must say which argument it belongs to. Workers run one BLAS thread each and keep freed memory
-(WORKER_ENVIRONMENT); process-pool workers stop on SIGTERM as on Ctrl-C (studies.interrupts). A
+(WORKER_ENVIRONMENT); process-pool workers are forked from a fork server that imported and loaded
+all of it once (studies.warm_worker; spawned, each loading it, where the platform has no fork
+server), and stop on SIGTERM as on Ctrl-C (studies.interrupts). A
 worker's warnings come back with its batch and are issued again in this process (its filters and
 formatting apply; each distinct warning once per pool), so that workers print nothing themselves.
 """
@@ -24,7 +26,8 @@ import os
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from multiprocessing import get_context
+from multiprocessing import get_all_start_methods, get_context
+from multiprocessing.context import BaseContext
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -81,9 +84,20 @@ def warm_up() -> None:
 
 def start_process_worker() -> None:
     """Process-pool worker initializer: SIGTERM stops it as Ctrl-C does (studies.interrupts), then
-    :func:`warm_up`."""
+    :func:`warm_up` (a few milliseconds in a worker forked from the warm fork server)."""
     worker_stops_like_ctrl_c()
     warm_up()
+
+
+def worker_context() -> BaseContext:
+    """The process pools' start method: a fork server that imports studies.warm_worker before it forks
+    the first worker (on this machine a worker is ready in milliseconds instead of the ~0.9 CPU s a
+    spawned one takes to import and load everything: docs/performance.md); spawn where there is none."""
+    if "forkserver" not in get_all_start_methods():
+        return get_context("spawn")
+    context = get_context("forkserver")
+    context.set_forkserver_preload(["rpdrill.studies.warm_worker"])
+    return context
 
 def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
     """In this process, one after the other (each result its own batch)."""
@@ -121,8 +135,8 @@ def _completed(futures: list[Any], as_done: Callable[[list[Any]], Iterator[Any]]
 
 @contextlib.contextmanager
 def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
-    """A runner bound to one pool of spawned workers (WORKER_ENVIRONMENT), kept for many calls; every
-    worker starts (and imports, :func:`warm_up`) with the first call, none when nothing is run."""
+    """A runner bound to one pool of local workers (:func:`worker_context`, WORKER_ENVIRONMENT), kept for
+    many calls; every worker starts (warm, :func:`warm_up`) with the first call, none when nothing is run."""
     workers = workers or os.cpu_count() or 1
     executors: list[ProcessPoolExecutor] = []
     registry: dict[Any, Any] = {}
@@ -130,7 +144,7 @@ def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
     def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
         if not executors:
             with _environment(WORKER_ENVIRONMENT):  # the workers start inside: the setting reaches them
-                executors.append(ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
+                executors.append(ProcessPoolExecutor(max_workers=workers, mp_context=worker_context(),
                                                      initializer=start_process_worker))
                 for _ in range(workers):  # a new worker per task pending when submitted: all start now
                     executors[0].submit(math.sqrt, 0.0)

@@ -13,6 +13,7 @@ import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 import yaml
@@ -24,7 +25,7 @@ from rpdrill.models.stability import StepLimitWarning
 from rpdrill.studies.cli import main
 from rpdrill.studies.loading import read_yaml
 from rpdrill.studies.points import run_point
-from rpdrill.studies.runners import BATCHES_PER_WORKER, WORKER_ENVIRONMENT, batches
+from rpdrill.studies.runners import BATCHES_PER_WORKER, WORKER_ENVIRONMENT, batches, process_pool
 from rpdrill.studies.specs import METRIC_NAMES
 from rpdrill.studies.study import load_study
 
@@ -174,6 +175,33 @@ def test_resume_after_kill(tmp_path, capsys):
     after = rows(out)
     assert sorted(int(r["point"]) for r in after) == list(range(6))
     assert all(r == before[r["point"]] for r in after if r["point"] in before)
+
+
+def worker_state(_: int) -> tuple[int, bool, bool, str | None, bool]:
+    """What a pool worker holds when it takes its first task (a top-level function: it is pickled)."""
+    import multiprocessing
+
+    return (os.getpid(), "rpdrill.studies.warm_worker" in sys.modules, "matplotlib.pyplot" in sys.modules,
+            os.environ.get("OPENBLAS_NUM_THREADS"), multiprocessing.parent_process() is not None)
+
+
+def test_pool_workers_start_warm_from_the_fork_server():
+    """The process pool's workers are forked from the fork server that imported studies.warm_worker (the
+    formulations, the kernels, matplotlib), with the workers' environment, and a second pool forks from
+    the same server."""
+    first, second = ([s for batch in run(worker_state, [0, 1, 2, 3]) for s in batch]
+                     for run in (process_pool_runner(), process_pool_runner()))
+    for states in (first, second):
+        assert all(warm and plots and blas == "1" and child for _, warm, plots, blas, child in states)
+    assert not {pid for pid, *_ in first} & {pid for pid, *_ in second}  # new workers, same warm server
+
+
+def process_pool_runner() -> Any:
+    """A two-worker process pool's runner, closed once its results are read."""
+    def run(function: Any, arguments: list[int]) -> Iterator[list[Any]]:
+        with process_pool(2) as runner:
+            yield from runner(function, arguments)
+    return run
 
 
 @pytest.mark.parametrize("count, workers", [(0, 2), (1, 2), (7, 2), (92, 2), (207, 3)])
