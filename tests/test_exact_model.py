@@ -337,3 +337,21 @@ def test_works_from_the_propagators_close_the_energy_balance_at_sparse_samples(m
     for name in ("impact_work_j", "damping_j"):
         extrapolated = (4 * getattr(fine, name)[-1] - getattr(coarse, name)[-1]) / 3
         assert abs(getattr(account, name)[-1] - extrapolated) < 1e-7 * extrapolated
+
+
+def test_a_scan_reuses_the_propagators_and_its_results_are_those_of_a_fresh_build():
+    """models.exact_model.OPERATOR_CACHE: a run at another impact frequency builds no key again (the
+    propagators depend on the matrices, not on the frequency), and a run from cached propagators is bit
+    for bit the run that built them."""
+    cache = rpdrill.models.exact_model.OPERATOR_CACHE
+    base = crushing_scene(solver__end_time_s=0.2, **SHORT_METRICS).with_solver("exact")
+    cache.clear()
+    fresh = simulate(base)
+    keys = len(cache.entries)
+    assert keys == fresh.info["operator_keys"] > 0
+    again = simulate(base)
+    other = simulate(base.model_copy(update={"impact": base.impact.model_copy(update={"frequency_hz": 47.0})}))
+    assert len(cache.entries) == keys and other.info["operator_keys"] <= keys
+    for name in ("time_s", "position_m", "velocity_m_per_s", "bottom_m", "rock_force_n"):
+        assert np.array_equal(getattr(fresh, name), getattr(again, name)), name
+    assert all(np.array_equal(fresh.works_j[k], again.works_j[k]) for k in fresh.works_j)
