@@ -57,7 +57,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections import OrderedDict
+from collections import Counter, OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -496,12 +496,11 @@ class ExactSolver:
 def _switch_counts(model: Model, before: Modes, entered: list[Modes]) -> dict[str, int]:
     """How often each element mode was entered (``mode`` for the rock, ``link:mode`` for a link)."""
     counts: dict[str, int] = {}
-    for modes in entered:
-        for index, (old, new) in enumerate(zip(before, modes, strict=True)):
+    for (previous, modes), times in Counter(zip([before, *entered], entered)).items():  # each distinct switch once
+        for index, (old, new) in enumerate(zip(previous, modes, strict=True)):
             if old != new:
                 key = new if index == 0 else f"{model.pieces[index].name}:{new}"
-                counts[key] = counts.get(key, 0) + 1
-        before = modes
+                counts[key] = counts.get(key, 0) + times
     return counts
 
 
