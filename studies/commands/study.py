@@ -57,7 +57,8 @@ def run(args: argparse.Namespace) -> int:
     study = load_study(args.study, args.formulation, budget(args))
     with pool(args.dask, args.workers) as runner:
         rows, optima = run_study(study, out, runner, args.quiet)
-        from rpdrill.studies.plots.scans import draw_plots  # matplotlib once the points have run, not at start
+        # matplotlib once the points have run, not at start
+        from rpdrill.studies.plots.scans import draw_plots
 
         written, skipped = draw_plots(study, rows, optima, out, runner[1])  # by the workers, side by side
     failed = [row for row in rows if row["status"] != "ok"]
