@@ -102,13 +102,23 @@ def test_no_result_number_is_typed_into_the_generated_page_templates():
 
 @pytest.mark.slow
 def test_the_shipped_scene_reproduces_every_optimum_and_trend_the_paper_states(tmp_path):
-    """The product's claim, on the shipped files as they are: every optimum the paper states within the
-    reproduction file's tolerance and both rising trends (exit 0), the run's record saying so."""
+    """The product's claim, on the shipped scene and cases as they are: every optimum the paper states
+    within the reproduction file's tolerance and both rising trends (exit 0), the run's record saying so.
+    The file's variants (other upper strings, three quarters of its runs) are left out of this copy of
+    it: they state no claim of the paper, and neither the exit status nor the shipped scene's optima
+    and trends depend on them (a variant's run is tested with the small file above)."""
+    shipped = ROOT / "studies" / "paper" / "reproduction.yaml"
+    data = yaml.safe_load(shipped.read_text(encoding="utf-8"))
+    assert data.pop("variants")
+    data["base_scene"] = str(shipped.parent / data["base_scene"])
+    data["calibration"] = str(shipped.parent / data["calibration"])
     out = tmp_path / "out"
-    assert main(["reproduce", "--out", str(out), "--quiet"]) == 0
-    record = json.loads((out / "reproduction.json").read_text())["variants"]["None"]
+    assert main(["reproduce", str(write(tmp_path / "reproduction.yaml", data)), "--out", str(out), "--quiet"]) == 0
+    record = json.loads((out / "reproduction.json").read_text())["variants"]
+    assert list(record) == ["None"]
+    record = record["None"]
     assert len(record["trends"]) == 2 and all(t["rises"] for t in record["trends"])
-    reproduction = load_reproduction(ROOT / "studies" / "paper" / "reproduction.yaml")
+    reproduction = load_reproduction(shipped)
     stated = {c.label: c.paper.optimum_hz for c in reproduction.spec.cases if c.paper.optimum_hz is not None}
     reached = {o["label"]: o["main_hz"] for o in record["optima"]}
     assert len(stated) == 6
