@@ -8,7 +8,8 @@ Exudyn model at the scene's solver setting and the SciPy ODE formulation (DOP853
 against the exact solution on a finer grid (samples and sub-step 1e-6 s; the exact run's own
 difference to it is round-off). The error is max |x_n - x_n,ref| over the blow starts divided by
 |x_n,ref| at the end, and absolute. The exact runs are timed after a warm-up call (median of
-``--repeats`` runs); the compile time of the numba kernels (models.exact_kernels) is measured
+``--repeats`` runs), each with the propagator cache (models.exact_model.OPERATOR_CACHE) emptied first,
+and again reusing the propagators of the run before (a scan's later points); the compile time of the numba kernels (models.exact_kernels) is measured
 separately, in a fresh process with an empty numba cache, and the first call with a warm cache.
 
 Usage: python benchmarks/bench_exact.py [--end-time-s 0.5] [--repeats 9]
@@ -36,6 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rpdrill.models.exact_model import OPERATOR_CACHE
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
@@ -85,12 +87,16 @@ def blow_start_error(result: SimulationResult, reference: SimulationResult) -> f
     return float(np.max(np.abs(held(result) - held(reference))) / abs(reference.bottom_m[-1]))
 
 
-def timed(run: Callable[[], SimulationResult], repeats: int) -> tuple[SimulationResult, float]:
+def timed(run: Callable[[], SimulationResult], repeats: int, cold: bool = False) -> tuple[SimulationResult, float]:
     """The last result and the median CPU time of ``repeats`` runs, each result dropped before the next
     run as in a study (a kept result pins its sample arrays, and the next run's fresh memory costs
-    page faults: ~20 ms for the 7 MB of a 0.5 s run at 1e-5 s samples on the shared VM)."""
+    page faults: ~20 ms for the 7 MB of a 0.5 s run at 1e-5 s samples on the shared VM). ``cold``: the
+    exact solver's propagator cache emptied before each run (a run as a user starts it; otherwise each
+    run reuses the propagators of the one before, as a scan's later points do)."""
     times = []
     for _ in range(repeats):
+        if cold:
+            OPERATOR_CACHE.clear()
         result = run()
         times.append(result.cpu_time_s)
     return result, statistics.median(times)
@@ -133,7 +139,8 @@ def main() -> None:
             exact = label.startswith("exact")
             if exact:
                 run()  # warm-up
-            result, cpu = timed(run, args.repeats if exact else 1)
+                warm = timed(run, args.repeats)[1]
+            result, cpu = timed(run, args.repeats if exact else 1, cold=exact)
             error = blow_start_error(result, reference)
             print(f"{name:<21} {label:<28} {cpu / args.end_time_s:<15.4f} {error:<16.2e} "
                   f"{error * abs(reference.bottom_m[-1]):<10.1e} {result.bottom_m[-1] * 1e3:.9f}")
@@ -142,7 +149,8 @@ def main() -> None:
                 summary_metrics(result)
                 metrics_s = (time.process_time() - start) / args.end_time_s
                 print(f"{'':<24}({result.info['mode_switches']} switches, {result.info['samples']} samples, "
-                      f"every {result.info['sample_interval_s']:.0e} s; its metrics: {metrics_s:.4f} CPU s / sim s)")
+                      f"every {result.info['sample_interval_s']:.0e} s; its metrics: {metrics_s:.4f} CPU s / sim s; "
+                      f"with the propagators of a run before: {warm / args.end_time_s:.4f} CPU s / sim s)")
             del result
         print(f"{name:<21} reference: exact, sub-step {reference.info['sub_step_s']:.3g} s")
 
