@@ -6,10 +6,13 @@ the three paper scans (studies/paper/{frequency,impulse,stiffness}_scan.yaml, 20
 run through the study command's own code (studies.commands.study.run_study: load, resumable results,
 optima; then studies.plots.scans.draw_plots) on one process pool opened for the three, into a scratch
 directory.
-Prints the wall time from opening the pool to the last plot, the CPU seconds of this process and its
-workers over the same span (on a shared machine the wall time depends on the other load; the CPU
-time is what the run needs: on N idle cores the wall time is about CPU / N), the CPU seconds the
-simulations reported (``cpu_time_s`` of every point) and their share of all CPU.
+Each formulation's three scans run in a process of their own (its own pool and fork server, as one
+command has). Prints the wall time from opening the pool to the last plot, of it the time spent
+drawing the plots (by the pool's workers), the CPU seconds of that process, its fork server and its
+workers (read from /proc before the pool closes: Linux; on a shared machine the wall time depends
+on the other load, the CPU time is what the run needs: on N idle cores the wall time is about
+CPU / N), the CPU seconds the simulations reported (``cpu_time_s`` of every point) and their share
+of all CPU.
 Then one ``rpdrill study`` command of the frequency scan as a user runs it (a new process: imports,
 pool start, plots), its wall time.
 """
@@ -17,7 +20,8 @@ pool start, plots), its wall time.
 from __future__ import annotations
 
 import argparse
-import resource
+import contextlib
+import os
 import subprocess
 import sys
 import tempfile
@@ -48,25 +52,44 @@ def study_file(scan: str, solver: str, folder: Path) -> Path:
     return path
 
 
-def cpu_s() -> float:
-    """CPU seconds of this process and of its finished children (the pool's workers once it closed)."""
-    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+def process_tree_cpu_s(pid: int) -> float:
+    """CPU seconds (user + system) of process ``pid`` and of its living descendants, from /proc (Linux):
+    the pool's fork server and its workers, which are not this process's waited-for children."""
+    tick = os.sysconf("SC_CLK_TCK")
+    parents, cpu = {}, {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            with contextlib.suppress(OSError):
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+                parents[int(entry.name)] = int(fields[1])
+                cpu[int(entry.name)] = (int(fields[11]) + int(fields[12])) / tick
+
+    def descends(p: int) -> bool:
+        while p > 1:
+            if p == pid:
+                return True
+            p = parents.get(p, 0)
+        return False
+
+    return sum(seconds for p, seconds in cpu.items() if descends(p))
 
 
 def three_scans(solver: str, workers: int, folder: Path) -> None:
-    start, cpu_start = time.perf_counter(), cpu_s()
-    simulated_cpu, points, plots_written = 0.0, 0, 0
+    """The three scans on one pool in this process (a child of main: its own fork server); one line."""
+    start, simulated_cpu, points, plots_written, plots_s = time.perf_counter(), 0.0, 0, 0, 0.0
     with pool(None, workers) as runner:
         for scan in SCANS:
             study = load_study(study_file(scan, solver, folder))
             rows, optima = run_study(study, folder / f"{scan}_{solver}", runner, quiet=True)
+            plots_start = time.perf_counter()
             plots_written += len(draw_plots(study, rows, optima, folder / f"{scan}_{solver}", runner[1])[0])
+            plots_s += time.perf_counter() - plots_start
             simulated_cpu += sum(float(row["cpu_time_s"]) for row in rows if row["status"] == "ok")
             points += len(rows)
-    wall, cpu = time.perf_counter() - start, cpu_s() - cpu_start
-    print(f"{solver:<10}{points:<8}{wall:<10.2f}{cpu:<18.2f}{simulated_cpu:<22.2f}{simulated_cpu / cpu:<24.2f}"
-          f"{plots_written}")
+        cpu = process_tree_cpu_s(os.getpid())
+    wall = time.perf_counter() - start
+    print(f"{solver:<10}{points:<8}{wall:<10.2f}{plots_s:<10.2f}{cpu:<13.2f}{simulated_cpu:<20.2f}"
+          f"{simulated_cpu / cpu:<20.2f}{plots_written}")
 
 
 def one_command(solver: str, workers: int, folder: Path) -> float:
@@ -81,15 +104,21 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--formulations", default="exact,fast")
+    parser.add_argument("--one", help=argparse.SUPPRESS)  # a child: the three scans of one formulation
+    parser.add_argument("--folder", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.one:
+        three_scans(args.one, args.workers, Path(args.folder))
+        return
     solvers = args.formulations.split(",")
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
-        print(f"three paper scans on one pool of {args.workers} workers")
-        print(f"{'solver':<10}{'points':<8}{'wall s':<10}{'all CPU s':<18}{'simulation CPU s':<22}"
-              f"{'simulation / all':<24}plots")
+        print(f"three paper scans on one pool of {args.workers} workers, a process each")
+        print(f"{'solver':<10}{'points':<8}{'wall s':<10}{'plots s':<10}{'all CPU s':<13}{'simulation CPU s':<20}"
+              f"{'simulation / all':<20}plots")
         for solver in solvers:
-            three_scans(solver, args.workers, folder)
+            subprocess.run([sys.executable, __file__, "--one", solver, "--folder", str(folder), "--workers",
+                            str(args.workers)], check=True)
         for solver in solvers:
             print(f"one command (rpdrill study frequency_scan, 23 points, {solver}): "
                   f"{one_command(solver, args.workers, folder):.2f} s wall")

@@ -96,7 +96,7 @@ def worker_context() -> BaseContext:
     if "forkserver" not in get_all_start_methods():
         return get_context("spawn")
     context = get_context("forkserver")
-    context.set_forkserver_preload(["rpdrill.studies.warm_worker"])
+    context.set_forkserver_preload(["__main__", "rpdrill.studies.warm_worker"])
     return context
 
 def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
