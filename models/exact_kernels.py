@@ -410,10 +410,12 @@ def assemble(one_step: np.ndarray, matrix: np.ndarray, readout_rows: np.ndarray,
 @njit(cache=True)
 def power_integrals(one_step: np.ndarray, balanced: np.ndarray, scale: np.ndarray, forms: np.ndarray, step_s: float,
                     step_powers: np.ndarray, step_grams: np.ndarray, series: np.ndarray) -> None:
-    """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of one key's power forms Q_q (models.exact_model
-    .Operators.add_powers): ``step_powers`` [j] = E^j (E = expm(A h), j <= p, the sub-steps of a sample);
-    ``series`` [q, k] = S_k / (k + 1) with S_0 = Q, S_k = (A^T S_(k-1) + S_(k-1) A) / k, formed on the balanced
-    matrix A_b = D^-1 A D (S_k = D^-1 S_k,b(D Q D) D^-1), so that G(s) = sum_k s^(k+1) series[q, k] for s <= h;
+    """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of one key's power forms Q_q (power w^T Q w,
+    models.exact_model.Model.power_forms): ``step_powers`` [j] = E^j (E = expm(A h), j <= p, the sub-steps
+    of a sample); ``series`` [q, k] = S_k / (k + 1), the integrand's Taylor coefficients S_0 = Q,
+    S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on the balanced matrix
+    A_b = D^-1 A D (S_k = D^-1 S_k,b(D Q D) D^-1), so that G(s) = sum_k s^(k+1) series[q, k] for s <= h (the
+    truncation after the Taylor order K of the sub-step leaves 2^(K+1) / (K+1)! of it, below 1e-14);
     ``step_grams`` [q, j] = G(j h) = sum_(l < j) (E^l)^T G(h) E^l."""
     size, steps, terms = one_step.shape[0], step_powers.shape[0], series.shape[1]
     step_powers[0] = np.eye(size)

@@ -36,7 +36,7 @@ reaches it.
 Works (with the energy outputs): the impact work and the work the links, the rock and the torsion
 line absorb are quadratic forms w^T Q w integrated exactly between the samples,
 int_0^s w^T Q w = w^T G(s) w with G(s) = int_0^s expm(A^T u) Q expm(A u) du per key, a series in s
-(Operators.add_powers, models.exact_kernels.integrate_powers), so the samples stay at the output
+(models.exact_kernels.power_integrals and integrate_powers), so the samples stay at the output
 interval.
 
 Zero-length modes: a mode lasts at least ``min_switch_interval_s``. Its start is taken as not
@@ -101,6 +101,9 @@ MAX_ENUMERATED_MODES = 256  # mode combinations whose norms are all measured to 
 # products (a 13 x 13 expm took 8 ms with two threads on a loaded 2-core machine, 0.1 ms with one).
 BLAS = ThreadpoolController()
 Modes = tuple[str, ...]
+CacheKey = tuple[bytes, bytes, bytes, float, int, int]  # A, R, power forms, h, sub-steps per sample, order
+
+
 class OperatorCache:
     """The propagators of the keys built last in this process, by (A, R, power forms, h, sub-steps per
     sample, Taylor order): they depend on neither the impact frequency nor the end time, so the runs of
@@ -110,15 +113,15 @@ class OperatorCache:
 
     def __init__(self, max_bytes: int) -> None:
         self.max_bytes, self.bytes = max_bytes, 0
-        self.entries: OrderedDict[tuple[bytes, bytes, bytes, float, int, int], tuple[np.ndarray, ...]] = OrderedDict()
+        self.entries: OrderedDict[CacheKey, tuple[np.ndarray, ...]] = OrderedDict()
 
-    def get(self, key: tuple[bytes, bytes, bytes, float, int, int]) -> tuple[np.ndarray, ...] | None:
+    def get(self, key: CacheKey) -> tuple[np.ndarray, ...] | None:
         arrays = self.entries.get(key)
         if arrays is not None:
             self.entries.move_to_end(key)
         return arrays
 
-    def put(self, key: tuple[bytes, bytes, bytes, float, int, int], arrays: tuple[np.ndarray, ...]) -> None:
+    def put(self, key: CacheKey, arrays: tuple[np.ndarray, ...]) -> None:
         self.entries[key] = arrays
         self.bytes += sum(a.nbytes for a in arrays)
         while self.bytes > self.max_bytes and self.entries:
@@ -366,18 +369,10 @@ class Operators:
         self.one_step[i] = scale[:, None] * expm(balanced * self.step_s) / scale[None, :]
         assemble(self.one_step[i], matrix, readout, ANCHORS, PER_ANCHOR, self.readout[i], self.anchors[i],
                  self.taylor[i])
-        if len(self.series):
-            self.add_powers(i, balanced, scale, forms)
+        if len(self.series):  # the integrals of the power forms (module doc)
+            power_integrals(self.one_step[i], balanced, scale, forms, self.step_s, self.step_powers[i],
+                            self.step_grams[i], self.series[i])
 
-    def add_powers(self, i: int, balanced: np.ndarray, scale: np.ndarray, forms: np.ndarray) -> None:
-        """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of key ``i``'s power forms (compiled:
-        models.exact_kernels.power_integrals): for s <= h the series G(s) = sum_k s^(k+1) S_k / (k + 1) of the
-        integrand's Taylor coefficients, S_0 = Q, S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves
-        F' = A^T F + F A), formed on the balanced matrix (the truncation after the Taylor order of the
-        sub-step leaves 2^(K+1) / (K+1)! of it, below 1e-14); then G(j h) = sum_(l < j) (E^l)^T G(h) E^l for j
-        up to the sub-steps of a sample (E = expm(A h)). ``balanced``, ``scale``: balance(A)."""
-        power_integrals(self.one_step[i], balanced, scale, forms, self.step_s, self.step_powers[i],
-                        self.step_grams[i], self.series[i])
 
 def sub_step(simulation: Simulation, phases: list[str], model: Model | None = None) -> tuple[float, int, float]:
     """(||A_bal||_1, sub-steps per sample, sub-step h) of the global sub-grid (module doc): the
