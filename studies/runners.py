@@ -3,19 +3,18 @@ results as it completes.
 
 Each runner is ``runner(function, arguments) -> Iterator[list[result]]``: :func:`sequential` (in this
 process, one argument per batch), or one bound to a pool that lives for many calls,
-:func:`process_pool` (local worker processes, all cores by default) and :func:`dask_pool` (a Dask cluster or
-a LocalCluster); :func:`pool` picks one for the command line options. A pool's workers start and
-import rpdrill once (a process pool's with its first call, so that a study refused before it runs
-starts none) and take batches of arguments (:func:`batches`): a run pays the process machinery once
-per pool and once per batch, not per argument. Results come in completion order, so the function's
-result must say which argument it belongs to. Workers run one BLAS thread each and keep freed memory
-(WORKER_ENVIRONMENT); process-pool workers are forked from a fork server that imported and loaded
-all of it once (studies.warm_worker; spawned, each loading it, where the platform has no fork
-server), and stop on SIGTERM as on Ctrl-C (studies.interrupts). A
-worker's warnings come back with its batch and are issued again in this process (its filters and
-formatting apply; each distinct warning once per pool), so that workers print nothing themselves.
+:func:`process_pool` (local worker processes, all cores by default) and :func:`dask_pool` (a Dask
+cluster or a LocalCluster); :func:`pool` picks one for the command line options. A pool's workers
+start and import rpdrill once (a process pool's with its first call, so that a study refused before
+it runs starts none) and take batches of arguments (:func:`batches`): a run pays the process
+machinery once per pool and once per batch, not per argument. Results come in completion order, so
+the function's result must say which argument it belongs to. Workers run one BLAS thread each and
+keep freed memory (WORKER_ENVIRONMENT); process-pool workers are forked from a fork server that
+imported and loaded all of it once (studies.warm_worker; spawned, each loading it, where the
+platform has no fork server), and stop on SIGTERM as on Ctrl-C (studies.interrupts). A worker's
+warnings come back with its batch and are issued again in this process (its filters and formatting
+apply; each distinct warning once per pool), so that workers print nothing themselves.
 """
-
 from __future__ import annotations
 
 import contextlib
@@ -91,13 +90,14 @@ def start_process_worker() -> None:
 
 def worker_context() -> BaseContext:
     """The process pools' start method: a fork server that imports studies.warm_worker before it forks
-    the first worker (on this machine a worker is ready in milliseconds instead of the ~0.9 CPU s a
-    spawned one takes to import and load everything: docs/performance.md); spawn where there is none."""
+    the first worker, so that each worker starts with everything loaded instead of importing and
+    loading it itself (docs/performance.md); spawn where the platform has no fork server."""
     if "forkserver" not in get_all_start_methods():
         return get_context("spawn")
     context = get_context("forkserver")
-    context.set_forkserver_preload(["__main__", "rpdrill.studies.warm_worker"])
+    context.set_forkserver_preload(["rpdrill.studies.warm_worker"])
     return context
+
 
 def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
     """In this process, one after the other (each result its own batch)."""

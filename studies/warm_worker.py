@@ -1,14 +1,14 @@
 """Imported by the process pool's fork server (studies.runners): what every worker needs, loaded once.
 
 The server imports every command with what it imports (the study machinery, the formulations, the
-plots' matplotlib), loads the exact solver's compiled kernels
-(studies.runners.warm_up) and draws one small figure (fonts, mathtext and both file formats' writers
-loaded); the workers forked from it start with all of it in memory instead of each importing and
-loading it again. Python 3.11's fork server cannot preload the main module itself (it passes the
-main path under a key its server does not read), so what a worker's main module imports (the command
-line, or a benchmark's imports of the same modules) is imported here; not the command line module itself,
-which a worker started by ``python -m rpdrill.studies.cli`` runs again as its main module (runpy warns
-when that module was imported before).
+plots' matplotlib), loads the exact solver's compiled kernels (studies.runners.warm_up) and draws one
+small figure (fonts, mathtext and both file formats' writers loaded); the workers forked from it
+start with all of it in memory instead of each importing and loading it again. Python 3.11's fork
+server cannot preload the main module itself (it passes the main path under a key its server does
+not read), so what a worker's main module imports (the command line, or a benchmark's imports of
+the same modules) is imported here; not the command line module itself, which a worker started by
+``python -m rpdrill.studies.cli`` runs again as its main module (runpy warns when that module was
+imported before).
 """
 
 import gc
