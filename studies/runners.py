@@ -10,8 +10,8 @@ it runs starts none) and take batches of arguments (:func:`batches`): a run pays
 machinery once per pool and once per batch, not per argument. Results come in completion order, so
 the function's result must say which argument it belongs to. Workers run one BLAS thread each and
 keep freed memory (WORKER_ENVIRONMENT); process-pool workers are forked from a fork server that
-imported and loaded all of it once (studies.warm_worker; spawned, each loading it, where the
-platform has no fork server), and stop on SIGTERM as on Ctrl-C (studies.interrupts). A worker's
+imported and loaded all of it once (studies.warm_worker; on Linux: spawned elsewhere, each loading
+it), and stop on SIGTERM as on Ctrl-C (studies.interrupts). A worker's
 warnings come back with its batch and are issued again in this process (its filters and formatting
 apply; each distinct warning once per pool), so that workers print nothing themselves.
 """
@@ -22,6 +22,7 @@ import itertools
 import logging
 import math
 import os
+import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -89,10 +90,11 @@ def start_process_worker() -> None:
 
 
 def worker_context() -> BaseContext:
-    """The process pools' start method: a fork server that imports studies.warm_worker before it forks
-    the first worker, so that each worker starts with everything loaded instead of importing and
-    loading it itself (docs/performance.md); spawn where the platform has no fork server."""
-    if "forkserver" not in get_all_start_methods():
+    """The process pools' start method: on Linux a fork server that imports studies.warm_worker before it
+    forks the first worker, so that each worker starts with everything loaded instead of importing and
+    loading it itself (docs/performance.md); spawn elsewhere (macOS forbids forking a process that has
+    loaded its system frameworks, which NumPy's BLAS may be; Windows has no fork)."""
+    if not sys.platform.startswith("linux") or "forkserver" not in get_all_start_methods():
         return get_context("spawn")
     context = get_context("forkserver")
     context.set_forkserver_preload(["rpdrill.studies.warm_worker"])

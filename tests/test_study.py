@@ -185,6 +185,7 @@ def worker_state(_: int) -> tuple[int, bool, bool, str | None, bool]:
             os.environ.get("OPENBLAS_NUM_THREADS"), multiprocessing.parent_process() is not None)
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the fork server is used on Linux only")
 def test_pool_workers_start_warm_from_the_fork_server():
     """The process pool's workers are forked from the fork server that imported studies.warm_worker (the
     formulations, the kernels, matplotlib), with the workers' environment, and a second pool forks from
