@@ -7,12 +7,14 @@ run through the study command's own code (studies.commands.study.run_study: load
 optima; then studies.plots.scans.draw_plots) on one process pool opened for the three, into a scratch
 directory.
 Each formulation's three scans run in a process of their own (its own pool and fork server, as one
-command has). Prints the wall time from opening the pool to the last plot, of it the time spent
-drawing the plots (by the pool's workers), the CPU seconds of that process, its fork server and its
+command has: the process starts the pool's fork server before its own imports, as the command line
+does). Prints the wall time from opening the pool to the last plot, of it the time spent drawing the
+plots (by the pool's workers), the CPU seconds of that process, its fork server and its
 workers (read from /proc before the pool closes: Linux; on a shared machine the wall time depends
 on the other load, the CPU time is what the run needs: on N idle cores the wall time is about
-CPU / N), the CPU seconds the simulations reported (``cpu_time_s`` of every point) and their share
-of all CPU.
+CPU / N), the CPU seconds the simulations reported (``cpu_time_s`` of every point), their share of
+all CPU, the plots written and the wall time of the whole process (interpreter start, imports, the
+three scans and their plots, exit).
 Then one ``rpdrill study`` command of the frequency scan as a user runs it (a new process: imports,
 pool start, plots), its wall time.
 """
@@ -27,6 +29,11 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from rpdrill.studies.runners import start_worker_server
+
+if __name__ == "__main__" and "--one" in sys.argv:
+    start_worker_server()  # as the command line does, before the heavy imports below
 
 import yaml
 
@@ -89,7 +96,7 @@ def three_scans(solver: str, workers: int, folder: Path) -> None:
         cpu = process_tree_cpu_s(os.getpid())
     wall = time.perf_counter() - start
     print(f"{solver:<10}{points:<8}{wall:<10.2f}{plots_s:<10.2f}{cpu:<13.2f}{simulated_cpu:<20.2f}"
-          f"{simulated_cpu / cpu:<20.2f}{plots_written}")
+          f"{simulated_cpu / cpu:<20.2f}{plots_written:<7}", end="", flush=True)
 
 
 def one_command(solver: str, workers: int, folder: Path) -> float:
@@ -115,10 +122,12 @@ def main() -> None:
         folder = Path(scratch)
         print(f"three paper scans on one pool of {args.workers} workers, a process each")
         print(f"{'solver':<10}{'points':<8}{'wall s':<10}{'plots s':<10}{'all CPU s':<13}{'simulation CPU s':<20}"
-              f"{'simulation / all':<20}plots")
+              f"{'simulation / all':<20}{'plots':<7}process s")
         for solver in solvers:
+            start = time.perf_counter()
             subprocess.run([sys.executable, __file__, "--one", solver, "--folder", str(folder), "--workers",
                             str(args.workers)], check=True)
+            print(f"{time.perf_counter() - start:.2f}")
         for solver in solvers:
             print(f"one command (rpdrill study frequency_scan, 23 points, {solver}): "
                   f"{one_command(solver, args.workers, folder):.2f} s wall")

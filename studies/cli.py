@@ -14,6 +14,7 @@ import argparse
 import contextlib
 import importlib
 import importlib.metadata
+import itertools
 import sys
 import traceback
 import warnings
@@ -23,6 +24,7 @@ from pathlib import Path
 from rpdrill.studies.budgets import BudgetError
 from rpdrill.studies.interrupts import Terminated, raise_if_stopped, stops_handled
 from rpdrill.studies.loading import InputError
+from rpdrill.studies.runners import start_worker_server
 
 # name: (module, one-line help); a module is imported only when its command runs
 COMMANDS = {
@@ -39,6 +41,8 @@ COMMANDS = {
                         "the rotation-speed note (rpm x frequency map, best speed against the manual's rule)"),
     "advise": ("rpdrill.studies.commands.advise", "the operating point that maximises a metric within bounds"),
 }
+# the commands whose runs go to a process pool by default
+POOL_COMMANDS = ("study", "accuracy", "calibrate", "reproduce", "sensitivity", "advise")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -67,8 +71,18 @@ def _version() -> str:
     return f"rpdrill {importlib.metadata.version('rpdrill')} (Exudyn {importlib.metadata.version('exudyn')})"
 
 
+def _runs_a_process_pool(argv: list[str]) -> bool:
+    """Whether the command line will run a process pool (a hint read before parsing: a wrong guess only
+    starts the pool's fork server in vain): a pool command without --dask, --workers 1 or --help."""
+    one_worker = "--workers=1" in argv or any(a == "--workers" and b == "1" for a, b in itertools.pairwise(argv))
+    dask = any(word == "--dask" or word.startswith("--dask=") for word in argv)
+    return bool(argv) and argv[0] in POOL_COMMANDS and not (one_worker or dask or {"-h", "--help"} & set(argv))
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
+    if _runs_a_process_pool(argv):
+        start_worker_server()  # its imports overlap this process's (studies.runners)
     parser = _Parser(prog="rpdrill", description="Rotary-percussive drilling simulator on Exudyn")
     parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)

@@ -26,7 +26,7 @@ import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from multiprocessing import get_all_start_methods, get_context
+from multiprocessing import forkserver, get_all_start_methods, get_context
 from multiprocessing.context import BaseContext
 from pathlib import Path
 from typing import Any, TypeVar
@@ -99,6 +99,15 @@ def worker_context() -> BaseContext:
     context = get_context("forkserver")
     context.set_forkserver_preload(["rpdrill.studies.warm_worker"])
     return context
+
+
+def start_worker_server() -> None:
+    """Start the process pools' fork server now (Linux; nothing elsewhere), so that its imports and
+    warm-up (studies.warm_worker, about 2 s) run while this process does its own; the first pool then
+    forks its workers at once. The server is shared by every pool of this process and ends with it."""
+    if worker_context().get_start_method() == "forkserver":
+        with _environment(WORKER_ENVIRONMENT):  # the server starts inside: its workers inherit the setting
+            forkserver.ensure_running()
 
 
 def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
