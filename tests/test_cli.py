@@ -92,3 +92,16 @@ def test_the_fork_server_starts_early_only_for_a_process_pool(argv, pool):
     from rpdrill.studies.cli import _runs_a_process_pool
 
     assert _runs_a_process_pool(argv) is pool
+
+
+def test_the_pool_commands_are_those_that_open_a_pool():
+    """POOL_COMMANDS (the early fork-server hint) lists exactly the commands whose module opens a pool
+    (studies.runners.pool), so that a new command that runs points is not left cold."""
+    import importlib
+    import inspect
+
+    from rpdrill.studies.cli import POOL_COMMANDS
+
+    opening = {name for name, (module, _) in COMMANDS.items()
+               if "pool(" in inspect.getsource(importlib.import_module(module))}
+    assert opening == set(POOL_COMMANDS)
