@@ -1,16 +1,17 @@
 """The Exudyn accuracy presets against their targets, measured in one run.
 
-Usage: python benchmarks/bench_presets.py [--repeats N] [--presets fast,standard,reference] [--front | --modules]
+Usage: python benchmarks/bench_presets.py [--repeats N] [--presets fast,standard,reference] [--front [--sweeps S,...] | --modules]
 With ``--modules``: each preset's CPU seconds per simulated second on the paper scene with Exudyn's
 regular compiled module (``EXUDYN_MODULE=regular``) and with the fast one rpdrill loads
 (rocklaw.exudyn_module), each in its own child process, alternated three times; the medians, their
 ratio and the largest relative difference of the penetration rate between the two.
-With ``--front``: the work-precision front the presets are picked from. Every candidate step rule
-(rk44, rk67 and generalized-alpha at step = min(1e-4 s, pulse / 10, c / |lambda|_max) over a range of
-c) runs on the paper scene and on every hard scene; printed per candidate: its CPU seconds per
-simulated second on the paper scene (median of N runs after a warm-up) and its largest penetration-rate and energy-balance errors over
-the scenes (the damped scenes and the undamped one apart: its errors grow blow by blow), the
-candidates on the front (no other both cheaper and more accurate over the damped scenes) marked.
+With ``--front``: the work-precision fronts the presets are picked from, one per bound of their step
+rule (:func:`front`): rk44, rk67 and generalized-alpha at step = min(1e-4 s, pulse / 10, c x the
+bound's time scale) over a range of c, on the scenes the bound governs; printed per candidate: its
+CPU seconds per simulated second (median of N runs after a warm-up), its largest penetration-rate and
+energy-balance errors over those scenes, the candidates on the front (no other both cheaper and more
+accurate) marked; then the automatic-step dopri5 and ode23 at a few tolerances on every scene
+(:func:`automatic`). ``--sweeps`` picks some of them (stability, ringing, damper, automatic).
 Otherwise prints, for each preset of models.solver_settings: its solver and step on the shipped paper scene,
 the CPU seconds per simulated second there (1 s simulated, every output, median of N runs after a
 warm-up, results dropped between runs), and on the paper scene and every hard scene of
@@ -30,16 +31,19 @@ for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse
 import json
+import math
 import statistics
 import subprocess
 import sys
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
 from rpdrill.models.solver_settings import EXUDYN_PRESETS
+from rpdrill.models.stability import StepScales
 from rpdrill.models.workprecision import pareto_front
 from rpdrill.studies.loading import load_scene
 
@@ -64,40 +68,81 @@ def cost(scene: Scene, repeats: int) -> float:
     return statistics.median(runs) / scene.solver.end_time_s
 
 
-FRONT_CANDIDATES = [("rk44", c) for c in (2.2, 1.9, 1.5, 1.0, 0.7, 0.5)] + \
-    [("rk67", c) for c in (1.0, 0.8, 0.6, 0.4, 0.2)] + [("generalized_alpha", c) for c in (2.0, 1.0, 0.5, 0.25)]
-UNDAMPED = "no_damping"
+UNDAMPED, CRITICAL = "no_damping", "critical_damping"
+SOLVERS = ("rk44", "rk67", "generalized_alpha")
+# (what the factor c multiplies, the scenes the bound governs, the rate it divides by, the factors)
+SWEEPS: dict[str, tuple[str, tuple[str, ...] | None, Callable[[StepScales], float], tuple[float, ...]]] = {
+    "stability": ("1 / |lambda|_max", None, lambda scales: scales.spectral_radius_per_s, (2.2, 1.9, 1.5, 1.0, 0.7, 0.5)),
+    "ringing": ("1 / |lambda| of the fastest mode ringing at the next blow", (UNDAMPED,),
+                lambda scales: scales.ringing_radius_per_s, (0.5, 0.4, 0.3, 0.2, 0.1)),
+    "damper": ("m_bit / c_n", (CRITICAL,), lambda scales: scales.damper_rate_per_s, (0.1, 0.07, 0.05, 0.03, 0.02)),
+}
 
 
-def front(scenes: dict[str, Scene], exact: dict[str, dict[str, float]], repeats: int) -> None:
-    """The candidates' cost on the paper scene (median of ``repeats`` runs after a warm-up) and largest
-    errors over the scenes (module doc)."""
-    print(f"{'solver':<20}{'c':<6}{'CPU s / sim s':<15}{'rate, damped':<14}{'rate, undamped':<16}"
-          f"{'energy, damped':<16}front")
-    rows = []
-    for solver, factor in FRONT_CANDIDATES:
-        rate, energy, undamped, per_second = 0.0, 0.0, 0.0, float("nan")
+AUTOMATIC = tuple((solver, tolerance) for solver in ("dopri5", "ode23") for tolerance in (1e-2, 1e-3, 1e-4))
+
+
+def automatic(scenes: dict[str, Scene], exact: dict[str, dict[str, float]], repeats: int) -> None:
+    """The automatic-step solvers (their largest step min(1e-4 s, pulse / 10), absolute tolerance
+    1e-12, the default) at each relative tolerance: CPU seconds per simulated second on paper_base,
+    the largest rate and energy errors over every scene and the scene of the largest rate error."""
+    print("\nautomatic: dopri5 and ode23, largest step min(1e-4 s, pulse / 10), on every scene; CPU on paper_base")
+    print(f"{'solver':<10}{'rtol':<8}{'CPU s / sim s':<15}{'rate error':<14}{'energy error':<14}worst scene")
+    for solver, tolerance in AUTOMATIC:
+        errors, energy, per_second = {}, 0.0, float("nan")
         for name, scene in scenes.items():
-            radius = prepare(scene).spectral_radius_per_s
-            step = min(1e-4, scene.impact.duration_s / 10, factor / radius)
+            candidate = scene.with_solver("exudyn", type=solver, relative_tolerance=tolerance,
+                                          step_s=min(1e-4, scene.impact.duration_s / 10))
             try:
-                result = prepare(scene.with_solver("exudyn", type=solver, step_s=step)).run()
-            except Exception:  # noqa: BLE001 - a diverged candidate is off the front
-                rate = energy = float("inf")
-                break
-            metrics = summary_metrics(result)
+                metrics = summary_metrics(prepare(candidate).run())
+            except Exception:  # noqa: BLE001 - a failed run is off the front
+                errors[name] = energy = float("inf")
+                continue
             if name == "paper_base":
-                per_second = cost(scene.with_solver("exudyn", type=solver, step_s=step), repeats)
-            if name == UNDAMPED:
-                undamped = rate_error(metrics, exact[name])
-            else:
-                rate = max(rate, rate_error(metrics, exact[name]))
-                energy = max(energy, metrics["energy_balance_relative_error"])
-        rows.append((solver, factor, per_second, rate, undamped, energy))
-    on_front = set(pareto_front([r[2] for r in rows], [r[3] for r in rows]))
-    for i, (solver, factor, per_second, rate, undamped, energy) in enumerate(rows):
-        print(f"{solver:<20}{factor:<6g}{per_second:<15.4f}{rate:<14.2e}{undamped:<16.2e}{energy:<16.2e}"
-              f"{'*' if i in on_front else ''}")
+                per_second = cost(candidate, repeats)
+            errors[name] = rate_error(metrics, exact[name])
+            energy = max(energy, metrics["energy_balance_relative_error"])
+        worst = max(errors, key=errors.__getitem__)
+        print(f"{solver:<10}{tolerance:<8g}{per_second:<15.4f}{errors[worst]:<14.2e}{energy:<14.2e}{worst}")
+
+
+def front(scenes: dict[str, Scene], exact: dict[str, dict[str, float]], repeats: int,
+          sweeps: list[str]) -> None:
+    """Per bound of the presets' step rule (models.solver_settings.ExudynPreset.step_limits), every
+    solver at step = min(1e-4 s, pulse / 10, c x the bound's time scale) on the scenes that bound
+    governs: ``stability`` on paper_base and the damped hard scenes, ``ringing`` on the undamped one,
+    ``damper`` on the critically damped one. Printed: the CPU seconds per simulated second on the first
+    scene (median of ``repeats`` runs after a warm-up), the largest penetration-rate and energy-balance
+    errors over the scenes, ``*`` on the front of cost against rate error."""
+    for bound, (scale, names, rate_per_s, factors) in SWEEPS.items():
+        if bound not in sweeps:
+            continue
+        chosen = {name: scenes[name] for name in names} if names else \
+            {name: scene for name, scene in scenes.items() if name != UNDAMPED}
+        print(f"\n{bound}: step = min(1e-4 s, pulse / 10, c x {scale}) on {', '.join(chosen)}; CPU on {next(iter(chosen))}")
+        print(f"{'solver':<20}{'c':<6}{'CPU s / sim s':<15}{'rate error':<14}{'energy error':<14}front")
+        rows = []
+        for solver in SOLVERS:
+            for factor in factors:
+                rate, energy, per_second = 0.0, 0.0, float("nan")
+                for name, scene in chosen.items():
+                    step = min(1e-4, scene.impact.duration_s / 10, factor / rate_per_s(prepare(scene).step_scales))
+                    candidate = scene.with_solver("exudyn", type=solver, step_s=step)
+                    try:
+                        metrics = summary_metrics(prepare(candidate).run())
+                    except Exception:  # noqa: BLE001 - a diverged candidate is off the front
+                        rate = energy = float("inf")
+                        break
+                    if math.isnan(per_second):
+                        per_second = cost(candidate, repeats)
+                    rate = max(rate, rate_error(metrics, exact[name]))
+                    energy = max(energy, metrics["energy_balance_relative_error"])
+                rows.append((solver, factor, per_second, rate, energy))
+        on_front = set(pareto_front([r[2] for r in rows], [r[3] for r in rows]))
+        for i, (solver, factor, per_second, rate, energy) in enumerate(rows):
+            print(f"{solver:<20}{factor:<6g}{per_second:<15.4f}{rate:<14.2e}{energy:<14.2e}{'*' if i in on_front else ''}")
+    if "automatic" in sweeps:
+        automatic(scenes, exact, repeats)
 
 
 def paper_costs(presets: list[str], repeats: int) -> dict[str, tuple[float, float]]:
@@ -133,6 +178,8 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--presets", default=",".join(EXUDYN_PRESETS))
     parser.add_argument("--front", action="store_true", help="measure the candidates' front instead")
+    parser.add_argument("--sweeps", default=",".join([*SWEEPS, "automatic"]),
+                        help="the fronts to measure with --front (default: all)")
     parser.add_argument("--modules", action="store_true", help="the regular against the fast Exudyn module")
     parser.add_argument("--one-module", action="store_true", help=argparse.SUPPRESS)  # a child of --modules
     args = parser.parse_args()
@@ -147,7 +194,7 @@ def main() -> None:
     scenes.update({name: hard_scene(overrides) for name, overrides in HARD_SCENES.items()})
     exact = {name: summary_metrics(prepare(scene.with_solver("exact")).run()) for name, scene in scenes.items()}
     if args.front:
-        front(scenes, exact, args.repeats)
+        front(scenes, exact, args.repeats, args.sweeps.split(","))
         return
     for preset in args.presets.split(","):
         stated = EXUDYN_PRESETS[preset]

@@ -33,6 +33,7 @@ from rpdrill.models.formulations import DEFAULT_PRESET, FORMULATIONS
 from rpdrill.models.pulse import phase_pieces
 from rpdrill.models.simulation import Simulation
 from rpdrill.models.solver_settings import EXUDYN_PRESETS
+from rpdrill.models.stability import element_rates
 
 # Measured by benchmarks/bench_budgets.py (one BLAS thread, shared 2-core machine):
 # (a, b, p) of a + b n^p; the exact formulation with its energy works (an energy output asked for), and
@@ -83,6 +84,13 @@ def _fastest(simulation: Simulation) -> Cause:
     return Cause(simulation.fastest.key, simulation.fastest.value)
 
 
+def _rock_damper(simulation: Simulation) -> Cause:
+    """The key of the rock damper's rate c_n / m_bit that departs more from the drill's other values."""
+    damper = next(e for e in element_rates(simulation.scene, simulation.chain, simulation.rock, simulation.torsion)
+                  if "rock.damping_n_s_per_m" in (e.key, e.other_key))
+    return Cause(damper.key, damper.value)
+
+
 def _interval(simulation: Simulation) -> Cause:
     """The key of the sample interval of the exact and ODE formulations (given, or the output interval)."""
     key = "sample_interval_s" if simulation.scene.solver.sample_interval_s is not None else "output_interval_s"
@@ -96,10 +104,14 @@ Part = tuple[Cause, float, float | None]
 def _exudyn(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     settings, scene, n = simulation.settings, simulation.scene, simulation.chain.size
     step = settings.step_s
+    limits = EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].step_limits(scene.impact.duration_s,
+                                                                          simulation.step_scales)
     if scene.solver.step_s is not None:
         cause = Cause("solver.step_s", step)
-    elif math.isclose(step, scene.impact.duration_s / EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].steps_per_pulse):
+    elif math.isclose(step, limits["pulse"]):
         cause = Cause("impact.duration_s", scene.impact.duration_s)
+    elif math.isclose(step, limits["damper"]):
+        cause = _rock_damper(simulation)
     else:
         cause = _fastest(simulation)
     every_step = "energy" in simulation.needed_data or settings.output_interval_s < step

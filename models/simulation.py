@@ -34,7 +34,7 @@ from rpdrill.models.scene import (
     requested_outputs,
 )
 from rpdrill.models.solver_settings import Settings, resolve_settings
-from rpdrill.models.stability import FastestElement, fastest_element, spectral_radius_per_s
+from rpdrill.models.stability import FastestElement, StepScales, fastest_element, step_scales
 from rpdrill.rocklaw import RockLaw, State
 
 if TYPE_CHECKING:
@@ -62,13 +62,18 @@ class Simulation:
     initial_positions_m: np.ndarray
     initial_rock_state: State
     initial_torsion_angle_rad: float
-    spectral_radius_per_s: float | None  # |lambda|_max with the bit on the rock (Exudyn runs only)
+    step_scales: StepScales | None  # the rates a fixed step resolves, bit on the rock (Exudyn runs only)
     fastest: FastestElement  # the element of the highest rate and the keys that set it
     indexing: Indexing | None = None
 
     @property
     def name(self) -> str:
         return self.scene.name
+
+    @property
+    def spectral_radius_per_s(self) -> float | None:
+        """|lambda|_max with the bit on the rock (Exudyn runs only)."""
+        return None if self.step_scales is None else self.step_scales.spectral_radius_per_s
 
     @property
     def impact(self) -> Impact:
@@ -128,12 +133,12 @@ def prepare(scene: Scene) -> Simulation:
                             indexed=effects.indexing)
     torsion = scene.torsion if effects.torsion else None
     fastest = fastest_element(scene, chain, rock, torsion)
-    radius = spectral_radius_per_s(chain, rock, torsion) if scene.solver.formulation == "exudyn" else None
-    if not math.isfinite(fastest.rate_per_s) or not math.isfinite(radius or 0.0):
+    scales = step_scales(chain, rock, torsion, scene.impact.period_s) if scene.solver.formulation == "exudyn" else None
+    if not math.isfinite(fastest.rate_per_s) or not math.isfinite(scales.spectral_radius_per_s if scales else 0.0):
         raise SceneError(tuple(fastest.key.split(".")), fastest.value,
                          f"with {fastest.other_key} {fastest.other_value:g} the model's fastest rate overflows "
                          f"(k/m or c/m beyond {sys.float_info.max:.3g}); give values of a physical drill")
-    settings = resolve_settings(scene.solver, scene.impact.duration_s, radius)
+    settings = resolve_settings(scene.solver, scene.impact.duration_s, scales)
     positions, angle = np.zeros(chain.size), 0.0
     if scene.start == "preloaded":
         try:
@@ -148,7 +153,7 @@ def prepare(scene: Scene) -> Simulation:
         indexing = Indexing(scene.bit, scene.rotation.speed_rpm if scene.rotation else None, scene.impact.frequency_hz)
         if indexing.speed_rpm is not None:  # the same share every blow: the law has it from the start
             rock = replace(rock, fresh_fraction=indexing.fresh_fraction(indexing.prescribed_angle_rad))
-    return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, radius, fastest,
+    return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, scales, fastest,
                       indexing)
 
 

@@ -51,11 +51,10 @@ class StepLimitWarning(UserWarning):
     """A fixed explicit step beyond the measured stability limit of the scene's stiffest mode."""
 
 
-def spectral_radius_per_s(chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> float:
-    """|lambda|_max of the first-order system z' = A z, A = [[0, I], [-M^-1 K, -M^-1 C]] of every link
-    at its full stiffness, with the bit on the rock (its stiffest slope and its damper added on the
-    bit), and the torsion line when given: what limits an explicit solver's step, the stiffest mode
-    for light damping and the fastest decay for heavy damping. Infinite when an entry of A overflows
+def contact_eigenvalues_per_s(chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> np.ndarray:
+    """The eigenvalues lambda of the first-order system z' = A z, A = [[0, I], [-M^-1 K, -M^-1 C]] of
+    every link at its full stiffness, with the bit on the rock (its stiffest slope and its damper added
+    on the bit), and the torsion line when given. Infinite when an entry of A overflows
     (:func:`fastest_element` names the scene key)."""
     stiffest = max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m)
     with np.errstate(over="ignore"):
@@ -63,8 +62,42 @@ def spectral_radius_per_s(chain: AxialChain, law: RockLaw, torsion: Torsion | No
         if torsion is not None:
             system = block_diag(system, torsion_first_order_matrix(torsion)[:, :-1])
     if not np.isfinite(system).all():
-        return math.inf
-    return float(np.abs(np.linalg.eigvals(system)).max())
+        return np.array([math.inf])
+    return np.linalg.eigvals(system)
+
+
+def spectral_radius_per_s(chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> float:
+    """|lambda|_max of :func:`contact_eigenvalues_per_s`: what limits an explicit solver's step, the
+    stiffest mode for light damping and the fastest decay for heavy damping."""
+    return float(np.abs(contact_eigenvalues_per_s(chain, law, torsion)).max())
+
+
+@dataclass(frozen=True)
+class StepScales:
+    """The rates, in 1/s, a fixed explicit step must resolve (models.solver_settings):
+
+    * ``spectral_radius_per_s``: |lambda|_max, for stability;
+    * ``ringing_radius_per_s``: the largest |lambda| of the modes that still ring when the next blow
+      comes, decaying by less than a factor e over a blow period T (-Re(lambda) T < 1; 0 if none).
+      The solver's phase and amplitude error on such a mode is carried into the next blow's contacts
+      and adds up blow by blow, so the mode must be resolved, not only kept stable; a mode that dies
+      within a blow starts afresh at each contact;
+    * ``damper_rate_per_s``: c_n / m_bit. The rock damper's force jumps by c_n v when the bit meets
+      the rock; a fixed step that straddles that instant puts the jump in the wrong part of the step,
+      an impulse error up to c_n v h, the share c_n h / m_bit of the bit's momentum.
+    """
+
+    spectral_radius_per_s: float
+    ringing_radius_per_s: float
+    damper_rate_per_s: float
+
+
+def step_scales(chain: AxialChain, law: RockLaw, torsion: Torsion | None, blow_period_s: float) -> StepScales:
+    """The :class:`StepScales` of a drill on its rock, blows ``blow_period_s`` apart."""
+    eigenvalues = contact_eigenvalues_per_s(chain, law, torsion)
+    ringing = np.abs(eigenvalues[-eigenvalues.real * blow_period_s < 1.0])
+    return StepScales(float(np.abs(eigenvalues).max()), float(ringing.max(initial=0.0)),
+                      law.damping_n_s_per_m / chain.bodies[chain.bit_body].mass_kg)
 
 
 @dataclass(frozen=True)
@@ -94,8 +127,13 @@ def _mass_key(scene: Scene, body: str) -> tuple[str, float]:
 
 
 def fastest_element(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> FastestElement:
-    """The element of the highest rate (:class:`FastestElement`): every link, the rock under the bit,
-    the torsion line when given."""
+    """The element of the highest rate (:class:`FastestElement`) of :func:`element_rates`."""
+    return max(element_rates(scene, chain, law, torsion), key=lambda element: element.rate_per_s)
+
+
+def element_rates(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> list[FastestElement]:
+    """The rate of every element (:class:`FastestElement`): the rock's spring and damper under the
+    bit, every link's spring and damper, the torsion line's when given."""
     owner = {i: name for name, (first, last) in chain.groups.items() for i in range(first, last + 1)}
     masses = [body.mass_kg for body in chain.bodies]
     connectors = scene.drill_string.connectors
@@ -130,7 +168,7 @@ def fastest_element(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Tors
             departs = math.log10(value / TORSION_REFERENCE[key]) if value > 0 else -math.inf
             first, second = pair if departs >= math.log10(TORSION_REFERENCE["inertia_kg_m2"] / inertia) else pair[::-1]
             candidates.append(FastestElement(rate, *first, *second))
-    return max(candidates, key=lambda element: element.rate_per_s)
+    return candidates
 
 
 def largest_stable_step_s(simulation: Simulation, solver_type: str | None = None) -> float | None:

@@ -170,15 +170,17 @@ def _setting(fixed: dict[str, Any], key: str | None, value: Any, atol_ratio: flo
 
 
 def _checked(setting: Setting, scene: dict[str, Any], spec: AccuracySpec, source: str, key: str,
-             budget: Budget) -> float:
-    """The estimated CPU seconds of the setting's runs (each at most ``time_limit_s``); InputError naming
-    ``source`` and ``key`` unless its windowed scene validates and prepares, BudgetError beyond the run
-    budget."""
+             budget: Budget) -> tuple[float, str]:
+    """(The estimated CPU seconds of the setting's runs (each at most ``time_limit_s``), its solver as
+    resolved: the Exudyn solver type, a preset's included, the ODE method, or the formulation);
+    InputError naming ``source`` and ``key`` unless its windowed scene validates and prepares,
+    BudgetError beyond the run budget."""
     grid, where = spec.grid_interval_s, f"{source}: {key}"
     simulation = prepare_scene(parse(Scene, scene_for(scene, setting, grid), where, ()), where)
     cost = budget.check_run(simulation, source, f"{key}, over blows: {spec.blows}: ",
                             resampled=Cause("grid_interval_s", grid))
-    return setting.repeats * min(cost.cpu_s, spec.time_limit_s)
+    solver = getattr(simulation.settings, "type", None) or getattr(simulation.settings, "method", setting.formulation)
+    return setting.repeats * min(cost.cpu_s, spec.time_limit_s), solver
 
 
 def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> AccuracyStudy:
@@ -202,15 +204,13 @@ def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Ac
         (key, axis), = family.sweep.items()
         for value in axis.expand():
             setting = _setting(family.solver, key, value, family.atol_ratio, family.repeats or spec.repeats)
-            cpu = _checked(setting, scene, spec, source, f"families.{i}.sweep.{key}: {value!r}", budget)
-            solver = setting.solver.get("type", "rk44") if setting.formulation == "exudyn" \
-                else setting.solver.get("method", setting.formulation)
+            cpu, solver = _checked(setting, scene, spec, source, f"families.{i}.sweep.{key}: {value!r}", budget)
             points.append(Point(len(points), {"family": family.label, "formulation": setting.formulation,
                                               "solver": solver, "setting": key, "value": value}, None, cpu))
             runs.append(setting)
     references = [None if run is None else _setting(run.solver, None, None, run.atol_ratio, 1)
                   for run in (spec.reference, spec.reference_check)]
-    cpu = [_checked(setting, scene, spec, source, key, budget)
+    cpu = [_checked(setting, scene, spec, source, key, budget)[0]
            for setting, key in zip(references, ("reference", "reference_check")) if setting is not None]
     budget.check_total(source, what, sum(r.repeats for r in runs) + len(cpu), sum(p.cpu_s for p in points) + sum(cpu))
     return AccuracyStudy(path, spec, base, scene, points, runs, *references)

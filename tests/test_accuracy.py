@@ -22,7 +22,7 @@ from rpdrill.models.workprecision import (
     signature,
     uniform_grid_s,
 )
-from rpdrill.studies.accuracy import TimeLimitExceeded, cpu_time_limit
+from rpdrill.studies.accuracy import TimeLimitExceeded, cpu_time_limit, load_accuracy_study
 from rpdrill.studies.cli import main
 
 END_S = 0.04  # two blows at 50 Hz
@@ -123,6 +123,14 @@ def test_accuracy_study_end_to_end(tmp_path):
     assert (out / "workprecision.png").stat().st_size > 10_000
     # a rerun finds every setting finished
     assert main(["accuracy", str(tmp_path / "s.yaml"), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+
+
+def test_the_solver_column_names_what_a_preset_resolves_to(tmp_path):
+    """A preset family's rows name the preset's own solver (reference is rk67), not a default."""
+    families = [{"label": "presets", "solver": {"formulation": "exudyn"}, "sweep": {"preset": ["fast", "reference"]}},
+                {"label": "DOP853", "solver": {"formulation": "ode"}, "sweep": {"relative_tolerance": [1e-5]}}]
+    study = load_accuracy_study(write_study(tmp_path / "s.yaml", families=families))
+    assert [point.parameters["solver"] for point in study.points] == ["rk44", "rk67", "DOP853"]
 
 
 @pytest.mark.parametrize("changes, expected", [

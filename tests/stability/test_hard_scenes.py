@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scenes import simulate
 
+from rpdrill.models.cost import run_cost
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.simulation import prepare
@@ -19,6 +20,7 @@ from rpdrill.models.stability import (
     SimulationFailed,
     StepLimitWarning,
     largest_stable_step_s,
+    step_scales,
 )
 from stability.hard_scenes import HARD_SCENES, LONG_RUN, hard_scene
 
@@ -54,6 +56,31 @@ def test_preset_is_stable_and_within_its_stated_errors(name, preset):
     stated = EXUDYN_PRESETS[preset]
     assert metrics["energy_balance_relative_error"] <= stated.energy_balance_error
     assert rate_error(metrics, exact(name)) <= stated.penetration_rate_error
+
+
+def test_a_mode_sets_the_accuracy_step_while_it_rings_at_the_next_blow():
+    """The test drill's stiffest mode decays by e^-(sigma T) over a blow, sigma ~ 50/s: it still rings at
+    65 Hz (sigma T ~ 0.76), not at 45 Hz (~1.1); without damping it rings at any frequency."""
+    simulation = prepare(hard_scene(HARD_SCENES["never_crushes"]))
+    chain, rock = simulation.chain, simulation.rock
+    at_65, at_45 = (step_scales(chain, rock, None, 1 / f) for f in (65.0, 45.0))
+    assert at_65.ringing_radius_per_s == pytest.approx(at_65.spectral_radius_per_s)
+    assert at_45.ringing_radius_per_s < 0.1 * at_45.spectral_radius_per_s
+    undamped = prepare(hard_scene(HARD_SCENES["no_damping"], {"preset": "fast"}))
+    ringing = undamped.step_scales.ringing_radius_per_s
+    assert ringing == pytest.approx(undamped.step_scales.spectral_radius_per_s)
+    assert undamped.settings.step_s == pytest.approx(EXUDYN_PRESETS["fast"].step_times_ringing_radius / ringing)
+
+
+def test_standard_resolves_the_rock_dampers_jump_and_names_its_key():
+    simulation = prepare(hard_scene(HARD_SCENES["critical_damping"], {"preset": "standard"}))
+    rate = simulation.step_scales.damper_rate_per_s
+    assert rate == pytest.approx(simulation.rock.damping_n_s_per_m / simulation.chain.bodies[simulation.chain.bit_body].mass_kg)
+    assert simulation.settings.step_s == pytest.approx(EXUDYN_PRESETS["standard"].damper_step_share / rate)
+    # of c_n / m_bit, the key that departs more from the drill's other values: the 30 kg bit beside a 3 t collar
+    assert run_cost(simulation).steps_cause.key == "drill_string.bodies.bit.mass_kg"
+    fast = prepare(hard_scene(HARD_SCENES["critical_damping"], {"preset": "fast"}))  # fast leaves the jump
+    assert fast.settings.step_s > 10 * simulation.settings.step_s
 
 
 @pytest.mark.parametrize("solver", [s for s, f in STABLE_STEP_FACTOR.items() if f is not None])
