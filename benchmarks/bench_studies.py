@@ -1,22 +1,22 @@
 """What the study machinery costs beside the simulations: the three paper scans, measured in one run.
 
-Usage: python benchmarks/bench_studies.py [--workers N] [--formulations exact,fast]
+Usage: python benchmarks/bench_studies.py [--workers N] [--formulations exact,fast] [--repeats N]
 For each formulation (``exact``: the exact formulation; ``fast``/``standard``: Exudyn at that preset),
 the three paper scans (studies/paper/{frequency,impulse,stiffness}_scan.yaml, 207 points of 1.5 s)
-run through the study command's own code (studies.commands.study.run_study: load, resumable results,
-optima; then studies.plots.scans.draw_plots) on one process pool opened for the three, into a scratch
-directory.
-Each formulation's three scans run in a process of their own (its own pool and fork server, as one
-command has: the process starts the pool's fork server before its own imports, as the command line
-does). Prints the wall time from opening the pool to the last plot, of it the time spent drawing the
-plots (by the pool's workers), the CPU seconds of that process, its fork server and its
-workers (read from /proc before the pool closes: Linux; on a shared machine the wall time depends
-on the other load, the CPU time is what the run needs: on N idle cores the wall time is about
-CPU / N), the CPU seconds the simulations reported (``cpu_time_s`` of every point), their share of
-all CPU, the plots written and the wall time of the whole process (interpreter start, imports, the
-three scans and their plots, exit).
-Then one ``rpdrill study`` command of the frequency scan as a user runs it (a new process: imports,
-pool start, plots), its wall time.
+run through the study command's own loop (studies.commands.study.run_studies: resumable results,
+optima, each scan's plots drawn by the workers beside the next scan's points) on one process pool,
+into a scratch directory, each formulation in a process of its own (its own pool and fork server,
+started before its own imports with the study command's module preloaded, as the command line
+does). Prints the wall time from opening the pool to the last plot, the CPU seconds of that process,
+its fork server and its workers (read from /proc before the pool closes: Linux; on a shared machine
+the wall time depends on the other load, the CPU time is what the run needs: on N idle cores the wall
+time is about CPU / N), the CPU seconds the simulations reported (``cpu_time_s`` of every point),
+their share of all CPU, the plot files written, the CPU seconds of drawing each plot (PNG and SVG)
+again in that process after the pool closed, and the wall time of the whole process (interpreter
+start, imports, the three scans and their plots, exit).
+Then, as a user runs them (a new process each: imports, pool, plots): one ``rpdrill study`` command
+of the three scans, and one of the frequency scan alone; their wall times (median of --repeats runs;
+each run starts afresh: the finished points are in a new folder).
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -33,13 +34,13 @@ from pathlib import Path
 from rpdrill.studies.runners import start_worker_server
 
 if __name__ == "__main__" and "--one" in sys.argv:
-    start_worker_server()  # as the command line does, before the heavy imports below
+    start_worker_server(["rpdrill.studies.commands.study"])  # as the command line does, before the imports below
 
 import yaml
 
-from rpdrill.studies.commands.study import run_study
+from rpdrill.studies.commands.study import run_studies
 from rpdrill.studies.loading import read_yaml
-from rpdrill.studies.plots.scans import draw_plots
+from rpdrill.studies.plots.scans import draw_plot, plot_tasks
 from rpdrill.studies.runners import pool
 from rpdrill.studies.study import load_study
 
@@ -82,28 +83,38 @@ def process_tree_cpu_s(pid: int) -> float:
 
 
 def three_scans(solver: str, workers: int, folder: Path) -> None:
-    """The three scans on one pool in this process (a child of main: its own fork server); one line."""
-    start, simulated_cpu, points, plots_written, plots_s = time.perf_counter(), 0.0, 0, 0, 0.0
+    """The three scans on one pool in this process (a child of main: its own fork server), through the
+    study command's own loop (studies.commands.study.run_studies); one line."""
+    studies = [load_study(study_file(scan, solver, folder)) for scan in SCANS]
+    folders = [folder / f"{scan}_{solver}" for scan in SCANS]
+    start = time.perf_counter()
     with pool(None, workers) as runner:
-        for scan in SCANS:
-            study = load_study(study_file(scan, solver, folder))
-            rows, optima = run_study(study, folder / f"{scan}_{solver}", runner, quiet=True)
-            plots_start = time.perf_counter()
-            plots_written += len(draw_plots(study, rows, optima, folder / f"{scan}_{solver}", runner[1])[0])
-            plots_s += time.perf_counter() - plots_start
-            simulated_cpu += sum(float(row["cpu_time_s"]) for row in rows if row["status"] == "ok")
-            points += len(rows)
+        outcomes = run_studies(studies, folders, runner, plots_here=False, quiet=True)
+        plots_written = sum(len(written) for *_, written, _ in outcomes)
         cpu = process_tree_cpu_s(os.getpid())
     wall = time.perf_counter() - start
-    print(f"{solver:<10}{points:<8}{wall:<10.2f}{plots_s:<10.2f}{cpu:<13.2f}{simulated_cpu:<20.2f}"
-          f"{simulated_cpu / cpu:<20.2f}{plots_written:<7}", end="", flush=True)
+    simulated_cpu = sum(float(row["cpu_time_s"]) for _, _, rows, *_ in outcomes for row in rows if row["status"] == "ok")
+    points = sum(len(rows) for _, _, rows, *_ in outcomes)
+    plots_cpu = []
+    for study, out, rows, optima, *_ in outcomes:  # each plot again, in this process, for its CPU time
+        (folder / "replotted" / out.name).mkdir(parents=True)
+        for task in plot_tasks(study, rows, optima, folder / "replotted" / out.name)[0]:
+            start = time.process_time()
+            draw_plot(task)
+            plots_cpu.append(time.process_time() - start)
+    print(f"{solver:<10}{points:<8}{wall:<10.2f}{cpu:<13.2f}{simulated_cpu:<20.2f}"
+          f"{simulated_cpu / cpu:<20.2f}{plots_written:<7}{sum(plots_cpu):<12.2f}"
+          f"{' '.join(f'{c:.2f}' for c in plots_cpu):<32}", end="", flush=True)
 
 
-def one_command(solver: str, workers: int, folder: Path) -> float:
-    study = study_file("frequency_scan", solver, folder)
+def one_command(solver: str, workers: int, folder: Path, scans: tuple[str, ...]) -> float:
+    """Wall seconds of one ``rpdrill study`` command of the ``scans`` as a user runs it (a new process)."""
+    files = [str(study_file(scan, solver, folder)) for scan in scans]
+    out = tempfile.mkdtemp(prefix=f"command_{solver}_{len(scans)}_", dir=folder)  # new: nothing to resume
     start = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "rpdrill.studies.cli", "study", str(study), "--out",
-                    str(folder / f"command_{solver}"), "--workers", str(workers), "--quiet"], check=True)
+    subprocess.run([sys.executable, "-m", "rpdrill.studies.cli", "study", *files, "--out", out,
+                    "--workers", str(workers), "--quiet"],
+                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     return time.perf_counter() - start
 
 
@@ -111,6 +122,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--formulations", default="exact,fast")
+    parser.add_argument("--repeats", type=int, default=3, help="runs of each command (their median)")
     parser.add_argument("--one", help=argparse.SUPPRESS)  # a child: the three scans of one formulation
     parser.add_argument("--folder", help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -121,16 +133,18 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
         print(f"three paper scans on one pool of {args.workers} workers, a process each")
-        print(f"{'solver':<10}{'points':<8}{'wall s':<10}{'plots s':<10}{'all CPU s':<13}{'simulation CPU s':<20}"
-              f"{'simulation / all':<20}{'plots':<7}process s")
+        print(f"{'solver':<10}{'points':<8}{'wall s':<10}{'all CPU s':<13}{'simulation CPU s':<20}"
+              f"{'simulation / all':<20}{'plots':<7}{'plots CPU s':<12}{'per plot':<32}process s")
         for solver in solvers:
             start = time.perf_counter()
             subprocess.run([sys.executable, __file__, "--one", solver, "--folder", str(folder), "--workers",
                             str(args.workers)], check=True)
             print(f"{time.perf_counter() - start:.2f}")
         for solver in solvers:
-            print(f"one command (rpdrill study frequency_scan, 23 points, {solver}): "
-                  f"{one_command(solver, args.workers, folder):.2f} s wall")
+            for scans in (SCANS, SCANS[:1]):
+                walls = [one_command(solver, args.workers, folder, scans) for _ in range(args.repeats)]
+                print(f"one command (rpdrill study {' '.join(scans)}, {solver}): {statistics.median(walls):.2f} s "
+                      f"wall, median of {args.repeats} ({' '.join(f'{w:.2f}' for w in walls)})", flush=True)
 
 
 if __name__ == "__main__":

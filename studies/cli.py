@@ -21,9 +21,7 @@ import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
-from rpdrill.studies.budgets import BudgetError
 from rpdrill.studies.interrupts import Terminated, raise_if_stopped, stops_handled
-from rpdrill.studies.loading import InputError
 from rpdrill.studies.runners import start_worker_server
 
 # name: (module, one-line help); a module is imported only when its command runs
@@ -82,7 +80,11 @@ def _runs_a_process_pool(argv: list[str]) -> bool:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if _runs_a_process_pool(argv):
-        start_worker_server()  # its imports overlap this process's (studies.runners)
+        start_worker_server([COMMANDS[argv[0]][0]])  # its imports overlap this process's (studies.runners)
+    # imported after the fork server starts: they import the models (0.4 s), which it imports too
+    from rpdrill.studies.budgets import BudgetError
+    from rpdrill.studies.loading import InputError
+
     parser = _Parser(prog="rpdrill", description="Rotary-percussive drilling simulator on Exudyn")
     parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)

@@ -10,19 +10,21 @@ it runs starts none) and take batches of arguments (:func:`batches`): a run pays
 machinery once per pool and once per batch, not per argument. Results come in completion order, so
 the function's result must say which argument it belongs to. Workers run one BLAS thread each and
 keep freed memory (WORKER_ENVIRONMENT); process-pool workers are forked from a fork server that
-imported and loaded all of it once (studies.warm_worker; on Linux: spawned elsewhere, each loading
-it), and stop on SIGTERM as on Ctrl-C (studies.interrupts). A worker's
+imported and loaded all of it once (the command's module and studies.warm_worker; on Linux: spawned
+elsewhere, each loading it), and stop on SIGTERM as on Ctrl-C (studies.interrupts). A worker's
 warnings come back with its batch and are issued again in this process (its filters and formatting
 apply; each distinct warning once per pool), so that workers print nothing themselves.
 """
 from __future__ import annotations
 
 import contextlib
+import importlib
 import itertools
 import logging
 import math
 import os
 import sys
+import threading
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -89,25 +91,39 @@ def start_process_worker() -> None:
     warm_up()
 
 
-def worker_context() -> BaseContext:
-    """The process pools' start method: on Linux a fork server that imports studies.warm_worker before it
-    forks the first worker, so that each worker starts with everything loaded instead of importing and
-    loading it itself (docs/performance.md); spawn elsewhere (macOS forbids forking a process that has
-    loaded its system frameworks, which NumPy's BLAS may be; Windows has no fork)."""
+WARM_WORKER = "rpdrill.studies.warm_worker"
+
+
+def worker_context(preload: Sequence[str] = ()) -> BaseContext:
+    """The process pools' start method: on Linux a fork server that imports the ``preload`` modules and
+    studies.warm_worker before it forks the first worker, so that each worker starts with everything
+    loaded instead of importing and loading it itself (docs/performance.md); spawn elsewhere (macOS
+    forbids forking a process that has loaded its system frameworks, which NumPy's BLAS may be;
+    Windows has no fork)."""
     if not sys.platform.startswith("linux") or "forkserver" not in get_all_start_methods():
         return get_context("spawn")
     context = get_context("forkserver")
-    context.set_forkserver_preload(["rpdrill.studies.warm_worker"])
+    context.set_forkserver_preload([*preload, WARM_WORKER])  # read once, when the server starts
     return context
 
 
-def start_worker_server() -> None:
-    """Start the process pools' fork server now (Linux; nothing elsewhere), so that its imports and
-    warm-up (studies.warm_worker, about 2 s) run while this process does its own; the first pool then
-    forks its workers at once. The server is shared by every pool of this process and ends with it."""
-    if worker_context().get_start_method() == "forkserver":
+def start_worker_server(preload: Sequence[str] = ()) -> None:
+    """Start the process pools' fork server now (Linux; nothing elsewhere) with the ``preload`` modules
+    (the command's, whose workers' functions they hold) and studies.warm_worker, so that its imports and
+    warm-up (about 1.6 s) run while this process does its own; the first pool then forks its workers at
+    once. The server is shared by every pool of this process and ends with it."""
+    if worker_context(preload).get_start_method() == "forkserver":
         with _environment(WORKER_ENVIRONMENT):  # the server starts inside: its workers inherit the setting
             forkserver.ensure_running()
+
+
+def import_in_background(*modules: str) -> threading.Thread:
+    """Import ``modules`` in a thread of this process and return it: for what a command needs once its
+    workers' results are back (the optima's SciPy, the plots' matplotlib), imported while it waits for
+    them instead of after (the thread holds Python's lock only while it runs Python code)."""
+    thread = threading.Thread(target=lambda: [importlib.import_module(name) for name in modules], daemon=True)
+    thread.start()
+    return thread
 
 
 def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:

@@ -122,6 +122,10 @@ class Study:
         data.update(base_scene=Scene.model_validate(self.base).model_dump(mode="json", by_alias=True), scan=self.axes)
         return data
 
+    def zipped_with(self, axis: str) -> list[str]:
+        """The scan axes that change together with ``axis`` (its ``combine`` group, itself included)."""
+        return next(group for group in _groups(self.spec, str(self.source)) if axis in group)
+
     @property
     def hash(self) -> str:
         """SHA-256 of what determines the results: the point scenes and the collected metrics."""

@@ -121,3 +121,31 @@ def test_study_plots_show_no_raw_key_names(tmp_path, plot_texts):
     text = "\n".join(plot_texts)
     assert "penetration rate" in text and "mm/s" in text and "rock stiffness" in text and "MN/m" in text
     assert_no_raw_keys(text)
+
+
+def test_a_map_keeps_axes_zipped_with_its_rows_in_one_panel(tmp_path, monkeypatch):
+    """The rock's damping zipped with its stiffness changes along the map's rows: one panel of two rows,
+    the damping named in the row label, not a panel per damping."""
+    from rpdrill.studies.plots import scans
+    from rpdrill.studies.study import load_study
+
+    study_file = tmp_path / "s.yaml"
+    study_file.write_text(yaml.safe_dump({
+        "name": "zipped", "base_scene": str(PAPER_BASE),
+        "scan": {"impact.frequency_hz": [40.0, 50.0, 60.0], "rock.stiffness_n_per_m": [2e8, 5e8],
+                 "rock.damping_n_s_per_m": [2e3, 5e3]},
+        "combine": [["rock.stiffness_n_per_m", "rock.damping_n_s_per_m"]],
+        "metrics": ["penetration_rate_m_per_s"],
+        "plots": [{"kind": "map", "x": "impact.frequency_hz", "y": "rock.stiffness_n_per_m",
+                   "z": "penetration_rate_m_per_s"}]}))
+    study = load_study(study_file)
+    assert study.zipped_with("rock.stiffness_n_per_m") == ["rock.stiffness_n_per_m", "rock.damping_n_s_per_m"]
+    rows = [{"point": str(p.index), **{a: str(v) for a, v in p.parameters.items()}, "status": "ok", "error": "",
+             "wall_time_s": "1", "penetration_rate_m_per_s": str(0.001 * (p.index + 1))} for p in study.points]
+    figures = []
+    monkeypatch.setattr(scans, "save", lambda figure, path: figures.append(figure) or [path])
+    scans.draw_plots(study, rows, [], tmp_path)
+    panels = [ax for ax in figures[0].axes if ax.collections and ax.get_ylabel().startswith("rock stiffness")]
+    assert len(panels) == 1 and "rock damping" in panels[0].get_ylabel()
+    assert panels[0].collections[0].get_array().size == 6  # 3 frequencies x 2 rocks
+    scans.plt.close(figures[0])

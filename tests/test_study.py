@@ -124,6 +124,33 @@ def test_study_end_to_end(small_run):
     assert len(list(out.glob("*.png"))) == 2
 
 
+def test_several_studies_run_on_one_pool_into_folders_of_their_names(small_run, tmp_path):
+    """Two studies in one command: each in --out/<file name>, with the rows and plots a command of its own
+    gives (the first study's plots drawn while the second's points run)."""
+    study, single, _ = small_run
+    other = write_study(tmp_path / "other.yaml", scan={"impact.frequency_hz": [50, 70], "impact.amplitude_n": [220e3]},
+                        plots=[{"x": "impact.frequency_hz", "y": "bit_velocity_peak_m_per_s"}])
+    out = tmp_path / "both"
+    assert main(["study", str(study), str(other), "--out", str(out), "--workers", "2", "--quiet"]) == 0
+
+    def table(folder: Path) -> list[dict[str, str]]:
+        return sorted(({k: v for k, v in row.items() if k != "wall_time_s"} for row in rows(folder)),
+                      key=lambda row: int(row["point"]))
+
+    assert table(out / "small") == table(single)
+    assert len(table(out / "other")) == 2
+    assert len(list((out / "small").glob("*.png"))) == 2 and len(list((out / "other").glob("*.png"))) == 1
+
+
+def test_two_studies_of_one_name_are_refused_before_any_runs(tmp_path, capsys):
+    first, second = tmp_path / "a" / "scan.yaml", tmp_path / "b" / "scan.yaml"
+    for path in (first, second):
+        path.parent.mkdir()
+        write_study(path)
+    assert main(["study", str(first), str(second), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    assert "several files named scan" in capsys.readouterr().err and not (tmp_path / "out").exists()
+
+
 def test_failed_point_is_recorded_and_the_study_goes_on(tmp_path):
     study = write_study(tmp_path / "fail.yaml", scan={"solver.step_s": [2e-5, 1e-3]},
                         base_overrides={**SHORT, "impact.frequency_hz": 40}, plots=[])

@@ -55,10 +55,10 @@ def budget(args: argparse.Namespace) -> Budget:
     return Budget(args.max_steps, args.max_memory_gb, getattr(args, "yes", False))
 
 
-def add_resumable_arguments(parser: argparse.ArgumentParser, name: str, help: str) -> None:
-    """A command of many runs that resumes: its input file ``name``, ``--out`` (new, empty, or its own
-    from an earlier session), where the runs go and their budgets."""
-    parser.add_argument(name, help=help)
+def add_resumable_arguments(parser: argparse.ArgumentParser, name: str, help: str, many: bool = False) -> None:
+    """A command of many runs that resumes: its input file ``name`` (one or more when ``many``), ``--out``
+    (new, empty, or its own from an earlier session), where the runs go and their budgets."""
+    parser.add_argument(name, help=help, nargs="+" if many else None)
     parser.add_argument("--out", required=True, help="output directory: new, empty, or this command's own (to resume)")
     add_runner_arguments(parser)
     add_budget_arguments(parser)

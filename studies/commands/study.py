@@ -1,9 +1,12 @@
-"""``rpdrill study STUDY.yaml --out DIR``: run a YAML study (a scan of scenes) on all cores or a Dask cluster.
+"""``rpdrill study STUDY.yaml [STUDY.yaml ...] --out DIR``: run YAML studies (scans of scenes) on all
+cores or a Dask cluster.
 
 Running again into the same DIR skips finished points; a changed study, and a DIR holding anything
-else, are refused (studies.resumable). Every point and the whole study are checked against the
-budgets before any runs (studies.budgets). The exit status is 1 when some point failed. What DIR
-holds: FILES below.
+else, are refused (studies.resumable). Every study is read and every point and study checked against
+the budgets before any runs (studies.budgets). Several studies run one after the other on one pool
+of workers, each into DIR/<its file name without .yaml>; a study's plots are drawn by the workers
+while the next study's points run. The exit status is 1 when some point failed. What DIR holds:
+FILES below.
 """
 
 from __future__ import annotations
@@ -15,14 +18,15 @@ from pathlib import Path
 
 from rpdrill.models.formulations import FORMULATIONS
 from rpdrill.studies.commands import add_resumable_arguments, budget
+from rpdrill.studies.loading import InputError
 from rpdrill.studies.points import run_point
 from rpdrill.studies.resumable import RECORD, STATUS_COLUMNS, Row, run_points
 from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
-from rpdrill.studies.runners import Runner, pool, sequential
+from rpdrill.studies.runners import Runner, import_in_background, pool, sequential
 from rpdrill.studies.study import Study, load_study
 from rpdrill.studies.study_optima import Record, csv_rows, optima_table, study_optima
 
-FILES = """files written to DIR:
+FILES = """files written to DIR (to DIR/<file name without .yaml> for each of several studies):
   results.csv    one row per point (scan values, status, error, wall time, metrics in SI units),
                  appended as points finish
   study.json     provenance (study hash, versions, the resolved study, sessions, wall time per
@@ -35,7 +39,7 @@ FILES = """files written to DIR:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.epilog = FILES
-    add_resumable_arguments(parser, "study", "study YAML file")
+    add_resumable_arguments(parser, "study", "study YAML file(s)", many=True)
     parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
                         help="run every point with this formulation (default: the scene's solver.formulation)")
 
@@ -52,16 +56,22 @@ def run_study(study: Study, out: Path, runner: tuple[str, Runner], quiet: bool) 
     return rows, optima
 
 
-def run(args: argparse.Namespace) -> int:
-    out = check_out(args.out, None, RECORD)
-    study = load_study(args.study, args.formulation, budget(args))
-    with pool(args.dask, args.workers) as runner:
-        rows, optima = run_study(study, out, runner, args.quiet)
-        # matplotlib once the points have run, not at start
-        from rpdrill.studies.plots.scans import draw_plots
+def study_folders(paths: list[str], out: str) -> list[Path]:
+    """``--out`` for one study, ``--out``/<file stem> for each of several; InputError when two files
+    share a stem, or a folder cannot take its study's files (studies.run_files.check_out)."""
+    if len(paths) == 1:
+        return [check_out(out, None, RECORD)]
+    stems = [Path(path).stem for path in paths]
+    twice = sorted({stem for stem in stems if stems.count(stem) > 1})
+    if twice:
+        raise InputError(f"study: {', '.join(paths)}: several files named {', '.join(twice)}: each study of a "
+                         "command goes to --out/<file name>; give files of different names")
+    return [check_out(Path(out) / stem, None, RECORD) for stem in stems]
 
-        # by the pool's workers, side by side; here with Dask, whose workers may write on another machine
-        written, skipped = draw_plots(study, rows, optima, out, sequential if args.dask is not None else runner[1])
+
+def report(study: Study, out: Path, rows: list[Row], optima: list[Record], written: list[Path],
+           skipped: list[str]) -> None:
+    """What a study wrote and its failed points (stderr), its optima table (stdout)."""
     failed = [row for row in rows if row["status"] != "ok"]
     print(f"{study.spec.name}: {len(rows) - len(failed)} points ok, {len(failed)} failed; wrote "
           f"{out / 'results.csv'}, {out / 'study.json'}, {out / 'optima.csv'}" + "".join(f", {p}" for p in written),
@@ -73,4 +83,33 @@ def run(args: argparse.Namespace) -> int:
     table = optima_table(optima)
     print(table or f"{study.spec.name}: no optima (no figure of merit collected, or no numeric axis with "
                     "three or more values)")
-    return 1 if failed else 0
+
+
+Outcome = tuple[Study, Path, list[Row], list[Record], list[Path], list[str]]
+
+
+def run_studies(studies: list[Study], folders: list[Path], runner: tuple[str, Runner], plots_here: bool,
+                quiet: bool) -> list[Outcome]:
+    """Run the studies one after the other on ``runner`` into their folders (:func:`run_study`), each
+    study's plots drawn by its workers beside the next study's points (``plots_here``: in this process,
+    as with Dask, whose workers may write on another machine): per study (the study, its folder, rows,
+    optima, the plot files written, the plots left out)."""
+    import_in_background("scipy.signal", "rpdrill.studies.plots.scans")  # for the optima and plots
+    started = []
+    for study, out in zip(studies, folders, strict=True):
+        rows, optima = run_study(study, out, runner, quiet)
+        from rpdrill.studies.plots.scans import start_plots  # imported while the first points ran
+
+        started.append((study, out, rows, optima, start_plots(study, rows, optima, out,
+                                                              sequential if plots_here else runner[1])))
+    return [(study, out, rows, optima, *wait_for_plots()) for study, out, rows, optima, wait_for_plots in started]
+
+
+def run(args: argparse.Namespace) -> int:
+    folders = study_folders(args.study, args.out)
+    studies = [load_study(path, args.formulation, budget(args)) for path in args.study]
+    with pool(args.dask, args.workers) as runner:
+        outcomes = run_studies(studies, folders, runner, args.dask is not None, args.quiet)
+    for outcome in outcomes:
+        report(*outcome)
+    return 1 if any(row["status"] != "ok" for outcome in outcomes for row in outcome[2]) else 0

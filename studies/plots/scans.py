@@ -15,6 +15,7 @@ value anywhere (every point failed) is not drawn.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -105,9 +106,11 @@ def metric_grid(rows: list[Row], x: str, y: str, z: str) -> tuple[list[float], l
 
 
 def _map(plot: Plot, study: Study, rows: list[Row], optima: list[Record], path: Path) -> list[Path]:
-    """One panel of cells per combination of the other axes (one panel when there are none)."""
+    """One panel of cells per combination of the other axes (one panel when there are none); axes zipped
+    with x or y change with them, not per panel, and are named in that axis's label."""
     xq, yq, zq = quantity(plot.x), quantity(plot.y), metric(plot.z)
-    others = [a for a in study.axes if a not in (plot.x, plot.y)]
+    along = {axis: [a for a in study.zipped_with(axis) if a != axis] for axis in (plot.x, plot.y)}
+    others = [a for a in study.axes if a not in (plot.x, plot.y, *along[plot.x], *along[plot.y])]
     panels: dict[tuple[str, ...], list[Row]] = {}
     for row in rows:
         panels.setdefault(tuple(row[a] for a in others), []).append(row)
@@ -117,6 +120,9 @@ def _map(plot: Plot, study: Study, rows: list[Row], optima: list[Record], path: 
     for ax, (key, members) in zip(axes[:, 0], panels.items()):
         xs, ys, z = metric_grid(members, plot.x, plot.y, plot.z)
         position = cell_map(fig, ax, xs, ys, z, xq, yq, zq)
+        for axis, set_label, label in ((plot.x, ax.set_xlabel, xq.label()), (plot.y, ax.set_ylabel, yq.label())):
+            if along[axis]:
+                set_label(f"{label}\nwith {', '.join(quantity(a).name for a in along[axis])}")
         marked, texts = [], {float(r[plot.y]): r[plot.y] for r in members}
         fixed = dict(zip(others, key, strict=True))
         for i, y in enumerate(ys):
@@ -143,17 +149,18 @@ def plot_name(plot: Plot) -> str:
     return f"{'_'.join(plot.metrics) if len(plot.metrics) == 1 else 'metrics'}_vs_{plot.x}".replace(".", "_")
 
 
-def draw_plot(task: tuple[Plot, Study, list[Row], list[Record], Path]) -> list[Path]:
+PlotTask = tuple[Plot, Study, list[Row], list[Record], Path]
+
+
+def draw_plot(task: PlotTask) -> list[Path]:
     """Worker: draw one plot of a study into its path; the files written."""
     plot, study, rows, optima, path = task
     return (_map if plot.kind == "map" else _curves)(plot, study, rows, optima, path)
 
 
-def draw_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
-               runner: Runner = sequential) -> tuple[list[Path], list[str]]:
-    """Draw every plot of the study that has a result into ``out``, one plot per task of ``runner`` (a
-    pool's workers draw them side by side): (the files written, the names of the plots left out because
-    none of their metrics has a finite value)."""
+def plot_tasks(study: Study, rows: list[Row], optima: list[Record], out: Path) -> tuple[list[PlotTask], list[str]]:
+    """(A :func:`draw_plot` task per plot of the study that has a result, into ``out``; the names of the
+    plots left out because none of their metrics has a finite value)."""
     tasks, skipped = [], []
     for i, plot in enumerate(study.spec.plots):
         name = f"{i:02d}_{plot_name(plot)}"
@@ -161,5 +168,21 @@ def draw_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
             tasks.append((plot, study, rows, optima, out / f"{name}.{study.spec.format}"))
         else:
             skipped.append(name)
-    written = [path for batch in (runner(draw_plot, tasks) if tasks else ()) for paths in batch for path in paths]
-    return sorted(written), skipped
+    return tasks, skipped
+
+
+def start_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
+                runner: Runner = sequential) -> Callable[[], tuple[list[Path], list[str]]]:
+    """Hand every plot of the study that has a result to ``runner`` now, one plot per task (a pool's
+    workers start drawing them at once, side by side, while this process goes on), and return the call
+    that waits for them: (the files written, the names of the plots left out because none of their
+    metrics has a finite value). With the sequential runner the plots are drawn by that call."""
+    tasks, skipped = plot_tasks(study, rows, optima, out)
+    pending = runner(draw_plot, tasks) if tasks else iter(())
+    return lambda: (sorted(path for batch in pending for paths in batch for path in paths), skipped)
+
+
+def draw_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
+               runner: Runner = sequential) -> tuple[list[Path], list[str]]:
+    """Draw every plot of the study that has a result into ``out`` (:func:`start_plots`) and wait for them."""
+    return start_plots(study, rows, optima, out, runner)()
