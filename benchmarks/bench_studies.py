@@ -40,7 +40,7 @@ import yaml
 
 from rpdrill.studies.commands.study import run_studies
 from rpdrill.studies.loading import read_yaml
-from rpdrill.studies.plots.scans import draw_plot, plot_tasks
+from rpdrill.studies.plots.tasks import draw_plot, plot_tasks
 from rpdrill.studies.runners import pool
 from rpdrill.studies.study import load_study
 

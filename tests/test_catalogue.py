@@ -99,7 +99,7 @@ def plot_texts(monkeypatch) -> list[str]:
 
 
 def test_study_plots_show_no_raw_key_names(tmp_path, plot_texts):
-    from rpdrill.studies.plots.scans import draw_plots
+    from rpdrill.studies.plots.tasks import draw_plots
     from rpdrill.studies.study import load_study
     from rpdrill.studies.study_optima import study_optima
 
@@ -126,7 +126,7 @@ def test_study_plots_show_no_raw_key_names(tmp_path, plot_texts):
 def test_a_map_keeps_axes_zipped_with_its_rows_in_one_panel(tmp_path, monkeypatch):
     """The rock's damping zipped with its stiffness changes along the map's rows: one panel of two rows,
     the damping named in the row label, not a panel per damping."""
-    from rpdrill.studies.plots import scans
+    from rpdrill.studies.plots import scans, tasks
     from rpdrill.studies.study import load_study
 
     study_file = tmp_path / "s.yaml"
@@ -144,7 +144,7 @@ def test_a_map_keeps_axes_zipped_with_its_rows_in_one_panel(tmp_path, monkeypatc
              "wall_time_s": "1", "penetration_rate_m_per_s": str(0.001 * (p.index + 1))} for p in study.points]
     figures = []
     monkeypatch.setattr(scans, "save", lambda figure, path: figures.append(figure) or [path])
-    scans.draw_plots(study, rows, [], tmp_path)
+    tasks.draw_plots(study, rows, [], tmp_path)
     panels = [ax for ax in figures[0].axes if ax.collections and ax.get_ylabel().startswith("rock stiffness")]
     assert len(panels) == 1 and "rock damping" in panels[0].get_ylabel()
     assert panels[0].collections[0].get_array().size == 6  # 3 frequencies x 2 rocks

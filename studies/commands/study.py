@@ -19,6 +19,7 @@ from pathlib import Path
 from rpdrill.models.formulations import FORMULATIONS
 from rpdrill.studies.commands import add_resumable_arguments, budget
 from rpdrill.studies.loading import InputError
+from rpdrill.studies.plots.tasks import start_plots
 from rpdrill.studies.points import run_point
 from rpdrill.studies.resumable import RECORD, STATUS_COLUMNS, Row, run_points
 from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
@@ -94,12 +95,10 @@ def run_studies(studies: list[Study], folders: list[Path], runner: tuple[str, Ru
     study's plots drawn by its workers beside the next study's points (``plots_here``: in this process,
     as with Dask, whose workers may write on another machine): per study (the study, its folder, rows,
     optima, the plot files written, the plots left out)."""
-    import_in_background("scipy.signal", "rpdrill.studies.plots.scans")  # for the optima and plots
+    import_in_background("scipy.signal")  # for the optima
     started = []
     for study, out in zip(studies, folders, strict=True):
         rows, optima = run_study(study, out, runner, quiet)
-        from rpdrill.studies.plots.scans import start_plots  # imported while the first points ran
-
         started.append((study, out, rows, optima, start_plots(study, rows, optima, out,
                                                               sequential if plots_here else runner[1])))
     return [(study, out, rows, optima, *wait_for_plots()) for study, out, rows, optima, wait_for_plots in started]

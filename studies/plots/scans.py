@@ -15,7 +15,6 @@ value anywhere (every point failed) is not drawn.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +24,6 @@ from rpdrill.models.scene import Scene
 from rpdrill.studies.catalogue import Quantity, describe_scene, metric, quantity
 from rpdrill.studies.plots.cells import cell_map, no_result_patch
 from rpdrill.studies.plots.style import line_styles, plt, save
-from rpdrill.studies.runners import Runner, sequential
 from rpdrill.studies.study import Plot, Study
 from rpdrill.studies.study_optima import Record, Row, curves, metric_value, number_or_text
 
@@ -143,46 +141,6 @@ def _map(plot: Plot, study: Study, rows: list[Row], optima: list[Record], path: 
     return save(fig, path)
 
 
-def plot_name(plot: Plot) -> str:
-    if plot.kind == "map":
-        return f"map_{plot.z}_over_{plot.x}_{plot.y}".replace(".", "_")
-    return f"{'_'.join(plot.metrics) if len(plot.metrics) == 1 else 'metrics'}_vs_{plot.x}".replace(".", "_")
-
-
-PlotTask = tuple[Plot, Study, list[Row], list[Record], Path]
-
-
-def draw_plot(task: PlotTask) -> list[Path]:
-    """Worker: draw one plot of a study into its path; the files written."""
-    plot, study, rows, optima, path = task
+def draw(plot: Plot, study: Study, rows: list[Row], optima: list[Record], path: Path) -> list[Path]:
+    """Draw one plot of a study into ``path``; the files written."""
     return (_map if plot.kind == "map" else _curves)(plot, study, rows, optima, path)
-
-
-def plot_tasks(study: Study, rows: list[Row], optima: list[Record], out: Path) -> tuple[list[PlotTask], list[str]]:
-    """(A :func:`draw_plot` task per plot of the study that has a result, into ``out``; the names of the
-    plots left out because none of their metrics has a finite value)."""
-    tasks, skipped = [], []
-    for i, plot in enumerate(study.spec.plots):
-        name = f"{i:02d}_{plot_name(plot)}"
-        if any(np.isfinite(metric_value(row, m)) for row in rows for m in plot.metrics):
-            tasks.append((plot, study, rows, optima, out / f"{name}.{study.spec.format}"))
-        else:
-            skipped.append(name)
-    return tasks, skipped
-
-
-def start_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
-                runner: Runner = sequential) -> Callable[[], tuple[list[Path], list[str]]]:
-    """Hand every plot of the study that has a result to ``runner`` now, one plot per task (a pool's
-    workers start drawing them at once, side by side, while this process goes on), and return the call
-    that waits for them: (the files written, the names of the plots left out because none of their
-    metrics has a finite value). With the sequential runner the plots are drawn by that call."""
-    tasks, skipped = plot_tasks(study, rows, optima, out)
-    pending = runner(draw_plot, tasks) if tasks else iter(())
-    return lambda: (sorted(path for batch in pending for paths in batch for path in paths), skipped)
-
-
-def draw_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
-               runner: Runner = sequential) -> tuple[list[Path], list[str]]:
-    """Draw every plot of the study that has a result into ``out`` (:func:`start_plots`) and wait for them."""
-    return start_plots(study, rows, optima, out, runner)()
