@@ -7,22 +7,24 @@ run through the study command's own loop (studies.commands.study.run_studies: re
 optima, each scan's plots drawn by the workers beside the next scan's points) on one process pool,
 into a scratch directory, each formulation in a process of its own (its own pool and fork server,
 started before its own imports with the study command's module preloaded, as the command line
-does). Prints the wall time from opening the pool to the last plot, the CPU seconds of that process,
+does), --repeats times. Prints, of the run of median wall time, the wall time from opening the pool to the last plot, the CPU seconds of that process,
 its fork server and its workers (read from /proc before the pool closes: Linux; on a shared machine
 the wall time depends on the other load, the CPU time is what the run needs: on N idle cores the wall
 time is about CPU / N), the CPU seconds the simulations reported (``cpu_time_s`` of every point),
 their share of all CPU, the plot files written, the CPU seconds of drawing each plot (PNG and SVG)
 again in that process after the pool closed, and the wall time of the whole process (interpreter
-start, imports, the three scans and their plots, exit).
+start, imports, the three scans and their plots, the plots again, exit); then every run's wall time.
 Then, as a user runs them (a new process each: imports, pool, plots): one ``rpdrill study`` command
 of the three scans, and one of the frequency scan alone; their wall times (median of --repeats runs;
-each run starts afresh: the finished points are in a new folder).
+each run starts afresh: the finished points are in a new folder), after the start and exit of a
+Python process with the libraries of a study loaded, with and without gc.freeze() before its exit.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import os
 import statistics
 import subprocess
@@ -84,9 +86,10 @@ def process_tree_cpu_s(pid: int) -> float:
 
 def three_scans(solver: str, workers: int, folder: Path) -> None:
     """The three scans on one pool in this process (a child of main: its own fork server), through the
-    study command's own loop (studies.commands.study.run_studies); one line."""
+    study command's own loop (studies.commands.study.run_studies), into new folders; its figures as
+    one line of JSON."""
     studies = [load_study(study_file(scan, solver, folder)) for scan in SCANS]
-    folders = [folder / f"{scan}_{solver}" for scan in SCANS]
+    folders = [Path(tempfile.mkdtemp(prefix=f"{scan}_{solver}_", dir=folder)) for scan in SCANS]
     start = time.perf_counter()
     with pool(None, workers) as runner:
         outcomes = run_studies(studies, folders, runner, plots_here=False, quiet=True)
@@ -96,15 +99,15 @@ def three_scans(solver: str, workers: int, folder: Path) -> None:
     simulated_cpu = sum(float(row["cpu_time_s"]) for _, _, rows, *_ in outcomes for row in rows if row["status"] == "ok")
     points = sum(len(rows) for _, _, rows, *_ in outcomes)
     plots_cpu = []
+    import rpdrill.studies.plots.scans  # noqa: F401 - matplotlib loaded first, as in the pool's workers
     for study, out, rows, optima, *_ in outcomes:  # each plot again, in this process, for its CPU time
         (folder / "replotted" / out.name).mkdir(parents=True)
         for task in plot_tasks(study, rows, optima, folder / "replotted" / out.name)[0]:
             start = time.process_time()
             draw_plot(task)
             plots_cpu.append(time.process_time() - start)
-    print(f"{solver:<10}{points:<8}{wall:<10.2f}{cpu:<13.2f}{simulated_cpu:<20.2f}"
-          f"{simulated_cpu / cpu:<20.2f}{plots_written:<7}{sum(plots_cpu):<12.2f}"
-          f"{' '.join(f'{c:.2f}' for c in plots_cpu):<32}", end="", flush=True)
+    print(json.dumps({"points": points, "wall": wall, "cpu": cpu, "simulated_cpu": simulated_cpu,
+                      "plots_written": plots_written, "plots_cpu": plots_cpu}))
 
 
 def one_command(solver: str, workers: int, folder: Path, scans: tuple[str, ...]) -> float:
@@ -118,11 +121,29 @@ def one_command(solver: str, workers: int, folder: Path, scans: tuple[str, ...])
     return time.perf_counter() - start
 
 
+EXIT_PROBE = ("import time; start = time.perf_counter(); import rpdrill.studies.commands.study, "
+              "rpdrill.studies.plots.scans, rpdrill.models.exact_kernels, scipy.signal; "
+              "print(time.perf_counter() - start)")
+
+
+def exit_cost(freeze: bool, repeats: int = 5) -> float:
+    """Median wall seconds of a Python process that imports what a study command and its workers load,
+    less its imports: the interpreter's start and exit (``freeze``: gc.freeze() before exiting, as the
+    rpdrill program does)."""
+    code = EXIT_PROBE + ("; import gc; gc.freeze()" if freeze else "")
+    rest = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        imports = float(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout)
+        rest.append(time.perf_counter() - start - imports)
+    return statistics.median(rest)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--formulations", default="exact,fast")
-    parser.add_argument("--repeats", type=int, default=3, help="runs of each command (their median)")
+    parser.add_argument("--repeats", type=int, default=3, help="runs of each measurement (the median shown)")
     parser.add_argument("--one", help=argparse.SUPPRESS)  # a child: the three scans of one formulation
     parser.add_argument("--folder", help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -134,12 +155,21 @@ def main() -> None:
         folder = Path(scratch)
         print(f"three paper scans on one pool of {args.workers} workers, a process each")
         print(f"{'solver':<10}{'points':<8}{'wall s':<10}{'all CPU s':<13}{'simulation CPU s':<20}"
-              f"{'simulation / all':<20}{'plots':<7}{'plots CPU s':<12}{'per plot':<32}process s")
+              f"{'simulation / all':<20}{'plots':<7}{'plots CPU s':<12}{'per plot':<32}{'process s':<11}wall s of each run")
         for solver in solvers:
-            start = time.perf_counter()
-            subprocess.run([sys.executable, __file__, "--one", solver, "--folder", str(folder), "--workers",
-                            str(args.workers)], check=True)
-            print(f"{time.perf_counter() - start:.2f}")
+            runs = []
+            for _ in range(args.repeats):
+                start = time.perf_counter()
+                child = subprocess.run([sys.executable, __file__, "--one", solver, "--folder", str(folder),
+                                        "--workers", str(args.workers)], check=True, capture_output=True, text=True)
+                runs.append({**json.loads(child.stdout.splitlines()[-1]), "process": time.perf_counter() - start})
+            run = min(runs, key=lambda r: abs(r["wall"] - statistics.median(r["wall"] for r in runs)))  # the median run
+            print(f"{solver:<10}{run['points']:<8}{run['wall']:<10.2f}{run['cpu']:<13.2f}{run['simulated_cpu']:<20.2f}"
+                  f"{run['simulated_cpu'] / run['cpu']:<20.2f}{run['plots_written']:<7}{sum(run['plots_cpu']):<12.2f}"
+                  f"{' '.join(f'{c:.2f}' for c in run['plots_cpu']):<32}{run['process']:<11.2f}"
+                  + " ".join(f"{r['wall']:.2f}" for r in runs), flush=True)
+        print(f"a process's start and exit with the study command's libraries loaded: {exit_cost(False):.3f} s, "
+              f"{exit_cost(True):.3f} s with gc.freeze() before the exit (median of 5)")
         for solver in solvers:
             for scans in (SCANS, SCANS[:1]):
                 walls = [one_command(solver, args.workers, folder, scans) for _ in range(args.repeats)]

@@ -18,13 +18,11 @@ apply; each distinct warning once per pool), so that workers print nothing thems
 from __future__ import annotations
 
 import contextlib
-import importlib
 import itertools
 import logging
 import math
 import os
 import sys
-import threading
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -115,15 +113,6 @@ def start_worker_server(preload: Sequence[str] = ()) -> None:
     if worker_context(preload).get_start_method() == "forkserver":
         with _environment(WORKER_ENVIRONMENT):  # the server starts inside: its workers inherit the setting
             forkserver.ensure_running()
-
-
-def import_in_background(*modules: str) -> threading.Thread:
-    """Import ``modules`` in a thread of this process and return it: for what a command needs once its
-    workers' results are back (the optima's SciPy, the plots' matplotlib), imported while it waits for
-    them instead of after (the thread holds Python's lock only while it runs Python code)."""
-    thread = threading.Thread(target=lambda: [importlib.import_module(name) for name in modules], daemon=True)
-    thread.start()
-    return thread
 
 
 def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:

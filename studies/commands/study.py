@@ -12,6 +12,7 @@ FILES below.
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from pathlib import Path
@@ -23,7 +24,7 @@ from rpdrill.studies.plots.tasks import start_plots
 from rpdrill.studies.points import run_point
 from rpdrill.studies.resumable import RECORD, STATUS_COLUMNS, Row, run_points
 from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
-from rpdrill.studies.runners import Runner, import_in_background, pool, sequential
+from rpdrill.studies.runners import Runner, pool, sequential
 from rpdrill.studies.study import Study, load_study
 from rpdrill.studies.study_optima import Record, csv_rows, optima_table, study_optima
 
@@ -95,7 +96,9 @@ def run_studies(studies: list[Study], folders: list[Path], runner: tuple[str, Ru
     study's plots drawn by its workers beside the next study's points (``plots_here``: in this process,
     as with Dask, whose workers may write on another machine): per study (the study, its folder, rows,
     optima, the plot files written, the plots left out)."""
-    import_in_background("scipy.signal")  # for the optima
+    # the optima's SciPy (0.6 s), imported before the first points go out, while the pool's fork server
+    # is still loading what the workers need: not beside the workers, not after them
+    importlib.import_module("scipy.signal")
     started = []
     for study, out in zip(studies, folders, strict=True):
         rows, optima = run_study(study, out, runner, quiet)
