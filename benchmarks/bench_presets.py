@@ -82,6 +82,25 @@ SWEEPS: dict[str, tuple[str, tuple[str, ...] | None, Callable[[StepScales], floa
 AUTOMATIC = tuple((solver, tolerance) for solver in ("dopri5", "ode23") for tolerance in (1e-2, 1e-3, 1e-4))
 
 
+def measure(candidates: dict[str, Scene], exact: dict[str, dict[str, float]],
+            repeats: int) -> tuple[float, dict[str, float], float]:
+    """(CPU seconds per simulated second of the first candidate, median of ``repeats`` runs after a
+    warm-up; each scene's penetration-rate error, inf for a run that failed; the largest energy-balance
+    error) of the candidate scenes, by scene name."""
+    per_second, errors, energy = float("nan"), {}, 0.0
+    for name, candidate in candidates.items():
+        try:
+            metrics = summary_metrics(prepare(candidate).run())
+        except Exception:  # noqa: BLE001 - a diverged or failed candidate is off the front
+            errors[name] = energy = float("inf")
+            continue
+        if math.isnan(per_second):
+            per_second = cost(candidate, repeats)
+        errors[name] = rate_error(metrics, exact[name])
+        energy = max(energy, metrics["energy_balance_relative_error"])
+    return per_second, errors, energy
+
+
 def automatic(scenes: dict[str, Scene], exact: dict[str, dict[str, float]], repeats: int) -> None:
     """The automatic-step solvers (their largest step min(1e-4 s, pulse / 10), absolute tolerance
     1e-12, the default) at each relative tolerance: CPU seconds per simulated second on paper_base,
@@ -89,19 +108,10 @@ def automatic(scenes: dict[str, Scene], exact: dict[str, dict[str, float]], repe
     print("\nautomatic: dopri5 and ode23, largest step min(1e-4 s, pulse / 10), on every scene; CPU on paper_base")
     print(f"{'solver':<10}{'rtol':<8}{'CPU s / sim s':<15}{'rate error':<14}{'energy error':<14}worst scene")
     for solver, tolerance in AUTOMATIC:
-        errors, energy, per_second = {}, 0.0, float("nan")
-        for name, scene in scenes.items():
-            candidate = scene.with_solver("exudyn", type=solver, relative_tolerance=tolerance,
-                                          step_s=min(1e-4, scene.impact.duration_s / 10))
-            try:
-                metrics = summary_metrics(prepare(candidate).run())
-            except Exception:  # noqa: BLE001 - a failed run is off the front
-                errors[name] = energy = float("inf")
-                continue
-            if name == "paper_base":
-                per_second = cost(candidate, repeats)
-            errors[name] = rate_error(metrics, exact[name])
-            energy = max(energy, metrics["energy_balance_relative_error"])
+        per_second, errors, energy = measure(
+            {name: scene.with_solver("exudyn", type=solver, relative_tolerance=tolerance,
+                                     step_s=min(1e-4, scene.impact.duration_s / 10)) for name, scene in scenes.items()},
+            exact, repeats)
         worst = max(errors, key=errors.__getitem__)
         print(f"{solver:<10}{tolerance:<8g}{per_second:<15.4f}{errors[worst]:<14.2e}{energy:<14.2e}{worst}")
 
@@ -121,23 +131,15 @@ def front(scenes: dict[str, Scene], exact: dict[str, dict[str, float]], repeats:
             {name: scene for name, scene in scenes.items() if name != UNDAMPED}
         print(f"\n{bound}: step = min(1e-4 s, pulse / 10, c x {scale}) on {', '.join(chosen)}; CPU on {next(iter(chosen))}")
         print(f"{'solver':<20}{'c':<6}{'CPU s / sim s':<15}{'rate error':<14}{'energy error':<14}front")
+        steps = {name: prepare(scene).step_scales for name, scene in chosen.items()}
         rows = []
         for solver in SOLVERS:
             for factor in factors:
-                rate, energy, per_second = 0.0, 0.0, float("nan")
-                for name, scene in chosen.items():
-                    step = min(1e-4, scene.impact.duration_s / 10, factor / rate_per_s(prepare(scene).step_scales))
-                    candidate = scene.with_solver("exudyn", type=solver, step_s=step)
-                    try:
-                        metrics = summary_metrics(prepare(candidate).run())
-                    except Exception:  # noqa: BLE001 - a diverged candidate is off the front
-                        rate = energy = float("inf")
-                        break
-                    if math.isnan(per_second):
-                        per_second = cost(candidate, repeats)
-                    rate = max(rate, rate_error(metrics, exact[name]))
-                    energy = max(energy, metrics["energy_balance_relative_error"])
-                rows.append((solver, factor, per_second, rate, energy))
+                per_second, errors, energy = measure(
+                    {name: scene.with_solver("exudyn", type=solver, step_s=min(
+                        1e-4, scene.impact.duration_s / 10, factor / rate_per_s(steps[name])))
+                     for name, scene in chosen.items()}, exact, repeats)
+                rows.append((solver, factor, per_second, max(errors.values()), energy))
         on_front = set(pareto_front([r[2] for r in rows], [r[3] for r in rows]))
         for i, (solver, factor, per_second, rate, energy) in enumerate(rows):
             print(f"{solver:<20}{factor:<6g}{per_second:<15.4f}{rate:<14.2e}{energy:<14.2e}{'*' if i in on_front else ''}")
