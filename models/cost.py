@@ -8,7 +8,7 @@ of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2
 * exudyn: T / ``step_s`` steps (for dopri5 and ode23 ``step_s`` is the largest step: a lower
   bound); it stores every step when an energy output is asked for, else every
   ``output_interval_s``, two values (time, value) per sensor of 2 n + 4;
-* exact: T / h sub-grid points, h the exact solver's own sub-step (models.exact_model.sub_step:
+* exact: T / h sub-grid points, h the exact solver's own sub-step (models.exact_system.sub_step:
   the sample interval over ceil(sample interval x ||A_bal||_1)); it stores m + 2 values per
   sample and per allowed switch, and about OPERATOR_VALUES m^2 values per (mode, pulse phase) of
   the rock law;
@@ -29,7 +29,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from rpdrill.models.formulations import DEFAULT_PRESET, FORMULATIONS
+from rpdrill.models.exact_system import sub_step
+from rpdrill.models.formulations import DEFAULT_PRESET
 from rpdrill.models.pulse import phase_pieces
 from rpdrill.models.simulation import Simulation
 from rpdrill.models.solver_settings import EXUDYN_PRESETS
@@ -127,7 +128,7 @@ def _state_size(simulation: Simulation) -> int:
 def _exact(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     settings, m, sampled = simulation.settings, _state_size(simulation), _interval(simulation)
     one_period = phase_pieces(simulation.impact, simulation.impact.period_s)[1]  # every pulse phase of the run
-    _, _, step = FORMULATIONS["exact"].implementation().sub_step(simulation, one_period)
+    _, _, step = sub_step(simulation, one_period)
     switches = settings.max_switches_per_blow * math.ceil(settings.end_time_s * simulation.impact.frequency_hz)
     keys = len(simulation.rock.modes()) * len(set(one_period))
     return step, sampled if step == settings.sample_interval_s else _fastest(simulation), [

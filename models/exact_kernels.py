@@ -411,7 +411,7 @@ def assemble(one_step: np.ndarray, matrix: np.ndarray, readout_rows: np.ndarray,
 def power_integrals(one_step: np.ndarray, balanced: np.ndarray, scale: np.ndarray, forms: np.ndarray, step_s: float,
                     step_powers: np.ndarray, step_grams: np.ndarray, series: np.ndarray) -> None:
     """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of one key's power forms Q_q (power w^T Q w,
-    models.exact_model.Model.power_forms): ``step_powers`` [j] = E^j (E = expm(A h), j <= p, the sub-steps
+    models.exact_system.Model.power_forms): ``step_powers`` [j] = E^j (E = expm(A h), j <= p, the sub-steps
     of a sample); ``series`` [q, k] = S_k / (k + 1), the integrand's Taylor coefficients S_0 = Q,
     S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on the balanced matrix
     A_b = D^-1 A D (S_k = D^-1 S_k,b(D Q D) D^-1), so that G(s) = sum_k s^(k+1) series[q, k] for s <= h (the

@@ -54,19 +54,15 @@ mode found again, and the loop goes on.
 
 from __future__ import annotations
 
-import itertools
 import math
 import time
 from collections import Counter, OrderedDict
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import expm
-from scipy.linalg.lapack import dgebal
 from threadpoolctl import ThreadpoolController
 
-from rpdrill.models.chain import torsion_first_order_matrix
 from rpdrill.models.exact_kernels import (
     BLOW_START,
     DIVERGED,
@@ -77,13 +73,11 @@ from rpdrill.models.exact_kernels import (
     power_integrals,
     run_events,
 )
-from rpdrill.models.links import RATE
-from rpdrill.models.piecewise import Element, elements, undeclared
+from rpdrill.models.exact_system import Model, Modes, balance, sub_step, unsupported
 from rpdrill.models.pulse import (
     PHASES,
     blow_start_times,
     generator_states,
-    phase_generator,
     phase_pieces,
     phase_row,
 )
@@ -91,16 +85,12 @@ from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import SceneError, Simulation, as_simulation
 from rpdrill.models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
-from rpdrill.rocklaw.base import VELOCITY
-from rpdrill.rocklaw.modes import Affine
 
 ANCHORS, PER_ANCHOR = 16, 16  # A, B: a batch is J = A B sub-grid points from one state (module doc)
 TAYLOR_REMAINDER = 1e-20  # relative truncation of the Taylor series on pieces shorter than h
-MAX_ENUMERATED_MODES = 256  # mode combinations whose norms are all measured to choose h
 # The operators are small (m ~ 10-300): a multi-threaded BLAS spends more on its threads than on the
 # products (a 13 x 13 expm took 8 ms with two threads on a loaded 2-core machine, 0.1 ms with one).
 BLAS = ThreadpoolController()
-Modes = tuple[str, ...]
 CacheKey = tuple[bytes, bytes, bytes, float, int, int]  # A, R, power forms, h, sub-steps per sample, order
 
 
@@ -136,28 +126,6 @@ OPERATOR_CACHE = OperatorCache(64 << 20)
 CACHED_ARRAYS = ("one_step", "readout", "anchors", "taylor", "step_powers", "step_grams", "series")
 
 
-@dataclass(frozen=True)
-class Layout:
-    """Indices into w = (x, v, rock states, [phi, phi'], 1, u1, u2) for ``n`` bodies."""
-
-    n: int
-    rock_states: int
-    torsion: bool
-
-    @property
-    def angle(self) -> int:
-        """phi (phi' follows); only with torsion."""
-        return 2 * self.n + self.rock_states
-
-    @property
-    def one(self) -> int:
-        return self.size - 3
-
-    @property
-    def size(self) -> int:
-        return 2 * self.n + self.rock_states + 2 * self.torsion + 3
-
-
 def taylor_order(norm_times_step: float) -> int:
     """Smallest K with (||A|| h)^(K+1) / (K+1)! below TAYLOR_REMAINDER."""
     order, term = 0, 1.0
@@ -165,113 +133,6 @@ def taylor_order(norm_times_step: float) -> int:
         order += 1
         term *= norm_times_step / order
     return order
-
-
-def balance(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(D^-1 A D, diagonal of D): LAPACK's diagonal balancing (``scipy.linalg.matrix_balance`` without
-    permutation). Its 1-norm bounds the growth of the Taylor terms; it is the better conditioned
-    argument of expm."""
-    balanced, _, _, scale, info = dgebal(matrix, scale=1, permute=0)
-    if info < 0:
-        raise ValueError(f"dgebal: illegal argument {-info}")
-    return balanced, scale
-
-
-class Model:
-    """The generated matrices, rows and resets of one simulation (module doc)."""
-
-    def __init__(self, simulation: Simulation) -> None:
-        chain, rock = simulation.chain, simulation.rock
-        self.simulation, self.impact = simulation, simulation.impact
-        self.layout = layout = Layout(chain.size, len(rock.state_names), simulation.torsion is not None)
-        self.pieces: tuple[Element, ...] = elements(chain, rock, layout.size)
-        self.masses_kg = np.array([b.mass_kg for b in chain.bodies])
-        n, m, one = layout.n, layout.size, layout.one
-        base = np.zeros((m, m))
-        linear = chain.first_order_matrix()
-        base[:2 * n, :2 * n], base[:2 * n, one] = linear[:, :-1], linear[:, -1]
-        if simulation.torsion is not None:
-            torsion = torsion_first_order_matrix(simulation.torsion)
-            phi = layout.angle
-            base[phi:phi + 2, phi:phi + 2], base[phi:phi + 2, one] = torsion[:, :2], torsion[:, 2]
-        self.base = base
-        self.max_exits = sum(max(len(mode.exits) for mode in element.table.values()) for element in self.pieces)
-        self.max_resets = max((len(mode.entry) for e in self.pieces for mode in e.table.values()), default=0) or 1
-
-    def row(self, element: Element, affine: Affine) -> np.ndarray:
-        """An affine function of an element's local variables as a row over w (constant on ``one``)."""
-        row, constant = element.row(affine)
-        row[self.layout.one] += constant
-        return row
-
-    def rock_force_row(self, modes: Modes) -> np.ndarray:
-        rock = self.pieces[0]
-        return self.row(rock, rock.table[modes[0]].force)
-
-    def matrix(self, modes: Modes, phase: str) -> np.ndarray:
-        """A of (modes, phase): base + each element's force along its load and its state rates + the pulse."""
-        n, one = self.layout.n, self.layout.one
-        matrix = self.base.copy()
-        for element, mode in zip(self.pieces, modes, strict=True):
-            declared = element.table[mode]
-            matrix[n:2 * n] += np.outer(element.load / self.masses_kg, self.row(element, declared.force))
-            for state, affine in declared.rates.items():
-                matrix[element.states[state]] += self.row(element, affine)
-        matrix[n + self.simulation.chain.impact_body, one:] += phase_row(self.impact, phase) \
-            / self.masses_kg[self.simulation.chain.impact_body]
-        matrix[one:, one:] = phase_generator(self.impact, phase)
-        return matrix
-
-    def power_forms(self, modes: Modes, phase: str) -> np.ndarray:
-        """(Q_impact, Q_internal) with power = w^T Q w: the piston's F_d v_shank, and the power every link,
-        the rock and the torsion line absorb, sum of F u over them (F the force row of the element in its
-        mode, u its stretch rate: a link's delta', the rock's v_bit, the torsion line's omega)."""
-        layout, chain = self.layout, self.simulation.chain
-        n, size = layout.n, layout.size
-        pairs = []  # (force row, rate row) over w
-        for link in chain.linear_links():
-            stretch, rate = np.zeros(size), np.zeros(size)
-            stretch[link.body_b], rate[n + link.body_b] = 1.0, 1.0
-            if link.body_a is not None:
-                stretch[link.body_a], rate[n + link.body_a] = -1.0, -1.0
-            pairs.append((link.stiffness_n_per_m * stretch + link.damping_n_s_per_m * rate, rate))
-        for element, mode in zip(self.pieces, modes, strict=True):
-            velocity = element.variables[VELOCITY if element is self.pieces[0] else RATE]
-            pairs.append((self.row(element, element.table[mode].force), velocity))
-        if self.simulation.torsion is not None:
-            torsion, force, rate = self.simulation.torsion, np.zeros(size), np.zeros(size)
-            force[layout.angle] = torsion.stiffness_n_m_per_rad
-            force[layout.angle + 1], rate[layout.angle + 1] = torsion.damping_n_m_s_per_rad, 1.0
-            pairs.append((force, rate))
-        impact = np.zeros(size)
-        impact[layout.one:] = phase_row(self.impact, phase)
-        shank = np.zeros(size)
-        shank[n + chain.impact_body] = 1.0
-        forces, rates = (np.array(rows) for rows in zip(*pairs, strict=True))
-        internal = forces.T @ rates  # sum over the pairs of F u^T
-        return 0.5 * np.stack([np.outer(impact, shank) + np.outer(shank, impact), internal + internal.T])
-
-    def exits(self, modes: Modes) -> list[tuple[np.ndarray, int, Modes, list[tuple[int, np.ndarray]]]]:
-        """(row, direction, next modes, entry resets (target index, row)) of every exit of ``modes``."""
-        out = []
-        for index, (element, mode) in enumerate(zip(self.pieces, modes, strict=True)):
-            for switch in element.table[mode].exits:
-                following = modes[:index] + (switch.next_mode,) + modes[index + 1:]
-                resets = [(element.states[state], self.row(element, affine))
-                          for state, affine in element.table[switch.next_mode].entry.items()]
-                out.append((self.row(element, switch.surface), switch.direction, following, resets))
-        return out
-
-    def norm_candidates(self, phases: list[str]) -> list[np.ndarray]:
-        """The matrices whose balanced norms choose the sub-step: every mode combination when they are
-        few, else every mode of each element with the others in their first mode."""
-        tables = [list(element.table) for element in self.pieces]
-        if math.prod(len(t) for t in tables) <= MAX_ENUMERATED_MODES:
-            combinations = list(itertools.product(*tables))
-        else:
-            first = tuple(t[0] for t in tables)
-            combinations = [first[:i] + (mode,) + first[i + 1:] for i, t in enumerate(tables) for mode in t]
-        return [self.matrix(modes, phase) for modes in combinations for phase in dict.fromkeys(phases)]
 
 
 class Operators:
@@ -372,16 +233,6 @@ class Operators:
         if len(self.series):  # the integrals of the power forms (module doc)
             power_integrals(self.one_step[i], balanced, scale, forms, self.step_s, self.step_powers[i],
                             self.step_grams[i], self.series[i])
-
-
-def sub_step(simulation: Simulation, phases: list[str], model: Model | None = None) -> tuple[float, int, float]:
-    """(||A_bal||_1, sub-steps per sample, sub-step h) of the global sub-grid (module doc): the
-    largest balanced 1-norm over the modes and the pulse ``phases``, and h = sample interval / ceil(
-    sample interval x norm)."""
-    model = model or Model(simulation)
-    norm = max(np.linalg.norm(balance(matrix)[0], 1) for matrix in model.norm_candidates(phases))
-    per_sample = max(1, math.ceil(simulation.settings.sample_interval_s * norm))
-    return norm, per_sample, simulation.settings.sample_interval_s / per_sample
 
 
 class ExactSolver:
@@ -498,21 +349,6 @@ def _switch_counts(model: Model, before: Modes, entered: list[Modes]) -> dict[st
                 counts[key] = counts.get(key, 0) + times
     return counts
 
-
-def unsupported(simulation: Simulation) -> str | None:
-    """Why the exact formulation cannot run ``simulation``, or None: a law that declares no modes (its
-    switching and matrices come from them), or an indexing share taken from the torsion line blow by
-    blow into a law whose mode rows carry it (Jenkins: the crushing rates), so that its matrices would
-    change at every blow."""
-    undeclared_laws = undeclared(simulation.chain, simulation.rock)
-    if undeclared_laws:
-        return undeclared_laws
-    indexing = simulation.indexing
-    if indexing is not None and indexing.speed_rpm is None and simulation.rock.modes_follow_fresh_fraction:
-        return (f"the {simulation.rock.name} law's crushing rates carry the indexing share of each blow, which "
-                "comes from the torsion angle and changes from blow to blow, so the matrices would change at "
-                "every blow; give rotation.speed_rpm (a constant share) or use the ode or exudyn formulation")
-    return None
 
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Exact solution of the simulation from its start to its end time (formulation "exact").

@@ -34,12 +34,14 @@ ODE_METHODS = ("DOP853", "Radau", "LSODA")
 
 @dataclass(frozen=True)
 class Formulation:
-    """A formulation: its implementation module and the ``solver`` keys it takes."""
+    """A formulation: its implementation module, the ``solver`` keys it takes, and the module with its
+    ``unsupported`` check when that is lighter to import than the implementation (``checks``)."""
 
     name: str
     module: str
     option_keys: tuple[str, ...]
     summary: str
+    checks: str | None = None
 
     def implementation(self) -> ModuleType:
         return importlib.import_module(self.module)
@@ -51,7 +53,7 @@ FORMULATIONS: dict[str, Formulation] = {f.name: f for f in (
                 "the Exudyn multibody model"),
     Formulation("exact", "rpdrill.models.exact_model",
                 ("sample_interval_s", "min_switch_interval_s", "max_switches_per_blow"),
-                "exact piecewise-linear propagation between located switches"),
+                "exact piecewise-linear propagation between located switches", checks="rpdrill.models.exact_system"),
     Formulation("ode", "rpdrill.models.ode_model",
                 ("method", "relative_tolerance", "absolute_tolerance", "sample_interval_s"),
                 "the paper's Eq. 4 as an event-located SciPy ODE"),
@@ -66,5 +68,6 @@ def simulate(simulation: Simulation, progress: Callable[[float], None] | None = 
 
 def unsupported(name: str, simulation: Simulation) -> str | None:
     """Why formulation ``name`` cannot run ``simulation``, or None if it can."""
-    check = getattr(FORMULATIONS[name].implementation(), "unsupported", None)
+    formulation = FORMULATIONS[name]
+    check = getattr(importlib.import_module(formulation.checks or formulation.module), "unsupported", None)
     return check(simulation) if check else None

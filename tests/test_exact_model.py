@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scenes import PER_BODY, crushing_scene, scene, simulate
+from scenes import PAPER_BASE, PER_BODY, crushing_scene, scene, simulate
 
 import rpdrill.models.exact_model
 import rpdrill.models.stability
@@ -81,6 +81,15 @@ def relative_error(result: SimulationResult, reference: SimulationResult, column
 
 def test_does_not_import_exudyn() -> None:
     code = "import rpdrill.models.exact_model, sys; assert 'exudyn' not in sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_checking_and_estimating_a_run_does_not_load_the_kernels() -> None:
+    """A study's points are checked and their cost estimated (models.exact_system) before any runs,
+    in the command's own process: numba (0.25 s to import) is for the workers that run them."""
+    code = ("import sys; from rpdrill.models.cost import run_cost; from rpdrill.studies.loading import load_scene, "
+            f"prepare_scene; run_cost(prepare_scene(load_scene({str(PAPER_BASE)!r}).with_solver('exact'), 'test')); "
+            "assert 'numba' not in sys.modules and 'rpdrill.models.exact_system' in sys.modules")
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
