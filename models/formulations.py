@@ -8,7 +8,9 @@ A scene chooses one in ``solver.formulation`` and gives its options next to it (
 here; a key of another formulation is an error). Each implementation module is imported on first
 use (the exact and ODE formulations never import Exudyn) and provides ``simulate(simulation,
 progress=None)`` (``progress(t)`` is called as simulated time advances) and, if it cannot run every
-scene, ``unsupported(simulation) -> str | None``.
+scene, ``unsupported(simulation) -> str | None``, there or in a lighter ``checks`` module that the
+registry names (the exact formulation's, models.exact_system: a study checks its points before any
+run without loading the compiled kernels).
 """
 
 from __future__ import annotations
