@@ -99,7 +99,7 @@ def plot_texts(monkeypatch) -> list[str]:
 
 
 def test_study_plots_show_no_raw_key_names(tmp_path, plot_texts):
-    from rpdrill.studies.plots.tasks import draw_plots
+    from rpdrill.studies.plots.tasks import start_plots
     from rpdrill.studies.study import load_study
     from rpdrill.studies.study_optima import study_optima
 
@@ -116,7 +116,7 @@ def test_study_plots_show_no_raw_key_names(tmp_path, plot_texts):
     rows = [{"point": str(p.index), **{a: str(v) for a, v in p.parameters.items()}, "status": "ok", "error": "",
              "wall_time_s": "1", "penetration_rate_m_per_s": str(rng.uniform(0, 0.02)),
              "advance_per_blow_m": str(rng.uniform(0, 3e-4))} for p in study.points]
-    written, _ = draw_plots(study, rows, study_optima(study, rows), tmp_path)
+    written, _ = start_plots(study, rows, study_optima(study, rows), tmp_path)()
     assert {p.suffix for p in written} == {".png", ".svg"}
     text = "\n".join(plot_texts)
     assert "penetration rate" in text and "mm/s" in text and "rock stiffness" in text and "MN/m" in text
@@ -144,7 +144,7 @@ def test_a_map_keeps_axes_zipped_with_its_rows_in_one_panel(tmp_path, monkeypatc
              "wall_time_s": "1", "penetration_rate_m_per_s": str(0.001 * (p.index + 1))} for p in study.points]
     figures = []
     monkeypatch.setattr(scans, "save", lambda figure, path: figures.append(figure) or [path])
-    tasks.draw_plots(study, rows, [], tmp_path)
+    tasks.start_plots(study, rows, [], tmp_path)()
     panels = [ax for ax in figures[0].axes if ax.collections and ax.get_ylabel().startswith("rock stiffness")]
     assert len(panels) == 1 and "rock damping" in panels[0].get_ylabel()
     assert panels[0].collections[0].get_array().size == 6  # 3 frequencies x 2 rocks

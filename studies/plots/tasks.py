@@ -52,9 +52,3 @@ def start_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
     tasks, skipped = plot_tasks(study, rows, optima, out)
     pending = runner(draw_plot, tasks) if tasks else iter(())
     return lambda: (sorted(path for batch in pending for paths in batch for path in paths), skipped)
-
-
-def draw_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
-               runner: Runner = sequential) -> tuple[list[Path], list[str]]:
-    """Draw every plot of the study that has a result into ``out`` (:func:`start_plots`) and wait for them."""
-    return start_plots(study, rows, optima, out, runner)()
