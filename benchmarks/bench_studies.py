@@ -3,14 +3,16 @@
 Usage: python benchmarks/bench_studies.py [--workers N] [--formulations exact,fast] [--repeats N]
 For each formulation (``exact``: the exact formulation; ``fast``/``standard``: Exudyn at that preset),
 the three paper scans (studies/paper/{frequency,impulse,stiffness}_scan.yaml, 207 points of 1.5 s)
-run through the study command's own loop (studies.commands.study.run_studies: resumable results,
-optima, each scan's plots drawn by the workers beside the next scan's points) on one process pool,
+run through the study command's own loop (studies.commands.study.run_studies: resumable results, the
+scans' points as one run, a point two scans share run once, optima, each scan's plots drawn by the
+workers once its points are done) on one process pool,
 into a scratch directory, each formulation in a process of its own (its own pool and fork server,
 started before its own imports with the study command's module preloaded, as the command line
 does), --repeats times. Prints, of the run of median wall time, the wall time from opening the pool to the last plot, the CPU seconds of that process,
 its fork server and its workers (read from /proc before the pool closes: Linux; on a shared machine
 the wall time depends on the other load, the CPU time is what the run needs: on N idle cores the wall
-time is about CPU / N), the CPU seconds the simulations reported (``cpu_time_s`` of every point),
+time is about CPU / N), the points and how many were run, the CPU seconds the simulations reported
+(``cpu_time_s`` of every point run),
 their share of all CPU, the plot files written, the CPU seconds of drawing each plot (PNG and SVG)
 again in that process after the pool closed, and the wall time of the whole process (interpreter
 start, imports, the three scans and their plots, the plots again, exit); then every run's wall time.
@@ -98,8 +100,10 @@ def three_scans(solver: str, workers: int, folder: Path) -> None:
         plots_written = sum(len(written) for *_, written, _ in outcomes)
         cpu = process_tree_cpu_s(os.getpid())
     wall = time.perf_counter() - start
-    simulated_cpu = sum(float(row["cpu_time_s"]) for _, _, rows, *_ in outcomes for row in rows if row["status"] == "ok")
-    points = sum(len(rows) for _, _, rows, *_ in outcomes)
+    run_once = {study.scene_keys[int(row["point"])]: float(row["cpu_time_s"]) if row["status"] == "ok" else 0.0
+                for study, _, rows, *_ in outcomes for row in rows}  # a point two scans share ran once
+    simulated_cpu = sum(run_once.values())
+    points = f"{sum(len(rows) for _, _, rows, *_ in outcomes)} ({len(run_once)})"
     plots_cpu = []
     import rpdrill.studies.plots.scans  # noqa: F401 - matplotlib loaded first, as in the pool's workers
     for study, out, rows, optima, *_ in outcomes:  # each plot again, in this process, for its CPU time
@@ -159,7 +163,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
         print(f"three paper scans on one pool of {args.workers} workers, a process each")
-        print(f"{'solver':<10}{'points':<8}{'wall s':<10}{'all CPU s':<13}{'simulation CPU s':<20}"
+        print(f"{'solver':<10}{'points (run)':<14}{'wall s':<10}{'all CPU s':<13}{'simulation CPU s':<20}"
               f"{'simulation / all':<20}{'plots':<7}{'plots CPU s':<12}{'per plot':<32}{'process s':<11}wall s of each run")
         for solver in solvers:
             runs = []
@@ -169,7 +173,7 @@ def main() -> None:
                                         "--workers", str(args.workers)], check=True, capture_output=True, text=True)
                 runs.append({**json.loads(child.stdout.splitlines()[-1]), "process": time.perf_counter() - start})
             run = min(runs, key=lambda r: abs(r["wall"] - statistics.median(r["wall"] for r in runs)))  # the median run
-            print(f"{solver:<10}{run['points']:<8}{run['wall']:<10.2f}{run['cpu']:<13.2f}{run['simulated_cpu']:<20.2f}"
+            print(f"{solver:<10}{run['points']:<14}{run['wall']:<10.2f}{run['cpu']:<13.2f}{run['simulated_cpu']:<20.2f}"
                   f"{run['simulated_cpu'] / run['cpu']:<20.2f}{run['plots_written']:<7}{sum(run['plots_cpu']):<12.2f}"
                   f"{' '.join(f'{c:.2f}' for c in run['plots_cpu']):<32}{run['process']:<11.2f}"
                   + " ".join(f"{r['wall']:.2f}" for r in runs), flush=True)

@@ -6,7 +6,10 @@ study, every session); ``DIR/<table>.csv`` gets the rows of each batch of points
 (studies.runners). A rerun
 into the same directory keeps the complete rows (a row cut by a kill is dropped), runs only the
 points without one, and refuses a study whose hash differs. Failed points count as finished
-(their errors are in the table; delete their rows to retry them).
+(their errors are in the table; delete their rows to retry them). Several tables run as one: their
+points go to the workers together, and a point whose scene equals another's (by resolved scene,
+studies.study.Study.scene_keys: the formulations are deterministic; the paper's impulse scan repeats
+the frequency scan's 23 points at 220 kN) runs once, its outcome written to both.
 
 A study is anything with ``spec.name``, ``source``, ``hash``, ``points`` (each with ``index`` and
 ``parameters``) and ``resolved()``: studies.study.Study and studies.accuracy.AccuracyStudy.
@@ -22,6 +25,7 @@ import os
 import sys
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Protocol
@@ -132,47 +136,118 @@ def result_row(point: Point, outcome: dict[str, Any]) -> dict[str, Any]:
             "wall_time_s": f"{outcome['wall_time_s']:.4g}", **outcome["metrics"]}
 
 
+@dataclass
+class Table:
+    """One study's points and where their results go: ``out/table`` with ``columns``; ``task(point)`` is
+    what ``worker`` receives, ``row(outcome)`` the table row of its outcome (default :func:`result_row`,
+    the outcome's ``point`` its index). ``scene_keys``: each point's scene, when points of equal keys
+    give equal results (module doc; the worker's outcome then names its point by index)."""
+
+    study: ResumableStudy
+    out: Path
+    table: str
+    columns: list[str]
+    task: Callable[[Point], Any]
+    worker: Callable[[Any], dict[str, Any]]
+    row: Callable[[dict[str, Any]], dict[str, Any]] | None = None
+    scene_keys: Sequence[str] | None = None
+
+    def to_row(self, outcome: dict[str, Any]) -> dict[str, Any]:
+        return (self.row or (lambda o: result_row(self.study.points[o["point"]], o)))(outcome)
+
+
+def run_tagged(item: tuple[Callable[[Any], Any], int, Any]) -> tuple[int, Any]:
+    """Worker: ``(worker, tag, task)`` -> ``(tag, worker(task))``, so that an outcome finds its points."""
+    worker, tag, task = item
+    return tag, worker(task)
+
+
+def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
+               finished: Callable[[int, list[Row]], None] = lambda index, rows: None) -> list[list[Row]]:
+    """Run the points of every table without a finished row (module doc) in one call of ``runner``, so
+    that the workers go from one study's points to the next without waiting; each batch's rows are
+    appended to their tables as it completes; a point whose scene key equals another's runs once and
+    its outcome goes to both. ``finished(i, rows)`` is called as soon as table ``i`` is complete (in
+    this process, while the workers go on), with its rows in point order. Prints what it runs, shows
+    progress, records each table's session; returns every table's rows."""
+    label, run = runner
+    records, remaining = [], []
+    tasks: list[tuple[Callable[[Any], Any], int, Any]] = []
+    targets: list[list[tuple[int, int]]] = []  # per task: the (table, point index) its outcome goes to
+    task_of: dict[Any, int] = {}  # scene key -> task
+    for i, job in enumerate(tables):
+        job.out.mkdir(parents=True, exist_ok=True)
+        records.append(provenance(job.study, job.out, job.table))
+        write_json(job.out / RECORD, records[-1])
+        done = finished_rows(job.out / job.table, job.columns, len(job.study.points))
+        todo = [p for p in job.study.points if p.index not in done]
+        runs = []
+        for point in todo:
+            key = job.scene_keys[point.index] if job.scene_keys is not None else (i, point.index)
+            if key not in task_of:
+                task_of[key] = len(tasks)
+                tasks.append((job.worker, len(tasks), job.task(point)))
+                targets.append([])
+                runs.append(point)
+            targets[task_of[key]].append((i, point.index))
+        remaining.append(len(todo))
+        same = f"{len(todo) - len(runs)} the same as another point (run once), " if len(runs) < len(todo) else ""
+        print(f"{job.study.spec.name}: {len(job.study.points)} points, {len(done)} finished earlier, {same}running "
+              f"{len(runs)} on {label} (estimated {duration(sum(p.cpu_s for p in runs))} of CPU)", file=sys.stderr)
+    rows: list[list[Row] | None] = [None] * len(tables)
+    ran, copied = [0] * len(tables), [0] * len(tables)  # points written: run for the table, or copied to it
+    start = time.perf_counter()
+
+    def complete(i: int, interrupted: bool = False) -> None:
+        rows[i] = _record_session(records[i], tables[i].out, tables[i].out / tables[i].table, label, ran[i],
+                                  copied[i], start, interrupted)
+        if not interrupted:
+            finished(i, rows[i])
+
+    try:
+        for i in range(len(tables)):
+            if remaining[i] == 0:
+                complete(i)
+        names = ", ".join(job.study.spec.name for job in tables)
+        with tqdm(total=sum(remaining), desc=names, unit="point", disable=quiet) as bar:
+            for batch in run(run_tagged, tasks) if tasks else ():
+                raise_if_stopped()  # points cut by the interrupt are not results
+                by_table: dict[int, list[dict[str, Any]]] = {}
+                for tag, outcome in batch:
+                    for n, (i, index) in enumerate(targets[tag]):
+                        by_table.setdefault(i, []).append({**outcome, "point": index} if tables[i].scene_keys
+                                                          is not None else outcome)
+                        (copied if n else ran)[i] += 1
+                for i, outcomes in by_table.items():  # a batch's rows, then one flush per table
+                    with (tables[i].out / tables[i].table).open("a", newline="", encoding="utf-8") as handle:
+                        csv.DictWriter(handle, tables[i].columns).writerows(map(tables[i].to_row, outcomes))
+                    remaining[i] -= len(outcomes)
+                    bar.update(len(outcomes))
+                    if remaining[i] == 0:
+                        complete(i)
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM (studies.cli): the finished rows stay, the sessions are recorded
+        for i in range(len(tables)):
+            if rows[i] is None:
+                complete(i, interrupted=True)
+        raise
+    return [r for r in rows if r is not None]
+
+
 def run_points(study: ResumableStudy, out: Path, table: str, columns: list[str], task: Callable[[Point], Any],
                worker: Callable[[Any], dict[str, Any]], runner: tuple[str, Runner], quiet: bool,
                row: Callable[[dict[str, Any]], dict[str, Any]] | None = None) -> list[Row]:
-    """Run every point of ``study`` without a finished row in ``out/table`` (module doc): ``task(point)``
-    is what ``worker`` receives, ``row(outcome)`` the table row of its outcome (default
-    :func:`result_row`). Prints what it runs, shows progress, records the session; returns all rows."""
-    out.mkdir(parents=True, exist_ok=True)
-    record = provenance(study, out, table)
-    write_json(out / RECORD, record)
-    path = out / table
-    done = finished_rows(path, columns, len(study.points))
-    todo = [p for p in study.points if p.index not in done]
-    label, run = runner
-    name = study.spec.name
-    print(f"{name}: {len(study.points)} points, {len(done)} finished earlier, running {len(todo)} on {label} "
-          f"(estimated {duration(sum(p.cpu_s for p in todo))} of CPU)", file=sys.stderr)
-    to_row = row or (lambda outcome: result_row(study.points[outcome["point"]], outcome))
-    start, ran = time.perf_counter(), 0
-    try:
-        with path.open("a", newline="", encoding="utf-8") as handle, \
-                tqdm(total=len(study.points), initial=len(done), desc=name, unit="point", disable=quiet) as bar:
-            writer = csv.DictWriter(handle, columns)
-            for batch in run(worker, [task(p) for p in todo]) if todo else ():  # a batch's rows, then one flush
-                raise_if_stopped()  # points cut by the interrupt are not results
-                writer.writerows(to_row(outcome) for outcome in batch)
-                handle.flush()
-                ran += len(batch)
-                bar.update(len(batch))
-    except KeyboardInterrupt:  # Ctrl-C or SIGTERM (studies.cli): the finished rows stay, the session is recorded
-        _record_session(record, out, path, label, ran, start, interrupted=True)
-        raise
-    return _record_session(record, out, path, label, ran, start, interrupted=False)
+    """:func:`run_tables` of one study: its rows."""
+    return run_tables([Table(study, out, table, columns, task, worker, row)], runner, quiet)[0]
 
 
-def _record_session(record: dict[str, Any], out: Path, path: Path, label: str, ran: int, start: float,
-                    interrupted: bool) -> list[Row]:
-    """Add this session (and every point's wall time) to the record in out/study.json; the rows."""
-    rows = read_rows(path)
+def _record_session(record: dict[str, Any], out: Path, path: Path, label: str, ran: int, copied: int,
+                    start: float, interrupted: bool) -> list[Row]:
+    """Add this session (and every point's wall time) to the record in out/study.json; the rows in point
+    order (the table holds them in the order they finished)."""
+    rows = sorted(read_rows(path), key=lambda r: int(r["point"]))
     record["sessions"].append({"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-                               "runner": label, "points_run": ran, "interrupted": interrupted,
-                               "wall_time_s": round(time.perf_counter() - start, 3)})
-    record["point_wall_time_s"] = {r["point"]: float(r["wall_time_s"]) for r in sorted(rows, key=lambda r: int(r["point"]))}
+                               "runner": label, "points_run": ran, "points_copied": copied,
+                               "interrupted": interrupted, "wall_time_s": round(time.perf_counter() - start, 3)})
+    record["point_wall_time_s"] = {r["point"]: float(r["wall_time_s"]) for r in rows}
     write_json(out / RECORD, record)
     return rows

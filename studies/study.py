@@ -35,6 +35,7 @@ import hashlib
 import itertools
 import json
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -126,11 +127,18 @@ class Study:
         """The scan axes that change together with ``axis`` (its ``combine`` group, itself included)."""
         return next(group for group in _groups(self.spec, str(self.source)) if axis in group)
 
+    @cached_property
+    def scene_keys(self) -> list[str]:
+        """Each point's resolved scene (models.simulation.Simulation.resolved_scene: with its outputs and
+        solver settings) as canonical JSON: equal keys, equal results."""
+        return [json.dumps(p.simulation.resolved_scene(), sort_keys=True) for p in self.points]
+
     @property
     def hash(self) -> str:
-        """SHA-256 of what determines the results: the point scenes and the collected metrics."""
-        content = {"points": [p.simulation.resolved_scene() for p in self.points], "metrics": list(self.spec.metrics)}
-        return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
+        """SHA-256 of what determines the results: the point scenes and the collected metrics (the JSON
+        of {"metrics": [...], "points": [scene, ...]} with sorted keys, assembled from :attr:`scene_keys`)."""
+        content = f'{{"metrics": {json.dumps(list(self.spec.metrics))}, "points": [{", ".join(self.scene_keys)}]}}'
+        return hashlib.sha256(content.encode()).hexdigest()
 
 
 def _groups(spec: StudySpec, source: str) -> list[list[str]]:

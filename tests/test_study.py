@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import hashlib
 import json
 import os
 import signal
@@ -107,6 +108,15 @@ def test_metric_names_are_those_of_summary_metrics():
     assert set(summary_metrics(simulate(scene))) == set(METRIC_NAMES)
 
 
+def test_study_hash_is_the_json_of_its_scenes_and_metrics(tmp_path):
+    """Study.hash, assembled from the points' scene keys, is the hash of the JSON of the point scenes and
+    metrics: folders written before it was assembled so stay resumable."""
+    study = load_study(write_study(tmp_path / "hash.yaml"))
+    content = {"points": [p.simulation.resolved_scene() for p in study.points], "metrics": list(study.spec.metrics)}
+    assert study.hash == hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
+    assert len(set(study.scene_keys)) == len(study.points)
+
+
 def test_study_end_to_end(small_run):
     study, out, status = small_run
     assert status == 0
@@ -124,20 +134,28 @@ def test_study_end_to_end(small_run):
     assert len(list(out.glob("*.png"))) == 2
 
 
-def test_several_studies_run_on_one_pool_into_folders_of_their_names(small_run, tmp_path):
+def test_several_studies_run_on_one_pool_into_folders_of_their_names(small_run, tmp_path, capsys):
     """Two studies in one command: each in --out/<file name>, with the rows and plots a command of its own
-    gives (the first study's plots drawn while the second's points run)."""
+    gives; their points go to the workers as one run, and the point both have (40 Hz, 220 kN) runs once,
+    its result written to both."""
     study, single, _ = small_run
-    other = write_study(tmp_path / "other.yaml", scan={"impact.frequency_hz": [50, 70], "impact.amplitude_n": [220e3]},
-                        plots=[{"x": "impact.frequency_hz", "y": "bit_velocity_peak_m_per_s"}])
+    other = write_study(tmp_path / "other.yaml", name="other",
+                        scan={"impact.frequency_hz": [40, 70], "impact.amplitude_n": [220e3]}, plots=[{"x": "impact.frequency_hz", "y": "bit_velocity_peak_m_per_s"}])
     out = tmp_path / "both"
     assert main(["study", str(study), str(other), "--out", str(out), "--workers", "2", "--quiet"]) == 0
+    assert "other: 2 points, 0 finished earlier, 1 the same as another point (run once), running 1" \
+        in capsys.readouterr().err
 
     def table(folder: Path) -> list[dict[str, str]]:
         return sorted(({k: v for k, v in row.items() if k != "wall_time_s"} for row in rows(folder)),
                       key=lambda row: int(row["point"]))
 
     assert table(out / "small") == table(single)
+    shared = [next(r for r in rows(out / name) if float(r["impact.frequency_hz"]) == 40
+                   and float(r["impact.amplitude_n"]) == 220e3) for name in ("small", "other")]
+    assert shared[0] == {**shared[1], "point": shared[0]["point"]}  # the same run: its wall time too
+    sessions = [json.loads((out / name / "study.json").read_text())["sessions"][-1] for name in ("small", "other")]
+    assert [(s["points_run"], s["points_copied"]) for s in sessions] == [(4, 0), (1, 1)]
     assert len(table(out / "other")) == 2
     assert len(list((out / "small").glob("*.png"))) == 2 and len(list((out / "other").glob("*.png"))) == 1
 

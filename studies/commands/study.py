@@ -3,10 +3,11 @@ cores or a Dask cluster.
 
 Running again into the same DIR skips finished points; a changed study, and a DIR holding anything
 else, are refused (studies.resumable). Every study is read and every point and study checked against
-the budgets before any runs (studies.budgets). Several studies run one after the other on one pool
-of workers, each into DIR/<its file name without .yaml>; a study's plots are drawn by the workers
-while the next study's points run. The exit status is 1 when some point failed. What DIR holds:
-FILES below.
+the budgets before any runs (studies.budgets). Several studies run on one pool of workers as one
+run, each into DIR/<its file name without .yaml>: the workers go from one study's points to the
+next, a point whose scene equals another's runs once (the paper's impulse scan repeats the
+frequency scan at 220 kN), and a study's plots are drawn by the workers once its points are done.
+The exit status is 1 when some point failed. What DIR holds: FILES below.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import argparse
 import importlib
 import json
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from rpdrill.models.formulations import FORMULATIONS
@@ -22,7 +24,7 @@ from rpdrill.studies.commands import add_resumable_arguments, budget
 from rpdrill.studies.loading import InputError
 from rpdrill.studies.plots.tasks import start_plots
 from rpdrill.studies.points import run_point
-from rpdrill.studies.resumable import RECORD, STATUS_COLUMNS, Row, run_points
+from rpdrill.studies.resumable import RECORD, STATUS_COLUMNS, Row, Table, run_tables
 from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
 from rpdrill.studies.runners import Runner, pool, sequential
 from rpdrill.studies.study import Study, load_study
@@ -46,16 +48,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="run every point with this formulation (default: the scene's solver.formulation)")
 
 
-def run_study(study: Study, out: Path, runner: tuple[str, Runner], quiet: bool) -> tuple[list[Row], list[Record]]:
-    """Run the study's points into ``out`` (resumable), then write its optima (optima.csv, study.json):
-    (all rows, the optima)."""
-    columns = ["point", *study.axes, *STATUS_COLUMNS, *study.spec.metrics]
-    rows = run_points(study, out, "results.csv", columns, lambda p: (p.index, p.simulation), run_point, runner, quiet)
+def write_optima(study: Study, out: Path, rows: list[Row]) -> list[Record]:
+    """The study's optima (studies.study_optima) into optima.csv and study.json."""
     optima = study_optima(study, rows)
     write_rows_csv(out / "optima.csv", csv_rows(optima))
     record = json.loads((out / "study.json").read_text(encoding="utf-8"))
     write_json(out / "study.json", {**record, "optima": optima})
-    return rows, optima
+    return optima
 
 
 def study_folders(paths: list[str], out: str) -> list[Path]:
@@ -92,19 +91,26 @@ Outcome = tuple[Study, Path, list[Row], list[Record], list[Path], list[str]]
 
 def run_studies(studies: list[Study], folders: list[Path], runner: tuple[str, Runner], plots_here: bool,
                 quiet: bool) -> list[Outcome]:
-    """Run the studies one after the other on ``runner`` into their folders (:func:`run_study`), each
-    study's plots drawn by its workers beside the next study's points (``plots_here``: in this process,
-    as with Dask, whose workers may write on another machine): per study (the study, its folder, rows,
-    optima, the plot files written, the plots left out)."""
+    """Run the studies' points on ``runner`` into their folders as one run (studies.resumable.run_tables:
+    the workers go from one study to the next without waiting, a point whose scene another study has
+    runs once); as each study completes, its optima are written and its plots handed to the workers
+    (``plots_here``: drawn in this process, as with Dask, whose workers may write on another machine):
+    per study (the study, its folder, rows, optima, the plot files written, the plots left out)."""
     # the optima's SciPy (0.6 s), imported before the first points go out, while the pool's fork server
     # is still loading what the workers need: not beside the workers, not after them
     importlib.import_module("scipy.signal")
-    started = []
-    for study, out in zip(studies, folders, strict=True):
-        rows, optima = run_study(study, out, runner, quiet)
-        started.append((study, out, rows, optima, start_plots(study, rows, optima, out,
-                                                              sequential if plots_here else runner[1])))
-    return [(study, out, rows, optima, *wait_for_plots()) for study, out, rows, optima, wait_for_plots in started]
+    started: dict[int, tuple[list[Record], Callable[[], tuple[list[Path], list[str]]]]] = {}
+
+    def finished(i: int, rows: list[Row]) -> None:
+        optima = write_optima(studies[i], folders[i], rows)
+        started[i] = optima, start_plots(studies[i], rows, optima, folders[i], sequential if plots_here else runner[1])
+
+    tables = [Table(study, out, "results.csv", ["point", *study.axes, *STATUS_COLUMNS, *study.spec.metrics],
+                    lambda p: (p.index, p.simulation), run_point, scene_keys=study.scene_keys)
+              for study, out in zip(studies, folders, strict=True)]
+    all_rows = run_tables(tables, runner, quiet, finished)
+    return [(study, out, rows, started[i][0], *started[i][1]())
+            for i, (study, out, rows) in enumerate(zip(studies, folders, all_rows, strict=True))]
 
 
 def run(args: argparse.Namespace) -> int:
