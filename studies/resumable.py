@@ -153,7 +153,7 @@ class Table:
     scene_keys: Sequence[str] | None = None
 
     def to_row(self, outcome: dict[str, Any]) -> dict[str, Any]:
-        return (self.row or (lambda o: result_row(self.study.points[o["point"]], o)))(outcome)
+        return self.row(outcome) if self.row else result_row(self.study.points[outcome["point"]], outcome)
 
 
 def run_tagged(item: tuple[Callable[[Any], Any], int, Any]) -> tuple[int, Any]:
