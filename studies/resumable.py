@@ -213,14 +213,17 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
             for batch in run(run_tagged, tasks) if tasks else ():
                 raise_if_stopped()  # points cut by the interrupt are not results
                 by_table: dict[int, list[dict[str, Any]]] = {}
+                first: dict[int, int] = {}  # per table: the outcomes of points run for it (the others copied)
                 for tag, outcome in batch:
                     for n, (i, index) in enumerate(targets[tag]):
                         by_table.setdefault(i, []).append({**outcome, "point": index} if tables[i].scene_keys
                                                           is not None else outcome)
-                        (copied if n else ran)[i] += 1
+                        first[i] = first.get(i, 0) + (n == 0)
                 for i, outcomes in by_table.items():  # a batch's rows, then one flush per table
                     with (tables[i].out / tables[i].table).open("a", newline="", encoding="utf-8") as handle:
                         csv.DictWriter(handle, tables[i].columns).writerows(map(tables[i].to_row, outcomes))
+                    ran[i] += first.get(i, 0)
+                    copied[i] += len(outcomes) - first.get(i, 0)
                     remaining[i] -= len(outcomes)
                     bar.update(len(outcomes))
                     if remaining[i] == 0:
