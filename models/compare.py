@@ -18,8 +18,8 @@ import math
 
 import numpy as np
 
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.results import SimulationResult
+from .metrics import summary_metrics
+from .results import SimulationResult
 
 HISTORIES = {
     "borehole_bottom_m": lambda r: r.bottom_m,

@@ -29,12 +29,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from rpdrill.models.exact_system import sub_step
-from rpdrill.models.formulations import DEFAULT_PRESET
-from rpdrill.models.pulse import phase_pieces
-from rpdrill.models.simulation import Simulation
-from rpdrill.models.solver_settings import EXUDYN_PRESETS
-from rpdrill.models.stability import element_rates
+from .exact_system import sub_step
+from .formulations import DEFAULT_PRESET
+from .pulse import phase_pieces
+from .simulation import Simulation
+from .solver_settings import EXUDYN_PRESETS
+from .stability import element_rates
 
 # Measured by benchmarks/bench_budgets.py (one BLAS thread, shared 2-core machine):
 # (a, b, p) of a + b n^p; the exact formulation with its energy works (an energy output asked for), and

@@ -63,7 +63,7 @@ import numpy as np
 from scipy.linalg import expm
 from threadpoolctl import ThreadpoolController
 
-from rpdrill.models.exact_kernels import (
+from .exact_kernels import (
     BLOW_START,
     DIVERGED,
     MISSING_KEY,
@@ -73,18 +73,18 @@ from rpdrill.models.exact_kernels import (
     power_integrals,
     run_events,
 )
-from rpdrill.models.exact_system import Model, Modes, balance, sub_step, unsupported
-from rpdrill.models.pulse import (
+from .exact_system import Model, Modes, balance, sub_step, unsupported
+from .pulse import (
     PHASES,
     blow_start_times,
     generator_states,
     phase_pieces,
     phase_row,
 )
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import SceneError, Simulation, as_simulation
-from rpdrill.models.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
+from .results import SimulationResult
+from .scene import Scene
+from .simulation import SceneError, Simulation, as_simulation
+from .stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
 
 ANCHORS, PER_ANCHOR = 16, 16  # A, B: a batch is J = A B sub-grid points from one state (module doc)
 TAYLOR_REMAINDER = 1e-20  # relative truncation of the Taylor series on pieces shorter than h

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from rpdrill.rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled module
+from ..rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled module
 
 # isort: split
 from exudyn.itemInterface import (
@@ -38,16 +38,16 @@ from exudyn.itemInterface import (
     SensorObject,
 )
 
-from rpdrill.models.chain import AxialChain, Link
-from rpdrill.models.formulations import AUTOMATIC_STEP_SOLVERS
-from rpdrill.models.indexing import BlowStarts
-from rpdrill.models.pulse import impact_force
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import Simulation, as_simulation
-from rpdrill.models.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
-from rpdrill.rocklaw.backends import SCALAR, SymbolicBackend
-from rpdrill.rocklaw.exudyn_element import ExudynRockContact, attach_user_function
+from .chain import AxialChain, Link
+from .formulations import AUTOMATIC_STEP_SOLVERS
+from .indexing import BlowStarts
+from .pulse import impact_force
+from .results import SimulationResult
+from .scene import Scene
+from .simulation import Simulation, as_simulation
+from .stability import SimulationFailed, StepLimitWarning, check_result, step_warning
+from ..rocklaw.backends import SCALAR, SymbolicBackend
+from ..rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 
 SOLVER_TYPES = {
     "rk67": exu.DynamicSolverType.RK67,

@@ -22,8 +22,8 @@ from types import ModuleType
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from rpdrill.models.results import SimulationResult
-    from rpdrill.models.simulation import Simulation
+    from .results import SimulationResult
+    from .simulation import Simulation
 
 # accuracy tiers that every formulation resolves into its own settings (models.solver_settings)
 PRESETS = ("fast", "standard", "reference")
@@ -36,7 +36,7 @@ ODE_METHODS = ("DOP853", "Radau", "LSODA")
 
 @dataclass(frozen=True)
 class Formulation:
-    """A formulation: its implementation module, the ``solver`` keys it takes, and the module with its
+    """A formulation: its implementation module (relative to this package), the ``solver`` keys it takes, and the module with its
     ``unsupported`` check when that is lighter to import than the implementation (``checks``)."""
 
     name: str
@@ -46,17 +46,17 @@ class Formulation:
     checks: str | None = None
 
     def implementation(self) -> ModuleType:
-        return importlib.import_module(self.module)
+        return importlib.import_module(self.module, __package__)
 
 
 FORMULATIONS: dict[str, Formulation] = {f.name: f for f in (
-    Formulation("exudyn", "rpdrill.models.exudyn_model",
+    Formulation("exudyn", ".exudyn_model",
                 ("type", "step_s", "spectral_radius", "relative_tolerance", "absolute_tolerance"),
                 "the Exudyn multibody model"),
-    Formulation("exact", "rpdrill.models.exact_model",
+    Formulation("exact", ".exact_model",
                 ("sample_interval_s", "min_switch_interval_s", "max_switches_per_blow"),
-                "exact piecewise-linear propagation between located switches", checks="rpdrill.models.exact_system"),
-    Formulation("ode", "rpdrill.models.ode_model",
+                "exact piecewise-linear propagation between located switches", checks=".exact_system"),
+    Formulation("ode", ".ode_model",
                 ("method", "relative_tolerance", "absolute_tolerance", "sample_interval_s"),
                 "the paper's Eq. 4 as an event-located SciPy ODE"),
 )}
@@ -71,5 +71,6 @@ def simulate(simulation: Simulation, progress: Callable[[float], None] | None = 
 def unsupported(name: str, simulation: Simulation) -> str | None:
     """Why formulation ``name`` cannot run ``simulation``, or None if it can."""
     formulation = FORMULATIONS[name]
-    check = getattr(importlib.import_module(formulation.checks or formulation.module), "unsupported", None)
+    module = importlib.import_module(formulation.checks or formulation.module, __package__)
+    check = getattr(module, "unsupported", None)
     return check(simulation) if check else None

@@ -16,8 +16,8 @@ from functools import cached_property
 
 import numpy as np
 
-from rpdrill.models.energy import EnergyAccount, energy_account, impact_work_j
-from rpdrill.models.results import SimulationResult
+from .energy import EnergyAccount, energy_account, impact_work_j
+from .results import SimulationResult
 
 
 class _Window:

@@ -31,15 +31,15 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from rpdrill.models.chain import link_load_n, torsion_first_order_matrix
-from rpdrill.models.indexing import BlowStarts
-from rpdrill.models.piecewise import Element, elements, rock_element, undeclared
-from rpdrill.models.pulse import blow_start_times, impact_force, switch_times
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Impact
-from rpdrill.models.simulation import Scene, Simulation, as_simulation
-from rpdrill.models.stability import SimulationFailed, diverged_index
-from rpdrill.rocklaw.backends import NUMERIC
+from .chain import link_load_n, torsion_first_order_matrix
+from .indexing import BlowStarts
+from .piecewise import Element, elements, rock_element, undeclared
+from .pulse import blow_start_times, impact_force, switch_times
+from .results import SimulationResult
+from .scene import Impact
+from .simulation import Scene, Simulation, as_simulation
+from .stability import SimulationFailed, diverged_index
+from ..rocklaw.backends import NUMERIC
 
 # Mode switches at one instant beyond this mean a law chatters: report instead of looping.
 MAX_SWITCHES_AT_ONE_TIME = 20

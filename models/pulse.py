@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from rpdrill.models.scene import Impact
-from rpdrill.rocklaw.backends import NUMERIC, Backend
+from .scene import Impact
+from ..rocklaw.backends import NUMERIC, Backend
 
 OFF, ON, RISING, FALLING = PHASES = ("off", "on", "rising", "falling")
 

@@ -7,11 +7,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rpdrill.models.chain import AxialChain
-from rpdrill.models.scene import Scene
+from .chain import AxialChain
+from .scene import Scene
 
 if TYPE_CHECKING:
-    from rpdrill.models.simulation import Simulation
+    from .simulation import Simulation
 
 
 @dataclass

@@ -18,17 +18,17 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
-from rpdrill.models.formulations import (
+from .formulations import (
     COMMON_SOLVER_KEYS,
     EXUDYN_SOLVERS,
     FORMULATIONS,
     ODE_METHODS,
     PRESETS,
 )
-from rpdrill.models.links import LINK_TYPES
-from rpdrill.models.outputs import METRICS, SERIES, Need, needs
-from rpdrill.rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
-from rpdrill.rocklaw.catalog import TABLE_1
+from .links import LINK_TYPES
+from .outputs import METRICS, SERIES, Need, needs
+from ..rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
+from ..rocklaw.catalog import TABLE_1
 
 Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]

@@ -19,12 +19,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rpdrill.models.chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
-from rpdrill.models.formulations import simulate
-from rpdrill.models.indexing import BlowStarts, Indexing
-from rpdrill.models.outputs import needs
-from rpdrill.models.pulse import impulse_per_blow_n_s
-from rpdrill.models.scene import (
+from .chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
+from .formulations import simulate
+from .indexing import BlowStarts, Indexing
+from .outputs import needs
+from .pulse import impulse_per_blow_n_s
+from .scene import (
     BuiltEffects,
     Impact,
     Outputs,
@@ -33,12 +33,12 @@ from rpdrill.models.scene import (
     built_effects,
     requested_outputs,
 )
-from rpdrill.models.solver_settings import Settings, resolve_settings
-from rpdrill.models.stability import FastestElement, StepScales, fastest_element, step_scales
-from rpdrill.rocklaw import RockLaw, State
+from .solver_settings import Settings, resolve_settings
+from .stability import FastestElement, StepScales, fastest_element, step_scales
+from ..rocklaw import RockLaw, State
 
 if TYPE_CHECKING:
-    from rpdrill.models.results import SimulationResult
+    from .results import SimulationResult
 
 
 class SceneError(ValueError):

@@ -24,9 +24,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from rpdrill.models.formulations import DEFAULT_PRESET
-from rpdrill.models.scene import Solver
-from rpdrill.models.stability import StepScales
+from .formulations import DEFAULT_PRESET
+from .scene import Solver
+from .stability import StepScales
 
 
 @dataclass(frozen=True)

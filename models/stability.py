@@ -17,15 +17,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.linalg import block_diag
 
-from rpdrill.models.chain import AxialChain, torsion_first_order_matrix
-from rpdrill.models.energy import energy_account
-from rpdrill.models.pulse import impulse_per_blow_n_s
-from rpdrill.models.scene import Scene, Torsion
-from rpdrill.rocklaw import RockLaw
+from .chain import AxialChain, torsion_first_order_matrix
+from .energy import energy_account
+from .pulse import impulse_per_blow_n_s
+from .scene import Scene, Torsion
+from ..rocklaw import RockLaw
 
 if TYPE_CHECKING:
-    from rpdrill.models.results import SimulationResult
-    from rpdrill.models.simulation import Simulation
+    from .results import SimulationResult
+    from .simulation import Simulation
 
 # Positions beyond this are not drilling: the solver has blown up (states near 1e300 seen with
 # explicit solvers at too large a step, reported as success by the solver).

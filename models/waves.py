@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rpdrill.models.results import SimulationResult
+from .results import SimulationResult
 
 
 def first_crossing_s(time_s: np.ndarray, values: np.ndarray, fraction: float = 0.5) -> float:

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.results import SimulationResult
+from .metrics import summary_metrics
+from .results import SimulationResult
 
 ERROR_MEASURES = ("bottom_end_error_rel", "penetration_rate_error_rel", "bit_velocity_rms_error_rel")
 ERROR_LABELS = {

@@ -3,10 +3,10 @@
 ``LAWS`` maps the scene's ``rock.law`` names to the law classes (:class:`rocklaw.base.RockLaw`).
 """
 
-from rpdrill.rocklaw.base import RockLaw, State, force_and_state
-from rpdrill.rocklaw.bilinear import BilinearRock
-from rpdrill.rocklaw.catalog import TABLE_1, RockProperties
-from rpdrill.rocklaw.jenkins import JenkinsRock
+from .base import RockLaw, State, force_and_state
+from .bilinear import BilinearRock
+from .catalog import TABLE_1, RockProperties
+from .jenkins import JenkinsRock
 
 LAWS: dict[str, type[RockLaw]] = {JenkinsRock.name: JenkinsRock, BilinearRock.name: BilinearRock}
 

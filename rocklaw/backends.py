@@ -76,7 +76,7 @@ class SymbolicBackend:
     """``exudyn.symbolic`` evaluation: every constant is wrapped as a symbolic ``Real``."""
 
     def __init__(self) -> None:
-        from rpdrill.rocklaw.exudyn_module import exu
+        from .exudyn_module import exu
 
         self._sym = exu.symbolic
 

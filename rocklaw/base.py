@@ -34,8 +34,8 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from rpdrill.rocklaw.backends import NUMERIC, Backend
-from rpdrill.rocklaw.modes import ModeTable
+from .backends import NUMERIC, Backend
+from .modes import ModeTable
 
 State = tuple[float, ...]
 POSITION, VELOCITY = "position", "velocity"  # the bit's local variables in a law's mode table

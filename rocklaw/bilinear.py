@@ -57,9 +57,9 @@ from typing import Any
 
 import numpy as np
 
-from rpdrill.rocklaw.backends import NUMERIC, Backend
-from rpdrill.rocklaw.base import POSITION, VELOCITY, State, trapezoidal_plastic_work_j
-from rpdrill.rocklaw.modes import Mode, ModeTable, Switch
+from .backends import NUMERIC, Backend
+from .base import POSITION, VELOCITY, State, trapezoidal_plastic_work_j
+from .modes import Mode, ModeTable, Switch
 
 FREE, LIFTED, LOADING, UNLOADING = "free", "lifted", "loading", "unloading"
 SURFACE, BOTTOM = "surface_m", "bottom_m"

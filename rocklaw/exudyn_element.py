@@ -17,14 +17,14 @@ from typing import Any
 
 import numpy as np
 
-from rpdrill.rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled module
+from .exudyn_module import exu  # first: it chooses Exudyn's compiled module
 
 # isort: split
 from exudyn.advancedUtilities import CreateSymbolicUserFunction
 from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
 
-from rpdrill.rocklaw.backends import SCALAR, SymbolicBackend
-from rpdrill.rocklaw.base import RockLaw, State
+from .backends import SCALAR, SymbolicBackend
+from .base import RockLaw, State
 
 COORDINATE = exu.OutputVariableType.Coordinates
 

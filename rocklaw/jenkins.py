@@ -57,9 +57,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-from rpdrill.rocklaw.backends import NUMERIC, Backend
-from rpdrill.rocklaw.base import POSITION, VELOCITY, State, trapezoidal_plastic_work_j
-from rpdrill.rocklaw.modes import ONE, Mode, ModeTable, Switch
+from .backends import NUMERIC, Backend
+from .base import POSITION, VELOCITY, State, trapezoidal_plastic_work_j
+from .modes import ONE, Mode, ModeTable, Switch
 
 DampingMode = Literal["contact", "always"]
 FREE, CONTACT, CLIPPED, CRUSHING = "free", "contact", "clipped", "crushing"

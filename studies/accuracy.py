@@ -48,10 +48,10 @@ from typing import Any, Literal
 
 from pydantic import Field
 
-from rpdrill.models.cost import Cause
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import MAX_COUNT, Scene
-from rpdrill.models.workprecision import (
+from ..models.cost import Cause
+from ..models.results import SimulationResult
+from ..models.scene import MAX_COUNT, Scene
+from ..models.workprecision import (
     ERROR_MEASURES,
     Signature,
     errors,
@@ -59,11 +59,11 @@ from rpdrill.models.workprecision import (
     signature,
     uniform_grid_s,
 )
-from rpdrill.studies.budgets import DEFAULT_BUDGET, Budget, check_size
-from rpdrill.studies.loading import InputError, parse, prepare_scene, read_yaml
-from rpdrill.studies.resumable import STATUS_COLUMNS, result_row
-from rpdrill.studies.specs import Axis, SceneSpec, StrictSpec
-from rpdrill.studies.study import Point
+from .budgets import DEFAULT_BUDGET, Budget, check_size
+from .loading import InputError, parse, prepare_scene, read_yaml
+from .resumable import STATUS_COLUMNS, result_row
+from .specs import Axis, SceneSpec, StrictSpec
+from .study import Point
 
 # Exudyn runs store every step (a write period below any step): the error of a run includes the
 # linear interpolation of its own steps onto the grid, not that of a coarser storage interval.
@@ -219,7 +219,7 @@ def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Ac
 def simulate_setting(scene: dict[str, Any], setting: Setting, grid_interval_s: float) -> SimulationResult:
     """One run of the windowed ``scene`` with ``setting`` (StepLimitWarnings silenced: a diverged
     run is reported as SimulationFailed by the formulation)."""
-    from rpdrill.models.simulation import prepare
+    from ..models.simulation import prepare
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

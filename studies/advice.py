@@ -41,15 +41,15 @@ import numpy as np
 from pydantic import ValidationError
 from scipy import optimize
 
-from rpdrill.models.formulations import unsupported
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import SceneError, Simulation, prepare
-from rpdrill.studies.catalogue import describe_scene, parameter
-from rpdrill.studies.loading import InputError, describe_validation_error
-from rpdrill.studies.optima import band_hz
-from rpdrill.studies.runners import Runner
-from rpdrill.studies.specs import set_path
-from rpdrill.studies.targets import scan_target
+from ..models.formulations import unsupported
+from ..models.scene import Scene
+from ..models.simulation import SceneError, Simulation, prepare
+from .catalogue import describe_scene, parameter
+from .loading import InputError, describe_validation_error
+from .optima import band_hz
+from .runners import Runner
+from .specs import set_path
+from .targets import scan_target
 
 FREQUENCY, FEED = "impact.frequency_hz", "feed.force_n"
 METRICS = ("penetration_rate_m_per_s", "penetration_per_impact_energy_m_per_j")

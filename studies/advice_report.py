@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from rpdrill.studies.advice import FEED, FREQUENCY, Advice, peak_position
-from rpdrill.studies.catalogue import metric, parameter
-from rpdrill.studies.tables import markdown_table, text_table
+from .advice import FEED, FREQUENCY, Advice, peak_position
+from .catalogue import metric, parameter
+from .tables import markdown_table, text_table
 
 BAR_WIDTH = 30
 

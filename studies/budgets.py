@@ -18,10 +18,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from rpdrill.models.cost import Cause, RunCost, run_cost
-from rpdrill.models.simulation import Simulation
-from rpdrill.studies.loading import InputError
-from rpdrill.studies.points import prepare_point
+from ..models.cost import Cause, RunCost, run_cost
+from ..models.simulation import Simulation
+from .loading import InputError
+from .points import prepare_point
 
 DEFAULT_MAX_STEPS = 1e7
 DEFAULT_MAX_MEMORY_GB = 2.0

@@ -27,11 +27,11 @@ from typing import Any
 import numpy as np
 from scipy import optimize
 
-from rpdrill.studies.calibration_log import EvaluationLog, Record, unit_key
-from rpdrill.studies.calibration_spec import Calibration
-from rpdrill.studies.interrupts import raise_if_stopped
-from rpdrill.studies.runners import Runner
-from rpdrill.studies.targets import ScanTask, rising_shortfalls, run_scans, scan_all, scan_cost, scan_optimum
+from .calibration_log import EvaluationLog, Record, unit_key
+from .calibration_spec import Calibration
+from .interrupts import raise_if_stopped
+from .runners import Runner
+from .targets import ScanTask, rising_shortfalls, run_scans, scan_all, scan_cost, scan_optimum
 
 Progress = Callable[[Record, bool], None]  # (record, replayed)
 

@@ -15,10 +15,10 @@ import os
 from pathlib import Path
 from typing import Any, TextIO
 
-from rpdrill.studies.calibration_spec import Calibration
-from rpdrill.studies.loading import InputError
-from rpdrill.studies.resumable import checked_record
-from rpdrill.studies.run_files import write_json
+from .calibration_spec import Calibration
+from .loading import InputError
+from .resumable import checked_record
+from .run_files import write_json
 
 Record = dict[str, Any]
 EVALUATIONS = "evaluations.jsonl"

@@ -19,10 +19,10 @@ from typing import Any
 import numpy as np
 import yaml
 
-from rpdrill.studies.calibration import CalibrationResult
-from rpdrill.studies.calibration_log import Record
-from rpdrill.studies.calibration_spec import Calibration
-from rpdrill.studies.run_files import write_json, write_rows_csv
+from .calibration import CalibrationResult
+from .calibration_log import Record
+from .calibration_spec import Calibration
+from .run_files import write_json, write_rows_csv
 
 TARGET_COLUMNS = ("label", "metric", "paper_optimum_hz", "paper_band_low_hz", "paper_band_high_hz",
                   "resonance_estimate_hz", "main_lobe_optimum_hz", "main_lobe_band_80_low_hz",

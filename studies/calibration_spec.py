@@ -34,18 +34,18 @@ from typing import Annotated, Any, Literal, Union, get_args, get_origin
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from rpdrill.models.scene import Scene
-from rpdrill.studies.budgets import (
+from ..models.scene import Scene
+from .budgets import (
     AXIS_VALUE_BYTES,
     DEFAULT_BUDGET,
     EVALUATION_BYTES,
     Budget,
     base_estimate_s,
 )
-from rpdrill.studies.loading import InputError, field_at, parse, read_yaml
-from rpdrill.studies.points import prepare_point
-from rpdrill.studies.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
-from rpdrill.studies.targets import FREQUENCY, Scan, scan_scene
+from .loading import InputError, field_at, parse, read_yaml
+from .points import prepare_point
+from .specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
+from .targets import FREQUENCY, Scan, scan_scene
 
 PositiveFloat = Annotated[float, Field(gt=0)]
 # keys that do not change what an evaluation gives: a rerun may change them and continue

@@ -16,7 +16,7 @@ from collections.abc import Collection
 from dataclasses import dataclass, replace
 from typing import Any
 
-from rpdrill.models.scene import Scene
+from ..models.scene import Scene
 
 
 @dataclass(frozen=True)

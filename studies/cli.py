@@ -22,8 +22,8 @@ import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
-from rpdrill.studies.interrupts import Terminated, raise_if_stopped, stops_handled
-from rpdrill.studies.runners import start_worker_server
+from .interrupts import Terminated, raise_if_stopped, stops_handled
+from .runners import start_worker_server
 
 # name: (module, one-line help); a module is imported only when its command runs
 COMMANDS = {
@@ -83,8 +83,8 @@ def main(argv: list[str] | None = None) -> int:
     if _runs_a_process_pool(argv):
         start_worker_server([COMMANDS[argv[0]][0]])  # its imports overlap this process's (studies.runners)
     # imported after the fork server starts: they import the models (0.4 s), which it imports too
-    from rpdrill.studies.budgets import BudgetError
-    from rpdrill.studies.loading import InputError
+    from .budgets import BudgetError
+    from .loading import InputError
 
     parser = _Parser(prog="rpdrill", description="Rotary-percussive drilling simulator on Exudyn")
     parser.add_argument("--version", action="version", version=_version())

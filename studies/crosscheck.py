@@ -17,8 +17,8 @@ overlay plot DIR/crosscheck.png.
 
 from __future__ import annotations
 
-from rpdrill.models.scene import Scene
-from rpdrill.studies.loading import parse
+from ..models.scene import Scene
+from .loading import parse
 
 DEFAULT_STEP_S = 5e-6
 

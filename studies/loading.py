@@ -21,9 +21,9 @@ from typing import Any, TypeVar, get_args, get_origin
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from rpdrill.models.formulations import unsupported
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import SceneError, Simulation, prepare
+from ..models.formulations import unsupported
+from ..models.scene import Scene
+from ..models.simulation import SceneError, Simulation, prepare
 
 ModelT = TypeVar("ModelT", bound=BaseModel)
 MAX_FILE_BYTES = 16 * 2**20

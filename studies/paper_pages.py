@@ -11,12 +11,12 @@ import math
 from pathlib import Path
 from typing import Any
 
-from rpdrill.models.modal import rock_mode_frequency_hz
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
-from rpdrill.studies.calibration_spec import Calibration
-from rpdrill.studies.reproduction import CaseResult, Reproduction, sub_harmonic_lobes, trend_checks, within
-from rpdrill.studies.sensitivity import scene_values
+from ..models.modal import rock_mode_frequency_hz
+from ..models.scene import Scene
+from ..models.simulation import prepare
+from .calibration_spec import Calibration
+from .reproduction import CaseResult, Reproduction, sub_harmonic_lobes, trend_checks, within
+from .sensitivity import scene_values
 
 COMMAND = ("rpdrill reproduce --out runs/reproduction --calibration runs/calibration --sensitivity runs/sensitivity "
            "--docs docs")

@@ -13,10 +13,10 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import Simulation
-from rpdrill.studies.loading import InputError, prepare_scene, problem
+from ..models.metrics import summary_metrics
+from ..models.scene import Scene
+from ..models.simulation import Simulation
+from .loading import InputError, prepare_scene, problem
 
 
 def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]) -> list[str]:

@@ -23,11 +23,11 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from rpdrill.studies.loading import InputError, parse, read_yaml
-from rpdrill.studies.optima import CurveOptimum, curve_optimum
-from rpdrill.studies.runners import Runner
-from rpdrill.studies.specs import Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
-from rpdrill.studies.targets import Scan, rising_shortfalls, scan_all, scan_optimum
+from .loading import InputError, parse, read_yaml
+from .optima import CurveOptimum, curve_optimum
+from .runners import Runner
+from .specs import Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
+from .targets import Scan, rising_shortfalls, scan_all, scan_optimum
 
 PositiveFloat = Field(gt=0, allow_inf_nan=False)
 

@@ -32,11 +32,11 @@ from typing import Any, Protocol
 
 from tqdm import tqdm
 
-from rpdrill.studies.budgets import duration
-from rpdrill.studies.interrupts import raise_if_stopped
-from rpdrill.studies.loading import InputError
-from rpdrill.studies.run_files import write_json
-from rpdrill.studies.runners import Runner
+from .budgets import duration
+from .interrupts import raise_if_stopped
+from .loading import InputError
+from .run_files import write_json
+from .runners import Runner
 
 STATUS_COLUMNS = ("status", "error", "wall_time_s")
 RECORD = "study.json"

@@ -20,11 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.models.indexing import Indexing
-from rpdrill.models.scene import Bit
-from rpdrill.studies.catalogue import metric
-from rpdrill.studies.loading import InputError
-from rpdrill.studies.plots.rotation import draw_rotation_map
+from ..models.indexing import Indexing
+from ..models.scene import Bit
+from .catalogue import metric
+from .loading import InputError
+from .plots.rotation import draw_rotation_map
 
 RATE, ADVANCE = "penetration_rate_m_per_s", "advance_per_blow_m"
 SPEED, FREQUENCY, ROCK = "rotation.speed_rpm", "impact.frequency_hz", "rock.name"

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from rpdrill.studies.loading import InputError
+from .loading import InputError
 
 
 def check_out(out: str | Path, overwrite: bool | None = False, record: str | None = None) -> Path:

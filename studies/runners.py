@@ -31,7 +31,7 @@ from multiprocessing.context import BaseContext
 from pathlib import Path
 from typing import Any, TypeVar
 
-from rpdrill.studies.interrupts import worker_stops_like_ctrl_c
+from .interrupts import worker_stops_like_ctrl_c
 
 Arg = TypeVar("Arg")
 Result = TypeVar("Result")
@@ -71,11 +71,11 @@ def run_batch(task: tuple[Callable[[Arg], Result], list[Arg]]) -> tuple[list[Res
 def warm_up() -> None:
     """Worker initializer: import the study machinery and both formulations, and load the exact solver's
     compiled kernels from numba's cache (one blow of the shipped paper scene), once per worker."""
-    import rpdrill.models.exudyn_model  # noqa: F401 - imported for what it loads (Exudyn)
-    from rpdrill.models.scene import Scene
-    from rpdrill.models.simulation import prepare
-    from rpdrill.studies.loading import read_yaml
-    from rpdrill.studies.points import run_point  # noqa: F401 - the study machinery
+    from ..models import exudyn_model  # noqa: F401 - imported for what it loads (Exudyn)
+    from ..models.scene import Scene
+    from ..models.simulation import prepare
+    from .loading import read_yaml
+    from .points import run_point  # noqa: F401 - the study machinery
 
     one_blow = {**read_yaml(PAPER_SCENE), "metrics": {"transient_blows": 0, "block_blows": 1},
                 "solver": {"formulation": "exact", "end_time_s": 0.02}}

@@ -32,11 +32,11 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from rpdrill.models.scene import Scene
-from rpdrill.studies.budgets import DEFAULT_BUDGET, Budget, base_estimate_s
-from rpdrill.studies.loading import InputError, parse, read_yaml
-from rpdrill.studies.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
-from rpdrill.studies.targets import (
+from ..models.scene import Scene
+from .budgets import DEFAULT_BUDGET, Budget, base_estimate_s
+from .loading import InputError, parse, read_yaml
+from .specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
+from .targets import (
     FREQUENCY,
     Scan,
     rising_shortfalls,

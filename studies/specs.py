@@ -15,9 +15,9 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from rpdrill.models.outputs import METRICS
-from rpdrill.models.scene import Scene
-from rpdrill.studies.loading import InputError, allowed_keys, parse, read_yaml
+from ..models.outputs import METRICS
+from ..models.scene import Scene
+from .loading import InputError, allowed_keys, parse, read_yaml
 
 METRIC_NAMES = tuple(METRICS)
 MetricName = Literal[METRIC_NAMES]  # type: ignore[valid-type]

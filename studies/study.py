@@ -41,12 +41,12 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
-from rpdrill.models.scene import Scene, switch_formulation
-from rpdrill.models.simulation import Simulation
-from rpdrill.studies.budgets import DEFAULT_BUDGET, Budget, BudgetError, base_estimate_s, check_size
-from rpdrill.studies.loading import InputError, parse, read_yaml
-from rpdrill.studies.points import prepare_point
-from rpdrill.studies.specs import (
+from ..models.scene import Scene, switch_formulation
+from ..models.simulation import Simulation
+from .budgets import DEFAULT_BUDGET, Budget, BudgetError, base_estimate_s, check_size
+from .loading import InputError, parse, read_yaml
+from .points import prepare_point
+from .specs import (
     METRIC_NAMES,
     Axis,
     MetricName,

@@ -23,11 +23,11 @@ from __future__ import annotations
 from collections import defaultdict
 from typing import Any
 
-from rpdrill.models.modal import rock_mode_frequency_hz
-from rpdrill.studies.catalogue import metric, quantity
-from rpdrill.studies.optima import curve_optimum
-from rpdrill.studies.study import Study
-from rpdrill.studies.tables import text_table
+from ..models.modal import rock_mode_frequency_hz
+from .catalogue import metric, quantity
+from .optima import curve_optimum
+from .study import Study
+from .tables import text_table
 
 FREQUENCY = "impact.frequency_hz"
 Row = dict[str, str]

@@ -21,12 +21,12 @@ from typing import Any
 
 from pydantic import Field
 
-from rpdrill.models.modal import rock_mode_frequency_hz
-from rpdrill.studies.loading import InputError
-from rpdrill.studies.optima import curve_optimum
-from rpdrill.studies.points import prepare_point, run_point
-from rpdrill.studies.runners import Runner
-from rpdrill.studies.specs import MetricName, StrictSpec, set_path
+from ..models.modal import rock_mode_frequency_hz
+from .loading import InputError
+from .optima import curve_optimum
+from .points import prepare_point, run_point
+from .runners import Runner
+from .specs import MetricName, StrictSpec, set_path
 
 FREQUENCY = "impact.frequency_hz"
 # (key, scene dict, metrics, frequencies)

@@ -14,8 +14,8 @@ rpdrill.studies.cli`` runs that light module again as its main module.
 import gc
 import io
 
-from rpdrill.studies.plots.scans import plt
-from rpdrill.studies.runners import warm_up
+from .plots.scans import plt
+from .runners import warm_up
 
 warm_up()
 _figure, _axes = plt.subplots(layout="constrained")

@@ -12,75 +12,96 @@ from pathlib import Path
 import pytest
 from scenes import simulate
 
-import rpdrill.models
-import rpdrill.rocklaw
-import rpdrill.studies
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.studies.loading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = {"rpdrill.rocklaw": rpdrill.rocklaw, "rpdrill.models": rpdrill.models, "rpdrill.studies": rpdrill.studies}
-LAYER = {"rpdrill.rocklaw": 0, "rpdrill.models": 1, "rpdrill.studies": 2}  # studies -> models -> rocklaw
+LAYER = {"rocklaw": 0, "models": 1, "studies": 2, "": 3}  # studies -> models -> rocklaw; the API on top
 
 
-def _module_imports(path: Path) -> set[str]:
-    """rpdrill modules a module imports, at module level or inside functions (a deferred import is a
-    dependency too); imports only for type checkers (``if TYPE_CHECKING:``) are not."""
+def package_files() -> dict[str, Path]:
+    """Every module of the checkout's package, read from the files (no install): dotted name below
+    ``rpdrill`` ("" the package itself, "models.scene", "studies.cli.main", ...) -> path."""
+    files = {"": ROOT / "__init__.py"}
+    for folder in ("rocklaw", "models", "studies"):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            parts = list(path.relative_to(ROOT).with_suffix("").parts)
+            files[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return files
+
+
+def _imports(name: str, path: Path) -> list[tuple[str, bool]]:
+    """(imported module or module.attribute, absolute?) of a module, at module level or inside functions
+    (a deferred import is a dependency too); imports only for type checkers (``if TYPE_CHECKING:``) are
+    not. Relative imports are resolved against the module's package, as Python does."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
     typing_only = {id(node) for block in ast.walk(tree)
                    if isinstance(block, ast.If) and "TYPE_CHECKING" in ast.unparse(block.test)
                    for statement in block.body for node in ast.walk(statement)}
-    found: set[str] = set()
+    package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+    package = [part for part in package if part]
+    found: list[tuple[str, bool]] = []
     for node in ast.walk(tree):
         if id(node) in typing_only:
             continue
         if isinstance(node, ast.Import):
-            found.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module:
-            found.add(node.module)
-            found.update(f"{node.module}.{alias.name}" for alias in node.names)
-    return {name for name in found if name.split(".")[0] == "rpdrill"}
+            found += [(alias.name, True) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package[:len(package) - (node.level - 1)] if node.level > 1 else package
+                assert node.level - 1 <= len(package), f"{path}: import beyond the package"
+                module = ".".join(base + ([node.module] if node.module else []))
+                found.append((module, False))
+                found += [(f"{module}.{alias.name}".strip("."), False) for alias in node.names]
+            elif node.module:
+                found.append((node.module, True))
+    return found
 
 
 def import_graph() -> dict[str, set[str]]:
-    """Installed rpdrill modules -> the rpdrill modules they import (names resolved to modules)."""
-    files = {}
-    for package, imported in PACKAGES.items():
-        for path in Path(imported.__path__[0]).glob("*.py"):
-            files[package if path.stem == "__init__" else f"{package}.{path.stem}"] = path
-    return {module: {name for name in _module_imports(path) if name in files}
-            for module, path in files.items()}
+    """The package's modules -> the package's modules they import, read statically from the files."""
+    files = package_files()
+    return {name: {target for target, _ in _imports(name, path) if target in files}
+            for name, path in files.items()}
+
+
+def _layer(module: str) -> int:
+    return LAYER[module.split(".")[0]]
 
 
 def test_installed_under_one_name_and_nothing_generic(tmp_path):
-    for package, imported in PACKAGES.items():
-        assert Path(imported.__path__[0]).resolve() == ROOT / package.split(".")[1]
-    for generic in ("models", "rocklaw", "studies"):  # from elsewhere than the checkout: not importable
-        assert importlib.util.find_spec(f"rpdrill.{generic}") is not None
-        done = subprocess.run([sys.executable, "-c", f"import {generic}"], check=False, cwd=tmp_path,
+    for folder in ("models", "rocklaw", "studies"):
+        spec = importlib.util.find_spec(f"rpdrill.{folder}")
+        assert spec is not None and Path(spec.submodule_search_locations[0]).resolve() == ROOT / folder
+        done = subprocess.run([sys.executable, "-c", f"import {folder}"], check=False, cwd=tmp_path,
                               capture_output=True)
-        assert done.returncode != 0, f"a generic top-level package '{generic}' is installed"
+        assert done.returncode != 0, f"a generic top-level package '{folder}' is installed"
 
 
-def test_no_module_imports_a_top_level_folder_by_its_bare_name():
-    for imported in PACKAGES.values():
-        for path in Path(imported.__path__[0]).glob("*.py"):
-            tree = ast.parse(path.read_text(encoding="utf-8"))
-            names = [alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names]
-            names += [node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module]
-            bare = [name for name in names if name.split(".")[0] in ("models", "rocklaw", "studies")]
-            assert not bare, f"{path}: {bare}"
+def test_the_package_imports_itself_only_relatively():
+    """Inside the package every import of its own modules is relative, so that the import graph read
+    from the files of a checkout (an editor, an import-graph tool: no install) is the real one."""
+    for name, path in package_files().items():
+        absolute = [target for target, is_absolute in _imports(name, path)
+                    if is_absolute and target.split(".")[0] in ("rpdrill", "models", "rocklaw", "studies")]
+        assert not absolute, f"{path}: {absolute}"
+
+
+def test_the_static_graph_holds_the_imports_between_the_folders():
+    graph = import_graph()
+    between = {(_layer(a), _layer(b)) for a, targets in graph.items() for b in targets}
+    assert {(2, 1), (1, 0)} <= between
 
 
 def test_dependencies_run_one_way():
     for module, imports in import_graph().items():
-        layer = LAYER[".".join(module.split(".")[:2])]
-        upward = [name for name in imports if LAYER[".".join(name.split(".")[:2])] > layer]
+        upward = [name for name in imports if _layer(name) > _layer(module)]
         assert not upward, f"{module} imports {upward} (studies -> models -> rocklaw)"
 
 
 def test_no_import_cycles():
     graph = import_graph()
+    assert len(graph) > 60  # every module, subpackages included
     state: dict[str, str] = {}
     cycles: list[list[str]] = []
 

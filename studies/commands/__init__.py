@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from rpdrill.studies.budgets import DEFAULT_MAX_MEMORY_GB, DEFAULT_MAX_STEPS, MAX_CPU_HOURS, Budget
+from ..budgets import DEFAULT_MAX_MEMORY_GB, DEFAULT_MAX_STEPS, MAX_CPU_HOURS, Budget
 
 
 def positive_number(text: str) -> float:

@@ -24,8 +24,8 @@ import argparse
 import sys
 import time
 
-from rpdrill.models.workprecision import Signature
-from rpdrill.studies.accuracy import (
+from ...models.workprecision import Signature
+from ..accuracy import (
     COLUMNS,
     PARETO_COLUMNS,
     AccuracyStudy,
@@ -37,12 +37,12 @@ from rpdrill.studies.accuracy import (
     reference_signature,
     run_setting,
 )
-from rpdrill.studies.commands import add_resumable_arguments, budget
-from rpdrill.studies.interrupts import raise_if_stopped
-from rpdrill.studies.plots.workprecision import plot_workprecision
-from rpdrill.studies.resumable import RECORD, run_points
-from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
-from rpdrill.studies.runners import pool
+from . import add_resumable_arguments, budget
+from ..interrupts import raise_if_stopped
+from ..plots.workprecision import plot_workprecision
+from ..resumable import RECORD, run_points
+from ..run_files import check_out, write_json, write_rows_csv
+from ..runners import pool
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

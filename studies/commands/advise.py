@@ -13,8 +13,8 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from rpdrill.rocklaw.catalog import TABLE_1
-from rpdrill.studies.advice import (
+from ...rocklaw.catalog import TABLE_1
+from ..advice import (
     METRICS,
     PARAMETERS,
     AdviseParameter,
@@ -24,13 +24,13 @@ from rpdrill.studies.advice import (
     planned_evaluations,
     runnable_scene,
 )
-from rpdrill.studies.advice_report import advice_markdown, advice_record, advice_text, best_table
-from rpdrill.studies.catalogue import metric, parameter
-from rpdrill.studies.commands import add_runner_arguments, positive_count, positive_number
-from rpdrill.studies.loading import load_scene
-from rpdrill.studies.plots.advice import plot_curves, plot_feed_map
-from rpdrill.studies.run_files import check_out, staged_directory, write_json
-from rpdrill.studies.runners import pool
+from ..advice_report import advice_markdown, advice_record, advice_text, best_table
+from ..catalogue import metric, parameter
+from . import add_runner_arguments, positive_count, positive_number
+from ..loading import load_scene
+from ..plots.advice import plot_curves, plot_feed_map
+from ..run_files import check_out, staged_directory, write_json
+from ..runners import pool
 
 FILES = """files written to DIR:
   advice.json                   the command, and per rock: the best point, the metric there, the search

@@ -20,14 +20,14 @@ import sys
 
 from tqdm import tqdm
 
-from rpdrill.studies.budgets import duration
-from rpdrill.studies.calibration import calibrate
-from rpdrill.studies.calibration_log import CHECKPOINT, EvaluationLog, Record
-from rpdrill.studies.calibration_report import write_report
-from rpdrill.studies.calibration_spec import load_calibration
-from rpdrill.studies.commands import add_resumable_arguments, budget
-from rpdrill.studies.run_files import check_out, staged_directory
-from rpdrill.studies.runners import pool
+from ..budgets import duration
+from ..calibration import calibrate
+from ..calibration_log import CHECKPOINT, EvaluationLog, Record
+from ..calibration_report import write_report
+from ..calibration_spec import load_calibration
+from . import add_resumable_arguments, budget
+from ..run_files import check_out, staged_directory
+from ..runners import pool
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -6,15 +6,15 @@ from __future__ import annotations
 import argparse
 import sys
 
-from rpdrill.models.compare import compare_runs, verdict
-from rpdrill.models.formulations import ODE_METHODS
-from rpdrill.models.stability import SimulationFailed
-from rpdrill.studies.commands import add_budget_arguments, budget, positive_count, positive_number
-from rpdrill.studies.crosscheck import DEFAULT_STEP_S, comparison_table, window_scenes
-from rpdrill.studies.interrupts import raise_if_stopped
-from rpdrill.studies.loading import load_scene, prepare_scene
-from rpdrill.studies.plots.crosscheck import plot_overlay
-from rpdrill.studies.run_files import check_out, staged_directory, write_json
+from ...models.compare import compare_runs, verdict
+from ...models.formulations import ODE_METHODS
+from ...models.stability import SimulationFailed
+from . import add_budget_arguments, budget, positive_count, positive_number
+from ..crosscheck import DEFAULT_STEP_S, comparison_table, window_scenes
+from ..interrupts import raise_if_stopped
+from ..loading import load_scene, prepare_scene
+from ..plots.crosscheck import plot_overlay
+from ..run_files import check_out, staged_directory, write_json
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

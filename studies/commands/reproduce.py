@@ -20,17 +20,17 @@ import shutil
 import sys
 from pathlib import Path
 
-import rpdrill.studies
-from rpdrill.studies.calibration_spec import load_calibration
-from rpdrill.studies.commands import add_runner_arguments
-from rpdrill.studies.loading import InputError
-from rpdrill.studies.paper_pages import figures_page, parameters_page, reproduction_page, sensitivity_page
-from rpdrill.studies.plots.paper_figures import draw_figure
-from rpdrill.studies.reproduction import load_reproduction, reproduce, trend_checks, within
-from rpdrill.studies.run_files import check_out, staged_directory, write_json, write_rows_csv
-from rpdrill.studies.runners import pool
 
-PAPER = Path(rpdrill.studies.__file__).parent / "paper"
+from ..calibration_spec import load_calibration
+from . import add_runner_arguments
+from ..loading import InputError
+from ..paper_pages import figures_page, parameters_page, reproduction_page, sensitivity_page
+from ..plots.paper_figures import draw_figure
+from ..reproduction import load_reproduction, reproduce, trend_checks, within
+from ..run_files import check_out, staged_directory, write_json, write_rows_csv
+from ..runners import pool
+
+PAPER = Path(__file__).resolve().parents[1] / "paper"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -10,8 +10,8 @@ import shutil
 import sys
 from pathlib import Path
 
-from rpdrill.studies.rotation_report import check_runs, write_report
-from rpdrill.studies.run_files import check_out, staged_directory
+from ..rotation_report import check_runs, write_report
+from ..run_files import check_out, staged_directory
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

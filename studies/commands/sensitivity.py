@@ -12,12 +12,12 @@ from __future__ import annotations
 import argparse
 import sys
 
-from rpdrill.studies.commands import add_resumable_arguments, budget
-from rpdrill.studies.plots.tornado import draw_tornados
-from rpdrill.studies.resumable import RECORD, run_points
-from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
-from rpdrill.studies.runners import pool
-from rpdrill.studies.sensitivity import (
+from . import add_resumable_arguments, budget
+from ..plots.tornado import draw_tornados
+from ..resumable import RECORD, run_points
+from ..run_files import check_out, write_json, write_rows_csv
+from ..runners import pool
+from ..sensitivity import (
     ONE_AT_A_TIME_COLUMNS,
     TREND_COLUMNS,
     columns,

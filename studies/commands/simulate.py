@@ -11,17 +11,17 @@ from __future__ import annotations
 import argparse
 import sys
 
-from rpdrill.models.cost import Cause
-from rpdrill.models.formulations import FORMULATIONS
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.stability import SimulationFailed
-from rpdrill.studies.catalogue import metric
-from rpdrill.studies.commands import add_budget_arguments, budget
-from rpdrill.studies.interrupts import raise_if_stopped
-from rpdrill.studies.loading import load_scene, prepare_scene
-from rpdrill.studies.plots.timeseries import plot_timeseries
-from rpdrill.studies.progress import time_progress
-from rpdrill.studies.run_files import (
+from ...models.cost import Cause
+from ...models.formulations import FORMULATIONS
+from ...models.metrics import summary_metrics
+from ...models.stability import SimulationFailed
+from ..catalogue import metric
+from . import add_budget_arguments, budget
+from ..interrupts import raise_if_stopped
+from ..loading import load_scene, prepare_scene
+from ..plots.timeseries import plot_timeseries
+from ..progress import time_progress
+from ..run_files import (
     check_out,
     staged_directory,
     write_columns_csv,

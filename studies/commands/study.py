@@ -19,16 +19,16 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from rpdrill.models.formulations import FORMULATIONS
-from rpdrill.studies.commands import add_resumable_arguments, budget
-from rpdrill.studies.loading import InputError
-from rpdrill.studies.plots.tasks import start_plots
-from rpdrill.studies.points import run_point
-from rpdrill.studies.resumable import RECORD, STATUS_COLUMNS, Row, Table, run_tables
-from rpdrill.studies.run_files import check_out, write_json, write_rows_csv
-from rpdrill.studies.runners import Runner, pool, sequential
-from rpdrill.studies.study import Study, load_study
-from rpdrill.studies.study_optima import Record, csv_rows, optima_table, study_optima
+from ...models.formulations import FORMULATIONS
+from . import add_resumable_arguments, budget
+from ..loading import InputError
+from ..plots.tasks import start_plots
+from ..points import run_point
+from ..resumable import RECORD, STATUS_COLUMNS, Row, Table, run_tables
+from ..run_files import check_out, write_json, write_rows_csv
+from ..runners import Runner, pool, sequential
+from ..study import Study, load_study
+from ..study_optima import Record, csv_rows, optima_table, study_optima
 
 FILES = """files written to DIR (to DIR/<file name without .yaml> for each of several studies):
   results.csv    one row per point (scan values, status, error, wall time, metrics in SI units),

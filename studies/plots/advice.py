@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.studies.advice import FEED, FREQUENCY, Advice
-from rpdrill.studies.catalogue import metric, parameter
-from rpdrill.studies.plots.cells import cell_map, no_result_patch
-from rpdrill.studies.plots.style import OKABE_ITO, plt, save
+from ..advice import FEED, FREQUENCY, Advice
+from ..catalogue import metric, parameter
+from .cells import cell_map, no_result_patch
+from .style import OKABE_ITO, plt, save
 
 
 def _title(advice: Advice, what: str) -> str:

@@ -11,8 +11,8 @@ from typing import Any
 import numpy as np
 from matplotlib.patches import Patch
 
-from rpdrill.studies.catalogue import Quantity
-from rpdrill.studies.plots.style import MAP_COLORMAP, NO_RESULT_COLOR
+from ..catalogue import Quantity
+from .style import MAP_COLORMAP, NO_RESULT_COLOR
 
 FEW_VALUES = 8
 Position = Callable[[float, float], tuple[float, float]]

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rpdrill.models.results import SimulationResult
-from rpdrill.studies.catalogue import series
-from rpdrill.studies.plots.style import OKABE_ITO, plt, save
+from ...models.results import SimulationResult
+from ..catalogue import series
+from .style import OKABE_ITO, plt, save
 
 # result attribute -> time-history column (studies.catalogue)
 PANELS = {"bottom_m": "borehole_bottom_m", "bit_velocity_m_per_s": "bit_velocity_m_per_s", "rock_force_n": "rock_force_n"}

@@ -11,7 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from rpdrill.studies.reproduction import CaseResult, Figure, Reproduction
+from ..reproduction import CaseResult, Figure, Reproduction
 
 # Okabe-Ito: distinct for colour-blind readers
 PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")

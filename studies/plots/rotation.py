@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.studies.catalogue import metric, quantity
-from rpdrill.studies.plots.cells import cell_map
-from rpdrill.studies.plots.scans import metric_grid
-from rpdrill.studies.plots.style import plt, save
+from ..catalogue import metric, quantity
+from .cells import cell_map
+from .scans import metric_grid
+from .style import plt, save
 
 SPEED, FREQUENCY, RATE = "rotation.speed_rpm", "impact.frequency_hz", "penetration_rate_m_per_s"
 

@@ -20,12 +20,12 @@ from typing import Any
 
 import numpy as np
 
-from rpdrill.models.scene import Scene
-from rpdrill.studies.catalogue import Quantity, describe_scene, metric, quantity
-from rpdrill.studies.plots.cells import cell_map, no_result_patch
-from rpdrill.studies.plots.style import line_styles, plt, save
-from rpdrill.studies.study import Plot, Study
-from rpdrill.studies.study_optima import Record, Row, curves, metric_value, number_or_text
+from ...models.scene import Scene
+from ..catalogue import Quantity, describe_scene, metric, quantity
+from .cells import cell_map, no_result_patch
+from .style import line_styles, plt, save
+from ..study import Plot, Study
+from ..study_optima import Record, Row, curves, metric_value, number_or_text
 
 
 def curve_label(values: dict[str, str]) -> str:

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.studies.runners import Runner, sequential
-from rpdrill.studies.study import Plot, Study
-from rpdrill.studies.study_optima import Record, Row, metric_value
+from ..runners import Runner, sequential
+from ..study import Plot, Study
+from ..study_optima import Record, Row, metric_value
 
 PlotTask = tuple[Plot, Study, list[Row], list[Record], Path]
 
@@ -25,7 +25,7 @@ def plot_name(plot: Plot) -> str:
 def draw_plot(task: PlotTask) -> list[Path]:
     """Worker: draw one plot of a study into its path (studies.plots.scans, matplotlib loaded here, in
     the worker); the files written."""
-    from rpdrill.studies.plots.scans import draw
+    from .scans import draw
 
     return draw(*task)
 

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.models.scene import Scene
-from rpdrill.studies.catalogue import describe_scene, series
-from rpdrill.studies.plots.style import OKABE_ITO, plt, save
+from ...models.scene import Scene
+from ..catalogue import describe_scene, series
+from .style import OKABE_ITO, plt, save
 
 PANELS = ("bit_velocity_m_per_s", "borehole_bottom_m", "rock_force_n", "impact_force_n")
 ZOOM_BLOWS = 3

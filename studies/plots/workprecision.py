@@ -8,9 +8,9 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
-from rpdrill.models.workprecision import ERROR_LABELS, ERROR_MEASURES
-from rpdrill.studies.accuracy import AccuracyStudy, Row, number
-from rpdrill.studies.plots.style import line_styles, plt, save
+from ...models.workprecision import ERROR_LABELS, ERROR_MEASURES
+from ..accuracy import AccuracyStudy, Row, number
+from .style import line_styles, plt, save
 
 
 def plot_workprecision(study: AccuracyStudy, rows: list[Row], front: list[dict[str, Any]],
