@@ -21,7 +21,7 @@ from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
 from rpdrill.models.solver_settings import EXUDYN_PRESETS
 from rpdrill.models.workprecision import cost_at_error, errors
-from rpdrill.studies.accuracy import load_accuracy_study, reference_signature, run_setting
+from rpdrill.studies.accuracy.accuracy_study import load_accuracy_study, reference_signature, run_setting
 
 ROOT = Path(__file__).resolve().parents[1]
 MEASURE = "penetration_rate_error_rel"

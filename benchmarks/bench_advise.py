@@ -3,7 +3,7 @@
 First the cost of one run of each advise metric on the exact path, in this process (median over
 nine frequencies at 75 kN on sandstone): the penetration per impact energy needs the impact work,
 so the samples are every 1e-5 s instead of the output interval. Then for each Table 1 rock on
-the shipped scene: the best point of advise (differential evolution, studies.advice) and the best
+the shipped scene: the best point of advise (differential evolution, studies.advice.advice_search) and the best
 point of a fine grid over the same bounds (every ``--step-hz`` and ``--step-kn``, the same runs
 and thrust limit), the ratio of the two best values, and the wall time of advise per rock
 (search, curves and map) on a process pool of ``--workers``. The pool is started (and its
@@ -27,9 +27,17 @@ from pathlib import Path
 import numpy as np
 
 from rpdrill.rocklaw.catalog import TABLE_1
-from rpdrill.studies.advice import FEED, FREQUENCY, METRICS, Evaluator, Request, advise, runnable_scene
-from rpdrill.studies.loading import load_scene
-from rpdrill.studies.runners import process_pool, sequential
+from rpdrill.studies.advice.advice_search import (
+    FEED,
+    FREQUENCY,
+    METRICS,
+    AdviceEvaluator,
+    Request,
+    advise,
+    runnable_scene,
+)
+from rpdrill.studies.inputs.reading import load_scene
+from rpdrill.studies.runtime.pools import process_pool, sequential
 
 SCENE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
 
@@ -40,14 +48,14 @@ def grid_best(scene: dict, rock: str, request: Request, runner, step_hz: float, 
     (f_low, f_high), (feed_low, feed_high) = request.bounds[FREQUENCY], request.bounds[FEED]
     points = [{FREQUENCY: f, FEED: feed} for f in np.arange(f_low, f_high + 1e-9, step_hz)
               for feed in np.arange(feed_low, feed_high + 1e-9, step_n)]
-    values = np.nan_to_num(Evaluator(data, request, runner)(points).values, nan=0.0)
+    values = np.nan_to_num(AdviceEvaluator(data, request, runner)(points).values, nan=0.0)
     best = int(np.argmax(values))
     return float(values[best]), points[best]
 
 
 def seconds_per_run(scene: dict, metric: str, request: Request) -> float:
     """Median wall time of one run in this process (after a first run that loads the kernels)."""
-    evaluate = Evaluator(runnable_scene(scene, "sandstone", Request(metric, request.bounds), str(SCENE)),
+    evaluate = AdviceEvaluator(runnable_scene(scene, "sandstone", Request(metric, request.bounds), str(SCENE)),
                          Request(metric, request.bounds), sequential)
     evaluate([{FREQUENCY: 65.0, FEED: 75e3}])
     times = []
@@ -77,7 +85,7 @@ def main() -> None:
     print("rock | advise best | at [Hz, kN] | advise wall time [s] | runs | grid best | at [Hz, kN] | advise / grid")
     with process_pool(args.workers) as runner:
         list(runner(abs, [-1.0] * args.workers * 4))  # start the workers
-        Evaluator(runnable_scene(scene, "sandstone", request, str(SCENE)), request, runner)(
+        AdviceEvaluator(runnable_scene(scene, "sandstone", request, str(SCENE)), request, runner)(
             [{FREQUENCY: 65.0, FEED: 75e3}] * args.workers * 2)  # load the compiled kernels in each worker
         for rock in TABLE_1:
             start = time.perf_counter()

@@ -8,7 +8,7 @@ after a warm-up, one BLAS thread), and their ratio; the CPU cost per step a + b 
 measurements of each formulation, and DOP853's steps per radian (steps / (r T), r the fastest
 element's rate), the constants of models.cost; (2) for runs that store much (every step, or fine samples), the memory
 estimate against the growth of the peak resident set during the run, each in a fresh process;
-(3) what a command holds besides its runs (studies.budgets): a prepared study point (tracemalloc)
+(3) what a command holds besides its runs (studies.runtime.budgets): a prepared study point (tracemalloc)
 and the CPU time to prepare it, and a calibration's evaluation record of the shipped calibration.
 """
 
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 
-# one BLAS thread, as in a study's workers (studies.runners.SINGLE_THREAD): set before NumPy loads
+# one BLAS thread, as in a study's workers (studies.runtime.pools.SINGLE_THREAD): set before NumPy loads
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
@@ -36,10 +36,10 @@ from rpdrill.models.cost import CPU_S_PER_STEP, Cause, cost_key, run_cost
 from rpdrill.models.formulations import unsupported
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.calibration import target_result
-from rpdrill.studies.calibration_spec import load_calibration
-from rpdrill.studies.loading import read_yaml
-from rpdrill.studies.points import prepare_point
+from rpdrill.studies.calibration.calibration_search import target_result
+from rpdrill.studies.calibration.calibration_spec import load_calibration
+from rpdrill.studies.inputs.reading import read_yaml
+from rpdrill.studies.runtime.point_runs import prepare_point
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "studies" / "scenes"

@@ -14,7 +14,7 @@ from pathlib import Path
 from rpdrill.models import exudyn_model
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.loading import load_scene
+from rpdrill.studies.inputs.reading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 

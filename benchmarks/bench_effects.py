@@ -15,7 +15,7 @@ from rpdrill.models.exudyn_model import build_exudyn
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.loading import read_yaml
+from rpdrill.studies.inputs.reading import read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 RATE_ONLY = {"effects": {"rock_damping": True, "joint_damping": True},

@@ -42,7 +42,7 @@ from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.loading import read_yaml
+from rpdrill.studies.inputs.reading import read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = ROOT / "studies" / "scenes" / "paper_base.yaml"

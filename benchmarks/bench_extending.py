@@ -29,7 +29,7 @@ from rpdrill.models.links import LINK_TYPES
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.loading import parse_yaml, read_yaml
+from rpdrill.studies.inputs.reading import parse_yaml, read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import os
 
-# one BLAS thread, as in a study's workers (studies.runners.WORKER_ENVIRONMENT): set before NumPy loads
+# one BLAS thread, as in a study's workers (studies.runtime.pools.WORKER_ENVIRONMENT): set before NumPy loads
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
@@ -45,7 +45,7 @@ from rpdrill.models.simulation import prepare
 from rpdrill.models.solver_settings import EXUDYN_PRESETS
 from rpdrill.models.stability import StepScales
 from rpdrill.models.workprecision import pareto_front
-from rpdrill.studies.loading import load_scene
+from rpdrill.studies.inputs.reading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))  # the hard scenes of the stability suite

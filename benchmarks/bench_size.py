@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import os
 
-# one BLAS thread, as in a study's workers (studies.runners.WORKER_ENVIRONMENT): set before NumPy loads
+# one BLAS thread, as in a study's workers (studies.runtime.pools.WORKER_ENVIRONMENT): set before NumPy loads
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
@@ -29,7 +29,7 @@ import numpy as np
 from rpdrill.models.exact_model import BLAS, OPERATOR_CACHE, ExactSolver
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.loading import read_yaml
+from rpdrill.studies.inputs.reading import read_yaml
 
 SCENE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "four_rod_string.yaml"
 RODS = ("rod1", "rod2", "rod3", "rod4")

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 
-# one BLAS thread, as in a study's workers (studies.runners.WORKER_ENVIRONMENT): set before NumPy loads
+# one BLAS thread, as in a study's workers (studies.runtime.pools.WORKER_ENVIRONMENT): set before NumPy loads
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
@@ -27,7 +27,7 @@ from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
 from rpdrill.models.waves import transmitted_pulse_n, travel_time_s
-from rpdrill.studies.loading import load_scene, read_yaml
+from rpdrill.studies.inputs.reading import load_scene, read_yaml
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 

@@ -3,13 +3,11 @@
 Usage: python benchmarks/bench_studies.py [--workers N] [--formulations exact,fast] [--repeats N]
 For each formulation (``exact``: the exact formulation; ``fast``/``standard``: Exudyn at that preset),
 the three paper scans (studies/paper/{frequency,impulse,stiffness}_scan.yaml, 207 points of 1.5 s)
-run through the study command's own loop (studies.commands.study.run_studies: resumable results, the
+run through the study command's own loop (studies.cli.study_command.run_studies: resumable results, the
 scans' points as one run, a point two scans share run once, optima, each scan's plots drawn by the
 workers once its points are done) on one process pool,
-into a scratch directory, each formulation in a process of its own (its own pool and fork server,
-started before its own imports with the study command's module preloaded, as the command line
-does), --repeats times. Prints, of the run of median wall time, the wall time from opening the pool to the last plot, the CPU seconds of that process,
-its fork server and its workers (read from /proc before the pool closes: Linux; on a shared machine
+into a scratch directory, each formulation in a process of its own (its own pool), --repeats times. Prints, of the run of median wall time, the wall time from opening the pool to the last plot, the CPU seconds of that process,
+and its workers (read from /proc before the pool closes: Linux; on a shared machine
 the wall time depends on the other load, the CPU time is what the run needs: on N idle cores the wall
 time is about CPU / N), the points and how many were run, the CPU seconds the simulations reported
 (``cpu_time_s`` of every point run),
@@ -37,18 +35,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from rpdrill.studies.runners import start_worker_server
-
-if __name__ == "__main__" and "--one" in sys.argv:
-    start_worker_server(["rpdrill.studies.commands.study"])  # as the command line does, before the imports below
-
 import yaml
 
-from rpdrill.studies.commands.study import run_studies
-from rpdrill.studies.loading import read_yaml
-from rpdrill.studies.plots.tasks import draw_plot, plot_tasks
-from rpdrill.studies.runners import pool
-from rpdrill.studies.study import load_study
+from rpdrill.studies.cli.study_command import run_studies
+from rpdrill.studies.figures.plot_tasks import draw_plot, plot_tasks
+from rpdrill.studies.inputs.reading import read_yaml
+from rpdrill.studies.runtime.pools import pool
+from rpdrill.studies.scan.study import load_study
 
 ROOT = Path(__file__).resolve().parents[1]
 SCANS = ("frequency_scan", "impulse_scan", "stiffness_scan")
@@ -68,7 +61,7 @@ def study_file(scan: str, solver: str, folder: Path) -> Path:
 
 def process_tree_cpu_s(pid: int) -> float:
     """CPU seconds (user + system) of process ``pid`` and of its living descendants, from /proc (Linux):
-    the pool's fork server and its workers, which are not this process's waited-for children."""
+    the pool's workers, which are not this process's waited-for children."""
     tick = os.sysconf("SC_CLK_TCK")
     parents, cpu = {}, {}
     for entry in Path("/proc").iterdir():
@@ -89,8 +82,8 @@ def process_tree_cpu_s(pid: int) -> float:
 
 
 def three_scans(solver: str, workers: int, folder: Path) -> None:
-    """The three scans on one pool in this process (a child of main: its own fork server), through the
-    study command's own loop (studies.commands.study.run_studies), into new folders; its figures as
+    """The three scans on one pool in this process (a child of main: its own pool), through the
+    study command's own loop (studies.cli.study_command.run_studies), into new folders; its figures as
     one line of JSON."""
     studies = [load_study(study_file(scan, solver, folder)) for scan in SCANS]
     folders = [Path(tempfile.mkdtemp(prefix=f"{scan}_{solver}_", dir=folder)) for scan in SCANS]
@@ -105,7 +98,7 @@ def three_scans(solver: str, workers: int, folder: Path) -> None:
     simulated_cpu = sum(run_once.values())
     points = f"{sum(len(rows) for _, _, rows, *_ in outcomes)} ({len(run_once)})"
     plots_cpu = []
-    import rpdrill.studies.plots.scans  # noqa: F401 - matplotlib loaded first, as in the pool's workers
+    import rpdrill.studies.figures.scan_figures  # noqa: F401 - matplotlib loaded first, as in the pool's workers
     for study, out, rows, optima, *_ in outcomes:  # each plot again, in this process, for its CPU time
         (folder / "replotted" / out.name).mkdir(parents=True)
         for task in plot_tasks(study, rows, optima, folder / "replotted" / out.name)[0]:
@@ -125,24 +118,6 @@ def one_command(solver: str, workers: int, folder: Path, scans: tuple[str, ...])
                     "--workers", str(workers), "--quiet"],
                    check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     return time.perf_counter() - start
-
-
-EXIT_PROBE = ("import time; start = time.perf_counter(); import rpdrill.studies.commands.study, "
-              "rpdrill.studies.plots.scans, rpdrill.models.exact_kernels, scipy.signal; "
-              "print(time.perf_counter() - start)")
-
-
-def exit_cost(freeze: bool, repeats: int = 5) -> float:
-    """Median wall seconds of a Python process that imports what a study command and its workers load,
-    less its imports: the interpreter's start and exit (``freeze``: gc.freeze() before exiting, as the
-    rpdrill program does)."""
-    code = EXIT_PROBE + ("; import gc; gc.freeze()" if freeze else "")
-    rest = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        imports = float(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout)
-        rest.append(time.perf_counter() - start - imports)
-    return statistics.median(rest)
 
 
 def main() -> None:
@@ -177,8 +152,6 @@ def main() -> None:
                   f"{run['simulated_cpu'] / run['cpu']:<20.2f}{run['plots_written']:<7}{sum(run['plots_cpu']):<12.2f}"
                   f"{' '.join(f'{c:.2f}' for c in run['plots_cpu']):<32}{run['process']:<11.2f}"
                   + " ".join(f"{r['wall']:.2f}" for r in runs), flush=True)
-        print(f"a process's start and exit with the study command's libraries loaded: {exit_cost(False):.3f} s, "
-              f"{exit_cost(True):.3f} s with gc.freeze() before the exit (median of 5)")
         for solver in solvers:
             for scans in (SCANS, SCANS[:1]):
                 walls = [one_command(solver, args.workers, folder, scans) for _ in range(args.repeats)]

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .results import SimulationResult
 from ..rocklaw.base import cumulative_trapezoid
+from .results import SimulationResult
 
 
 @dataclass

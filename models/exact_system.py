@@ -14,13 +14,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg.lapack import dgebal
 
+from ..rocklaw.base import VELOCITY
+from ..rocklaw.modes import Affine
 from .chain import torsion_first_order_matrix
 from .links import RATE
 from .piecewise import Element, elements, undeclared
 from .pulse import phase_generator, phase_row
 from .simulation import Simulation
-from ..rocklaw.base import VELOCITY
-from ..rocklaw.modes import Affine
 
 MAX_ENUMERATED_MODES = 256  # mode combinations whose norms are all measured to choose h
 Modes = tuple[str, ...]

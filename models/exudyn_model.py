@@ -38,6 +38,8 @@ from exudyn.itemInterface import (
     SensorObject,
 )
 
+from ..rocklaw.backends import SCALAR, SymbolicBackend
+from ..rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 from .chain import AxialChain, Link
 from .formulations import AUTOMATIC_STEP_SOLVERS
 from .indexing import BlowStarts
@@ -46,8 +48,6 @@ from .results import SimulationResult
 from .scene import Scene
 from .simulation import Simulation, as_simulation
 from .stability import SimulationFailed, StepLimitWarning, check_result, step_warning
-from ..rocklaw.backends import SCALAR, SymbolicBackend
-from ..rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 
 SOLVER_TYPES = {
     "rk67": exu.DynamicSolverType.RK67,

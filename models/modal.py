@@ -17,8 +17,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from .chain import AxialChain
 from ..rocklaw import RockLaw
+from .chain import AxialChain
 
 
 def rock_mode_frequency_hz(chain: AxialChain, rock: RockLaw) -> float:

@@ -31,6 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from ..rocklaw.backends import NUMERIC
 from .chain import link_load_n, torsion_first_order_matrix
 from .indexing import BlowStarts
 from .piecewise import Element, elements, rock_element, undeclared
@@ -39,7 +40,6 @@ from .results import SimulationResult
 from .scene import Impact
 from .simulation import Scene, Simulation, as_simulation
 from .stability import SimulationFailed, diverged_index
-from ..rocklaw.backends import NUMERIC
 
 # Mode switches at one instant beyond this mean a law chatters: report instead of looping.
 MAX_SWITCHES_AT_ONE_TIME = 20

@@ -18,6 +18,8 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
+from ..rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
+from ..rocklaw.catalog import TABLE_1
 from .formulations import (
     COMMON_SOLVER_KEYS,
     EXUDYN_SOLVERS,
@@ -27,8 +29,6 @@ from .formulations import (
 )
 from .links import LINK_TYPES
 from .outputs import METRICS, SERIES, Need, needs
-from ..rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
-from ..rocklaw.catalog import TABLE_1
 
 Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]

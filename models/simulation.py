@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..rocklaw import RockLaw, State
 from .chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
 from .formulations import simulate
 from .indexing import BlowStarts, Indexing
@@ -35,7 +36,6 @@ from .scene import (
 )
 from .solver_settings import Settings, resolve_settings
 from .stability import FastestElement, StepScales, fastest_element, step_scales
-from ..rocklaw import RockLaw, State
 
 if TYPE_CHECKING:
     from .results import SimulationResult

@@ -17,11 +17,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.linalg import block_diag
 
+from ..rocklaw import RockLaw
 from .chain import AxialChain, torsion_first_order_matrix
 from .energy import energy_account
 from .pulse import impulse_per_blow_n_s
 from .scene import Scene, Torsion
-from ..rocklaw import RockLaw
 
 if TYPE_CHECKING:
     from .results import SimulationResult

@@ -8,7 +8,7 @@ from typing import Any
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.loading import read_yaml
+from rpdrill.studies.inputs.reading import read_yaml
 
 PAPER_BASE = Path(__file__).resolve().parent / "test_drill.yaml"
 

@@ -22,8 +22,8 @@ from rpdrill.models.workprecision import (
     signature,
     uniform_grid_s,
 )
-from rpdrill.studies.accuracy import TimeLimitExceeded, cpu_time_limit, load_accuracy_study
-from rpdrill.studies.cli import main
+from rpdrill.studies.accuracy.accuracy_study import TimeLimitExceeded, cpu_time_limit, load_accuracy_study
+from rpdrill.studies.cli.main import main
 
 END_S = 0.04  # two blows at 50 Hz
 GRID = uniform_grid_s(END_S, 1e-4)

@@ -1,4 +1,4 @@
-"""``rpdrill advise`` (studies.advice): the search against brute force, the thrust limit, the
+"""``rpdrill advise`` (studies.advice.advice_search): the search against brute force, the thrust limit, the
 feed-force reading of the map, the penetration per impact energy, and the command."""
 
 from __future__ import annotations
@@ -14,12 +14,12 @@ from scenes import crushing_scene, scene, scene_dict, simulate
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.pulse import impulse_per_blow_n_s
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.advice import (
+from rpdrill.studies.advice.advice_search import (
     FEED,
     FREQUENCY,
     PARAMETERS,
+    AdviceEvaluator,
     AdviseParameter,
-    Evaluator,
     Request,
     advise,
     at_point,
@@ -28,8 +28,8 @@ from rpdrill.studies.advice import (
     runnable_scene,
     thrust_ratio,
 )
-from rpdrill.studies.cli import main
-from rpdrill.studies.runners import sequential
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.runtime.pools import sequential
 
 RATE = "penetration_rate_m_per_s"
 SHORT = {"solver": {"end_time_s": 0.3}, "metrics": {"transient_blows": 4, "block_blows": 4}}
@@ -45,7 +45,7 @@ def test_advise_finds_the_best_of_a_fine_grid():
     request = Request(RATE, {FREQUENCY: (45.0, 70.0), FEED: (35e3, 60e3)})
     grid = [{FREQUENCY: f, FEED: feed} for f in np.arange(45.0, 70.1, 1.0) for feed in np.arange(35e3, 60.1e3, 1e3)]
     data = runnable_scene(base, None, request, "test")
-    brute = np.nanmax(Evaluator(data, request, sequential)(grid).values)
+    brute = np.nanmax(AdviceEvaluator(data, request, sequential)(grid).values)
     advice = advise(data, None, request, sequential)
     assert brute > 0
     assert advice.best_value >= 0.99 * brute
@@ -78,13 +78,13 @@ def test_points_beyond_the_thrust_limit_are_not_run():
     data = runnable_scene(base, None, request, "test")
     limit = limit_feed_n(data, 60.0, 1.0)
     assert thrust_ratio(at_point(data, {FREQUENCY: 60.0, FEED: limit})) == pytest.approx(1.0)
-    evaluate = Evaluator(data, request, sequential)
+    evaluate = AdviceEvaluator(data, request, sequential)
     evaluation = evaluate([{FREQUENCY: 60.0, FEED: 0.9 * limit}, {FREQUENCY: 60.0, FEED: 1.1 * limit}])
     assert math.isfinite(evaluation.values[0]) and math.isnan(evaluation.values[1])
     assert (evaluate.runs, evaluate.beyond_limit) == (1, 1)
     objective = evaluation.objective()
     assert objective[0] <= 0 < objective[1]  # beyond the limit is worse than any point below it
-    half = Evaluator(data, Request(RATE, request.bounds, max_thrust_ratio=0.5), sequential)
+    half = AdviceEvaluator(data, Request(RATE, request.bounds, max_thrust_ratio=0.5), sequential)
     assert math.isnan(half([{FREQUENCY: 60.0, FEED: 0.9 * limit}]).values[0])
 
 

@@ -13,7 +13,7 @@ import pytest
 from scenes import simulate
 
 from rpdrill.models.metrics import summary_metrics
-from rpdrill.studies.loading import load_scene
+from rpdrill.studies.inputs.reading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 LAYER = {"rocklaw": 0, "models": 1, "studies": 2, "": 3}  # studies -> models -> rocklaw; the API on top
@@ -21,7 +21,7 @@ LAYER = {"rocklaw": 0, "models": 1, "studies": 2, "": 3}  # studies -> models ->
 
 def package_files() -> dict[str, Path]:
     """Every module of the checkout's package, read from the files (no install): dotted name below
-    ``rpdrill`` ("" the package itself, "models.scene", "studies.cli.main", ...) -> path."""
+    ``rpdrill`` ("" the package itself, "models.scene", "studies.cli.main.main", ...) -> path."""
     files = {"": ROOT / "__init__.py"}
     for folder in ("rocklaw", "models", "studies"):
         for path in sorted((ROOT / folder).rglob("*.py")):

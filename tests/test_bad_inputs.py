@@ -4,7 +4,7 @@ Clean: the declared exit status (2 bad input, 1 a budget exceeded or a run that 
 message on standard error that names the file (the ``--out`` folder, or the command-line argument,
 where that is what is wrong) and contains the declared word, no traceback, and nothing written to
 ``--out`` (absent before: absent after; holding something: unchanged). Each
-case runs in this process through ``rpdrill.studies.cli.main``; they are refused before anything
+case runs in this process through ``rpdrill.studies.cli.main.main``; they are refused before anything
 heavy runs, so the corpus is fast.
 """
 
@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from rpdrill.studies.cli import main
+from rpdrill.studies.cli.main import main
 
 CORPUS = Path(__file__).resolve().parent / "bad_inputs"
 CASES: dict[str, dict] = yaml.safe_load((CORPUS / "cases.yaml").read_text(encoding="utf-8"))

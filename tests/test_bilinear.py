@@ -15,8 +15,8 @@ from rpdrill.models.energy import energy_account
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.simulation import prepare
 from rpdrill.rocklaw import BilinearRock, force_and_state
-from rpdrill.studies.cli import main
-from rpdrill.studies.crosscheck import DEFAULT_STEP_S
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
 
 K_LOAD, K_UNLOAD = 2e8, 1e9
 LAW = BilinearRock(K_LOAD, K_UNLOAD)

@@ -13,11 +13,11 @@ import pytest
 import yaml
 from scenes import PAPER_BASE
 
-from rpdrill.studies import targets
-from rpdrill.studies.calibration import objective, refined_frequencies_hz
-from rpdrill.studies.calibration_report import non_dominated
-from rpdrill.studies.calibration_spec import Parameter, load_calibration
-from rpdrill.studies.cli import main
+from rpdrill.studies.calibration.calibration_report import non_dominated
+from rpdrill.studies.calibration.calibration_search import objective, refined_frequencies_hz
+from rpdrill.studies.calibration.calibration_spec import Parameter, load_calibration
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.scan import frequency_scans as targets
 
 ROOT = Path(__file__).resolve().parents[1]
 COLLAR = "drill_string.bodies.collar.mass_kg"

@@ -1,4 +1,4 @@
-"""studies.catalogue: every metric, time history and scene parameter has a name and a unit, and no
+"""studies.display.catalogue: every metric, time history and scene parameter has a name and a unit, and no
 plot shows a raw key name."""
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ from scenes import PAPER_BASE, scene
 
 from rpdrill.models.outputs import METRICS, SERIES
 from rpdrill.models.scene import Scene
-from rpdrill.studies import catalogue
-from rpdrill.studies.loading import allowed_keys
+from rpdrill.studies.display import catalogue
+from rpdrill.studies.inputs.reading import allowed_keys
 
 WORDS = re.compile(r"[a-z]+(?:[._][a-z0-9]+)+")  # snake_case or dotted keys
 
@@ -32,7 +32,7 @@ def scene_leaf_paths(prefix: tuple[str, ...] = ()) -> list[str]:
 def test_every_metric_has_an_entry_with_a_unit():
     """Fails when a metric is added to models.outputs without a catalogue entry."""
     missing = sorted(set(METRICS) - set(catalogue.METRICS))
-    assert not missing, f"studies/catalogue.py has no entry for the metrics {missing}"
+    assert not missing, f"studies/display/catalogue.py has no entry for the metrics {missing}"
     assert set(catalogue.METRICS) == set(METRICS), "catalogue entries for metrics the model does not have"
     for name, quantity in catalogue.METRICS.items():
         assert quantity.unit and quantity.si_unit and quantity.scale > 0, name
@@ -51,7 +51,7 @@ def test_every_scene_parameter_has_an_entry():
     paths = scene_leaf_paths()
     assert "drill_string.bodies.*.mass_kg" in paths and "impact.frequency_hz" in paths
     missing = [p for p in paths if p not in catalogue.PARAMETERS]
-    assert not missing, f"studies/catalogue.py has no entry for the scene keys {missing}"
+    assert not missing, f"studies/display/catalogue.py has no entry for the scene keys {missing}"
     assert set(catalogue.PARAMETERS) <= set(paths), "catalogue entries for keys the scene does not have"
     numeric = [p for p in paths if re.search(r"_(hz|n|s|m|kg|pa|m3|m2|rad|n_m|per_m|per_rad)$", p)]
     assert numeric and all(not catalogue.PARAMETERS[p].categorical for p in numeric)
@@ -99,9 +99,9 @@ def plot_texts(monkeypatch) -> list[str]:
 
 
 def test_study_plots_show_no_raw_key_names(tmp_path, plot_texts):
-    from rpdrill.studies.plots.tasks import start_plots
-    from rpdrill.studies.study import load_study
-    from rpdrill.studies.study_optima import study_optima
+    from rpdrill.studies.figures.plot_tasks import start_plots
+    from rpdrill.studies.scan.study import load_study
+    from rpdrill.studies.scan.study_optima import study_optima
 
     study_file = tmp_path / "s.yaml"
     study_file.write_text(yaml.safe_dump({
@@ -126,8 +126,9 @@ def test_study_plots_show_no_raw_key_names(tmp_path, plot_texts):
 def test_a_map_keeps_axes_zipped_with_its_rows_in_one_panel(tmp_path, monkeypatch):
     """The rock's damping zipped with its stiffness changes along the map's rows: one panel of two rows,
     the damping named in the row label, not a panel per damping."""
-    from rpdrill.studies.plots import scans, tasks
-    from rpdrill.studies.study import load_study
+    from rpdrill.studies.figures import plot_tasks as tasks
+    from rpdrill.studies.figures import scan_figures as scans
+    from rpdrill.studies.scan.study import load_study
 
     study_file = tmp_path / "s.yaml"
     study_file.write_text(yaml.safe_dump({

@@ -14,7 +14,7 @@ import pytest
 import yaml
 from scenes import PAPER_BASE, scene_dict
 
-from rpdrill.studies.cli import COMMANDS, main
+from rpdrill.studies.cli.main import COMMANDS, main
 
 ROOT = Path(__file__).resolve().parents[1]
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}
@@ -79,29 +79,3 @@ def test_worker_warnings_print_once_as_one_line(tmp_path):
     assert len(lines) == 1, done.stderr
     assert lines[0].startswith("rpdrill: warning: scene 'test_drill': solver.step_s 0.0002 exceeds the stability limit")
     assert ".py" not in done.stderr and "Traceback" not in done.stderr
-
-
-@pytest.mark.parametrize("argv, pool", [
-    (["study", "s.yaml", "--out", "o"], True), (["calibrate", "c.yaml", "--workers", "2"], True),
-    (["study", "s.yaml", "--workers", "1"], False), (["study", "s.yaml", "--workers=1"], False),
-    (["study", "s.yaml", "--dask"], False), (["study", "s.yaml", "--dask=tcp://host:8786"], False),
-    (["study", "--help"], False), (["simulate", "scene.yaml"], False), ([], False)])
-def test_the_fork_server_starts_early_only_for_a_process_pool(argv, pool):
-    """The hint read before parsing (studies.cli): the fork server starts with the command only when its
-    runs go to a process pool."""
-    from rpdrill.studies.cli import _runs_a_process_pool
-
-    assert _runs_a_process_pool(argv) is pool
-
-
-def test_the_pool_commands_are_those_that_open_a_pool():
-    """POOL_COMMANDS (the early fork-server hint) lists exactly the commands whose module opens a pool
-    (studies.runners.pool), so that a new command that runs points is not left cold."""
-    import importlib
-    import inspect
-
-    from rpdrill.studies.cli import POOL_COMMANDS
-
-    opening = {name for name, (module, _) in COMMANDS.items()
-               if "pool(" in inspect.getsource(importlib.import_module(module))}
-    assert opening == set(POOL_COMMANDS)

@@ -16,8 +16,8 @@ from scenes import PAPER_BASE, PER_BODY, scene_dict, simulate
 
 from rpdrill.models.compare import compare_runs, verdict
 from rpdrill.models.scene import Scene
-from rpdrill.studies.cli import main
-from rpdrill.studies.crosscheck import DEFAULT_STEP_S
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
 
 BLOWS = 15
 LIFT_OFF_M = 1e-9  # a gap below this (round-off of the start from rest, ~1e-19 m) is no lift-off

@@ -20,8 +20,8 @@ from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
 from rpdrill.models.waves import transmitted_pulse_n, travel_time_s
 from rpdrill.rocklaw.modes import check_mode_forces
-from rpdrill.studies.cli import main
-from rpdrill.studies.loading import load_scene, read_yaml
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.inputs.reading import load_scene, read_yaml
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 ROD = {"length_m": 3.66, "diameter_m": 0.045, "bore_diameter_m": 0.012}

@@ -29,7 +29,7 @@ from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.results import SimulationResult
 from rpdrill.models.scene import Scene
 from rpdrill.models.stability import SimulationFailed
-from rpdrill.studies.loading import read_yaml
+from rpdrill.studies.inputs.reading import read_yaml
 
 BLOWS = 12
 SHORT_METRICS = {"metrics__transient_blows": 2, "metrics__block_blows": 2}
@@ -87,7 +87,7 @@ def test_does_not_import_exudyn() -> None:
 def test_checking_and_estimating_a_run_does_not_load_the_kernels() -> None:
     """A study's points are checked and their cost estimated (models.exact_system) before any runs,
     in the command's own process: numba (0.25 s to import) is for the workers that run them."""
-    code = ("import sys; from rpdrill.models.cost import run_cost; from rpdrill.studies.loading import load_scene, "
+    code = ("import sys; from rpdrill.models.cost import run_cost; from rpdrill.studies.inputs.reading import load_scene, "
             f"prepare_scene; run_cost(prepare_scene(load_scene({str(PAPER_BASE)!r}).with_solver('exact'), 'test')); "
             "assert 'numba' not in sys.modules and 'rpdrill.models.exact_system' in sys.modules")
     subprocess.run([sys.executable, "-c", code], check=True)

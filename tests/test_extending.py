@@ -13,7 +13,7 @@ from rpdrill.models.energy import energy_account
 from rpdrill.models.links import LINK_TYPES, RATE, STRETCH, Link
 from rpdrill.models.scene import Scene
 from rpdrill.rocklaw.modes import check_mode_forces
-from rpdrill.studies.loading import parse_yaml
+from rpdrill.studies.inputs.reading import parse_yaml
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "extending.md"
 SHORT = {"solver.end_time_s": 0.2, "metrics.transient_blows": 3, "metrics.block_blows": 3,

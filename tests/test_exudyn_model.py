@@ -143,7 +143,7 @@ import json, sys
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.simulation import prepare
 from rpdrill.rocklaw.exudyn_module import FAST
-from rpdrill.studies.loading import load_scene
+from rpdrill.studies.inputs.reading import load_scene
 scene = load_scene(sys.argv[1]).with_solver("exudyn", preset="fast", end_time_s=0.3)
 rate = summary_metrics(prepare(scene).run())["penetration_rate_m_per_s"]
 print(json.dumps({"fast": FAST, "loaded": sorted(m for m in sys.modules if m.startswith("exudyn.exudynCPP")),

@@ -18,10 +18,10 @@ from rpdrill.models.indexing import CRATER, FRESH, MIN_FRESH_FRACTION, RIDGES, I
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Bit, Scene
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.cli import main
-from rpdrill.studies.crosscheck import DEFAULT_STEP_S
-from rpdrill.studies.loading import InputError, prepare_scene, read_yaml
-from rpdrill.studies.study import load_study
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
+from rpdrill.studies.inputs.reading import InputError, prepare_scene, read_yaml
+from rpdrill.studies.scan.study import load_study
 
 BIT = {"diameter_m": 0.216, "gauge_button_diameter_m": 0.019, "gauge_buttons": 12}  # the DTH bit
 DIAMETER, BUTTON = BIT["diameter_m"], BIT["gauge_button_diameter_m"]

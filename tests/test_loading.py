@@ -1,11 +1,11 @@
-"""Strict YAML reading (studies.loading): what it accepts that YAML 1.1 gets wrong or lets pass, and
+"""Strict YAML reading (studies.inputs.reading): what it accepts that YAML 1.1 gets wrong or lets pass, and
 that valid files still read as before. Malformed files are in the corpus (tests/test_bad_inputs.py)."""
 
 from __future__ import annotations
 
 import pytest
 
-from rpdrill.studies.loading import InputError, parse_yaml, read_yaml
+from rpdrill.studies.inputs.reading import InputError, parse_yaml, read_yaml
 
 
 def test_yaml_12_floats_are_numbers():

@@ -14,7 +14,7 @@ from rpdrill.models import ode_model
 from rpdrill.models.energy import energy_account
 from rpdrill.models.scene import Scene
 from rpdrill.models.stability import SimulationFailed
-from rpdrill.studies.loading import read_yaml
+from rpdrill.studies.inputs.reading import read_yaml
 
 
 def scene_from_base(blows: float = 15, **changes: object) -> Scene:

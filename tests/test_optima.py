@@ -1,9 +1,9 @@
-"""studies.optima on synthetic curves: refined peaks, lobes, main lobe, bands."""
+"""studies.scan.curve_optima on synthetic curves: refined peaks, lobes, main lobe, bands."""
 
 import numpy as np
 import pytest
 
-from rpdrill.studies.optima import band_hz, curve_optimum, parabola_vertex_hz
+from rpdrill.studies.scan.curve_optima import band_hz, curve_optimum, parabola_vertex_hz
 
 FREQUENCIES = np.arange(10.0, 121.0, 5.0)
 

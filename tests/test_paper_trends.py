@@ -16,9 +16,9 @@ from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.modal import rock_mode_frequency_hz
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import prepare
-from rpdrill.studies.loading import read_yaml
-from rpdrill.studies.optima import curve_optimum
-from rpdrill.studies.specs import set_path
+from rpdrill.studies.inputs.reading import read_yaml
+from rpdrill.studies.inputs.specs import set_path
+from rpdrill.studies.scan.curve_optima import curve_optimum
 
 PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"
 SOFT_ROCK = {"rock.stiffness_n_per_m": 8.93e7, "rock.damping_n_s_per_m": 683.0, "rock.threshold_n": 123e3}
@@ -32,7 +32,7 @@ def pipe_drill(**overrides: object) -> Scene:
 
 
 def main_lobe_optimum_hz(frequencies_hz: np.ndarray, metric: str, **overrides: object) -> float:
-    """The main-lobe optimum (studies.optima, the lobe nearest the rock mode) of a frequency scan."""
+    """The main-lobe optimum (studies.scan.curve_optima, the lobe nearest the rock mode) of a frequency scan."""
     values, resonance = [], None
     for frequency in frequencies_hz:
         simulation = prepare(pipe_drill(**overrides, **{"impact.frequency_hz": float(frequency),

@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from rpdrill.studies.calibration_spec import load_calibration
-from rpdrill.studies.cli import main
-from rpdrill.studies.reproduction import load_reproduction
+from rpdrill.studies.calibration.calibration_spec import load_calibration
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.reproduction.paper_reproduction import load_reproduction
 
 ROOT = Path(__file__).resolve().parents[1]
 PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"
@@ -95,7 +95,7 @@ def test_bad_reproduction_files_exit_2(tmp_path, capsys, changes, fragment):
 
 def test_no_result_number_is_typed_into_the_generated_page_templates():
     """The page module holds no numbers of results: every number it prints is formatted from a value."""
-    text = (ROOT / "studies" / "paper_pages.py").read_text()
+    text = (ROOT / "studies" / "pages" / "paper_pages.py").read_text()
     literals = re.findall(r"(?<![\w.{:])\d+\.\d+ ?(?:Hz|mm/s|m/s|%)", text)
     assert literals == []
 

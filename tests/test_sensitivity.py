@@ -12,8 +12,8 @@ import pytest
 import yaml
 from scenes import PAPER_BASE
 
-from rpdrill.studies.cli import main
-from rpdrill.studies.sensitivity import load_sensitivity, scene_values
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.sensitivity.sensitivity_study import load_sensitivity, scene_values
 
 COLLAR, ROCK = "drill_string.bodies.collar.mass_kg", "rock.stiffness_n_per_m"
 ROOT = Path(__file__).resolve().parents[1]

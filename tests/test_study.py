@@ -23,12 +23,12 @@ from scenes import PAPER_BASE, simulate
 from rpdrill.models.metrics import summary_metrics
 from rpdrill.models.scene import Scene
 from rpdrill.models.stability import StepLimitWarning
-from rpdrill.studies.cli import main
-from rpdrill.studies.loading import read_yaml
-from rpdrill.studies.points import run_point
-from rpdrill.studies.runners import BATCHES_PER_WORKER, WORKER_ENVIRONMENT, batches, process_pool
-from rpdrill.studies.specs import METRIC_NAMES
-from rpdrill.studies.study import load_study
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.inputs.reading import read_yaml
+from rpdrill.studies.inputs.specs import METRIC_NAMES
+from rpdrill.studies.runtime.point_runs import run_point
+from rpdrill.studies.runtime.pools import BATCHES_PER_WORKER, ONE_THREAD, batches, process_pool
+from rpdrill.studies.scan.study import load_study
 
 ROOT = Path(__file__).resolve().parents[1]
 SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}
@@ -222,24 +222,20 @@ def test_resume_after_kill(tmp_path, capsys):
     assert all(r == before[r["point"]] for r in after if r["point"] in before)
 
 
-def worker_state(_: int) -> tuple[int, bool, bool, str | None, bool]:
-    """What a pool worker holds when it takes its first task (a top-level function: it is pickled)."""
-    import multiprocessing
+def worker_state(_: int) -> tuple[int, int]:
+    """A pool worker's process id and the BLAS threads it runs (a top-level function: it is pickled)."""
+    from threadpoolctl import threadpool_info
 
-    return (os.getpid(), "rpdrill.studies.warm_worker" in sys.modules, "matplotlib.pyplot" in sys.modules,
-            os.environ.get("OPENBLAS_NUM_THREADS"), multiprocessing.parent_process() is not None)
+    return os.getpid(), max((pool["num_threads"] for pool in threadpool_info()), default=1)
 
 
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the fork server is used on Linux only")
-def test_pool_workers_start_warm_from_the_fork_server():
-    """The process pool's workers are forked from the fork server that imported studies.warm_worker (the
-    formulations, the kernels, matplotlib), with the workers' environment, and a second pool forks from
-    the same server."""
+def test_pool_workers_run_one_blas_thread_each_in_their_own_processes():
+    """Two workers on two cores run two BLAS threads, not four; a second pool starts new workers."""
     first, second = ([s for batch in run(worker_state, [0, 1, 2, 3]) for s in batch]
                      for run in (process_pool_runner(), process_pool_runner()))
     for states in (first, second):
-        assert all(warm and plots and blas == "1" and child for _, warm, plots, blas, child in states)
-    assert not {pid for pid, *_ in first} & {pid for pid, *_ in second}  # new workers, same warm server
+        assert all(threads == 1 and pid != os.getpid() for pid, threads in states)
+    assert not {pid for pid, _ in first} & {pid for pid, _ in second}
 
 
 def process_pool_runner() -> Any:
@@ -302,7 +298,7 @@ def dask_cluster(folder: Path, workers: int) -> Iterator[str]:
     from dask.distributed import Client
 
     scheduler_file = folder / "scheduler.json"
-    environment = {**os.environ, **WORKER_ENVIRONMENT}
+    environment = {**os.environ, **ONE_THREAD}
     command = [sys.executable, "-m", "dask"]
     processes = [subprocess.Popen([*command, "scheduler", "--scheduler-file", str(scheduler_file), "--port", "0",
                                    "--no-dashboard"], env=environment, stderr=subprocess.DEVNULL)]

@@ -1,4 +1,4 @@
-"""studies.study_optima: the curve axis, the optima of every curve of a study, the optima files and
+"""studies.scan.study_optima: the curve axis, the optima of every curve of a study, the optima files and
 table of ``rpdrill study``, and no plot for a study whose every point failed."""
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ from scenes import PAPER_BASE
 
 from rpdrill.models.modal import rock_mode_frequency_hz
 from rpdrill.models.stability import StepLimitWarning
-from rpdrill.studies.cli import main
-from rpdrill.studies.optima import curve_optimum
-from rpdrill.studies.study import load_study
-from rpdrill.studies.study_optima import csv_rows, curve_axis, optima_table, study_optima
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.scan.curve_optima import curve_optimum
+from rpdrill.studies.scan.study import load_study
+from rpdrill.studies.scan.study_optima import csv_rows, curve_axis, optima_table, study_optima
 
 SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}
 

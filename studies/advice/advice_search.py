@@ -1,0 +1,314 @@
+"""The operating point that maximises a metric within bounds (``rpdrill advise``).
+
+The point lies in the operating parameters of :data:`PARAMETERS` (data: a scene path each, shown
+through studies.display.catalogue; adding one, e.g. a rotation speed, is one entry): the impact frequency
+and the feed force, and optionally the impact amplitude. The metric is the penetration rate, or
+the penetration per joule of impact energy (models.metrics).
+
+* **Runs**: the exact formulation where it can run the scene (models.formulations.unsupported),
+  the Exudyn model otherwise; the scene's end time, raised where needed so that the metrics'
+  transient and block blows fit at the lowest frequency. A run that fails counts as 0.
+* **Static limit**: a point whose mean thrust, feed plus blow frequency x impulse per blow
+  (models.simulation.Simulation.mean_thrust_n), reaches the rock's threshold F_th (or
+  ``max_thrust_ratio`` x F_th) is not run: there a Jenkins rock yields under the mean load and the
+  bit sinks at a rate set only by the rock damper (runaway crushing, outside what the model
+  describes). The search treats it as a constraint: such a point is worse than any point below the
+  limit, the more the further beyond.
+* **AdviceSearch**: SciPy's differential evolution over the box of the bounds (best1bin, a population
+  of ``popsize`` x parameters, at most ``max_generations`` generations, seeded; no gradient
+  polish: the metric has steps where crushing starts). Each generation's population is one batch
+  on the runner (studies.runtime.pools), every run a one-point scan (studies.scan.frequency_scans.scan_target).
+* **Around the optimum**: the metric along each parameter across its bounds with the others at
+  the optimum (``SLICE_POINTS`` points and the optimum itself) and the interval where it stays at
+  or above 80 % of the optimum (studies.scan.curve_optima.band_hz).
+* **Feed x frequency map**: the metric on a ``MAP_POINTS`` x ``MAP_POINTS`` grid of feed force and
+  impact frequency (others at the optimum). Percussive drilling has an optimum feed force in
+  experiments (the rate rises, then falls, as the feed grows); :func:`feed_response` reads from the
+  map, frequency by frequency, whether the model has one.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from pydantic import ValidationError
+from scipy import optimize
+
+from ...models.formulations import unsupported
+from ...models.scene import Scene
+from ...models.simulation import SceneError, Simulation, prepare
+from ..display.catalogue import describe_scene, parameter
+from ..inputs.reading import InputError, describe_validation_error
+from ..inputs.specs import set_path
+from ..runtime.pools import Runner
+from ..scan.curve_optima import band_hz
+from ..scan.frequency_scans import scan_target
+
+FREQUENCY, FEED = "impact.frequency_hz", "feed.force_n"
+METRICS = ("penetration_rate_m_per_s", "penetration_per_impact_energy_m_per_j")
+SLICE_POINTS = 15
+MAP_POINTS = 12
+Bounds = dict[str, tuple[float, float]]  # scene path -> (low, high), SI
+Point = dict[str, float]  # scene path -> SI value
+
+
+@dataclass(frozen=True)
+class AdviseParameter:
+    """An operating parameter: its short ``name`` (the command-line option is ``--NAME-UNIT`` in the
+    catalogue's display unit), its scene path, and whether every search needs its bounds."""
+
+    name: str
+    path: str
+    required: bool
+
+    @property
+    def option(self) -> str:
+        """'--frequency-hz', '--feed-kn'."""
+        return f"--{self.name}-{parameter(self.path).unit.lower().replace('/', '-per-').replace(' ', '-')}"
+
+    def si_bounds(self, given: tuple[float, float]) -> tuple[float, float]:
+        """Bounds given in display units as SI values; InputError unless low < high."""
+        low, high = given
+        if not low < high:
+            raise InputError(f"{self.option} {low:g} {high:g}: the lower bound must be below the upper bound")
+        return low / parameter(self.path).scale, high / parameter(self.path).scale
+
+
+PARAMETERS = (AdviseParameter("frequency", FREQUENCY, True), AdviseParameter("feed", FEED, True),
+              AdviseParameter("amplitude", "impact.amplitude_n", False))
+
+
+@dataclass(frozen=True)
+class AdviceSearch:
+    """Differential evolution's budget: population ``popsize`` x parameters, ``max_generations``
+    after the first population, convergence at ``tolerance`` (SciPy's tol), ``seed``."""
+
+    popsize: int = 10
+    max_generations: int = 30
+    tolerance: float = 0.01
+    seed: int = 1
+
+
+@dataclass(frozen=True)
+class Request:
+    """What to maximise, over which bounds, below which thrust ratio, with which search budget."""
+
+    metric: str
+    bounds: Bounds
+    max_thrust_ratio: float = 1.0
+    search: AdviceSearch = AdviceSearch()
+
+
+@dataclass
+class Advice:
+    """The result for one scene (one rock): the best point, its value and how it was found, the
+    curves around it, the feed x frequency map. SI units."""
+
+    scene: str
+    description: str  # the scene, rock and impact in one line (studies.display.catalogue.describe_scene)
+    scene_description: str  # the same without the rock
+    rock: str | None
+    metric: str
+    formulation: str
+    end_time_s: float
+    bounds: Bounds
+    max_thrust_ratio: float
+    best: Point = field(default_factory=dict)
+    best_value: float = math.nan
+    best_thrust_ratio: float = math.nan  # mean thrust / F_th at the best point
+    runs: int = 0
+    failed_runs: int = 0
+    beyond_limit: int = 0  # points not run: beyond the thrust limit
+    first_error: str = ""
+    generations: int = 0
+    converged: bool = False
+    slices: dict[str, dict[str, Any]] = field(default_factory=dict)
+    feed_map: dict[str, Any] = field(default_factory=dict)
+    wall_time_s: float = 0.0
+
+
+def at_point(scene: dict[str, Any], point: Point) -> dict[str, Any]:
+    """The scene with the operating parameters of ``point`` set."""
+    data = copy.deepcopy(scene)
+    for path, value in point.items():
+        set_path(data, path, float(value))
+    return data
+
+
+def runnable_scene(scene: dict[str, Any], rock: str | None, request: Request, source: str) -> dict[str, Any]:
+    """The scene as advise runs it: the Table 1 ``rock`` in place of its rock (None: its own), the exact
+    formulation if it can run it, else Exudyn, the end time raised to fit the metrics' blows at the
+    lowest frequency, only the metric computed. InputError (naming ``source`` and the options) when a
+    corner of the bounds gives a scene that cannot run."""
+    checked = Scene.model_validate({**scene, **({"rock": {"name": rock}} if rock else {}),
+                                    "outputs": {"metrics": [request.metric]}})
+    formulation = "exact" if unsupported("exact", prepare(checked.with_solver("exact"))) is None else "exudyn"
+    data = checked.with_solver(formulation).model_dump(by_alias=True, exclude_none=True)
+    blows = checked.metrics.transient_blows + checked.metrics.block_blows
+    data["solver"]["end_time_s"] = max(checked.solver.end_time_s, blows / request.bounds[FREQUENCY][0])
+    options = {p.path: p.option for p in PARAMETERS}
+    for corner in itertools.product(*request.bounds.values()):
+        point = dict(zip(request.bounds, corner, strict=True))
+        try:
+            prepare(Scene.model_validate(at_point(data, point)))
+        except (ValidationError, SceneError) as error:
+            where = " ".join(f"{options[path]} {parameter(path).show(value)}" for path, value in point.items())
+            problem = describe_validation_error(source, error, Scene) if isinstance(error, ValidationError) else \
+                f"{source}: {'.'.join(error.location)}: {error}"
+            raise InputError(f"{source}: the scene cannot run at the corner {where} of the bounds:\n{problem}") from None
+    return data
+
+
+def _prepared(scene: dict[str, Any]) -> Simulation:
+    return prepare(Scene.model_validate(scene))
+
+
+def thrust_ratio(scene: dict[str, Any]) -> float:
+    """Mean thrust / the rock's threshold F_th (module doc: the static limit is 1)."""
+    simulation = _prepared(scene)
+    return simulation.mean_thrust_n / simulation.rock.threshold_n
+
+
+def limit_feed_n(scene: dict[str, Any], frequency_hz: float, ratio: float) -> float:
+    """The feed force at which the mean thrust reaches ``ratio`` x F_th at ``frequency_hz`` (inf for a
+    rock without a threshold, negative when the blows alone exceed it)."""
+    simulation = _prepared(at_point(scene, {FREQUENCY: frequency_hz}))
+    share = simulation.feed_total_n / simulation.scene.feed.force_n  # 1, or the bodies the feed acts on
+    return (ratio * simulation.rock.threshold_n - (simulation.mean_thrust_n - simulation.feed_total_n)) / share
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The metric at a batch of points (NaN where not run or failed), their thrust ratios and the
+    largest ratio run."""
+
+    values: np.ndarray
+    thrust_ratios: np.ndarray
+    max_thrust_ratio: float
+
+    def objective(self) -> np.ndarray:
+        """What the search minimises: -metric below the thrust limit (a failed run counts as 0), the
+        excess thrust ratio beyond it (worse than any point below)."""
+        excess = self.thrust_ratios - self.max_thrust_ratio
+        return np.where(excess < 0, -np.nan_to_num(self.values, nan=0.0), excess)
+
+
+class AdviceEvaluator:
+    """The metric at batches of points, the runs of a batch on the runner at once; counts runs,
+    failures and points beyond the thrust limit."""
+
+    def __init__(self, scene: dict[str, Any], request: Request, runner: Runner,
+                 progress: Callable[[int], None] | None = None) -> None:
+        self.scene, self.request, self.runner, self.progress = scene, request, runner, progress
+        self.runs = self.failed = self.beyond_limit = 0
+        self.first_error = ""
+
+    def __call__(self, points: list[Point]) -> Evaluation:
+        scenes = [at_point(self.scene, p) for p in points]
+        ratios = np.array([thrust_ratio(scene) for scene in scenes])
+        tasks = [(i, scene, [self.request.metric], [scene["impact"]["frequency_hz"]])
+                 for i, scene in enumerate(scenes) if ratios[i] < self.request.max_thrust_ratio]
+        values = np.full(len(points), np.nan)
+        for scan in (scan for batch in self.runner(scan_target, tasks) for scan in batch) if tasks else ():
+            values[scan["key"]] = scan["values"][self.request.metric][0]
+            self.failed += scan["failed_runs"]
+            self.first_error = self.first_error or scan["error"]
+        self.runs += len(tasks)
+        self.beyond_limit += len(points) - len(tasks)
+        if self.progress:
+            self.progress(len(points))
+        return Evaluation(values, ratios, self.request.max_thrust_ratio)
+
+
+def planned_evaluations(request: Request) -> int:
+    """Points of a search at most, with the curves and the map."""
+    count, search = len(request.bounds), request.search
+    return search.popsize * count * (search.max_generations + 1) + count * (SLICE_POINTS + 1) + MAP_POINTS**2
+
+
+def search_best(evaluate: AdviceEvaluator, request: Request) -> tuple[Point, float, int, bool]:
+    """Differential evolution (module doc): (best point, its value, generations, converged)."""
+    names, search = list(request.bounds), request.search
+
+    def objective(population: np.ndarray) -> np.ndarray:  # (parameters, members)
+        return evaluate([dict(zip(names, member, strict=True)) for member in population.T]).objective()
+
+    found = optimize.differential_evolution(
+        objective, list(request.bounds.values()), popsize=search.popsize, maxiter=search.max_generations,
+        tol=search.tolerance, rng=search.seed, polish=False, updating="deferred", vectorized=True)
+    return dict(zip(names, map(float, found.x), strict=True)), float(-found.fun), int(found.nit), bool(found.success)
+
+
+def slices(evaluate: AdviceEvaluator, bounds: Bounds, best: Point, best_value: float) -> dict[str, dict[str, Any]]:
+    """The metric along each parameter through the optimum (module doc), all in one batch."""
+    axes = {path: sorted({*map(float, np.linspace(*bounds[path], SLICE_POINTS)), best[path]}) for path in bounds}
+    results = iter(evaluate([{**best, path: value} for path, values in axes.items() for value in values]).values)
+    curves = {}
+    for path, values in axes.items():
+        metric = [float(next(results)) for _ in values]
+        at = values.index(best[path])
+        metric[at] = best_value  # the same point as the search's best
+        band = band_hz(np.array(values), np.nan_to_num(metric, nan=0.0), at, 0.8 * best_value)
+        curves[path] = {"values": values, "metric": metric, "band_80": list(band)}
+    return curves
+
+
+def feed_map(evaluate: AdviceEvaluator, request: Request, best: Point, scene: dict[str, Any]) -> dict[str, Any]:
+    """The metric on the feed x frequency grid, the other parameters at the optimum (NaN: not run or
+    failed), and the feed force of the thrust limit at each frequency."""
+    frequencies = [float(f) for f in np.linspace(*request.bounds[FREQUENCY], MAP_POINTS)]
+    feeds = [float(f) for f in np.linspace(*request.bounds[FEED], MAP_POINTS)]
+    values = evaluate([{**best, FREQUENCY: f, FEED: feed} for feed in feeds for f in frequencies]).values
+    at_best = at_point(scene, best)
+    return {FREQUENCY: frequencies, FEED: feeds, "metric": values.reshape(len(feeds), len(frequencies)).tolist(),
+            "limit_feed_n": [limit_feed_n(at_best, f, request.max_thrust_ratio) for f in frequencies]}
+
+
+def peak_position(values: list[float]) -> str:
+    """Where a curve along the feed is highest: 'interior' (it rises, then falls), 'lowest feed',
+    'highest feed' (the highest feed run: the bound or the last below the thrust limit), or 'none'
+    (nowhere positive). NaN: not run."""
+    column = np.array(values, dtype=float)
+    run = np.flatnonzero(np.isfinite(column))
+    if not np.any(column[run] > 0):
+        return "none"
+    best = int(np.nanargmax(column))
+    return "lowest feed" if best == run[0] else "highest feed" if best == run[-1] else "interior"
+
+
+def feed_response(feed_map_: dict[str, Any]) -> dict[str, Any]:
+    """Per map frequency, where the metric is highest along the feed (:func:`peak_position`), and the
+    frequencies of each kind."""
+    kinds = [peak_position(column) for column in np.array(feed_map_["metric"], dtype=float).T]
+    by_kind = {kind: [f for f, k in zip(feed_map_[FREQUENCY], kinds, strict=True) if k == kind]
+               for kind in ("interior", "highest feed", "lowest feed", "none")}
+    return {"best_feed_at": kinds, "frequencies_by_kind": by_kind}
+
+
+def advise(data: dict[str, Any], rock: str | None, request: Request, runner: Runner,
+           progress: Callable[[int], None] | None = None) -> Advice:
+    """The best operating point (module doc) of the scene ``data`` (:func:`runnable_scene`, on ``rock``),
+    with the curves around it and the feed x frequency map; ``progress(points)`` after each batch."""
+    start = time.perf_counter()
+    evaluate = AdviceEvaluator(data, request, runner, progress)
+    scene = Scene.model_validate(data)
+    advice = Advice(scene=data["name"], description=describe_scene(scene, request.bounds),
+                    scene_description=describe_scene(scene, [*request.bounds, "rock.name"]), rock=rock, metric=request.metric, formulation=data["solver"]["formulation"],
+                    end_time_s=data["solver"]["end_time_s"], bounds=request.bounds,
+                    max_thrust_ratio=request.max_thrust_ratio)
+    advice.best, advice.best_value, advice.generations, advice.converged = search_best(evaluate, request)
+    advice.best_thrust_ratio = thrust_ratio(at_point(data, advice.best))
+    advice.slices = slices(evaluate, request.bounds, advice.best, advice.best_value)
+    advice.feed_map = feed_map(evaluate, request, advice.best, data)
+    advice.feed_map["response"] = feed_response(advice.feed_map)
+    advice.runs, advice.failed_runs, advice.beyond_limit = evaluate.runs, evaluate.failed, evaluate.beyond_limit
+    advice.first_error = evaluate.first_error
+    advice.wall_time_s = time.perf_counter() - start
+    return advice

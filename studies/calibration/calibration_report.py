@@ -1,0 +1,125 @@
+"""What a calibration writes: the calibrated scene, the per-target table, the trade-off, the record.
+
+* ``calibrated_scene.yaml``: the base scene (with its overrides) and the best parameter values;
+* ``targets.csv`` and ``targets.md``: per target the paper's optimum and band, the reached
+  main-lobe and global-maximum optima (scan of the best set, refined around its optima), the
+  relative miss, whether it is within the target's tolerance, the peak value of the metric;
+* ``pareto.csv``: the non-dominated evaluations over the per-target |misses| (no other evaluation
+  misses every target by at most as much and one by less): the alternatives when the targets
+  cannot all be met together, and what each gives up;
+* ``best_curves.csv``: the best set's scans (target, frequency, metric value);
+* ``calibration.json``: the spec, the best evaluation, every evaluation, the cost.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from ..runtime.output_files import write_json, write_rows_csv
+from .calibration_search import CalibrationResult
+from .calibration_spec import Calibration
+from .evaluation_log import Record
+
+TARGET_COLUMNS = ("label", "metric", "paper_optimum_hz", "paper_band_low_hz", "paper_band_high_hz",
+                  "resonance_estimate_hz", "main_lobe_optimum_hz", "main_lobe_band_80_low_hz",
+                  "main_lobe_band_80_high_hz", "global_max_optimum_hz", "relative_miss", "tolerance",
+                  "within_tolerance", "main_lobe_peak_value", "global_max_peak_value", "failed_runs")
+
+
+HEADER = ("| target | metric | paper [Hz] | reached, main lobe [Hz] (80 % band) | reached, global max [Hz] "
+          "| miss | within tolerance | peak value |")
+
+
+def _number(value: float | None, digits: int = 4) -> str:
+    return "" if value is None else f"{value:.{digits}g}"
+
+
+def target_rows(calibration: Calibration, results: list[Record]) -> list[dict[str, str]]:
+    """One row per target (TARGET_COLUMNS); miss and tolerance are relative to the paper's optimum."""
+    rows = []
+    for index, (target, result) in enumerate(zip(calibration.spec.targets, results, strict=True)):
+        band = target.band_hz or (None, None)
+        reached = result["band_80_hz"] or (None, None)
+        rows.append({
+            "label": result["label"], "metric": calibration.metric(index),
+            "paper_optimum_hz": _number(target.optimum_hz), "paper_band_low_hz": _number(band[0]),
+            "paper_band_high_hz": _number(band[1]), "resonance_estimate_hz": _number(result["resonance_hz"]),
+            "main_lobe_optimum_hz": _number(result["main_hz"]), "main_lobe_band_80_low_hz": _number(reached[0]),
+            "main_lobe_band_80_high_hz": _number(reached[1]), "global_max_optimum_hz": _number(result["global_hz"]),
+            "relative_miss": _number(result["miss"], 3), "tolerance": _number(target.tolerance, 3),
+            "within_tolerance": "yes" if abs(result["miss"]) <= target.tolerance else "no",
+            "main_lobe_peak_value": _number(result["main_value"]), "global_max_peak_value": _number(result["global_value"]),
+            "failed_runs": str(result["failed_runs"]),
+        })
+    return rows
+
+
+def targets_markdown(calibration: Calibration, rows: list[dict[str, str]], refine_note: str) -> str:
+    """The per-target table in Markdown."""
+    lines = [f"# Calibration `{calibration.spec.name}`: reached optima", "",
+             f"Main lobe: the lobe whose peak is nearest (log frequency) to the rock-mode estimate; {refine_note}.",
+             "", HEADER, "|---|---|---|---|---|---|---|---|"]
+    for row in rows:
+        paper = row["paper_optimum_hz"] + (f" ({row['paper_band_low_hz']}-{row['paper_band_high_hz']})"
+                                           if row["paper_band_low_hz"] else "")
+        main = row["main_lobe_optimum_hz"] or "none"
+        if row["main_lobe_band_80_low_hz"]:
+            main += f" ({row['main_lobe_band_80_low_hz']}-{row['main_lobe_band_80_high_hz']})"
+        miss = f"{float(row['relative_miss']):+.1%}"
+        lines.append(f"| {row['label']} | {row['metric']} | {paper} | {main} | {row['global_max_optimum_hz'] or 'none'} "
+                     f"| {miss} | {row['within_tolerance']} (±{float(row['tolerance']):.0%}) "
+                     f"| {row['main_lobe_peak_value'] or '0'} |")
+    return "\n".join(lines) + "\n"
+
+
+def non_dominated(points: np.ndarray) -> list[int]:
+    """Indices of the rows of ``points`` (one cost per column, lower is better) that no other row
+    dominates (at most as large in every column and smaller in one)."""
+    kept = []
+    for i, point in enumerate(points):
+        dominated = np.all(points <= point, axis=1) & np.any(points < point, axis=1)
+        if not dominated.any():
+            kept.append(i)
+    return kept
+
+
+def pareto_rows(calibration: Calibration, records: list[Record]) -> list[dict[str, Any]]:
+    """The non-dominated evaluations over the |misses|, by objective: parameters, signed misses,
+    rising penalty, objective."""
+    misses = np.array([[abs(t["miss"]) for t in r["targets"]] for r in records])
+    front = sorted(non_dominated(misses), key=lambda i: records[i]["objective"])
+    return [{"evaluation": i, "objective": records[i]["objective"], "rising_penalty": records[i]["rising_penalty"],
+             **records[i]["parameters"],
+             **{f"miss {label}": t["miss"] for label, t in zip(calibration.labels, records[i]["targets"], strict=True)}}
+            for i in front]
+
+
+def write_report(directory: Path, calibration: Calibration, result: CalibrationResult,
+                 sessions: list[dict[str, Any]]) -> None:
+    """Every output file of a calibration with a best evaluation (module docstring)."""
+    best, final = result.best, result.final
+    scene = calibration.scene(best["parameters"])
+    (directory / "calibrated_scene.yaml").write_text(yaml.safe_dump(scene, sort_keys=False), encoding="utf-8")
+    rows = target_rows(calibration, final.results)
+    write_rows_csv(directory / "targets.csv", rows, list(TARGET_COLUMNS))
+    step = calibration.spec.refine_hz
+    note = (f"optima of the best parameter set scanned again with points every {step:g} Hz around its optima"
+            if step else "optima on the calibration's frequency axis")
+    (directory / "targets.md").write_text(targets_markdown(calibration, rows, note), encoding="utf-8")
+    pareto = pareto_rows(calibration, result.records)
+    write_rows_csv(directory / "pareto.csv", pareto, list(pareto[0]))
+    curves = [{"target": label, "frequency_hz": f, "metric": calibration.metric(t), "value": v}
+              for t, (label, (frequencies, values)) in enumerate(zip(calibration.labels, final.curves, strict=True))
+              for f, v in zip(frequencies, values, strict=True)]
+    write_rows_csv(directory / "best_curves.csv", curves, ["target", "frequency_hz", "metric", "value"])
+    write_json(directory / "calibration.json", {
+        "calibration": calibration.spec.model_dump(mode="json", by_alias=True), "hash": calibration.hash,
+        "best": best, "report": final.results,
+        "cost": {"sessions": sessions, "wall_time_s": sum(s["wall_time_s"] for s in sessions),
+                 "simulation_cpu_time_s": sum(s["simulation_cpu_time_s"] for s in sessions),
+                 "simulations": sum(s["simulations"] for s in sessions), "evaluations": len(result.records)},
+        "evaluations": result.records})

@@ -1,0 +1,84 @@
+"""The checkpoint of a calibration: every evaluation as one JSON line, as soon as it finishes.
+
+``OUT/evaluations.jsonl`` holds the evaluations (unit point, parameters, per-target optima,
+objective, cost); ``OUT/checkpoint.json`` the calibration's hash and one entry per session. A
+rerun into the same OUT replays the recorded evaluations (by their exact unit point) instead of
+recomputing them, so a seeded search retraces its path and continues where it stopped; a
+different calibration is refused (InputError; with ``overwrite`` it starts afresh). A line cut by a
+kill is dropped.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, TextIO
+
+from ..inputs.reading import InputError
+from ..runtime.output_files import write_json
+from ..runtime.resumable import checked_record
+from .calibration_spec import Calibration
+
+Record = dict[str, Any]
+EVALUATIONS = "evaluations.jsonl"
+CHECKPOINT = "checkpoint.json"
+
+
+def unit_key(unit: Any) -> tuple[float, ...]:
+    """The memo key of a unit point: its exact coordinates."""
+    return tuple(float(u) for u in unit)
+
+
+def _complete_records(path: Path) -> list[Record]:
+    """The records of whole lines (a last line cut by a kill is left out); InputError naming the file
+    and line when a whole line is not a record."""
+    records = []
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines(keepends=True) if path.exists() else []
+    except UnicodeDecodeError:
+        raise InputError(f"--out: {path}: not evaluations rpdrill wrote (not UTF-8 text)") from None
+    for number, line in enumerate(lines, 1):
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError:
+            if line.endswith("\n"):
+                raise InputError(f"--out: {path}: line {number} is not an evaluation rpdrill wrote") from None
+    return records
+
+
+class EvaluationLog:
+    """The recorded evaluations of one calibration in one output directory (close it when done)."""
+
+    def __init__(self, out: Path, calibration: Calibration, overwrite: bool = False) -> None:
+        self.out = out
+        self.checkpoint, resumed = self._checkpoint(calibration, overwrite)
+        path = out / EVALUATIONS
+        self.records = _complete_records(path) if resumed else []
+        temporary = path.with_suffix(".jsonl.tmp")
+        temporary.write_text("".join(json.dumps(r) + "\n" for r in self.records), encoding="utf-8")
+        os.replace(temporary, path)
+        self._handle: TextIO = path.open("a", encoding="utf-8")
+
+    def _checkpoint(self, calibration: Calibration, overwrite: bool) -> tuple[dict[str, Any], bool]:
+        """The checkpoint (this calibration's, or a fresh one) and whether it resumes an earlier run."""
+        self.out.mkdir(parents=True, exist_ok=True)
+        fresh = {"calibration": calibration.spec.name, "calibration_file": str(calibration.source),
+                 "hash": calibration.hash, "sessions": []}
+        checkpoint = checked_record(self.out / CHECKPOINT, fresh, calibration.source, [self.out / EVALUATIONS],
+                                    overwrite)
+        write_json(self.out / CHECKPOINT, checkpoint)
+        return checkpoint, checkpoint is not fresh
+
+    def append(self, record: Record) -> None:
+        """Record an evaluation now (one line, flushed)."""
+        self._handle.write(json.dumps(record) + "\n")
+        self._handle.flush()
+        self.records.append(record)
+
+    def add_session(self, session: dict[str, Any]) -> None:
+        self.checkpoint["sessions"].append(session)
+        write_json(self.out / CHECKPOINT, self.checkpoint)
+
+    def close(self) -> None:
+        self._handle.close()

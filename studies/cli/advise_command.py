@@ -1,0 +1,122 @@
+"""``rpdrill advise SCENE.yaml --frequency-hz LOW HIGH --feed-kn LOW HIGH --out DIR``: the operating point
+that maximises a metric within the bounds given (studies.advice.advice_search), for the scene's rock or for each
+``--rock``. Bounds are in the units of the option names. Prints the best point and the metric
+around it, one parameter at a time; exit status 1 when every run failed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+
+from tqdm import tqdm
+
+from ...rocklaw.catalog import TABLE_1
+from ..advice.advice_report import advice_markdown, advice_record, advice_text, best_table
+from ..advice.advice_search import (
+    METRICS,
+    PARAMETERS,
+    AdviceSearch,
+    AdviseParameter,
+    Request,
+    advise,
+    planned_evaluations,
+    runnable_scene,
+)
+from ..display.catalogue import metric, parameter
+from ..figures.advice_figures import plot_curves, plot_feed_map
+from ..inputs.reading import load_scene
+from ..runtime.output_files import check_out, staged_directory, write_json
+from ..runtime.pools import pool
+from .options import add_runner_arguments, positive_count, positive_number
+
+FILES = """files written to DIR:
+  advice.json                   the command, and per rock: the best point, the metric there, the search
+                                (runs, generations, wall time), the curves around the optimum, the
+                                feed x frequency map and where along the feed the metric is highest (SI units)
+  advice.md                     the table of best points and the feed-force response (display units)
+  ROCK_curves.png               the metric along each parameter through the optimum (and .svg)
+  ROCK_feed_frequency_map.png   the metric over feed force and impact frequency (and .svg)"""
+
+
+def _given(args: argparse.Namespace, entry: AdviseParameter) -> tuple[float, float] | None:
+    """The bounds given for a parameter (display units), or None."""
+    return getattr(args, entry.option.removeprefix("--").replace("-", "_"))
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.formatter_class = argparse.RawDescriptionHelpFormatter
+    parser.epilog = FILES
+    parser.add_argument("scene", help="scene YAML file")
+    parser.add_argument("--out", required=True, help="output directory: new, empty, or earlier advice's")
+    parser.add_argument("--overwrite", action="store_true", help="write into --out although it holds other files")
+    for entry in PARAMETERS:
+        q = parameter(entry.path)
+        parser.add_argument(entry.option, nargs=2, type=float, metavar=("LOW", "HIGH"),
+                            required=entry.required,
+                            help=f"bounds of the {q.name} [{q.unit}]" + ("" if entry.required else
+                                                                        " (default: fixed at the scene's value)"))
+    parser.add_argument("--metric", choices=METRICS, default=METRICS[0],
+                        help=f"what to maximise (default {METRICS[0]}; {METRICS[1]}: penetration rate / impact power)")
+    parser.add_argument("--rock", nargs="+", choices=tuple(TABLE_1), metavar="NAME",
+                        help=f"search again for each Table 1 rock ({', '.join(TABLE_1)}; default: the scene's rock)")
+    parser.add_argument("--max-thrust-ratio", type=positive_number, default=1.0,
+                        help="run only points whose mean thrust (feed + frequency x impulse per blow) is below this "
+                             "fraction of the rock's threshold F_th (default 1: the static limit, beyond which the "
+                             "rock yields under the mean load)")
+    parser.add_argument("--popsize", type=positive_count, default=AdviceSearch.popsize,
+                        help=f"differential evolution: population per parameter (default {AdviceSearch.popsize})")
+    parser.add_argument("--generations", type=positive_count, default=AdviceSearch.max_generations,
+                        help=f"differential evolution: at most this many generations (default {AdviceSearch.max_generations})")
+    parser.add_argument("--seed", type=int, default=AdviceSearch.seed, help=f"random seed (default {AdviceSearch.seed})")
+    parser.add_argument("--markdown", type=Path, help="also write advice.md to this file (e.g. docs/advice.md)")
+    add_runner_arguments(parser)
+
+
+def command_line(args: argparse.Namespace) -> str:
+    """The command as it could be typed again (the runner and progress options left out)."""
+    words = ["rpdrill", "advise", args.scene]
+    for entry in PARAMETERS:
+        if _given(args, entry) is not None:
+            words += [entry.option, *(f"{v:g}" for v in _given(args, entry))]
+    words += ["--metric", args.metric] + (["--rock", *args.rock] if args.rock else [])
+    words += ["--max-thrust-ratio", f"{args.max_thrust_ratio:g}"]
+    words += ["--popsize", str(args.popsize), "--generations", str(args.generations), "--seed", str(args.seed)]
+    words += ["--out", args.out] + (["--markdown", str(args.markdown)] if args.markdown else [])
+    return shlex.join(words)
+
+
+def run(args: argparse.Namespace) -> int:
+    check_out(args.out, args.overwrite, "advice.json")
+    scene = load_scene(args.scene).model_dump(by_alias=True, exclude_none=True)
+    bounds = {e.path: e.si_bounds(_given(args, e)) for e in PARAMETERS if _given(args, e) is not None}
+    request = Request(args.metric, bounds, args.max_thrust_ratio,
+                      AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed))
+    rocks = args.rock or [None]
+    scenes = [runnable_scene(scene, rock, request, args.scene) for rock in rocks]
+    advices = []
+    with pool(args.dask, args.workers) as (label, runner), \
+            tqdm(total=planned_evaluations(request) * len(rocks), desc="advise", unit="point", disable=args.quiet) as bar:
+        print(f"advise: maximising {metric(args.metric).name} over {', '.join(parameter(p).name for p in bounds)} "
+              f"for {len(rocks)} rock(s) on {label}", file=sys.stderr)
+        for rock, data in zip(rocks, scenes, strict=True):
+            advices.append(advise(data, rock, request, runner, bar.update))
+            tqdm.write(advice_text(advices[-1]), file=sys.stdout)
+    command = command_line(args)
+    with staged_directory(args.out) as stage:
+        write_json(stage / "advice.json", advice_record(advices, command))
+        (stage / "advice.md").write_text(advice_markdown(advices, command), encoding="utf-8")
+        for advice in advices:
+            name = advice.rock or advice.scene
+            plot_curves(advice, stage / f"{name}_curves.png")
+            plot_feed_map(advice, stage / f"{name}_feed_frequency_map.png")
+    if args.markdown:
+        args.markdown.write_text(advice_markdown(advices, command), encoding="utf-8")
+    print(best_table(advices))
+    print(f"wrote {args.out}" + (f", {args.markdown}" if args.markdown else ""), file=sys.stderr)
+    failed = [a for a in advices if a.failed_runs == a.runs]
+    for advice in failed:
+        print(f"advise: every run failed for {advice.rock or advice.scene}: {advice.first_error}", file=sys.stderr)
+    return 1 if failed else 0

@@ -1,0 +1,62 @@
+"""``rpdrill crosscheck SCENE.yaml``: the Exudyn model against the paper's Eq. 4 as a plain ODE over the
+first blows (studies.crosscheck.crosscheck_windows); exit 0 when they agree within the paper tolerances, 1 if not."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ...models.compare import compare_runs, verdict
+from ...models.formulations import ODE_METHODS
+from ...models.stability import SimulationFailed
+from ..crosscheck.crosscheck_windows import DEFAULT_STEP_S, comparison_table, window_scenes
+from ..figures.crosscheck_figure import plot_overlay
+from ..inputs.reading import load_scene, prepare_scene
+from ..runtime.interrupts import raise_if_stopped
+from ..runtime.output_files import check_out, staged_directory, write_json
+from .options import add_budget_arguments, budget, positive_count, positive_number
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="scene YAML file")
+    parser.add_argument("--out", help="output directory for crosscheck.json and crosscheck.png and .svg (new or empty)")
+    parser.add_argument("--overwrite", action="store_true", help="write into --out although it holds other files")
+    parser.add_argument("--blows", type=positive_count, default=20, help="compared window in impact periods (default 20)")
+    parser.add_argument("--step", type=positive_number, default=DEFAULT_STEP_S,
+                        help=f"Exudyn step [s] (default {DEFAULT_STEP_S:g}; solver type from the scene)")
+    parser.add_argument("--method", choices=ODE_METHODS, default="DOP853", help="ODE method (default DOP853)")
+    parser.add_argument("--rtol", type=positive_number, default=1e-10, help="ODE relative tolerance (default 1e-10)")
+    add_budget_arguments(parser, many_runs=False)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.out:
+        check_out(args.out, args.overwrite)
+    exudyn_scene, ode_scene = window_scenes(load_scene(args.scene), args.blows, args.step, args.method, args.rtol,
+                                            args.scene)
+    scene = exudyn_scene
+    simulations = [prepare_scene(window, args.scene) for window in (exudyn_scene, ode_scene)]
+    for simulation in simulations:
+        budget(args).check_run(simulation, args.scene, f"{simulation.settings.formulation} window: ")
+    try:
+        exudyn, ode = (simulation.run() for simulation in simulations)
+    except SimulationFailed as err:
+        raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
+        print(f"{args.scene}: {err}", file=sys.stderr)
+        return 1
+    report = compare_runs(ode, exudyn, scene.solver.end_time_s)
+    checks = verdict(report)
+    passed = all(c["passed"] for c in checks.values())
+    print(f"{scene.name}: {args.blows} blows, exudyn {exudyn.simulation.settings.type} at {args.step:g} s, "
+          f"ode {args.method} at rtol {args.rtol:g} ({ode.info['mode_switches']} rock mode switches)")
+    print(comparison_table(report, checks))
+    if args.out:
+        with staged_directory(args.out) as stage:
+            write_json(stage / "crosscheck.json", {"scene": scene.name, "blows": args.blows,
+                                                    "exudyn": {"solver": exudyn.simulation.settings.type,
+                                                               "step_s": args.step,
+                                                               **exudyn.info},
+                                                    "ode": ode.info, "checks": checks, "passed": passed, **report})
+            plot_overlay(ode, exudyn, f"{scene.name}: first {args.blows} blows", stage / "crosscheck.png")
+        print(f"wrote {args.out}")
+    return 0 if passed else 1

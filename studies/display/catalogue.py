@@ -1,0 +1,243 @@
+"""How every metric, time history and scene parameter is shown: its name, symbol, display unit and
+scale. Plots, tables and printed summaries take their labels from here; the data stay in SI units.
+
+A display value is the SI value times ``scale`` (0.00035 m per blow at scale 1e3 is 0.35 mm per blow).
+Metrics are keyed by the names of models.outputs.METRICS, time histories by their column names
+(models.results.SimulationResult.columns, ``*`` for a body's name), parameters by dotted scene
+paths (``*`` for a name in drill_string.bodies or drill_string.connectors, filled into the name).
+A parameter without a unit (``unit=""``) is categorical (a rock name, a solver type) and is
+never a plot axis. ``merit`` marks the figures of merit, larger is better, whose optima a study
+reports (studies.scan.study_optima).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection
+from dataclasses import dataclass, replace
+from typing import Any
+
+from ...models.scene import Scene
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """One displayed quantity: ``name``, ``symbol`` (matplotlib mathtext, without $), ``unit`` and
+    ``scale`` (display value = SI value x scale), the SI unit, and whether it is a figure of merit."""
+
+    name: str
+    symbol: str
+    unit: str
+    scale: float = 1.0
+    si_unit: str = ""
+    merit: bool = False
+
+    @property
+    def categorical(self) -> bool:
+        return not self.unit
+
+    def label(self) -> str:
+        """Plot label: 'penetration rate $v_p$ [mm/s]'."""
+        symbol = f" ${self.symbol}$" if self.symbol else ""
+        return f"{self.name}{symbol}" + (f" [{self.unit}]" if self.unit else "")
+
+    def heading(self) -> str:
+        """Plain-text column heading: 'penetration rate [mm/s]'."""
+        return self.name + (f" [{self.unit}]" if self.unit else "")
+
+    def display(self, value: float) -> float:
+        return value * self.scale
+
+    def show(self, value: Any, digits: int = 4) -> str:
+        """A value in display units without the unit ('0.35'); text as it is."""
+        if isinstance(value, str) or self.categorical:
+            return str(value)
+        return f"{self.display(float(value)):.{digits}g}"
+
+    def show_with_unit(self, value: Any, digits: int = 4) -> str:
+        """'0.35 mm/blow', 'sandstone'."""
+        return self.show(value, digits) + (f" {self.unit}" if self.unit and not isinstance(value, str) else "")
+
+
+def _q(name: str, symbol: str, unit: str, scale: float = 1.0, si_unit: str = "", merit: bool = False) -> Quantity:
+    return Quantity(name, symbol, unit, scale, si_unit or unit, merit)
+
+
+def _category(name: str) -> Quantity:
+    return Quantity(name, "", "")
+
+
+# SI -> display: velocities of the bit in m/s, the slow penetration in mm/s, forces in kN,
+# stiffnesses in MN/m, dampings in kN s/m.
+METRICS: dict[str, Quantity] = {
+    "penetration_rate_m_per_s": _q("penetration rate", "v_p", "mm/s", 1e3, "m/s", merit=True),
+    "penetration_rate_block_std_m_per_s": _q("penetration rate spread over blocks", r"\sigma_{v_p}", "mm/s", 1e3, "m/s"),
+    "penetration_rate_block_min_m_per_s": _q("penetration rate, slowest block", r"v_{p,min}", "mm/s", 1e3, "m/s"),
+    "penetration_rate_block_max_m_per_s": _q("penetration rate, fastest block", r"v_{p,max}", "mm/s", 1e3, "m/s"),
+    "penetration_per_impact_energy_m_per_j": _q("penetration per impact energy", r"v_p / P_d", "mm/kJ", 1e6, "m/J",
+                                                merit=True),
+    "advance_per_blow_m": _q("advance per blow", r"\Delta x_n", "mm/blow", 1e3, "m/blow", merit=True),
+    "advance_per_blow_std_m": _q("advance per blow, spread", r"\sigma_{\Delta x_n}", "mm/blow", 1e3, "m/blow"),
+    "borehole_bottom_final_m": _q("borehole bottom at the end", "x_n", "mm", 1e3, "m"),
+    "bit_velocity_peak_m_per_s": _q("peak bit velocity", r"\hat{v}_3", "m/s", merit=True),
+    "bit_velocity_rms_m_per_s": _q("RMS bit velocity", r"\tilde{v}_3", "m/s", merit=True),
+    "collar_velocity_peak_m_per_s": _q("peak collar velocity", r"\hat{v}_2", "m/s", merit=True),
+    "collar_velocity_rms_m_per_s": _q("RMS collar velocity", r"\tilde{v}_2", "m/s", merit=True),
+    "rock_force_max_n": _q("peak rock force", r"\hat{F}_r", "kN", 1e-3, "N"),
+    "impact_energy_j": _q("impact work in the window", "W_d", "J"),
+    "feed_energy_j": _q("feed work in the window", "W_f", "J"),
+    "crushing_work_j": _q("crushing work in the window", "W_c", "J"),
+    "energy_transfer_efficiency": _q("energy transfer efficiency", r"\eta", "%", 100.0, "1", merit=True),
+    "energy_balance_relative_error": _q("energy balance error", r"\epsilon_E", "%", 100.0, "1"),
+    "window_start_s": _q("averaging window start", "t_0", "s"),
+    "window_end_s": _q("averaging window end", "t_1", "s"),
+    "window_blows": _q("blows averaged", "N", "blows"),
+    "cpu_time_s": _q("CPU time", r"t_{CPU}", "s"),
+}
+
+SERIES: dict[str, Quantity] = {
+    "time_s": _q("time", "t", "s"),
+    "*_position_m": _q("{name} position", "x", "mm", 1e3, "m"),
+    "*_velocity_m_per_s": _q("{name} velocity", "v", "m/s"),
+    "borehole_bottom_m": _q("borehole bottom", "x_n", "mm", 1e3, "m"),
+    "rock_force_n": _q("rock force", "F_r", "kN", 1e-3, "N"),
+    "impact_force_n": _q("impact force", "F_d", "kN", 1e-3, "N"),
+    "torsion_angle_rad": _q("torsion angle", r"\varphi", "rad"),
+    "torsion_rate_rad_per_s": _q("torsion rate", r"\dot{\varphi}", "rad/s"),
+}
+
+PARAMETERS: dict[str, Quantity] = {
+    "name": _category("scene"),
+    "description": _category("description"),
+    "drill_string.bodies.*.mass_kg": _q("{name} mass", "m", "kg"),
+    "drill_string.bodies.*.length_m": _q("{name} length", "L", "m"),
+    "drill_string.bodies.*.diameter_m": _q("{name} diameter", "D", "mm", 1e3, "m"),
+    "drill_string.bodies.*.bore_diameter_m": _q("{name} bore diameter", "d", "mm", 1e3, "m"),
+    "drill_string.bodies.*.mass_per_length_kg_per_m": _q("{name} mass per length", "m'", "kg/m"),
+    "drill_string.bodies.*.youngs_modulus_pa": _q("{name} Young's modulus", "E", "GPa", 1e-9, "Pa"),
+    "drill_string.bodies.*.density_kg_per_m3": _q("{name} density", r"\rho", "kg/m³"),
+    "drill_string.bodies.*.segments": _q("{name} segments", "N", "segments"),
+    "drill_string.connectors.*.type": _category("{name} type"),
+    "drill_string.connectors.*.from": _category("{name} from"),
+    "drill_string.connectors.*.to": _category("{name} to"),
+    "drill_string.connectors.*.stiffness_n_per_m": _q("{name} stiffness", "k", "MN/m", 1e-6, "N/m"),
+    "drill_string.connectors.*.damping_n_s_per_m": _q("{name} damping", "c", "kN s/m", 1e-3, "N s/m"),
+    "drill_string.connectors.*.gap_m": _q("{name} gap", "g", "mm", 1e3, "m"),
+    "drill_string.impact_body": _category("impact body"),
+    "drill_string.rock_body": _category("rock body"),
+    "torsion.inertia_kg_m2": _q("torsion inertia", "J", "kg m²"),
+    "torsion.stiffness_n_m_per_rad": _q("torsion stiffness", "k_x", "kN m/rad", 1e-3, "N m/rad"),
+    "torsion.damping_n_m_s_per_rad": _q("torsion damping", "c_x", "N m s/rad"),
+    "torsion.drive_torque_n_m": _q("drive torque", "M_x", "N m"),
+    "torsion.resisting_torque_n_m": _q("resisting torque", "M_c", "N m"),
+    "feed.force_n": _q("feed force", r"F_{dt}", "kN", 1e-3, "N"),
+    "feed.acts_on": _category("feed acts on"),
+    "impact.amplitude_n": _q("impact amplitude", "I", "kN", 1e-3, "N"),
+    "impact.frequency_hz": _q("impact frequency", "f", "Hz"),
+    "impact.shape": _category("pulse shape"),
+    "impact.duration_s": _q("pulse duration", r"\tau", "ms", 1e3, "s"),
+    "rock.law": _category("rock law"),
+    "rock.name": _category("rock"),
+    "rock.stiffness_n_per_m": _q("rock stiffness", "k_n", "MN/m", 1e-6, "N/m"),
+    "rock.damping_n_s_per_m": _q("rock damping", "c_n", "kN s/m", 1e-3, "N s/m"),
+    "rock.threshold_n": _q("crushing threshold", r"F_{th}", "kN", 1e-3, "N"),
+    "rock.damping_mode": _category("rock damping mode"),
+    "rock.loading_stiffness_n_per_m": _q("rock loading stiffness", "k_l", "MN/m", 1e-6, "N/m"),
+    "rock.unloading_stiffness_n_per_m": _q("rock unloading stiffness", "k_u", "MN/m", 1e-6, "N/m"),
+    "bit.diameter_m": _q("bit diameter", "D", "mm", 1e3, "m"),
+    "bit.gauge_button_diameter_m": _q("gauge button diameter", "d", "mm", 1e3, "m"),
+    "bit.gauge_buttons": _q("gauge buttons", "N", "buttons"),
+    "bit.crater_width_m": _q("crater width", "w", "mm", 1e3, "m"),
+    "rotation.speed_rpm": _q("rotation speed", "n", "rpm"),
+    "solver.formulation": _category("formulation"),
+    "solver.preset": _category("accuracy preset"),
+    "solver.end_time_s": _q("end time", r"t_{end}", "s"),
+    "solver.output_interval_s": _q("output interval", r"\Delta t_{out}", "ms", 1e3, "s"),
+    "solver.type": _category("solver"),
+    "solver.step_s": _q("solver step", "h", "µs", 1e6, "s"),
+    "solver.spectral_radius": _q("spectral radius", r"\rho_\infty", "-", si_unit="1"),
+    "solver.relative_tolerance": _q("relative tolerance", "rtol", "-", si_unit="1"),
+    "solver.absolute_tolerance": _q("absolute tolerance", "atol", "SI"),
+    "solver.method": _category("ODE method"),
+    "solver.sample_interval_s": _q("sample interval", r"\Delta t_s", "µs", 1e6, "s"),
+    "solver.min_switch_interval_s": _q("shortest mode", r"\Delta t_{min}", "s"),
+    "solver.max_switches_per_blow": _q("switches per blow allowed", "", "switches/blow"),
+    "metrics.transient_blows": _q("transient blows", "", "blows"),
+    "metrics.block_blows": _q("blows per block", "", "blows"),
+    "effects.torsion": _category("torsion"),
+    "effects.rock_damping": _category("rock damping"),
+    "effects.rock_plasticity": _category("rock plasticity"),
+    "effects.joint_damping": _category("joint damping"),
+    "effects.indexing": _category("bit indexing"),
+    "effects.reasons": _category("effect reasons"),
+    "outputs.metrics": _category("metrics asked for"),
+    "outputs.timeseries": _category("histories asked for"),
+    "start": _category("start"),
+}
+
+
+def _named(found: Quantity, name: str) -> Quantity:
+    return replace(found, name=found.name.format(name=name))
+
+
+def metric(name: str) -> Quantity:
+    """The catalogue entry of a metric (KeyError for a metric without one)."""
+    return METRICS[name]
+
+
+def series(column: str) -> Quantity:
+    """The entry of a time-history column ('bit_velocity_m_per_s': the velocity of the body 'bit')."""
+    if column in SERIES:
+        return SERIES[column]
+    for pattern, found in SERIES.items():
+        suffix = pattern.removeprefix("*")
+        if pattern.startswith("*") and column.endswith(suffix) and len(column) > len(suffix):
+            return _named(found, column.removesuffix(suffix))
+    raise KeyError(f"studies.display.catalogue has no time history {column!r}")
+
+
+def parameter(path: str) -> Quantity:
+    """The entry of a dotted scene path ('drill_string.bodies.collar.mass_kg': 'collar mass')."""
+    if path in PARAMETERS:
+        return PARAMETERS[path]
+    parts = path.split(".")
+    for i, name in enumerate(parts):
+        pattern = ".".join([*parts[:i], "*", *parts[i + 1:]])
+        if pattern in PARAMETERS:
+            return _named(PARAMETERS[pattern], name)
+    raise KeyError(f"studies.display.catalogue has no scene parameter {path!r}")
+
+
+def quantity(key: str) -> Quantity:
+    """A metric or a scene parameter, whichever ``key`` names."""
+    return METRICS[key] if key in METRICS else parameter(key)
+
+
+def _shown(scene: Scene, path: str, varied: Collection[str], text: str = "{}") -> list[str]:
+    """``text`` with the value of ``path`` in display units ('500 MN/m'), or nothing if it is ``varied``."""
+    if path in varied:
+        return []
+    node: Any = scene
+    for part in path.split("."):
+        node = getattr(node, part)
+    return [text.format(parameter(path).show_with_unit(node, 3))]
+
+
+def describe_scene(scene: Scene, varied: Collection[str] = ()) -> str:
+    """The scene, its rock, impact and feed in one line for a title, leaving out the ``varied`` paths:
+    'paper_base: rock sandstone (k_n 510 MN/m, F_th 210 kN), impact 220 kN half-sine of 1.6 ms at 65 Hz,
+    feed 75 kN'."""
+    rock = scene.rock.completed()
+    filled = scene.model_copy(update={"rock": rock})
+    if "rock.name" in varied:
+        rock_text = "rock varied"
+    else:
+        symbols = {"stiffness_n_per_m": "k_n", "threshold_n": "F_th", "loading_stiffness_n_per_m": "k_l",
+                   "unloading_stiffness_n_per_m": "k_u"}
+        values = [v for key, symbol in symbols.items() if getattr(rock, key, None) is not None
+                  for v in _shown(filled, f"rock.{key}", varied, f"{symbol} {{}}")]
+        rock_text = " ".join(["rock"] + ([rock.name] if rock.name else []) + ([f"({', '.join(values)})"] if values else
+                                                                             [] if rock.name else ["varied"]))
+    impact = " ".join(["impact", *_shown(scene, "impact.amplitude_n", varied), scene.impact.shape.replace("_", "-"),
+                       *_shown(scene, "impact.duration_s", varied, "of {}"),
+                       *_shown(scene, "impact.frequency_hz", varied, "at {}")])
+    return f"{scene.name}: " + ", ".join([rock_text, impact, *_shown(scene, "feed.force_n", varied, "feed {}")])

@@ -1,0 +1,60 @@
+"""The paper's figures redrawn from a reproduction's cases (studies.reproduction.paper_reproduction): one panel per metric
+against impact frequency, one line per case, each case's main-lobe optimum marked (a filled star; an
+open one at a global maximum elsewhere)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+from ..reproduction.paper_reproduction import CaseResult, Figure, Reproduction
+
+# Okabe-Ito: distinct for colour-blind readers
+PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
+# display scale and label of the metrics the figures use
+DISPLAY = {
+    "penetration_rate_m_per_s": (1e3, "penetration rate [mm/s]"),
+    "advance_per_blow_m": (1e3, "borehole-bottom advance per blow [mm]"),
+    "bit_velocity_peak_m_per_s": (1.0, "peak bit velocity [m/s]"),
+    "collar_velocity_peak_m_per_s": (1.0, "peak collar velocity [m/s]"),
+}
+
+
+def draw_figure(reproduction: Reproduction, results: list[CaseResult], figure: Figure, stem: Path,
+                formats: tuple[str, ...] = ("png", "svg")) -> list[Path]:
+    """Draw one of the paper's figures into ``stem``.<format>; the paths written."""
+    by_label = {r.case.label: r for r in results}
+    frequencies = reproduction.frequencies_hz
+    fig, axes = plt.subplots(len(figure.metrics), 1, sharex=True, figsize=(8, 2.8 * len(figure.metrics) + 0.8),
+                             squeeze=False)
+    for ax, metric in zip(axes[:, 0], figure.metrics, strict=True):
+        scale, label = DISPLAY[metric]
+        for k, case in enumerate(figure.cases):
+            result, colour = by_label[case], PALETTE[k % len(PALETTE)]
+            values = [v * scale for v in result.curves[metric]]
+            ax.plot(frequencies, values, lw=1.2, color=colour, label=case)
+            if metric == result.metric:
+                optimum = result.optimum
+                marks = [(optimum["main_hz"], optimum["main_value"], colour)]
+                if optimum["global_hz"] != optimum["main_hz"]:
+                    marks.append((optimum["global_hz"], optimum["global_value"], "none"))
+                for frequency, value, fill in marks:
+                    if frequency is not None:
+                        ax.plot(frequency, value * scale, marker="*", ms=13, color=colour, mfc=fill, ls="none")
+        ax.set_ylabel(label, fontsize=9)
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("impact frequency [Hz]")
+    axes[0, 0].legend(fontsize=8)
+    axes[0, 0].set_title(f"Fig. {figure.number}: {figure.title}", fontsize=10)
+    fig.tight_layout()
+    written = []
+    for fmt in formats:
+        path = stem.with_suffix(f".{fmt}")
+        fig.savefig(path, dpi=110)
+        written.append(path)
+    plt.close(fig)
+    return written

@@ -1,0 +1,142 @@
+"""What the study, accuracy and calibration files share: a strict spec base naming a base scene
+with overrides, scan axes, and edits of scene dicts by dotted key path.
+
+``base_scene`` is a scene file (relative to the spec file) or an inline mapping; ``base_overrides``
+maps dotted scene paths to values, each replacing what is at that path (``solver.end_time_s: 1.5``,
+``rock: {name: sandstone}``).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from ...models.outputs import METRICS
+from ...models.scene import Scene
+from .reading import InputError, allowed_keys, parse, read_yaml
+
+METRIC_NAMES = tuple(METRICS)
+MetricName = Literal[METRIC_NAMES]  # type: ignore[valid-type]
+# a range's num is bounded so that its count stays a float; a study of so many points is refused by
+# its budget long before (studies.runtime.budgets)
+MAX_NUM = 10**15
+
+
+class StrictSpec(BaseModel):
+    """Unknown keys are errors; numbers are numbers and finite (as in the scene, models.scene.Strict)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True, strict=True, allow_inf_nan=False)
+
+
+class SceneSpec(StrictSpec):
+    """A spec file's common part: its name, and the base scene with overrides (module doc)."""
+
+    name: str
+    description: str = ""
+    base_scene: str | dict[str, Any]
+    base_overrides: dict[str, Any] = Field(default_factory=dict)
+
+    def base_scene_dict(self, source: Path) -> dict[str, Any]:
+        """The base scene as written, with the overrides set (not filled in: a scanned ``rock.name``
+        must still supply the rock values); InputError naming ``source`` otherwise."""
+        if isinstance(self.base_scene, str):
+            path = source.parent / self.base_scene
+            try:
+                data = read_yaml(path)
+            except InputError as error:
+                raise InputError(f"{source}: base_scene: {self.base_scene!r}: {error}") from None
+            parse(Scene, data, str(path))
+        else:
+            data = copy.deepcopy(self.base_scene)
+            parse(Scene, data, str(source), ("base_scene",))
+        for path, value in self.base_overrides.items():
+            check_scene_path(str(source), "base_overrides", path, data)
+            set_path(data, path, value)
+        parse(Scene, data, f"{source} (base_scene with base_overrides)")
+        return data
+
+
+class Axis(StrictSpec):
+    """Values of one scan axis: a list ``[..]``, ``{from, to, step}`` or ``{from, to, num, spacing}``."""
+
+    values: list[Any] | None = Field(None, min_length=1)
+    start: float | None = Field(None, alias="from")
+    to: float | None = None
+    step: float | None = None
+    num: int | None = Field(None, ge=2, le=MAX_NUM)
+    spacing: Literal["linear", "log"] = "linear"
+
+    @model_validator(mode="before")
+    @classmethod
+    def _list_is_values(cls, data: Any) -> Any:
+        return {"values": data} if isinstance(data, list) else data
+
+    @model_validator(mode="after")
+    def _one_form(self) -> Axis:
+        if self.values is not None:
+            if any(v is not None for v in (self.start, self.to, self.step, self.num)):
+                raise ValueError("give either a list of values or from/to with step or num, not both")
+            return self
+        if self.start is None or self.to is None or (self.step is None) == (self.num is None):
+            raise ValueError("give a list [..], {from, to, step} or {from, to, num, spacing: linear|log}")
+        if self.step is not None and (self.step == 0 or (self.to - self.start) * self.step < 0):
+            raise ValueError(f"step {self.step} does not lead from {self.start} to {self.to}")
+        if self.spacing == "log" and (self.num is None or self.start <= 0 or self.to <= 0):
+            raise ValueError("spacing: log needs num and positive from and to")
+        return self
+
+    @property
+    def count(self) -> float:
+        """How many values :meth:`expand` gives, known before expanding (inf beyond any float)."""
+        if self.values is not None:
+            return float(len(self.values))
+        if self.step is not None:
+            span = (self.to - self.start) / self.step
+            return float(math.floor(span + 1e-9) + 1) if math.isfinite(span) else math.inf
+        return float(self.num)
+
+    def expand(self) -> list[Any]:
+        """The axis values; ranges include ``to`` and are rounded to 12 significant digits."""
+        if self.values is not None:
+            return list(self.values)
+        if self.step is not None:
+            count = math.floor((self.to - self.start) / self.step + 1e-9) + 1
+            raw = [self.start + i * self.step for i in range(count)]
+        elif self.spacing == "log":
+            ratio = math.log(self.to / self.start) / (self.num - 1)
+            raw = [self.start * math.exp(i * ratio) for i in range(self.num)]
+        else:
+            raw = [self.start + i * (self.to - self.start) / (self.num - 1) for i in range(self.num)]
+        return [float(f"{v:.12g}") for v in raw]
+
+
+def set_path(data: dict[str, Any], path: str, value: Any) -> None:
+    """Set ``data[a][b][c] = value`` for ``path`` 'a.b.c', creating missing mappings."""
+    *parents, leaf = path.split(".")
+    for key in parents:
+        data = data.setdefault(key, {})
+    data[leaf] = copy.deepcopy(value)
+
+
+def check_scene_path(source: str, key: str, path: str, base: dict[str, Any] | None = None) -> None:
+    """A scan or override path must name a scene key; a name in a mapping (``drill_string.bodies.X``)
+    must exist in the ``base`` scene (a typo there would add a body, not change one)."""
+    parts = tuple(path.split("."))
+    allowed = allowed_keys(Scene, parts)
+    if allowed is None or parts[-1] not in allowed:
+        hint = f"allowed keys here: {', '.join(allowed)}" if allowed else "not a path to a scene key"
+        raise InputError(f"{source}: {key}.{path}: unknown scene key path; {hint}")
+    node: Any = base
+    for depth, part in enumerate(parts[:-1]):
+        if not isinstance(node, dict):
+            return
+        free_name = allowed_keys(Scene, parts[:depth + 1]) is None  # a key of a mapping of models
+        if free_name and part not in node:
+            names = ", ".join(node)
+            raise InputError(f"{source}: {key}.{path}: {part!r} is not in the base scene's "
+                             f"{'.'.join(parts[:depth])}; there: {names}")
+        node = node.get(part)

@@ -1,0 +1,60 @@
+"""One scene of a study, an accuracy study or a calibration: prepared once, run by a worker.
+
+Every point is validated and prepared where it is made (models.simulation.prepare: the chain, the
+rock law, the solver settings, the initial state); workers receive the prepared simulation and
+build the formulation's model themselves (Exudyn systems cannot be pickled). A point's problems
+are tied to the scan axis that caused them when there is one.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from pydantic import ValidationError
+
+from ...models.metrics import summary_metrics
+from ...models.scene import Scene
+from ...models.simulation import Simulation
+from ..inputs.reading import InputError, prepare_scene, problem
+
+
+def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]) -> list[str]:
+    """Problems of one point, each tied to the scan axis that caused it when there is one."""
+    lines = []
+    for item in error.errors():
+        loc = ".".join(str(p) for p in item["loc"] if p != "function-after")
+        related = [a for a in parameters if a == loc or a.startswith(loc + ".") or loc.startswith(a + ".")]
+        message = problem(item)
+        if len(related) == 1:
+            lines.append(f"{source}: scan.{related[0]}: {parameters[related[0]]!r}: {message}")
+        else:
+            lines.append(f"{source}: {_point(parameters)}{loc or 'scene'}: {message}")
+    return lines
+
+
+def _point(parameters: dict[str, Any]) -> str:
+    return f"scan point {parameters}: " if parameters else ""
+
+
+def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]) -> Simulation:
+    """Validate and prepare one point's scene; InputError naming the scan axis that made it invalid
+    (or the point), and when its formulation cannot run it (studies.inputs.reading.prepare_scene)."""
+    try:
+        validated = Scene.model_validate(scene)
+    except ValidationError as error:
+        raise InputError("\n".join(_point_error(source, error, parameters))) from None
+    return prepare_scene(validated, source, _point(parameters))
+
+
+def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
+    """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics; a
+    failure is returned, not raised."""
+    key, simulation = task
+    start = time.perf_counter()
+    try:
+        metrics = summary_metrics(simulation.run())
+    except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
+        return {"point": key, "status": "failed", "error": f"{type(err).__name__}: {err}",
+                "wall_time_s": time.perf_counter() - start, "metrics": {}}
+    return {"point": key, "status": "ok", "error": "", "wall_time_s": time.perf_counter() - start, "metrics": metrics}

@@ -1,0 +1,146 @@
+"""Runners: plug-ins that map a top-level function over arguments in batches, yielding each batch's
+results as it completes.
+
+Each runner is ``runner(function, arguments) -> Iterator[list[result]]``: :func:`sequential` (in this
+process, one argument per batch), or one bound to a pool that lives for many calls,
+:func:`process_pool` (local worker processes, all cores by default) and :func:`dask_pool` (a Dask
+cluster or a LocalCluster); :func:`pool` picks one for the command line options. A pool's workers
+start and import rpdrill once (a process pool's with its first call, so that a study refused before
+it runs starts none) and take batches of arguments (:func:`batches`): a run pays the process
+machinery once per pool and once per batch, not per argument. Results come in completion order, so
+the function's result must say which argument it belongs to. Workers run one BLAS thread each (so that
+two workers on two cores do not run four threads); process-pool workers are started the standard
+library's way for the platform (forked from the command's process on Linux, which has imported what
+they run) and stop on SIGTERM as on Ctrl-C (studies.runtime.interrupts). A worker's
+warnings come back with its batch and are issued again in this process (its filters and formatting
+apply; each distinct warning once per pool), so that workers print nothing themselves.
+"""
+from __future__ import annotations
+
+import contextlib
+import itertools
+import logging
+import os
+import warnings
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from typing import Any, TypeVar
+
+from threadpoolctl import threadpool_limits
+
+from .interrupts import worker_stops_like_ctrl_c
+
+Arg = TypeVar("Arg")
+Result = TypeVar("Result")
+Runner = Callable[[Callable[[Arg], Result], Sequence[Arg]], Iterator[list[Result]]]
+Caught = list[tuple[str, type[Warning], str, int]]
+
+# Child processes a Dask LocalCluster starts: one BLAS thread each (set before they load NumPy).
+ONE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+BATCHES_PER_WORKER = 4  # enough to even out unequal points; few enough that a batch costs ~nothing to send
+
+def batches(arguments: Sequence[Arg], workers: int) -> list[list[Arg]]:
+    """``arguments`` in order, cut into at most BATCHES_PER_WORKER batches per worker of equal size
+    (+-1): each worker takes several, so one slow batch does not leave the others idle."""
+    count = min(len(arguments), workers * BATCHES_PER_WORKER)
+    if count == 0:
+        return []
+    size, extra = divmod(len(arguments), count)
+    bounds = [i * size + min(i, extra) for i in range(count + 1)]
+    return [list(arguments[a:b]) for a, b in itertools.pairwise(bounds)]
+
+
+def run_batch(task: tuple[Callable[[Arg], Result], list[Arg]]) -> tuple[list[Result], Caught]:
+    """Worker: ``function`` over one batch of arguments, and the warnings it issued (text, category,
+    file, line)."""
+    function, arguments = task
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        results = [function(argument) for argument in arguments]
+    return results, [(str(w.message), w.category, w.filename, w.lineno) for w in caught]
+
+
+def start_process_worker() -> None:
+    """Process-pool worker initializer: SIGTERM stops it as Ctrl-C does (studies.runtime.interrupts), and
+    BLAS runs one thread."""
+    worker_stops_like_ctrl_c()
+    threadpool_limits(1)
+
+
+def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
+    """In this process, one after the other (each result its own batch)."""
+    return ([function(argument)] for argument in arguments)
+
+
+def _completed(futures: list[Any], as_done: Callable[[list[Any]], Iterator[Any]],
+               cancel: Callable[[list[Any]], None], registry: dict[Any, Any]) -> Iterator[list[Any]]:
+    """Each future's batch of results as it completes, after issuing its warnings here (``registry``:
+    those issued already); the rest cancelled when the caller stops early."""
+    try:
+        for future in as_done(futures):
+            results, caught = future.result()
+            for text, category, filename, lineno in caught:
+                warnings.warn_explicit(text, category, filename, lineno, registry=registry)
+            yield results
+    finally:
+        cancel(futures)
+
+
+@contextlib.contextmanager
+def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
+    """A runner bound to one pool of local workers, kept for many calls; every worker starts with the
+    first call, none when nothing is run."""
+    workers = workers or os.cpu_count() or 1
+    executors: list[ProcessPoolExecutor] = []
+    registry: dict[Any, Any] = {}
+
+    def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
+        if not executors:
+            executors.append(ProcessPoolExecutor(max_workers=workers, initializer=start_process_worker))
+        futures = [executors[0].submit(run_batch, (function, batch)) for batch in batches(arguments, workers)]
+        return _completed(futures, as_completed, lambda pending: [f.cancel() for f in pending], registry)
+
+    try:
+        yield run
+    finally:
+        for executor in executors:
+            executor.shutdown(wait=True, cancel_futures=True)
+
+
+@contextlib.contextmanager
+def dask_pool(address: str | None = None, workers: int | None = None) -> Iterator[Runner[Any, Any]]:
+    """A runner bound to one Dask client, kept for many calls: a cluster at ``address``
+    (``tcp://host:8786``), or a LocalCluster of single-thread workers."""
+    from dask.distributed import Client, LocalCluster
+    from dask.distributed import as_completed as dask_completed
+
+    with contextlib.ExitStack() as stack:
+        if address:
+            client = stack.enter_context(Client(address))
+        else:
+            cluster = stack.enter_context(LocalCluster(
+                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                dashboard_address=":0", silence_logs=logging.ERROR, env=ONE_THREAD))
+            client = stack.enter_context(Client(cluster))
+        slots = sum(client.nthreads().values()) or 1
+        registry: dict[Any, Any] = {}
+
+        def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
+            futures = client.map(run_batch, [(function, batch) for batch in batches(arguments, slots)], pure=False)
+            return _completed(futures, dask_completed, client.cancel, registry)
+
+        yield run
+
+
+@contextlib.contextmanager
+def pool(dask_address: str | None, workers: int | None) -> Iterator[tuple[str, Runner[Any, Any]]]:
+    """A runner kept for many calls, for the command line options: its description and the callable
+    (``--workers 1``: in this process; ``--dask [ADDRESS]``: Dask; otherwise a process pool)."""
+    if dask_address is not None:
+        with dask_pool(dask_address or None, workers) as run:
+            yield f"dask ({dask_address or 'LocalCluster'})", run
+    elif workers == 1:
+        yield "sequential", sequential
+    else:
+        with process_pool(workers) as run:
+            yield f"processes ({workers or os.cpu_count()} workers)", run

@@ -1,0 +1,240 @@
+"""YAML studies: scans of a base scene over dotted scene paths, expanded into validated points.
+
+A study names a ``base_scene`` (a file relative to the study file, or an inline mapping),
+optional ``base_overrides`` (dotted path -> value, each replacing what is at that path, e.g.
+``solver.end_time_s: 1.5`` or ``rock: {name: sandstone}``), the ``scan`` axes, how they
+``combine`` (``grid``, ``zip``, or a list of groups zipped inside and crossed with each
+other), the ``metrics`` to collect and the ``plots`` to draw. Every point is prepared once, at load
+(studies.runtime.point_runs); the formulation is the scene's ``solver.formulation`` (e.g. ``base_overrides:
+{solver.formulation: exact}``).
+
+Example (``studies/paper/stiffness_scan.yaml`` has the full file)::
+
+    name: stiffness_scan
+    base_scene: ../scenes/paper_base.yaml
+    base_overrides: {solver.end_time_s: 1.5}
+    scan:
+      rock.stiffness_n_per_m: [8.93e7, 2.1e8, 5.1e8, 8.4e8]
+      rock.damping_n_s_per_m: [6.83e2, 1.98e3, 4.9e3, 2.3e4]
+      impact.frequency_hz: {from: 10, to: 120, step: 5}        # or {from, to, num, spacing: log}
+    combine: [[rock.stiffness_n_per_m, rock.damping_n_s_per_m]]  # zipped, crossed with the frequency
+    metrics: [penetration_rate_m_per_s, bit_velocity_peak_m_per_s]
+    plots:
+      - {x: impact.frequency_hz, y: [penetration_rate_m_per_s], curves: rock.stiffness_n_per_m}
+      - {kind: map, x: impact.frequency_hz, y: rock.stiffness_n_per_m, z: penetration_rate_m_per_s}
+    format: png
+
+The end time is the study's choice: the paper scans set ``solver.end_time_s: 1.5`` in
+``base_overrides`` (10 transient + 5 averaged blows at 10 Hz) and leave the base scene file alone.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import Field, model_validator
+
+from ...models.scene import Scene, switch_formulation
+from ...models.simulation import Simulation
+from ..inputs.reading import InputError, parse, read_yaml
+from ..inputs.specs import (
+    METRIC_NAMES,
+    Axis,
+    MetricName,
+    SceneSpec,
+    StrictSpec,
+    check_scene_path,
+    set_path,
+)
+from ..runtime.budgets import DEFAULT_BUDGET, Budget, BudgetError, base_estimate_s, check_size
+from ..runtime.point_runs import prepare_point
+
+
+class Plot(StrictSpec):
+    """``curves``: metric(s) ``y`` against axis ``x``, one curve per value of the other axes
+    (``curves``: the axis the plot is about; every varied value is in the legend), the optimum of
+    each curve marked. ``map``: metric ``z`` over axes ``x`` and ``y`` as cells, the optimum along
+    ``x`` of each ``y`` marked, a panel for each combination of the other axes (studies.figures.scan_figures)."""
+
+    kind: Literal["curves", "map"] = "curves"
+    x: str
+    y: str | Annotated[list[str], Field(min_length=1)]
+    z: MetricName | None = None
+    curves: str | None = None
+
+    @model_validator(mode="after")
+    def _fields_of_kind(self) -> Plot:
+        if self.kind == "map" and (self.z is None or not isinstance(self.y, str) or self.curves):
+            raise ValueError("kind: map needs x and y (scan axes) and z (a metric), and no curves")
+        if self.kind == "curves" and self.z is not None:
+            raise ValueError("kind: curves takes x (a scan axis) and y (metric or list of metrics), not z")
+        return self
+
+    @property
+    def metrics(self) -> list[str]:
+        return [self.z] if self.kind == "map" else [self.y] if isinstance(self.y, str) else list(self.y)
+
+    @property
+    def axes(self) -> list[str]:
+        return [self.x, self.y] if self.kind == "map" else [self.x] + ([self.curves] if self.curves else [])
+
+
+class StudySpec(SceneSpec):
+    """The study file as written."""
+
+    scan: dict[str, Axis] = Field(min_length=1)
+    combine: Literal["grid", "zip"] | list[Annotated[list[str], Field(min_length=1)]] = "grid"
+    metrics: list[MetricName] = Field(list(METRIC_NAMES), min_length=1)
+    plots: list[Plot] = Field(default_factory=list)
+    format: Literal["png", "svg", "pdf"] = "png"  # an SVG is written beside a PNG or PDF
+
+
+@dataclass(frozen=True)
+class StudyPoint:
+    """One scene of a study: its index, its scan parameters, the prepared simulation and its
+    estimated CPU seconds (models.cost)."""
+
+    index: int
+    parameters: dict[str, Any]
+    simulation: Simulation | None
+    cpu_s: float
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated study with its resolved base scene and its expanded points."""
+
+    source: Path
+    spec: StudySpec
+    base: dict[str, Any]
+    axes: dict[str, list[Any]]
+    points: list[StudyPoint]
+
+    def resolved(self) -> dict[str, Any]:
+        """The study with the base scene (overrides applied, defaults filled) and the axis values."""
+        data = self.spec.model_dump(mode="json", by_alias=True)
+        data.update(base_scene=Scene.model_validate(self.base).model_dump(mode="json", by_alias=True), scan=self.axes)
+        return data
+
+    def zipped_with(self, axis: str) -> list[str]:
+        """The scan axes that change together with ``axis`` (its ``combine`` group, itself included)."""
+        return next(group for group in _groups(self.spec, str(self.source)) if axis in group)
+
+    @cached_property
+    def scene_keys(self) -> list[str]:
+        """Each point's resolved scene (models.simulation.Simulation.resolved_scene: with its outputs and
+        solver settings) as canonical JSON: equal keys, equal results."""
+        return [json.dumps(p.simulation.resolved_scene(), sort_keys=True) for p in self.points]
+
+    @property
+    def hash(self) -> str:
+        """SHA-256 of what determines the results: the point scenes and the collected metrics (the JSON
+        of {"metrics": [...], "points": [scene, ...]} with sorted keys, assembled from :attr:`scene_keys`)."""
+        content = f'{{"metrics": {json.dumps(list(self.spec.metrics))}, "points": [{", ".join(self.scene_keys)}]}}'
+        return hashlib.sha256(content.encode()).hexdigest()
+
+
+def _groups(spec: StudySpec, source: str) -> list[list[str]]:
+    """Axis groups zipped inside and crossed with each other."""
+    names = list(spec.scan)
+    if spec.combine == "grid":
+        return [[n] for n in names]
+    if spec.combine == "zip":
+        return [names]
+    listed = [n for group in spec.combine for n in group]
+    for n in listed:
+        if n not in spec.scan or listed.count(n) > 1:
+            raise InputError(f"{source}: combine: {n!r}: each group entry must be a scan axis, named once; "
+                             f"scan axes: {', '.join(names)}")
+    return list(spec.combine) + [[n] for n in names if n not in listed]
+
+
+def _point_count(groups: list[list[str]], spec: StudySpec, source: str) -> float:
+    """The number of points, from the axes' counts (before any is expanded); InputError when a
+    zipped group's axes differ in length."""
+    count = 1.0
+    for group in groups:
+        lengths = {n: spec.scan[n].count for n in group}
+        if len(set(lengths.values())) > 1:
+            raise InputError(f"{source}: combine: zipped axes need equal lengths, got "
+                             + ", ".join(f"scan.{n}: {k:.6g}" for n, k in lengths.items()))
+        count *= next(iter(lengths.values()))
+    return count
+
+
+def _combine(groups: list[list[str]], axes: dict[str, list[Any]]) -> list[dict[str, Any]]:
+    zipped = [[dict(zip(group, values)) for values in zip(*(axes[n] for n in group))] for group in groups]
+    return [{k: v for part in combo for k, v in part.items()} for combo in itertools.product(*zipped)]
+
+
+def _check_plots(spec: StudySpec, axes: dict[str, list[Any]], source: str) -> None:
+    for i, plot in enumerate(spec.plots):
+        for field, name in zip(("x", "y" if plot.kind == "map" else "curves"), plot.axes):
+            if name not in axes:
+                raise InputError(f"{source}: plots.{i}.{field}: {name!r}: not a scan axis; "
+                                 f"scan axes: {', '.join(axes)}")
+        for name in (plot.x, plot.y) if plot.kind == "map" else (plot.x,):
+            if not all(isinstance(v, (int, float)) for v in axes[name]) or len(axes[name]) < 2:
+                raise InputError(f"{source}: plots.{i}: axis {name!r} must have at least two numeric values")
+        for name in plot.metrics:
+            if name not in spec.metrics:
+                raise InputError(f"{source}: plots.{i}: metric {name!r} is not collected; "
+                                 f"metrics: {', '.join(spec.metrics)}")
+
+
+def load_study(path: str | Path, formulation: str | None = None, budget: Budget = DEFAULT_BUDGET) -> Study:
+    """Read, validate and expand a study file, every point with ``formulation`` when given (the base
+    scene's solver options of another formulation dropped) and checked against the ``budget`` before it
+    runs; InputError naming the file and key path, BudgetError naming the cost, otherwise."""
+    path = Path(path)
+    source = str(path)
+    spec = parse(StudySpec, read_yaml(path), source)
+    base = spec.base_scene_dict(path)
+    if formulation is not None:
+        base["solver"] = switch_formulation(base.get("solver", {}), formulation)
+    for axis in spec.scan:
+        check_scene_path(source, "scan", axis, base)
+    _check_rock_name_axis(spec, base, source)
+    groups = _groups(spec, source)
+    count = _point_count(groups, spec, source)
+    outputs = {"outputs": {"metrics": list(spec.metrics)}}  # the model records only what these need
+    what = f"scan: {count:.6g} points (" + ", ".join(f"scan.{n}: {a.count:.6g} values" for n, a in spec.scan.items()) + ")"
+    check_size(budget, source, what, count, base_estimate_s(source, {**base, **outputs}))
+    axes = {name: axis.expand() for name, axis in spec.scan.items()}
+    points, problems, bad_input = [], [], False
+    for index, parameters in enumerate(_combine(groups, axes)):
+        scene = copy.deepcopy(base)
+        for name, value in parameters.items():
+            set_path(scene, name, value)
+        try:
+            simulation = prepare_point(source, {**scene, **outputs}, parameters)
+            cost = budget.check_run(simulation, source, f"scan point {parameters}: ")
+            points.append(StudyPoint(index, parameters, simulation, cost.cpu_s))
+        except (InputError, BudgetError) as error:
+            bad_input |= isinstance(error, InputError)
+            problems += [line for line in str(error).splitlines() if line not in problems]
+    if problems:
+        more = f"\n... and {len(problems) - 5} more" if len(problems) > 5 else ""
+        raise (InputError if bad_input else BudgetError)("\n".join(problems[:5]) + more)
+    _check_plots(spec, axes, source)
+    budget.check_total(source, what, count, sum(p.cpu_s for p in points))
+    return Study(path, spec, base, axes, points)
+
+
+def _check_rock_name_axis(spec: StudySpec, base: dict[str, Any], source: str) -> None:
+    """A scanned rock.name supplies the rock values only where the base rock gives none."""
+    explicit = [k for k in ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n")
+                if k in base.get("rock", {}) and f"rock.{k}" not in spec.scan]
+    if "rock.name" in spec.scan and explicit:
+        raise InputError(f"{source}: scan.rock.name: the base rock sets {', '.join(explicit)}, which would "
+                         "override every named rock; name the base rock only, e.g. "
+                         "base_overrides: {rock: {name: sandstone}}")
+
+
