@@ -29,6 +29,7 @@ from .formulations import (
 )
 from .links import LINK_TYPES
 from .outputs import METRICS, SERIES, Need, needs
+from .validation import with_changes
 
 Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]
@@ -334,10 +335,8 @@ class Impact(Strict):
     @model_validator(mode="after")
     def _pulse_fits_period(self) -> Impact:
         if self.duration_s >= self.period_s:
-            raise ValueError(
-                f"duration_s {self.duration_s} must be shorter than the impact period "
-                f"1/frequency_hz = {self.period_s:.6g} s"
-            )
+            raise _key_error("Impact", ("duration_s",), self.duration_s, "must be shorter than the impact period "
+                             "1/frequency_hz = {period_s} s", period_s=float(f"{self.period_s:.6g}"))
         return self
 
 
@@ -536,6 +535,13 @@ class Scene(Strict):
     start: Literal["rest", "preloaded"] = Field(
         "rest", description="rest: every coordinate zero (Eq. 4 from rest); preloaded: the static "
         "equilibrium under the feed (and torque) with the bit pressed on the rock")
+
+    def with_(self, changes: dict[str, Any], source: str = "Scene.with_") -> Scene:
+        """A validated copy with ``changes``: dotted key paths of the scene file -> values
+        (``{"impact.frequency_hz": 70.0, "solver.formulation": "exact"}``; None removes a key). A bad
+        value raises :class:`~rpdrill.models.validation.InputError` naming the key path, the value and
+        what is allowed, as the command line reports a scene file."""
+        return with_changes(self, changes, source)
 
     def with_solver(self, formulation: str | None = None, **options: object) -> Scene:
         """This scene with another formulation (:func:`switch_formulation`) and/or other solver

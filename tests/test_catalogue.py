@@ -14,8 +14,8 @@ from scenes import PAPER_BASE, scene
 
 from rpdrill.models.outputs import METRICS, SERIES
 from rpdrill.models.scene import Scene
+from rpdrill.models.validation import allowed_keys
 from rpdrill.studies.display import catalogue
-from rpdrill.studies.inputs.reading import allowed_keys
 
 WORDS = re.compile(r"[a-z]+(?:[._][a-z0-9]+)+")  # snake_case or dotted keys
 

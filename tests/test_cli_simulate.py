@@ -48,7 +48,7 @@ BAD = [
      ["drill_string", "'bitt'", "collar_bit_joint"]),
     ("feed on a missing body", {"feed.acts_on": "hammer"}, ["feed.acts_on", "'hammer'", "every_body"]),
     ("threshold", {"rock.threshold_n": 0.0}, ["rock.threshold_n", "0.0", "greater than 0"]),
-    ("long pulse", {"impact.duration_s": 0.02}, ["impact", "duration_s 0.02", "shorter than the impact period"]),
+    ("long pulse", {"impact.duration_s": 0.02}, ["impact.duration_s: 0.02", "shorter than the impact period"]),
     ("short run", {"solver.end_time_s": 0.01}, ["solver.end_time_s 0.01", "shorter than one impact period"]),
     ("unknown rock", {"rock": {"name": "granite"}}, ["rock.name", "'granite'", "sandstone"]),
     ("unknown solver", {"solver.type": "rk45"}, ["solver.type", "'rk45'", "generalized_alpha"]),

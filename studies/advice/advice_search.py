@@ -44,8 +44,8 @@ from scipy import optimize
 from ...models.formulations import unsupported
 from ...models.scene import Scene
 from ...models.simulation import SceneError, Simulation, prepare
+from ...models.validation import InputError, describe_validation_error
 from ..display.catalogue import describe_scene, parameter
-from ..inputs.reading import InputError, describe_validation_error
 from ..inputs.specs import set_path
 from ..runtime.pools import Runner
 from ..scan.curve_optima import band_hz

@@ -35,7 +35,8 @@ import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from ...models.scene import Scene
-from ..inputs.reading import InputError, field_at, parse, read_yaml
+from ...models.validation import InputError, field_at, parse
+from ..inputs.reading import read_yaml
 from ..inputs.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
 from ..runtime.budgets import (
     AXIS_VALUE_BYTES,

@@ -11,20 +11,15 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ...models.cost import Cause
 from ...models.formulations import FORMULATIONS
-from ...models.metrics import summary_metrics
 from ...models.stability import SimulationFailed
+from ..api import simulate
 from ..display.catalogue import metric
-from ..figures.timeseries_figure import plot_timeseries
-from ..inputs.reading import load_scene, prepare_scene
+from ..inputs.reading import load_scene
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import (
     check_out,
     staged_directory,
-    write_columns_csv,
-    write_json,
-    write_resolved,
 )
 from ..runtime.progress import time_progress
 from .options import add_budget_arguments, budget
@@ -47,26 +42,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite)
     scene = load_scene(args.scene)
-    if args.formulation:
-        scene = scene.with_solver(args.formulation)
-    simulation = prepare_scene(scene, args.scene)
-    budget(args).check_run(simulation, args.scene, resampled=Cause("solver.output_interval_s", scene.solver.output_interval_s))
     try:
         with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
-            result = simulation.run(progress)
+            result = simulate(args.scene, args.formulation, progress, budget(args))
     except SimulationFailed as err:
         raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
         print(f"{args.scene}: {err}", file=sys.stderr)
         return 1
-    summary = summary_metrics(result)
-    columns = result.resampled(scene.solver.output_interval_s)
     with staged_directory(args.out) as stage:
-        write_columns_csv(stage / "timeseries.csv", columns)
-        write_json(stage / "summary.json", {"scene": scene.name, "formulation": result.formulation,
-                                            "metrics": summary, "run": result.info})
-        write_resolved(stage / "scene.resolved.yaml", simulation.resolved_scene())
-        plot_timeseries(columns, scene, stage / "timeseries.png")
-    shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}" for name, value in summary.items()
-                      if name in HEADLINE)
-    print(f"{scene.name} ({result.formulation}): {shown}; wrote {args.out}")
+        result.save(stage)
+    shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}"
+                      for name, value in result.metrics.items() if name in HEADLINE)
+    print(f"{result.scene.name} ({result.formulation}): {shown}; wrote {args.out}")
     return 0

@@ -16,25 +16,22 @@ from __future__ import annotations
 import re
 import unicodedata
 from pathlib import Path
-from typing import Any, TypeVar, get_args, get_origin
+from typing import Any
 
 import yaml
-from pydantic import BaseModel, ValidationError
 
 from ...models.formulations import unsupported
 from ...models.scene import Scene
 from ...models.simulation import SceneError, Simulation, prepare
+from ...models.validation import InputError, parse, short
 
-ModelT = TypeVar("ModelT", bound=BaseModel)
+__all__ = ["InputError", "load_scene", "parse", "parse_yaml", "prepare_scene", "read_text", "read_yaml"]
+
 MAX_FILE_BYTES = 16 * 2**20
 MAX_VALUES = 100_000  # values of a document, aliases expanded (a scene has about a hundred)
 MAX_DEPTH = 32  # nesting of mappings and lists (a scene has five levels)
 YAML_12_FLOAT = re.compile(r"^[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?$")
 MERGE = "tag:yaml.org,2002:merge"
-
-
-class InputError(Exception):
-    """Bad user input; the message is complete and meant for the user."""
 
 
 def read_text(path: str | Path) -> str:
@@ -158,7 +155,7 @@ def _hidden_text(data: Any) -> str | None:
             stack += [(item, _join(where, i)) for i, item in enumerate(value)]
         elif isinstance(value, str) and (hidden := _hidden_character(value)) is not None:
             name = unicodedata.name(hidden, "")
-            return (f"{where or '(top level)'}: {_short(value)}: holds the control or invisible character "
+            return (f"{where or '(top level)'}: {short(value)}: holds the control or invisible character "
                     f"U+{ord(hidden):04X}{f' ({name})' if name else ''}; text here is printable characters only")
     return None
 
@@ -192,7 +189,7 @@ def parse_yaml(text: str, source: str) -> dict[str, Any]:
             loader.dispose()
     if not isinstance(data, dict):
         raise InputError(f"{source}: expected a mapping of keys at the top level, found "
-                         f"{'a list' if isinstance(data, list) else _short(data)}")
+                         f"{'a list' if isinstance(data, list) else short(data)}")
     hidden = _hidden_text(data)
     if hidden:
         raise InputError(f"{source}: {hidden}")
@@ -203,104 +200,6 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
     """The mapping in a YAML file (:func:`read_text`, :func:`parse_yaml`), or InputError naming the
     file and the problem."""
     return parse_yaml(read_text(path), str(path))
-
-
-def _inner_model(annotation: Any) -> tuple[type[BaseModel] | None, bool]:
-    """The model inside a field's annotation (``Model``, ``Model | None``, ``dict[str, Model]``) and
-    whether it sits behind a free mapping key (the dict case)."""
-    keyed = get_origin(annotation) is dict
-    candidates = get_args(annotation)[1:] if keyed else getattr(annotation, "__args__", (annotation,))
-    model = next((a for a in candidates if isinstance(a, type) and issubclass(a, BaseModel)), None)
-    return model, keyed
-
-
-def _field(model: type[BaseModel], key: Any) -> Any:
-    """The field of ``model`` named ``key`` in a file (its alias or its name), None if there is none."""
-    return next((f for name, f in model.model_fields.items() if key in (name, f.alias)), None)
-
-
-def _parent_model(model: type[BaseModel], location: tuple[Any, ...]) -> type[BaseModel] | None:
-    """The model that holds the last key of ``location`` inside ``model`` (None if not a model there).
-
-    Keys are the names a scene file uses (field aliases such as ``from``); a mapping of models
-    (``drill_string.bodies``) takes any name, after which its model's keys apply again.
-    """
-    current: type[BaseModel] | None = model
-    keyed = False
-    for part in location[:-1]:
-        if keyed:  # a free name in a mapping of models
-            keyed = False
-            continue
-        if isinstance(part, int) or current is None:
-            return None
-        field = _field(current, part)
-        if field is None:
-            return None
-        current, keyed = _inner_model(field.annotation)
-    return None if keyed else current
-
-
-def allowed_keys(model: type[BaseModel], location: tuple[Any, ...]) -> list[str] | None:
-    """Keys allowed at the parent of ``location`` inside ``model`` (None if not a model there)."""
-    parent = _parent_model(model, location)
-    return None if parent is None else [field.alias or name for name, field in parent.model_fields.items()]
-
-
-def field_at(model: type[BaseModel], location: tuple[Any, ...]) -> Any:
-    """The pydantic field (FieldInfo) at the key path ``location`` inside ``model``, None if none."""
-    parent = _parent_model(model, location)
-    return None if parent is None else _field(parent, location[-1])
-
-
-def _short(value: Any) -> str:
-    text = "null" if value is None else repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
-
-
-# what a strict type accepts, for the messages of pydantic's type errors
-STRICT_TYPES = {
-    "float_type": "a number is required (not text, true/false or null; YAML reads yes/no/on/off as true/false)",
-    "int_type": "a whole number is required (not a fraction, text, true/false or null)",
-    "bool_type": "true or false is required",
-    "string_type": "text is required",
-    "dict_type": "a mapping of keys is required",
-    "list_type": "a list [..] is required",
-}
-
-
-def problem(item: Any) -> str:
-    """What one problem of a pydantic validation says: a validator's own text, or what the key allows."""
-    if item["type"] == "value_error":
-        return item["msg"].removeprefix("Value error, ")
-    return STRICT_TYPES.get(item["type"], item["msg"])
-
-
-def describe_validation_error(source: str, error: ValidationError, model: type[BaseModel],
-                              prefix: tuple[Any, ...] = ()) -> str:
-    """One message for all problems of a validation: '<file>: <key.path>: <value>: <what is allowed>'."""
-    lines = []
-    for item in error.errors():
-        location = tuple(part for part in item["loc"] if part not in ("function-after", "[key]"))
-        path = ".".join(str(p) for p in prefix + location) or "(top level)"
-        if item["type"] == "extra_forbidden":
-            allowed = allowed_keys(model, location)
-            hint = f"unknown key; allowed keys here: {', '.join(allowed)}" if allowed else "unknown key"
-            lines.append(f"{source}: {path}: {_short(item['input'])}: {hint}")
-        elif item["type"] == "missing":
-            lines.append(f"{source}: {path}: missing: a value is required")
-        elif item["type"] == "value_error":
-            lines.append(f"{source}: {path}: {problem(item)}")
-        else:
-            lines.append(f"{source}: {path}: {_short(item['input'])}: {problem(item)}")
-    return "\n".join(lines)
-
-
-def parse(model: type[ModelT], data: Any, source: str, prefix: tuple[Any, ...] = ()) -> ModelT:
-    """Validate ``data`` as ``model``; InputError with the described problems otherwise."""
-    try:
-        return model.model_validate(data)
-    except ValidationError as error:
-        raise InputError(describe_validation_error(source, error, model, prefix)) from None
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -315,7 +214,7 @@ def prepare_scene(scene: Scene, source: str, where: str = "") -> Simulation:
     try:
         simulation = prepare(scene)
     except SceneError as err:
-        raise InputError(f"{source}: {where}{'.'.join(err.location)}: {_short(err.value)}: {err}") from None
+        raise InputError(f"{source}: {where}{'.'.join(err.location)}: {short(err.value)}: {err}") from None
     formulation = simulation.settings.formulation
     why = unsupported(formulation, simulation)
     if why:

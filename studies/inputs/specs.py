@@ -17,7 +17,8 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ...models.outputs import METRICS
 from ...models.scene import Scene
-from .reading import InputError, allowed_keys, parse, read_yaml
+from ...models.validation import InputError, check_path, parse, set_path
+from .reading import read_yaml
 
 METRIC_NAMES = tuple(METRICS)
 MetricName = Literal[METRIC_NAMES]  # type: ignore[valid-type]
@@ -114,29 +115,7 @@ class Axis(StrictSpec):
         return [float(f"{v:.12g}") for v in raw]
 
 
-def set_path(data: dict[str, Any], path: str, value: Any) -> None:
-    """Set ``data[a][b][c] = value`` for ``path`` 'a.b.c', creating missing mappings."""
-    *parents, leaf = path.split(".")
-    for key in parents:
-        data = data.setdefault(key, {})
-    data[leaf] = copy.deepcopy(value)
-
-
 def check_scene_path(source: str, key: str, path: str, base: dict[str, Any] | None = None) -> None:
     """A scan or override path must name a scene key; a name in a mapping (``drill_string.bodies.X``)
-    must exist in the ``base`` scene (a typo there would add a body, not change one)."""
-    parts = tuple(path.split("."))
-    allowed = allowed_keys(Scene, parts)
-    if allowed is None or parts[-1] not in allowed:
-        hint = f"allowed keys here: {', '.join(allowed)}" if allowed else "not a path to a scene key"
-        raise InputError(f"{source}: {key}.{path}: unknown scene key path; {hint}")
-    node: Any = base
-    for depth, part in enumerate(parts[:-1]):
-        if not isinstance(node, dict):
-            return
-        free_name = allowed_keys(Scene, parts[:depth + 1]) is None  # a key of a mapping of models
-        if free_name and part not in node:
-            names = ", ".join(node)
-            raise InputError(f"{source}: {key}.{path}: {part!r} is not in the base scene's "
-                             f"{'.'.join(parts[:depth])}; there: {names}")
-        node = node.get(part)
+    must exist in the ``base`` scene (models.validation.check_path)."""
+    check_path(Scene, source, key, path, base)

@@ -16,7 +16,8 @@ from pydantic import ValidationError
 from ...models.metrics import summary_metrics
 from ...models.scene import Scene
 from ...models.simulation import Simulation
-from ..inputs.reading import InputError, prepare_scene, problem
+from ...models.validation import problem
+from ..inputs.reading import InputError, prepare_scene
 
 
 def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]) -> list[str]:
@@ -25,6 +26,9 @@ def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]
     for item in error.errors():
         loc = ".".join(str(p) for p in item["loc"] if p != "function-after")
         related = [a for a in parameters if a == loc or a.startswith(loc + ".") or loc.startswith(a + ".")]
+        parent = loc.rpartition(".")[0]
+        if not related and parent:  # a check across keys (a pulse longer than the period): its sibling axes
+            related = [a for a in parameters if a.startswith(parent + ".")]
         message = problem(item)
         if len(related) == 1:
             lines.append(f"{source}: scan.{related[0]}: {parameters[related[0]]!r}: {message}")

@@ -1,0 +1,129 @@
+"""The library's public functions (re-exported by ``import rpdrill``): a scene from a file, one run
+of it as a :class:`Result`, a study from a file, its points as a pandas table.
+
+The command line is a client of these: ``rpdrill simulate`` is :func:`simulate` then
+:meth:`Result.save`, ``rpdrill study`` is :func:`run_study_files`. Every function raises
+:class:`InputError` (a ``ValueError``) on bad input before anything runs, with the message the
+command line prints.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tempfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from ..models.cost import Cause
+from ..models.metrics import summary_metrics
+from ..models.results import SimulationResult
+from ..models.scene import Scene
+from .inputs.reading import InputError, load_scene, prepare_scene
+from .runtime.budgets import DEFAULT_BUDGET, Budget
+from .runtime.output_files import write_columns_csv, write_json, write_resolved
+from .scan.study import Study, load_study
+from .scan.study_runs import Outcome, run_studies, run_study_files, study_folders
+
+__all__ = ["InputError", "Result", "load_scene", "load_study", "run_study", "run_study_files", "simulate",
+           "table_frame"]
+
+
+@dataclass(frozen=True)
+class Result:
+    """One run of a scene: its metrics (SI units in the names), its time series as a DataFrame
+    (resampled every ``solver.output_interval_s``; columns with units in their names, as
+    ``timeseries.csv``), the formulation's raw result (``raw``: every sample, the chain, the run info)
+    and where it came from (``provenance``)."""
+
+    scene: Scene
+    raw: SimulationResult
+    metrics: dict[str, float]
+    provenance: dict[str, Any] = field(default_factory=dict)
+
+    @cached_property
+    def timeseries(self) -> pd.DataFrame:
+        """Time series every ``solver.output_interval_s`` (x_n held between its changes, the rest
+        interpolated), columns with units in their names; ``time_s`` the index."""
+        columns = self.raw.resampled(self.scene.solver.output_interval_s)
+        return pd.DataFrame(columns).set_index("time_s", drop=False)
+
+    @property
+    def formulation(self) -> str:
+        return self.raw.formulation
+
+    def save(self, folder: str | Path) -> list[Path]:
+        """What ``rpdrill simulate`` writes into ``folder`` (made if missing): ``timeseries.csv``,
+        ``summary.json``, ``scene.resolved.yaml`` and the ``timeseries.png``/``.svg`` figure."""
+        from .figures.timeseries_figure import plot_timeseries  # matplotlib only when saving
+
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        columns = {name: values.to_numpy() for name, values in self.timeseries.items()}
+        write_columns_csv(folder / "timeseries.csv", columns)
+        write_json(folder / "summary.json", {"scene": self.scene.name, "formulation": self.formulation,
+                                             "metrics": self.metrics, "run": self.raw.info,
+                                             "provenance": self.provenance})
+        write_resolved(folder / "scene.resolved.yaml", self.raw.simulation.resolved_scene())
+        figures = plot_timeseries(columns, self.scene, folder / "timeseries.png")
+        return [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml", *figures]
+
+
+def _scene(scene: Scene | str | Path) -> tuple[Scene, str]:
+    """A validated scene and the name its messages use."""
+    if isinstance(scene, Scene):
+        return scene, f"scene {scene.name!r}"
+    return load_scene(scene), str(scene)
+
+
+def simulate(scene: Scene | str | Path, formulation: str | None = None,
+             progress: Callable[[float], None] | None = None, budget: Budget | None = DEFAULT_BUDGET) -> Result:
+    """Run a scene (or a scene file) with its formulation, or ``formulation`` (``exudyn``, ``exact``,
+    ``ode``; the scene's options of another formulation dropped). InputError when it cannot run as
+    given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
+    it starts; models.stability.SimulationFailed when the run diverges."""
+    scene, source = _scene(scene)
+    if formulation is not None:
+        scene = scene.with_solver(formulation)
+    simulation = prepare_scene(scene, source)
+    if budget is not None:
+        budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
+                                                              scene.solver.output_interval_s))
+    raw = simulation.run(progress)
+    return Result(scene, raw, summary_metrics(raw), {"source": source, "formulation": raw.formulation})
+
+
+def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
+    """A results table (rows as read from ``results.csv``) as a DataFrame: numbers as numbers, text
+    (status, error, a rock's name) as text; one row a point, indexed by ``point``."""
+    frame = pd.DataFrame(list(rows))
+    if frame.empty:
+        return frame
+    for column in frame.columns.difference(["status", "error"]):
+        numbers = pd.to_numeric(frame[column], errors="coerce")
+        if numbers.notna().sum() == frame[column].ne("").sum():  # every non-empty cell a number
+            frame[column] = numbers
+    return frame.set_index("point", drop=False)
+
+
+def run_study(study: Study | str | Path, workers: int | None = None, out: str | Path | None = None,
+              dask: str | None = None, quiet: bool = True) -> pd.DataFrame:
+    """Run a study (or a study file) on ``workers`` processes (default all cores; 1: in this process) or
+    a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (results.csv, study.json,
+    optima.csv, plots; resumable as the command's) or, without ``out``, a scratch folder that is
+    removed after (no plots). The results table as a DataFrame, one row a point."""
+    from .runtime.pools import pool
+
+    if not isinstance(study, Study):
+        study = load_study(study)
+    with tempfile.TemporaryDirectory(prefix="rpdrill-study-") as scratch:
+        folder = study_folders([str(study.source)], str(out or scratch))[0]
+        if out is None:  # a scratch folder keeps no plots
+            study = dataclasses.replace(study, spec=study.spec.model_copy(update={"plots": []}))
+        with pool(dask, workers) as runner:
+            outcome: Outcome = run_studies([study], [folder], runner, dask is not None, quiet)[0]
+    return table_frame(outcome[2])
