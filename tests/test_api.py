@@ -1,0 +1,95 @@
+"""The library's front door, ``import rpdrill``: what a user of the Python API sees."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+from scenes import PAPER_BASE, scene_dict
+
+import rpdrill
+from rpdrill.studies.cli.main import main
+
+ROOT = Path(__file__).resolve().parents[1]
+QUICK = {"solver.end_time_s": 0.2, "metrics.transient_blows": 2, "metrics.block_blows": 2}
+
+
+def test_the_readme_snippet_runs_from_a_fresh_process(tmp_path):
+    """The issue's snippet, verbatim but for a shorter study, in a plain process outside the checkout."""
+    study = tmp_path / "scan.yaml"
+    study.write_text(yaml.safe_dump({
+        "name": "scan", "base_scene": str(ROOT / "studies/scenes/paper_base.yaml"),
+        "base_overrides": {"solver.formulation": "exact", "solver.end_time_s": 0.3},
+        "scan": {"impact.frequency_hz": [50.0, 65.0]}, "metrics": ["penetration_rate_m_per_s"]}))
+    code = f"""
+import rpdrill
+scene = rpdrill.load_scene({str(ROOT / "studies/scenes/paper_base.yaml")!r})
+scene = scene.with_({{"impact.frequency_hz": 70.0, "solver.formulation": "exact"}})
+result = rpdrill.simulate(scene)
+rate = result.metrics["penetration_rate_m_per_s"]
+assert isinstance(rate, float) and rate > 0, rate
+assert result.timeseries.index.name == "time_s" and "bit_velocity_m_per_s" in result.timeseries
+study = rpdrill.load_study({str(study)!r})
+table = rpdrill.run_study(study, workers=2)
+assert list(table["impact.frequency_hz"]) == [50.0, 65.0] and (table["status"] == "ok").all()
+print(rate)
+"""
+    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert float(done.stdout.split()[-1]) > 0
+
+
+def test_with_validates_every_change_and_names_the_key_path():
+    scene = rpdrill.load_scene(PAPER_BASE)
+    changed = scene.with_({"impact.frequency_hz": 70.0, "drill_string.bodies.collar.mass_kg": 2500.0})
+    assert changed.impact.frequency_hz == 70.0 and changed.drill_string.bodies["collar"].mass_kg == 2500.0
+    assert scene.impact.frequency_hz == 65.0  # a copy: the original is unchanged
+    with pytest.raises(rpdrill.InputError, match=r"impact\.duration_s: 0\.1: must be shorter than the impact period"):
+        scene.with_({"impact.duration_s": 0.1})
+    with pytest.raises(ValueError, match=r"impact\.amplitude_kn: unknown scene key path; allowed keys here: "):
+        scene.with_({"impact.amplitude_kn": 220.0})
+    with pytest.raises(rpdrill.InputError, match=r"'colar' is not in the scene's drill_string\.bodies; there: "):
+        scene.with_({"drill_string.bodies.colar.mass_kg": 2500.0})
+    with pytest.raises(rpdrill.InputError, match=r"impact\.frequency_hz: 'fast': a number is required"):
+        scene.with_({"impact.frequency_hz": "fast"})
+
+
+def test_the_library_and_the_command_line_give_the_same_run(tmp_path):
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(scene_dict(**QUICK)))
+    result = rpdrill.simulate(path, formulation="exact")
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet", "--formulation", "exact"]) == 0
+    written = pd.read_csv(tmp_path / "out" / "timeseries.csv")
+    assert list(written.columns) == list(result.timeseries.columns)
+    assert written["bit_velocity_m_per_s"].to_numpy() == pytest.approx(result.timeseries["bit_velocity_m_per_s"],
+                                                                       rel=1e-9, abs=1e-12)
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    same = {name: value for name, value in result.metrics.items() if name != "cpu_time_s"}  # CPU time differs
+    assert {name: summary["metrics"][name] for name in same} == pytest.approx(same)
+
+
+def test_a_bad_scene_file_raises_the_message_the_command_line_prints(tmp_path, capsys):
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(scene_dict(**{"impact.amplitude_kn": 220})))
+    with pytest.raises(rpdrill.InputError) as raised:
+        rpdrill.load_scene(path)
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out")]) == 2
+    assert capsys.readouterr().err.strip() == str(raised.value)
+
+
+def test_run_study_returns_typed_columns_and_keeps_files_when_asked(tmp_path):
+    study = tmp_path / "s.yaml"
+    study.write_text(yaml.safe_dump({
+        "name": "s", "base_scene": str(PAPER_BASE), "base_overrides": {"solver.end_time_s": 0.4},
+        "scan": {"impact.frequency_hz": [40.0, 60.0]}, "metrics": ["penetration_rate_m_per_s"],
+        "plots": [{"x": "impact.frequency_hz", "y": ["penetration_rate_m_per_s"]}]}))
+    table = rpdrill.run_study(rpdrill.load_study(study, formulation="exact"), workers=1)
+    assert table["penetration_rate_m_per_s"].dtype == float and table["status"].tolist() == ["ok", "ok"]
+    out = tmp_path / "out"
+    again = rpdrill.run_study(rpdrill.load_study(study, formulation="exact"), workers=1, out=out)
+    pd.testing.assert_series_equal(again["penetration_rate_m_per_s"], table["penetration_rate_m_per_s"])
+    assert {"results.csv", "study.json", "optima.csv"} <= {p.name for p in out.iterdir()}
+    assert any(p.suffix == ".png" for p in out.iterdir())
