@@ -27,7 +27,7 @@ from .inputs.reading import InputError, load_scene, prepare_scene
 from .runtime.budgets import DEFAULT_BUDGET, Budget
 from .runtime.output_files import write_columns_csv, write_json, write_resolved
 from .scan.study import Study, load_study
-from .scan.study_runs import Outcome, run_studies, run_study_files, study_folders
+from .study_runs import Outcome, run_studies, run_study_files, study_folders
 
 __all__ = ["InputError", "Result", "load_scene", "load_study", "run_study", "run_study_files", "simulate",
            "table_frame"]

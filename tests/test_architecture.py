@@ -16,53 +16,17 @@ from rpdrill.models.metrics import summary_metrics
 from rpdrill.studies.inputs.reading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
+_spec = importlib.util.spec_from_file_location("architecture_page", ROOT / "docs" / "architecture_page.py")
+architecture = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(architecture)
 LAYER = {"rocklaw": 0, "models": 1, "studies": 2, "": 3}  # studies -> models -> rocklaw; the API on top
-
-
-def package_files() -> dict[str, Path]:
-    """Every module of the checkout's package, read from the files (no install): dotted name below
-    ``rpdrill`` ("" the package itself, "models.scene", "studies.cli.main.main", ...) -> path."""
-    files = {"": ROOT / "__init__.py"}
-    for folder in ("rocklaw", "models", "studies"):
-        for path in sorted((ROOT / folder).rglob("*.py")):
-            parts = list(path.relative_to(ROOT).with_suffix("").parts)
-            files[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
-    return files
-
-
-def _imports(name: str, path: Path) -> list[tuple[str, bool]]:
-    """(imported module or module.attribute, absolute?) of a module, at module level or inside functions
-    (a deferred import is a dependency too); imports only for type checkers (``if TYPE_CHECKING:``) are
-    not. Relative imports are resolved against the module's package, as Python does."""
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    typing_only = {id(node) for block in ast.walk(tree)
-                   if isinstance(block, ast.If) and "TYPE_CHECKING" in ast.unparse(block.test)
-                   for statement in block.body for node in ast.walk(statement)}
-    package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
-    package = [part for part in package if part]
-    found: list[tuple[str, bool]] = []
-    for node in ast.walk(tree):
-        if id(node) in typing_only:
-            continue
-        if isinstance(node, ast.Import):
-            found += [(alias.name, True) for alias in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package[:len(package) - (node.level - 1)] if node.level > 1 else package
-                assert node.level - 1 <= len(package), f"{path}: import beyond the package"
-                module = ".".join(base + ([node.module] if node.module else []))
-                found.append((module, False))
-                found += [(f"{module}.{alias.name}".strip("."), False) for alias in node.names]
-            elif node.module:
-                found.append((node.module, True))
-    return found
+MAX_MODULES_PER_FOLDER = 15
+MAX_LINES_PER_MODULE = 500
 
 
 def import_graph() -> dict[str, set[str]]:
     """The package's modules -> the package's modules they import, read statically from the files."""
-    files = package_files()
-    return {name: {target for target, _ in _imports(name, path) if target in files}
-            for name, path in files.items()}
+    return architecture.import_graph(ROOT)
 
 
 def _layer(module: str) -> int:
@@ -81,8 +45,8 @@ def test_installed_under_one_name_and_nothing_generic(tmp_path):
 def test_the_package_imports_itself_only_relatively():
     """Inside the package every import of its own modules is relative, so that the import graph read
     from the files of a checkout (an editor, an import-graph tool: no install) is the real one."""
-    for name, path in package_files().items():
-        absolute = [target for target, is_absolute in _imports(name, path)
+    for name, path in architecture.package_files(ROOT).items():
+        absolute = [target for target, is_absolute in architecture.module_imports(name, path)
                     if is_absolute and target.split(".")[0] in ("rpdrill", "models", "rocklaw", "studies")]
         assert not absolute, f"{path}: {absolute}"
 
@@ -90,7 +54,7 @@ def test_the_package_imports_itself_only_relatively():
 def test_the_static_graph_holds_the_imports_between_the_folders():
     graph = import_graph()
     between = {(_layer(a), _layer(b)) for a, targets in graph.items() for b in targets}
-    assert {(2, 1), (1, 0)} <= between
+    assert {(3, 2), (2, 1), (1, 0)} <= between
 
 
 def test_dependencies_run_one_way():
@@ -118,6 +82,35 @@ def test_no_import_cycles():
         if module not in state:
             walk(module, [module])
     assert not cycles, cycles
+
+
+def test_the_architecture_page_matches_the_tree():
+    """docs/architecture.md is what docs/architecture_page.py makes of the files today."""
+    assert (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8") == architecture.page(ROOT), \
+        "docs/architecture.md is out of date: run python docs/architecture_page.py"
+
+
+def test_folders_and_modules_stay_small_and_names_unique():
+    files = architecture.package_files(ROOT)
+    folders: dict[Path, int] = {}
+    for path in files.values():
+        folders[path.parent] = folders.get(path.parent, 0) + 1
+        lines = len(path.read_text(encoding="utf-8").splitlines())
+        assert lines <= MAX_LINES_PER_MODULE, f"{path}: {lines} lines"
+    crowded = {str(folder): count for folder, count in folders.items()
+               if folder != ROOT and count > MAX_MODULES_PER_FOLDER}
+    assert not crowded
+    names: dict[str, list[str]] = {}
+    classes: dict[str, list[str]] = {}
+    for module, path in files.items():
+        if module.startswith("studies"):
+            if path.name not in ("__init__.py", "__main__.py"):
+                names.setdefault(path.stem, []).append(module)
+            for node in ast.parse(path.read_text(encoding="utf-8")).body:
+                if isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+                    classes.setdefault(node.name, []).append(module)
+    assert not {name: where for name, where in names.items() if len(where) > 1}
+    assert not {name: where for name, where in classes.items() if len(where) > 1}
 
 
 @pytest.fixture

@@ -8,15 +8,15 @@ import json
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from ..figures.plot_tasks import start_plots
-from ..inputs.reading import InputError
-from ..runtime.budgets import DEFAULT_BUDGET, Budget
-from ..runtime.output_files import check_out, write_json, write_rows_csv
-from ..runtime.point_runs import run_point
-from ..runtime.pools import Runner, pool, sequential
-from ..runtime.resumable import RECORD, STATUS_COLUMNS, Row, Table, run_tables
-from .study import Study, load_study
-from .study_optima import Record, csv_rows, study_optima
+from .figures.plot_tasks import start_plots
+from .inputs.reading import InputError
+from .runtime.budgets import DEFAULT_BUDGET, Budget
+from .runtime.output_files import check_out, write_json, write_rows_csv
+from .runtime.point_runs import run_point
+from .runtime.pools import Runner, pool, sequential
+from .runtime.resumable import RECORD, STATUS_COLUMNS, Row, Table, run_tables
+from .scan.study import Study, load_study
+from .scan.study_optima import Record, csv_rows, study_optima
 
 
 def write_optima(study: Study, out: Path, rows: list[Row]) -> list[Record]:

@@ -1,0 +1,223 @@
+"""docs/architecture.md and its picture, generated from the files of the checkout (nothing installed).
+
+    python docs/architecture_page.py          # writes docs/architecture.md and docs/architecture.svg
+
+The import graph is read statically: every ``.py`` file of the package (the root ``__init__.py``,
+``rocklaw/``, ``models/``, ``studies/`` and their subpackages), every ``import`` and ``from ... import``
+at any depth (relative imports resolved as Python does; imports only for type checkers left out).
+The picture draws it between packages; the page lists each package with its modules, what it holds
+and what it imports. tests/test_architecture.py checks that the page matches the tree.
+"""
+
+from __future__ import annotations
+
+import ast
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+FOLDERS = ("rocklaw", "models", "studies")
+
+# what each package holds (one paragraph each; a package missing here fails the page's test)
+ROLES = {
+    "": "The public API: `import rpdrill` re-exports the scene, the simulate and study functions, the result "
+        "and the errors a user catches (docs/api.md). Nothing else imports it.",
+    "rocklaw": "The rock contact laws (the paper's Jenkins law, a bilinear law): each written once against "
+               "evaluation backends (NumPy, floats, Exudyn symbolic) and declared as a piecewise-linear mode "
+               "table; the Exudyn user element; Exudyn itself, imported for rpdrill. Knows nothing of scenes.",
+    "models": "The drill models: the typed scene (data only) and validated edits of it, the drill string as a "
+              "chain of bodies and connectors, the impact pulse, and the three formulations of one model (the "
+              "Exudyn multibody system, the exact piecewise-linear propagation, the paper's Eq. 4 as a SciPy "
+              "ODE), their results, metrics, energy account, stability checks and costs. Knows nothing of "
+              "YAML files, studies or the command line.",
+    "studies": "Everything around a model: reading YAML, scans and analyses, reports and the command line "
+               "(the subpackages below, and two modules of their own).",
+    "studies.api": "The library's functions that the root package re-exports (load a scene, simulate it into "
+                   "a Result, load and run a study into a pandas table); the command line is their client.",
+    "studies.study_runs": "Running studies into their folders: the points of several studies as one run on "
+                          "one pool, each study's results table, optima and plots.",
+    "studies.inputs": "Reading YAML strictly (duplicate keys, YAML 1.2 numbers, sizes) into the models' "
+                      "validated types; the spec base the study, calibration and other files share.",
+    "studies.display": "How quantities are shown: the catalogue of every metric's and parameter's name, symbol "
+                       "and display unit, and text/Markdown tables.",
+    "studies.runtime": "Running many points: process pools and Dask, resumable result tables, interrupts, "
+                       "progress, output folders, budgets checked before anything runs, one point's run.",
+    "studies.scan": "Studies: scans of a base scene expanded into points, run into their folders; the optima "
+                    "of scanned curves (main lobe, bands); labelled frequency scans the analyses share.",
+    "studies.calibration": "Fitting scene parameters within argued bounds so that scans put their optima where "
+                           "the paper does (differential evolution, checkpointed), and its report.",
+    "studies.sensitivity": "The paper's section 3.3: one-at-a-time and SALib global sensitivity of the optima.",
+    "studies.accuracy": "Work-precision studies: every solver setting's error against its CPU time.",
+    "studies.advice": "The operating point that maximises a metric within bounds (`rpdrill advise`) and "
+                      "its report.",
+    "studies.crosscheck": "The Exudyn model against the paper's Eq. 4 as an ODE over the first blows.",
+    "studies.reproduction": "The paper reproduced: each headline case scanned, its optima against the "
+                            "paper's, the trends checked.",
+    "studies.figures": "Every figure (matplotlib): scans, maps, time series, work-precision, tornado, the "
+                       "paper's figures redrawn, and the plot tasks a pool's workers draw.",
+    "studies.pages": "The generated documentation pages (reproduction, parameters, sensitivity, figures, "
+                     "rotation).",
+    "studies.cli": "The `rpdrill` command line: `main.py` (argparse, exit statuses, one-line warnings) and a "
+                   "module per command; a command parses, calls the library and prints.",
+}
+
+
+def package_files(root: Path = ROOT) -> dict[str, Path]:
+    """Every module of the package, from the files: dotted name below ``rpdrill`` ("" the package
+    itself, "models.scene", "studies.cli.main", ...) -> path."""
+    files = {"": root / "__init__.py"}
+    for folder in FOLDERS:
+        for path in sorted((root / folder).rglob("*.py")):
+            parts = list(path.relative_to(root).with_suffix("").parts)
+            files[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return files
+
+
+def module_imports(name: str, path: Path) -> list[tuple[str, bool]]:
+    """(imported module or module.attribute, absolute?) of one module, at any depth; imports only for
+    type checkers (``if TYPE_CHECKING:``) left out; relative imports resolved against its package."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    typing_only = {id(node) for block in ast.walk(tree)
+                   if isinstance(block, ast.If) and "TYPE_CHECKING" in ast.unparse(block.test)
+                   for statement in block.body for node in ast.walk(statement)}
+    package = [part for part in (name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]) if part]
+    found: list[tuple[str, bool]] = []
+    for node in ast.walk(tree):
+        if id(node) in typing_only:
+            continue
+        if isinstance(node, ast.Import):
+            found += [(alias.name, True) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                if node.level - 1 > len(package):
+                    raise ValueError(f"{path}: a relative import beyond the package")
+                base = package[:len(package) - (node.level - 1)]
+                module = ".".join(base + ([node.module] if node.module else []))
+                found.append((module, False))
+                found += [(f"{module}.{alias.name}".strip("."), False) for alias in node.names]
+            elif node.module:
+                found.append((node.module, True))
+    return found
+
+
+def import_graph(root: Path = ROOT) -> dict[str, set[str]]:
+    """The package's modules -> the package's modules they import."""
+    files = package_files(root)
+    return {name: {target for target, _ in module_imports(name, path) if target in files}
+            for name, path in files.items()}
+
+
+def package_of(module: str, files: dict[str, Path]) -> str:
+    """The node a module belongs to in the picture: itself for a package's ``__init__`` and for a module
+    directly in ``studies/`` (``studies.api``), its package otherwise."""
+    if files[module].name == "__init__.py" or module.rpartition(".")[0] == "studies":
+        return module
+    return module.rpartition(".")[0]
+
+
+def package_graph(root: Path = ROOT) -> dict[str, set[str]]:
+    """Packages -> the other packages their modules import."""
+    files = package_files(root)
+    edges: dict[str, set[str]] = defaultdict(set)
+    for module, targets in import_graph(root).items():
+        source = package_of(module, files)
+        edges[source] |= {package_of(t, files) for t in targets} - {source}
+        edges.setdefault(source, set())
+    imported = set().union(*edges.values())
+    return {node: targets for node, targets in edges.items() if targets or node in imported}  # no empty __init__
+
+
+def layers(graph: dict[str, set[str]]) -> dict[str, int]:
+    """Each package's layer: 0 for one that imports no other package, else one above the highest it
+    imports (the graph has no cycle: tests/test_architecture.py)."""
+    level: dict[str, int] = {}
+
+    def of(package: str) -> int:
+        if package not in level:
+            level[package] = 1 + max((of(t) for t in graph[package]), default=-1)
+        return level[package]
+
+    for package in graph:
+        of(package)
+    return level
+
+
+def label(package: str) -> str:
+    return package or "rpdrill (api)"
+
+
+def draw(graph: dict[str, set[str]], path: Path) -> None:
+    """The package graph drawn bottom-up by layer (an arrow from importer to imported)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    level = layers(graph)
+    rows: dict[int, list[str]] = defaultdict(list)
+    for package in sorted(graph, key=lambda p: (p.split(".")[0], p)):
+        rows[level[package]].append(package)
+    position = {}
+    for y, packages in rows.items():
+        for i, package in enumerate(packages):
+            position[package] = ((i + 1) / (len(packages) + 1), y)
+    colours = {"rocklaw": "#cfe2f3", "models": "#d9ead3", "studies": "#fff2cc", "": "#f4cccc"}
+    fig, ax = plt.subplots(figsize=(13, 1.3 * (max(rows) + 1)))
+    for source, targets in graph.items():
+        for target in targets:
+            (x0, y0), (x1, y1) = position[source], position[target]
+            ax.annotate("", xy=(x1, y1 + 0.18), xytext=(x0, y0 - 0.18),
+                        arrowprops={"arrowstyle": "->", "color": "#888888", "lw": 0.7, "shrinkA": 2, "shrinkB": 2})
+    for package, (x, y) in position.items():
+        ax.text(x, y, label(package).removeprefix("studies."), ha="center", va="center", fontsize=9,
+                bbox={"boxstyle": "round,pad=0.35", "fc": colours[package.split(".")[0]], "ec": "#555555"})
+    ax.set_xlim(0, 1)
+    ax.set_ylim(-0.6, max(rows) + 0.6)
+    ax.axis("off")
+    ax.set_title("rpdrill: packages and their imports (arrow: imports; blue rocklaw, green models, "
+                 "yellow studies' subpackages, red the API), read from the files", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def page(root: Path = ROOT) -> str:
+    """docs/architecture.md."""
+    files = package_files(root)
+    graph = package_graph(root)
+    level = layers(graph)
+    modules: dict[str, list[str]] = defaultdict(list)
+    for module in files:
+        if files[module].name != "__init__.py":
+            modules[package_of(module, files)].append(module.rpartition(".")[2])
+    missing = sorted(set(graph) - set(ROLES))
+    if missing:
+        raise SystemExit(f"docs/architecture_page.py: no paragraph for the package(s) {', '.join(missing)}")
+    lines = ["# Architecture", "",
+             "Generated from the files of the checkout by `python docs/architecture_page.py` (the import graph "
+             "read statically: every import of every module, relative imports resolved; nothing installed). "
+             "tests/test_architecture.py checks that this page matches the tree, that dependencies run one "
+             "way (studies -> models -> rocklaw, the API on top) and that no import forms a cycle.", "",
+             "The checkout is the package `rpdrill`: its `__init__.py` is the public API, its folders "
+             "`rocklaw/`, `models/` and `studies/` are the subpackages `rpdrill.rocklaw`, `rpdrill.models`, "
+             "`rpdrill.studies` (pyproject.toml maps them; every import inside the package is relative, so "
+             "an editor or an import-graph tool follows them without an install).", "",
+             "![packages and their imports](architecture.svg)", "",
+             "Layer 0 imports no other package; each package imports only packages of lower layers.", ""]
+    for package in sorted(graph, key=lambda p: (-level[p], p)):
+        imports = ", ".join(f"`{label(t)}`" for t in sorted(graph[package])) or "none"
+        held = ", ".join(f"`{m}`" for m in sorted(modules[package])) or "(only `__init__.py`)"
+        lines += [f"## `{label(package)}` (layer {level[package]})", "", ROLES[package], "",
+                  f"Modules: {held}.", "", f"Imports: {imports}.", ""]
+    return "\n".join(lines)
+
+
+def main() -> None:
+    (ROOT / "docs" / "architecture.md").write_text(page(), encoding="utf-8")
+    draw(package_graph(), ROOT / "docs" / "architecture.svg")
+    print("wrote docs/architecture.md, docs/architecture.svg", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
