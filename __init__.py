@@ -14,9 +14,9 @@ three formulations), ``studies`` (YAML inputs, scans, analyses, reports and the 
 dependencies run one way, studies -> models -> rocklaw (``docs/architecture.md``).
 """
 
-from .models.scene import Scene
-from .models.stability import SimulationFailed
-from .models.validation import InputError
+from .models.definition.scene import Scene
+from .models.definition.validation import InputError
+from .models.evaluation.stability import SimulationFailed
 from .studies.api import Result, load_scene, load_study, run_study, simulate, table_frame
 from .studies.runtime.budgets import BudgetError
 from .studies.scan.study import Study

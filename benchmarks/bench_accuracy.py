@@ -17,10 +17,10 @@ import warnings
 from dataclasses import replace
 from pathlib import Path
 
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
-from rpdrill.models.solver_settings import EXUDYN_PRESETS
-from rpdrill.models.workprecision import cost_at_error, errors
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.solver_settings import EXUDYN_PRESETS
+from rpdrill.models.evaluation.workprecision import cost_at_error, errors
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.accuracy.accuracy_study import load_accuracy_study, reference_signature, run_setting
 
 ROOT = Path(__file__).resolve().parents[1]

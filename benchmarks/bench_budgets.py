@@ -1,12 +1,12 @@
-"""The run-cost estimate of models.cost against measurement: steps, CPU time and memory.
+"""The run-cost estimate of models.solvers.cost against measurement: steps, CPU time and memory.
 
 Usage: python benchmarks/bench_budgets.py [--repeats N]
 
 Prints (1) for the shipped scenes (paper_base 4 bodies, four_rod_string 19, wave_rod 64) with every
 formulation that runs them: steps and CPU seconds, estimated and measured (the median of N runs
-after a warm-up, one BLAS thread), and their ratio; the CPU cost per step a + b n^p (models.cost.CPU_S_PER_STEP) fitted to the
+after a warm-up, one BLAS thread), and their ratio; the CPU cost per step a + b n^p (models.solvers.cost.CPU_S_PER_STEP) fitted to the
 measurements of each formulation, and DOP853's steps per radian (steps / (r T), r the fastest
-element's rate), the constants of models.cost; (2) for runs that store much (every step, or fine samples), the memory
+element's rate), the constants of models.solvers.cost; (2) for runs that store much (every step, or fine samples), the memory
 estimate against the growth of the peak resident set during the run, each in a fresh process;
 (3) what a command holds besides its runs (studies.runtime.budgets): a prepared study point (tracemalloc)
 and the CPU time to prepare it, and a calibration's evaluation record of the shipped calibration.
@@ -32,10 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.models.cost import CPU_S_PER_STEP, Cause, cost_key, run_cost
-from rpdrill.models.formulations import unsupported
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.formulations import unsupported
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.solvers.cost import CPU_S_PER_STEP, Cause, cost_key, run_cost
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.calibration.calibration_search import target_result
 from rpdrill.studies.calibration.calibration_spec import load_calibration
 from rpdrill.studies.inputs.reading import read_yaml

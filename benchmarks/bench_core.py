@@ -11,9 +11,9 @@ import argparse
 import statistics
 from pathlib import Path
 
-from rpdrill.models import exudyn_model
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.solvers import exudyn_model
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]

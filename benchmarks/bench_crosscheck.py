@@ -25,7 +25,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 from scenes import simulate  # the frozen test drill
 from test_crosscheck import CASES, scene_from_base
 
-from rpdrill.models.compare import compare_bottom_at, compare_runs
+from rpdrill.models.evaluation.compare import compare_bottom_at, compare_runs
 
 
 def main() -> None:

@@ -11,10 +11,10 @@ import argparse
 import statistics
 from pathlib import Path
 
-from rpdrill.models.exudyn_model import build_exudyn
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.exudyn_model import build_exudyn
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,15 +1,15 @@
 """Cost and x_n accuracy of the three formulations, measured in one run.
 
 For each scene: CPU seconds per simulated second and the x_n error of the exact event-driven
-solution (models.exact_model, default settings: every output asked for, its works integrated
+solution (models.solvers.exact_model, default settings: every output asked for, its works integrated
 exactly from the propagators; and with only the penetration rate asked for; samples every 1e-4 s
 either way), with the CPU seconds of the metrics of the last exact result, the
 Exudyn model at the scene's solver setting and the SciPy ODE formulation (DOP853, rtol 1e-8), all
 against the exact solution on a finer grid (samples and sub-step 1e-6 s; the exact run's own
 difference to it is round-off). The error is max |x_n - x_n,ref| over the blow starts divided by
 |x_n,ref| at the end, and absolute. The exact runs are timed after a warm-up call (median of
-``--repeats`` runs), each with the propagator cache (models.exact_model.OPERATOR_CACHE) emptied first,
-and again reusing the propagators of the run before (a scan's later points); the compile time of the numba kernels (models.exact_kernels) is measured
+``--repeats`` runs), each with the propagator cache (models.solvers.exact_model.OPERATOR_CACHE) emptied first,
+and again reusing the propagators of the run before (a scan's later points); the compile time of the numba kernels (models.solvers.exact_kernels) is measured
 separately, in a fresh process with an empty numba cache, and the first call with a warm cache.
 
 Usage: python benchmarks/bench_exact.py [--end-time-s 0.5] [--repeats 9]
@@ -37,11 +37,11 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.models.exact_model import OPERATOR_CACHE
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.evaluation.results import SimulationResult
+from rpdrill.models.solvers.exact_model import OPERATOR_CACHE
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -54,7 +54,7 @@ import os, sys, time
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 sys.path.insert(0, {benchmarks!r})
 from bench_exact import scenes
-from rpdrill.models.simulation import prepare
+from rpdrill.models.solvers.simulation import prepare
 simulation = prepare(scenes(0.5)["paper_base"].with_solver("exact"))
 start = time.process_time()
 simulation.run()

@@ -24,11 +24,11 @@ import re
 import sys
 from pathlib import Path
 
-from rpdrill.models.compare import compare_bottom_at, compare_histories
-from rpdrill.models.links import LINK_TYPES
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.links import LINK_TYPES
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.compare import compare_bottom_at, compare_histories
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import parse_yaml, read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -13,9 +13,9 @@ import argparse
 import statistics
 from pathlib import Path
 
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -12,7 +12,7 @@ CPU seconds per simulated second (median of N runs after a warm-up), its largest
 energy-balance errors over those scenes, the candidates on the front (no other both cheaper and more
 accurate) marked; then the automatic-step dopri5 and ode23 at a few tolerances on every scene
 (:func:`automatic`). ``--sweeps`` picks some of them (stability, ringing, damper, automatic).
-Otherwise prints, for each preset of models.solver_settings: its solver and step on the shipped paper scene,
+Otherwise prints, for each preset of models.evaluation.solver_settings: its solver and step on the shipped paper scene,
 the CPU seconds per simulated second there (1 s simulated, every output, median of N runs after a
 warm-up, results dropped between runs), and on the paper scene and every hard scene of
 tests/stability/hard_scenes.py (the frozen test drill varied) the penetration-rate error against the
@@ -39,12 +39,12 @@ import warnings
 from collections.abc import Callable
 from pathlib import Path
 
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
-from rpdrill.models.solver_settings import EXUDYN_PRESETS
-from rpdrill.models.stability import StepScales
-from rpdrill.models.workprecision import pareto_front
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.evaluation.solver_settings import EXUDYN_PRESETS
+from rpdrill.models.evaluation.stability import StepScales
+from rpdrill.models.evaluation.workprecision import pareto_front
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -118,7 +118,7 @@ def automatic(scenes: dict[str, Scene], exact: dict[str, dict[str, float]], repe
 
 def front(scenes: dict[str, Scene], exact: dict[str, dict[str, float]], repeats: int,
           sweeps: list[str]) -> None:
-    """Per bound of the presets' step rule (models.solver_settings.ExudynPreset.step_limits), every
+    """Per bound of the presets' step rule (models.evaluation.solver_settings.ExudynPreset.step_limits), every
     solver at step = min(1e-4 s, pulse / 10, c x the bound's time scale) on the scenes that bound
     governs: ``stability`` on paper_base and the damped hard scenes, ``ringing`` on the undamped one,
     ``damper`` on the critically damped one. Printed: the CPU seconds per simulated second on the first

@@ -26,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.models.exact_model import BLAS, OPERATOR_CACHE, ExactSolver
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.solvers.exact_model import BLAS, OPERATOR_CACHE, ExactSolver
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
 SCENE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "four_rod_string.yaml"

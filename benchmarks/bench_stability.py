@@ -2,9 +2,9 @@
 
 Usage: python benchmarks/bench_stability.py [--solvers rk67,rk44,...] [--factors 0.1,0.2,...]
 Runs every hard scene of tests/stability/hard_scenes.py (the frozen test drill varied) with each
-solver at the fixed step h = factor / |lambda|_max (models.stability.spectral_radius_per_s of the
+solver at the fixed step h = factor / |lambda|_max (models.evaluation.stability.spectral_radius_per_s of the
 scene) and prints (1) |lambda|_max of each scene; (2) per solver and scene the largest factor tried
-up to which every factor ran without being rejected (models.stability.check_result: non-finite or
+up to which every factor ran without being rejected (models.evaluation.stability.check_result: non-finite or
 runaway states or energy created, "diverged"; the end time not reached, "stopped"), and the first
 rejected factor (steps above the suite's bound, pulse / 5 and period / 20, are not tried: such a
 scene gives only a lower bound, ">=", and does not bound the limit over every hard scene); (3) the
@@ -24,9 +24,9 @@ import sys
 import warnings
 from pathlib import Path
 
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.simulation import prepare
-from rpdrill.models.stability import SimulationFailed
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.evaluation.stability import SimulationFailed
+from rpdrill.models.solvers.simulation import prepare
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))  # the hard scenes of the stability suite

@@ -23,10 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
-from rpdrill.models.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.evaluation.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import load_scene, read_yaml
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"

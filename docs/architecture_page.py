@@ -26,11 +26,20 @@ ROLES = {
     "rocklaw": "The rock contact laws (the paper's Jenkins law, a bilinear law): each written once against "
                "evaluation backends (NumPy, floats, Exudyn symbolic) and declared as a piecewise-linear mode "
                "table; the Exudyn user element; Exudyn itself, imported for rpdrill. Knows nothing of scenes.",
-    "models": "The drill models: the typed scene (data only) and validated edits of it, the drill string as a "
-              "chain of bodies and connectors, the impact pulse, and the three formulations of one model (the "
-              "Exudyn multibody system, the exact piecewise-linear propagation, the paper's Eq. 4 as a SciPy "
-              "ODE), their results, metrics, energy account, stability checks and costs. Knows nothing of "
-              "YAML files, studies or the command line.",
+    "models": "The drill models (the subpackages below): knows nothing of YAML files, studies or the "
+              "command line.",
+    "models.definition": "What a scene is: the typed scene (data only), validated edits of it by key path and "
+                         "the messages of bad values, the outputs a scene can ask for, the connector types, "
+                         "the registry of formulations and their solver keys.",
+    "models.drill": "The drill string's mechanics: the chain of bodies and connectors (incidence, stiffness, "
+                    "static preload), its modes, its piecewise-linear modes of contact, the impact pulse, bit "
+                    "indexing.",
+    "models.evaluation": "What a run gives: the result and its time series, the energy account, metrics, "
+                         "stability checks and step bounds, the solver presets, comparisons between runs, "
+                         "work-precision fronts, stress-wave checks.",
+    "models.solvers": "Preparing a scene for a run and the three formulations of one model: the Exudyn "
+                      "multibody system, the exact piecewise-linear propagation (its linear system and "
+                      "compiled kernels), the paper's Eq. 4 as a SciPy ODE; a run's cost estimate.",
     "studies": "Everything around a model: reading YAML, scans and analyses, reports and the command line "
                "(the subpackages below, and two modules of their own).",
     "studies.api": "The library's functions that the root package re-exports (load a scene, simulate it into "
@@ -65,7 +74,7 @@ ROLES = {
 
 def package_files(root: Path = ROOT) -> dict[str, Path]:
     """Every module of the package, from the files: dotted name below ``rpdrill`` ("" the package
-    itself, "models.scene", "studies.cli.main", ...) -> path."""
+    itself, "models.definition.scene", "studies.cli.main", ...) -> path."""
     files = {"": root / "__init__.py"}
     for folder in FOLDERS:
         for path in sorted((root / folder).rglob("*.py")):

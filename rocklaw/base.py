@@ -16,7 +16,7 @@ and the state:
   names and ``one``, and :meth:`RockLaw.initial_mode`. The ODE and the exact formulations
   generate their events, state rates, resets and matrices from it;
 * blows: ``fresh_fraction`` eta is the share of a blow's footprint on fresh rock (1 without an
-  indexing model, models.indexing; a law per blow when it changes, ``modes_follow_fresh_fraction``
+  indexing model, models.drill.indexing; a law per blow when it changes, ``modes_follow_fresh_fraction``
   says whether the mode rows carry it); :meth:`RockLaw.start_blow` gives the state a blow meets, and
   ``resets_at_blows`` whether it changes anything (the formulations apply it at every blow start
   only then);

@@ -71,7 +71,7 @@ class BilinearRock:
 
     loading_stiffness_n_per_m: float
     unloading_stiffness_n_per_m: float
-    fresh_fraction: float = 1.0  # eta, the share of the next blow on fresh rock (models.indexing)
+    fresh_fraction: float = 1.0  # eta, the share of the next blow on fresh rock (models.drill.indexing)
 
     name = "bilinear"
     modes_follow_fresh_fraction = False  # eta acts at blow starts only

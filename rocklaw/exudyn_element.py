@@ -113,7 +113,7 @@ class ExudynRockContact:
         self.state_history.append((time_s, state))
 
     def set_law(self, rock: RockLaw) -> None:
-        """Go on with ``rock`` (the same law with another eta: models.indexing), in the expression too."""
+        """Go on with ``rock`` (the same law with another eta: models.drill.indexing), in the expression too."""
         if self._fresh_fraction is not None and rock.fresh_fraction != self.rock.fresh_fraction:
             self._fresh_fraction.SetValue(rock.fresh_fraction)
         self.rock, self._return_map = rock, rock.return_map

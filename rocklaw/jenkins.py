@@ -35,7 +35,7 @@ With damping_mode ``always``, or without rock damping, there is no ``clipped`` m
 Crater memory: the law keeps x_n when contact is lost, and a contact regained reloads along k_n up
 to F_th, so within a blow it remembers its crater.
 
-Indexing (``indexed``; models.indexing): a share eta (``fresh_fraction``) of the blow's footprint
+Indexing (``indexed``; models.drill.indexing): a share eta (``fresh_fraction``) of the blow's footprint
 lands on fresh rock, the rest on rock the last blow crushed (or on ridges it left). Only eta of the
 bit's crushing stroke advances the hole; the rest compacts what is already crushed, so the crushing
 force hardens: with the blow's threshold tau as a second state,

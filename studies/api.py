@@ -19,10 +19,10 @@ from typing import Any
 
 import pandas as pd
 
-from ..models.cost import Cause
-from ..models.metrics import summary_metrics
-from ..models.results import SimulationResult
-from ..models.scene import Scene
+from ..models.definition.scene import Scene
+from ..models.evaluation.metrics import summary_metrics
+from ..models.evaluation.results import SimulationResult
+from ..models.solvers.cost import Cause
 from .inputs.reading import InputError, load_scene, prepare_scene
 from .runtime.budgets import DEFAULT_BUDGET, Budget
 from .runtime.output_files import write_columns_csv, write_json, write_resolved
@@ -85,7 +85,7 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     """Run a scene (or a scene file) with its formulation, or ``formulation`` (``exudyn``, ``exact``,
     ``ode``; the scene's options of another formulation dropped). InputError when it cannot run as
     given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
-    it starts; models.stability.SimulationFailed when the run diverges."""
+    it starts; models.evaluation.stability.SimulationFailed when the run diverges."""
     scene, source = _scene(scene)
     if formulation is not None:
         scene = scene.with_solver(formulation)

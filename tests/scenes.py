@@ -5,9 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.results import SimulationResult
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
 PAPER_BASE = Path(__file__).resolve().parent / "test_drill.yaml"

@@ -13,8 +13,8 @@ import pytest
 import yaml
 from scenes import PAPER_BASE, PER_BODY, scene_dict, simulate
 
-from rpdrill.models.scene import Scene
-from rpdrill.models.workprecision import (
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.workprecision import (
     convergence_order,
     cost_at_error,
     errors,

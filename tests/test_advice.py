@@ -11,9 +11,9 @@ import pytest
 import yaml
 from scenes import crushing_scene, scene, scene_dict, simulate
 
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.pulse import impulse_per_blow_n_s
-from rpdrill.models.simulation import prepare
+from rpdrill.models.drill.pulse import impulse_per_blow_n_s
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.advice.advice_search import (
     FEED,
     FREQUENCY,

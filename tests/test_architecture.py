@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from scenes import simulate
 
-from rpdrill.models.metrics import summary_metrics
+from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.studies.inputs.reading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -119,7 +119,8 @@ def counts(monkeypatch):
     wherever a module holds a reference to them."""
     import numpy as np
 
-    from rpdrill.models import chain, stability
+    from rpdrill.models.drill import chain
+    from rpdrill.models.evaluation import stability
 
     counted = {"axial_chain": 0, "static_preload_m": 0, "eigvals": 0}
 

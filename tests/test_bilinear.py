@@ -10,10 +10,10 @@ import pytest
 import yaml
 from scenes import scene, scene_dict, simulate
 
-from rpdrill.models.compare import compare_runs, verdict
-from rpdrill.models.energy import energy_account
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.simulation import prepare
+from rpdrill.models.evaluation.compare import compare_runs, verdict
+from rpdrill.models.evaluation.energy import energy_account
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw import BilinearRock, force_and_state
 from rpdrill.studies.cli.main import main
 from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S

@@ -1,4 +1,4 @@
-"""Run-cost estimates (models.cost) and budgets (studies.runtime.budgets): what a run will cost, which key
+"""Run-cost estimates (models.solvers.cost) and budgets (studies.runtime.budgets): what a run will cost, which key
 makes it cost that, and the refusals above a budget. The estimate against measurement is
 benchmarks/bench_budgets.py (no timing here)."""
 
@@ -7,8 +7,8 @@ from __future__ import annotations
 import pytest
 from scenes import PAPER_BASE, scene
 
-from rpdrill.models.cost import Cause, run_cost
-from rpdrill.models.simulation import prepare
+from rpdrill.models.solvers.cost import Cause, run_cost
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.runtime.budgets import MAX_CPU_HOURS, Budget, BudgetError
 from rpdrill.studies.scan.study import load_study
 

@@ -12,9 +12,9 @@ from matplotlib.figure import Figure
 from matplotlib.text import Text
 from scenes import PAPER_BASE, scene
 
-from rpdrill.models.outputs import METRICS, SERIES
-from rpdrill.models.scene import Scene
-from rpdrill.models.validation import allowed_keys
+from rpdrill.models.definition.outputs import METRICS, SERIES
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.definition.validation import allowed_keys
 from rpdrill.studies.display import catalogue
 
 WORDS = re.compile(r"[a-z]+(?:[._][a-z0-9]+)+")  # snake_case or dotted keys
@@ -30,7 +30,7 @@ def scene_leaf_paths(prefix: tuple[str, ...] = ()) -> list[str]:
 
 
 def test_every_metric_has_an_entry_with_a_unit():
-    """Fails when a metric is added to models.outputs without a catalogue entry."""
+    """Fails when a metric is added to models.definition.outputs without a catalogue entry."""
     missing = sorted(set(METRICS) - set(catalogue.METRICS))
     assert not missing, f"studies/display/catalogue.py has no entry for the metrics {missing}"
     assert set(catalogue.METRICS) == set(METRICS), "catalogue entries for metrics the model does not have"

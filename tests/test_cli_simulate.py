@@ -8,7 +8,7 @@ import pytest
 import yaml
 from scenes import scene_dict
 
-from rpdrill.models.stability import StepLimitWarning
+from rpdrill.models.evaluation.stability import StepLimitWarning
 from rpdrill.studies.cli.main import main
 
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}

@@ -1,5 +1,5 @@
 """Cross-check of the Exudyn model against the exact formulation and the ODE of Eq. 4
-(models.compare, rpdrill crosscheck).
+(models.evaluation.compare, rpdrill crosscheck).
 
 Every case runs 15 blows from rest (the shortest window the default metrics accept), Exudyn at
 the cross-check's default step, the references at their reference preset.
@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from scenes import PAPER_BASE, PER_BODY, scene_dict, simulate
 
-from rpdrill.models.compare import compare_runs, verdict
-from rpdrill.models.scene import Scene
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.compare import compare_runs, verdict
 from rpdrill.studies.cli.main import main
 from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
 

@@ -12,13 +12,13 @@ import pytest
 from pydantic import ValidationError
 from scenes import scene, scene_dict, simulate
 
-from rpdrill.models.chain import axial_chain, link_load_n
-from rpdrill.models.energy import energy_account
-from rpdrill.models.links import RATE, STRETCH, Coupling, Link
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
-from rpdrill.models.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.models.definition.links import RATE, STRETCH, Coupling, Link
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.drill.chain import axial_chain, link_load_n
+from rpdrill.models.evaluation.energy import energy_account
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.evaluation.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw.modes import check_mode_forces
 from rpdrill.studies.cli.main import main
 from rpdrill.studies.inputs.reading import load_scene, read_yaml

@@ -5,9 +5,9 @@ import pytest
 import yaml
 from scenes import CRUSHING, scene, scene_dict, simulate
 
-from rpdrill.models.exudyn_model import build_exudyn
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.simulation import prepare
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.exudyn_model import build_exudyn
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.cli.main import main
 
 SHORT = {"solver__end_time_s": 0.25, "metrics__transient_blows": 3, "metrics__block_blows": 4}

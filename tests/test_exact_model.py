@@ -1,9 +1,9 @@
-"""The exact event-driven solution (models.exact_model) as the reference formulation.
+"""The exact event-driven solution (models.solvers.exact_model) as the reference formulation.
 
 (a) agreement with the tight-tolerance ODE formulation on crushing scenes, both feed arrangements
 and both rock damping modes; (b) energy conserved to round-off without damping; (c) a switch just
 after a sub-grid point is found at the same time; (d) chattering contact runs to the end, and an
-exceeded switch limit is reported; (e) the compiled event loop (models.exact_kernels) gives the
+exceeded switch limit is reported; (e) the compiled event loop (models.solvers.exact_kernels) gives the
 answer of the former pure-Python implementation and of its own Python execution; a diverged run is
 reported at its first bad sample.
 """
@@ -21,14 +21,21 @@ import numpy as np
 import pytest
 from scenes import PAPER_BASE, PER_BODY, crushing_scene, scene, simulate
 
-import rpdrill.models.exact_model
-import rpdrill.models.stability
-from rpdrill.models.energy import energy_account
-from rpdrill.models.exact_kernels import BRENT_RTOL, BRENT_XTOL, brent, first_crossing, horner, run_events
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.scene import Scene
-from rpdrill.models.stability import SimulationFailed
+import rpdrill.models.evaluation.stability
+import rpdrill.models.solvers.exact_model
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.energy import energy_account
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.evaluation.results import SimulationResult
+from rpdrill.models.evaluation.stability import SimulationFailed
+from rpdrill.models.solvers.exact_kernels import (
+    BRENT_RTOL,
+    BRENT_XTOL,
+    brent,
+    first_crossing,
+    horner,
+    run_events,
+)
 from rpdrill.studies.inputs.reading import read_yaml
 
 BLOWS = 12
@@ -80,16 +87,16 @@ def relative_error(result: SimulationResult, reference: SimulationResult, column
 
 
 def test_does_not_import_exudyn() -> None:
-    code = "import rpdrill.models.exact_model, sys; assert 'exudyn' not in sys.modules"
+    code = "import rpdrill.models.solvers.exact_model, sys; assert 'exudyn' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
 def test_checking_and_estimating_a_run_does_not_load_the_kernels() -> None:
-    """A study's points are checked and their cost estimated (models.exact_system) before any runs,
+    """A study's points are checked and their cost estimated (models.solvers.exact_system) before any runs,
     in the command's own process: numba (0.25 s to import) is for the workers that run them."""
-    code = ("import sys; from rpdrill.models.cost import run_cost; from rpdrill.studies.inputs.reading import load_scene, "
+    code = ("import sys; from rpdrill.models.solvers.cost import run_cost; from rpdrill.studies.inputs.reading import load_scene, "
             f"prepare_scene; run_cost(prepare_scene(load_scene({str(PAPER_BASE)!r}).with_solver('exact'), 'test')); "
-            "assert 'numba' not in sys.modules and 'rpdrill.models.exact_system' in sys.modules")
+            "assert 'numba' not in sys.modules and 'rpdrill.models.solvers.exact_system' in sys.modules")
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
@@ -233,7 +240,7 @@ def test_chattering_contact_runs_to_the_end() -> None:
         simulate(chatter, "exact", max_switches_per_blow=5)
 
 
-# The former pure-Python event loop (scipy brentq, before models.exact_kernels) on crushing("carriage",
+# The former pure-Python event loop (scipy brentq, before models.solvers.exact_kernels) on crushing("carriage",
 # "contact"): x_n, x_bit and phi at the end, and the switches.
 FORMER = {"bottom_m": 0.0011440227133556172, "bit_position_m": 0.0008398162377740555,
           "torsion_angle_rad": 0.0019999992542496306}
@@ -253,7 +260,7 @@ def test_compiled_loop_matches_its_python_execution(monkeypatch: pytest.MonkeyPa
     """The same kernel run by the interpreter (numba's py_func) gives the same samples."""
     short = crushing("carriage", "contact", blows=4)
     compiled = simulate(short, "exact", sample_interval_s=1e-4)
-    monkeypatch.setattr(rpdrill.models.exact_model, "run_events", run_events.py_func)
+    monkeypatch.setattr(rpdrill.models.solvers.exact_model, "run_events", run_events.py_func)
     interpreted = simulate(short, "exact", sample_interval_s=1e-4)
     assert compiled.info["switch_modes"] == interpreted.info["switch_modes"]
     np.testing.assert_array_equal(compiled.time_s, interpreted.time_s)
@@ -268,7 +275,7 @@ def test_divergence_is_reported_at_the_first_bad_sample(monkeypatch: pytest.Monk
     short = crushing("carriage", "contact", blows=4)
     free = simulate(short, "exact")
     first = np.argmax(np.any(np.abs(free.position_m) > limit, axis=1))
-    for module in (rpdrill.models.exact_model, rpdrill.models.stability):
+    for module in (rpdrill.models.solvers.exact_model, rpdrill.models.evaluation.stability):
         monkeypatch.setattr(module, "POSITION_LIMIT_M", limit)
     with pytest.raises(SimulationFailed, match=f"diverged at t = {free.time_s[first]:.6g} s"):
         simulate(short, "exact")
@@ -352,10 +359,10 @@ def test_works_from_the_propagators_close_the_energy_balance_at_sparse_samples(m
 
 
 def test_a_scan_reuses_the_propagators_and_its_results_are_those_of_a_fresh_build():
-    """models.exact_model.OPERATOR_CACHE: a run at another impact frequency builds no key again (the
+    """models.solvers.exact_model.OPERATOR_CACHE: a run at another impact frequency builds no key again (the
     propagators depend on the matrices, not on the frequency), and a run from cached propagators is bit
     for bit the run that built them."""
-    cache = rpdrill.models.exact_model.OPERATOR_CACHE
+    cache = rpdrill.models.solvers.exact_model.OPERATOR_CACHE
     base = crushing_scene(solver__end_time_s=0.2, **SHORT_METRICS).with_solver("exact")
     cache.clear()
     fresh = simulate(base)

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from scenes import PER_BODY, crushing_scene, scene, simulate
 
-from rpdrill.models import exudyn_model
-from rpdrill.models.energy import energy_account
-from rpdrill.models.exudyn_model import build_exudyn
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.simulation import prepare
+from rpdrill.models.evaluation.energy import energy_account
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers import exudyn_model
+from rpdrill.models.solvers.exudyn_model import build_exudyn
+from rpdrill.models.solvers.simulation import prepare
 
 SHORT = {"solver__end_time_s": 0.3, "metrics__transient_blows": 4, "metrics__block_blows": 3}
 PER_BODY_KW = {k.replace(".", "__"): v for k, v in PER_BODY.items()}
@@ -140,8 +140,8 @@ def test_preload_that_would_crush_is_refused():
 
 MODULE_PROBE = """
 import json, sys
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.simulation import prepare
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw.exudyn_module import FAST
 from rpdrill.studies.inputs.reading import load_scene
 scene = load_scene(sys.argv[1]).with_solver("exudyn", preset="fast", end_time_s=0.3)

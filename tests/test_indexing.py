@@ -1,4 +1,4 @@
-"""The indexing effect (models.indexing): the bit geometry and the angle turned between blows set how
+"""The indexing effect (models.drill.indexing): the bit geometry and the angle turned between blows set how
 each blow meets the rock. The geometry's regimes, paper mode untouched to the last bit, an optimum in
 rotation speed that scales with the blow frequency, every formulation running it (Exudyn against the
 ODE, the exact solver or its refusal), rotation speed as a scan axis, bad input."""
@@ -14,10 +14,10 @@ import pytest
 import yaml
 from scenes import CRUSHING, crushing_scene, scene_dict, simulate
 
-from rpdrill.models.indexing import CRATER, FRESH, MIN_FRESH_FRACTION, RIDGES, Indexing
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.scene import Bit, Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.scene import Bit, Scene
+from rpdrill.models.drill.indexing import CRATER, FRESH, MIN_FRESH_FRACTION, RIDGES, Indexing
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.cli.main import main
 from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
 from rpdrill.studies.inputs.reading import InputError, prepare_scene, read_yaml

@@ -1,15 +1,15 @@
-"""models.modal: the rock mode of the in-contact chain on chains with known answers and on a scene."""
+"""models.drill.modal: the rock mode of the in-contact chain on chains with known answers and on a scene."""
 
 import math
 
 import pytest
 from scenes import scene, scene_dict
 
-from rpdrill.models.chain import AxialChain, ChainBody
-from rpdrill.models.links import Link
-from rpdrill.models.modal import rock_mode_frequency_hz
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.links import Link
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.drill.chain import AxialChain, ChainBody
+from rpdrill.models.drill.modal import rock_mode_frequency_hz
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw import JenkinsRock
 
 

@@ -1,4 +1,4 @@
-"""The plain ODE of Eq. 4 (models.ode_model): law, energy, events, methods, failures."""
+"""The plain ODE of Eq. 4 (models.solvers.ode_model): law, energy, events, methods, failures."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from scenes import PAPER_BASE, simulate
 
-from rpdrill.models import ode_model
-from rpdrill.models.energy import energy_account
-from rpdrill.models.scene import Scene
-from rpdrill.models.stability import SimulationFailed
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.energy import energy_account
+from rpdrill.models.evaluation.stability import SimulationFailed
+from rpdrill.models.solvers import ode_model
 from rpdrill.studies.inputs.reading import read_yaml
 
 
@@ -44,7 +44,7 @@ def result(case: str):
 
 
 def test_does_not_import_exudyn() -> None:
-    code = "import rpdrill.models.ode_model, sys; assert 'exudyn' not in sys.modules"
+    code = "import rpdrill.models.solvers.ode_model, sys; assert 'exudyn' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
 
 

@@ -10,12 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rpdrill.models.compare import compare_runs, verdict
-from rpdrill.models.energy import energy_account
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.modal import rock_mode_frequency_hz
-from rpdrill.models.scene import Scene
-from rpdrill.models.simulation import prepare
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.drill.modal import rock_mode_frequency_hz
+from rpdrill.models.evaluation.compare import compare_runs, verdict
+from rpdrill.models.evaluation.energy import energy_account
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 from rpdrill.studies.inputs.specs import set_path
 from rpdrill.studies.scan.curve_optima import curve_optimum

@@ -20,9 +20,9 @@ import pytest
 import yaml
 from scenes import PAPER_BASE, simulate
 
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.scene import Scene
-from rpdrill.models.stability import StepLimitWarning
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.evaluation.stability import StepLimitWarning
 from rpdrill.studies.cli.main import main
 from rpdrill.studies.inputs.reading import read_yaml
 from rpdrill.studies.inputs.specs import METRIC_NAMES

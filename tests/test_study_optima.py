@@ -11,8 +11,8 @@ import pytest
 import yaml
 from scenes import PAPER_BASE
 
-from rpdrill.models.modal import rock_mode_frequency_hz
-from rpdrill.models.stability import StepLimitWarning
+from rpdrill.models.drill.modal import rock_mode_frequency_hz
+from rpdrill.models.evaluation.stability import StepLimitWarning
 from rpdrill.studies.cli.main import main
 from rpdrill.studies.scan.curve_optima import curve_optimum
 from rpdrill.studies.scan.study import load_study

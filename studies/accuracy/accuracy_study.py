@@ -5,7 +5,7 @@ A study names a ``base_scene`` with ``base_overrides`` (as in studies/scan/study
 ``time_limit_s`` per run (default 60 s; a run beyond it is a failed setting), the
 ``reference`` run and an independent ``reference_check`` run, the ``grid_interval_s`` of the
 bit-velocity comparison, and the solver ``families`` to compare. A setting is a scene ``solver``
-mapping (models.scene.Solver: the ``formulation`` and its options); a family is one solver (a line
+mapping (models.definition.scene.Solver: the ``formulation`` and its options); a family is one solver (a line
 of the plot) swept over one of its keys::
 
     name: paper_base_workprecision
@@ -48,10 +48,9 @@ from typing import Any, Literal
 
 from pydantic import Field
 
-from ...models.cost import Cause
-from ...models.results import SimulationResult
-from ...models.scene import MAX_COUNT, Scene
-from ...models.workprecision import (
+from ...models.definition.scene import MAX_COUNT, Scene
+from ...models.evaluation.results import SimulationResult
+from ...models.evaluation.workprecision import (
     ERROR_MEASURES,
     Signature,
     errors,
@@ -59,6 +58,7 @@ from ...models.workprecision import (
     signature,
     uniform_grid_s,
 )
+from ...models.solvers.cost import Cause
 from ..inputs.reading import InputError, parse, prepare_scene, read_yaml
 from ..inputs.specs import Axis, SceneSpec, StrictSpec
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, check_size
@@ -219,7 +219,7 @@ def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Ac
 def simulate_setting(scene: dict[str, Any], setting: Setting, grid_interval_s: float) -> SimulationResult:
     """One run of the windowed ``scene`` with ``setting`` (StepLimitWarnings silenced: a diverged
     run is reported as SimulationFailed by the formulation)."""
-    from ...models.simulation import prepare
+    from ...models.solvers.simulation import prepare
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -3,13 +3,13 @@
 The point lies in the operating parameters of :data:`PARAMETERS` (data: a scene path each, shown
 through studies.display.catalogue; adding one, e.g. a rotation speed, is one entry): the impact frequency
 and the feed force, and optionally the impact amplitude. The metric is the penetration rate, or
-the penetration per joule of impact energy (models.metrics).
+the penetration per joule of impact energy (models.evaluation.metrics).
 
-* **Runs**: the exact formulation where it can run the scene (models.formulations.unsupported),
+* **Runs**: the exact formulation where it can run the scene (models.definition.formulations.unsupported),
   the Exudyn model otherwise; the scene's end time, raised where needed so that the metrics'
   transient and block blows fit at the lowest frequency. A run that fails counts as 0.
 * **Static limit**: a point whose mean thrust, feed plus blow frequency x impulse per blow
-  (models.simulation.Simulation.mean_thrust_n), reaches the rock's threshold F_th (or
+  (models.solvers.simulation.Simulation.mean_thrust_n), reaches the rock's threshold F_th (or
   ``max_thrust_ratio`` x F_th) is not run: there a Jenkins rock yields under the mean load and the
   bit sinks at a rate set only by the rock damper (runaway crushing, outside what the model
   describes). The search treats it as a constraint: such a point is worse than any point below the
@@ -41,10 +41,10 @@ import numpy as np
 from pydantic import ValidationError
 from scipy import optimize
 
-from ...models.formulations import unsupported
-from ...models.scene import Scene
-from ...models.simulation import SceneError, Simulation, prepare
-from ...models.validation import InputError, describe_validation_error
+from ...models.definition.formulations import unsupported
+from ...models.definition.scene import Scene
+from ...models.definition.validation import InputError, describe_validation_error
+from ...models.solvers.simulation import SceneError, Simulation, prepare
 from ..display.catalogue import describe_scene, parameter
 from ..inputs.specs import set_path
 from ..runtime.pools import Runner

@@ -34,8 +34,8 @@ from typing import Annotated, Any, Literal, Union, get_args, get_origin
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from ...models.scene import Scene
-from ...models.validation import InputError, field_at, parse
+from ...models.definition.scene import Scene
+from ...models.definition.validation import InputError, field_at, parse
 from ..inputs.reading import read_yaml
 from ..inputs.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
 from ..runtime.budgets import (
@@ -155,7 +155,7 @@ class Calibration:
     base: dict[str, Any]
     frequencies_hz: tuple[float, ...]
     labels: tuple[str, ...]
-    cpu_s: float = 0.0  # estimated for the whole calibration (models.cost)
+    cpu_s: float = 0.0  # estimated for the whole calibration (models.solvers.cost)
 
     @property
     def names(self) -> list[str]:

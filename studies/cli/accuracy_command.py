@@ -5,7 +5,7 @@ Runs the study's reference and reference check in this process, then every solve
 
 * DIR/workprecision.csv: one row per setting (appended as settings finish, resumable as for
   ``rpdrill study``): median CPU time, every repeat's CPU time, and the errors of
-  models.workprecision against the reference; a diverged or failed setting is a row with status
+  models.evaluation.workprecision against the reference; a diverged or failed setting is a row with status
   ``failed`` and its message;
 * DIR/pareto.csv: the Pareto front (cheapest settings for their accuracy) of each error measure;
 * DIR/reference.json: both references, their agreement, and whether it is below the smallest
@@ -24,7 +24,7 @@ import argparse
 import sys
 import time
 
-from ...models.workprecision import Signature
+from ...models.evaluation.workprecision import Signature
 from ..accuracy.accuracy_study import (
     COLUMNS,
     PARETO_COLUMNS,

@@ -6,9 +6,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ...models.compare import compare_runs, verdict
-from ...models.formulations import ODE_METHODS
-from ...models.stability import SimulationFailed
+from ...models.definition.formulations import ODE_METHODS
+from ...models.evaluation.compare import compare_runs, verdict
+from ...models.evaluation.stability import SimulationFailed
 from ..crosscheck.crosscheck_windows import DEFAULT_STEP_S, comparison_table, window_scenes
 from ..figures.crosscheck_figure import plot_overlay
 from ..inputs.reading import load_scene, prepare_scene

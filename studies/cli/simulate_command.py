@@ -11,8 +11,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ...models.formulations import FORMULATIONS
-from ...models.stability import SimulationFailed
+from ...models.definition.formulations import FORMULATIONS
+from ...models.evaluation.stability import SimulationFailed
 from ..api import simulate
 from ..display.catalogue import metric
 from ..inputs.reading import load_scene

@@ -16,7 +16,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ...models.formulations import FORMULATIONS
+from ...models.definition.formulations import FORMULATIONS
 from ..api import run_study_files
 from ..runtime.resumable import Row
 from ..scan.study import Study

@@ -3,7 +3,7 @@
 Both formulations run the scene over a window of ``--blows`` impact periods from the scene's start
 (default 20): the Exudyn model with the scene's solver type at ``--step`` (default 5e-6 s; the
 differences against the step on the shipped and test drills: docs/crosscheck.md), the ODE
-(models.ode_model) with event-located
+(models.solvers.ode_model) with event-located
 rock switches at a tight tolerance. Only a window of early blows is compared: the rock law switches
 (contact, crushing) amplify tiny differences from blow to blow, so after many blows two correct
 solutions drift apart in phase and a pointwise comparison stops measuring accuracy.
@@ -17,7 +17,7 @@ overlay plot DIR/crosscheck.png.
 
 from __future__ import annotations
 
-from ...models.scene import Scene
+from ...models.definition.scene import Scene
 from ..inputs.reading import parse
 
 DEFAULT_STEP_S = 5e-6

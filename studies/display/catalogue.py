@@ -2,8 +2,8 @@
 scale. Plots, tables and printed summaries take their labels from here; the data stay in SI units.
 
 A display value is the SI value times ``scale`` (0.00035 m per blow at scale 1e3 is 0.35 mm per blow).
-Metrics are keyed by the names of models.outputs.METRICS, time histories by their column names
-(models.results.SimulationResult.columns, ``*`` for a body's name), parameters by dotted scene
+Metrics are keyed by the names of models.definition.outputs.METRICS, time histories by their column names
+(models.evaluation.results.SimulationResult.columns, ``*`` for a body's name), parameters by dotted scene
 paths (``*`` for a name in drill_string.bodies or drill_string.connectors, filled into the name).
 A parameter without a unit (``unit=""``) is categorical (a rock name, a solver type) and is
 never a plot axis. ``merit`` marks the figures of merit, larger is better, whose optima a study
@@ -16,7 +16,7 @@ from collections.abc import Collection
 from dataclasses import dataclass, replace
 from typing import Any
 
-from ...models.scene import Scene
+from ...models.definition.scene import Scene
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ...models.results import SimulationResult
+from ...models.evaluation.results import SimulationResult
 from ..display.catalogue import series
 from .figure_style import OKABE_ITO, plt, save
 

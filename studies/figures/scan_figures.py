@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ...models.scene import Scene
+from ...models.definition.scene import Scene
 from ..display.catalogue import Quantity, describe_scene, metric, quantity
 from ..scan.study import Plot, Study
 from ..scan.study_optima import Record, Row, curves, metric_value, number_or_text

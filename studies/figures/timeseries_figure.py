@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...models.scene import Scene
+from ...models.definition.scene import Scene
 from ..display.catalogue import describe_scene, series
 from .figure_style import OKABE_ITO, plt, save
 

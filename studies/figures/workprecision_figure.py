@@ -8,7 +8,7 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
-from ...models.workprecision import ERROR_LABELS, ERROR_MEASURES
+from ...models.evaluation.workprecision import ERROR_LABELS, ERROR_MEASURES
 from ..accuracy.accuracy_study import AccuracyStudy, Row, number
 from .figure_style import line_styles, plt, save
 

@@ -20,10 +20,10 @@ from typing import Any
 
 import yaml
 
-from ...models.formulations import unsupported
-from ...models.scene import Scene
-from ...models.simulation import SceneError, Simulation, prepare
-from ...models.validation import InputError, parse, short
+from ...models.definition.formulations import unsupported
+from ...models.definition.scene import Scene
+from ...models.definition.validation import InputError, parse, short
+from ...models.solvers.simulation import SceneError, Simulation, prepare
 
 __all__ = ["InputError", "load_scene", "parse", "parse_yaml", "prepare_scene", "read_text", "read_yaml"]
 
@@ -209,7 +209,7 @@ def load_scene(path: str | Path) -> Scene:
 
 def prepare_scene(scene: Scene, source: str, where: str = "") -> Simulation:
     """Prepare a validated scene for a run; InputError naming ``source``, ``where`` (a scan point),
-    the key path and the value where it cannot run as given (models.simulation.SceneError, or a
+    the key path and the value where it cannot run as given (models.solvers.simulation.SceneError, or a
     formulation that cannot run it)."""
     try:
         simulation = prepare(scene)

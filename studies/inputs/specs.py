@@ -15,9 +15,9 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from ...models.outputs import METRICS
-from ...models.scene import Scene
-from ...models.validation import InputError, check_path, parse, set_path
+from ...models.definition.outputs import METRICS
+from ...models.definition.scene import Scene
+from ...models.definition.validation import InputError, check_path, parse, set_path
 from .reading import read_yaml
 
 METRIC_NAMES = tuple(METRICS)
@@ -28,7 +28,7 @@ MAX_NUM = 10**15
 
 
 class StrictSpec(BaseModel):
-    """Unknown keys are errors; numbers are numbers and finite (as in the scene, models.scene.Strict)."""
+    """Unknown keys are errors; numbers are numbers and finite (as in the scene, models.definition.scene.Strict)."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True, strict=True, allow_inf_nan=False)
 
@@ -117,5 +117,5 @@ class Axis(StrictSpec):
 
 def check_scene_path(source: str, key: str, path: str, base: dict[str, Any] | None = None) -> None:
     """A scan or override path must name a scene key; a name in a mapping (``drill_string.bodies.X``)
-    must exist in the ``base`` scene (models.validation.check_path)."""
+    must exist in the ``base`` scene (models.definition.validation.check_path)."""
     check_path(Scene, source, key, path, base)

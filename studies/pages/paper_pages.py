@@ -11,9 +11,9 @@ import math
 from pathlib import Path
 from typing import Any
 
-from ...models.modal import rock_mode_frequency_hz
-from ...models.scene import Scene
-from ...models.simulation import prepare
+from ...models.definition.scene import Scene
+from ...models.drill.modal import rock_mode_frequency_hz
+from ...models.solvers.simulation import prepare
 from ..calibration.calibration_spec import Calibration
 from ..reproduction.paper_reproduction import (
     CaseResult,
@@ -87,7 +87,7 @@ formulation ({provenance['simulations']} runs, {provenance['cpu_time_s']:.0f} CP
 Exudyn {provenance['exudyn_version']}.
 
 **Optimum**: the maximum of the case's *main lobe*, the lobe of the curve whose peak is nearest (on a log
-scale) to the rock-mode resonance of the in-contact drill (`models/modal.py`: the mode whose strain energy
+scale) to the rock-mode resonance of the in-contact drill (`models/drill/modal.py`: the mode whose strain energy
 lies most in the rock spring), refined by the parabola through the best point and its neighbours
 (`studies/scan/curve_optima.py`). The paper's figures show the main resonance; a sub-harmonic lobe (below) can be as
 high, so the global maximum is given beside it wherever it lies elsewhere. **Bands**: where the metric
@@ -107,7 +107,7 @@ stated maximum; the centre of its band where it gives only a band).
 ## The sawtooth below the resonance: sub-harmonic lobes
 
 The lobes of case `{spec.sub_harmonics}` on the 1 Hz scan, with the rock-mode resonance of its drill,
-f_r = {resonance:.1f} Hz (`models/modal.py`). A pulse train at f drives that mode in phase with every n-th blow
+f_r = {resonance:.1f} Hz (`models/drill/modal.py`). A pulse train at f drives that mode in phase with every n-th blow
 when f is near f_r / n: each lobe below the main one is such a sub-harmonic resonance when f_r over its
 peak lies near a whole number n. The 1 Hz scan resolves every lobe over several points, so they are
 lobes of the dynamics, not an artefact of the grid; the paper scans' 5 Hz grid samples each of these
@@ -195,7 +195,7 @@ else it leaves open. The model, the upper string above the shock absorber and it
 
 ## The resonance each case rides on
 
-The rock mode of the linearised in-contact drill (`models/modal.py`) against the main-lobe optimum
+The rock mode of the linearised in-contact drill (`models/drill/modal.py`) against the main-lobe optimum
 (contact losses and crushing soften the contact, so the optimum lies below the linear mode):
 
 | case | rock mode | main-lobe optimum |

@@ -6,7 +6,7 @@ A reproduction file (``studies/paper/reproduction.yaml``) names the base scene w
 scans, each with what the ``paper`` says: ``optimum_hz``, ``band_hz`` and the words), the ``rising``
 trends, the case whose lobes explain the sawtooth below the resonance (``sub_harmonics``) and the
 ``figures`` to redraw (cases and metrics of each). Every case's optimum is the maximum of its main
-lobe (the lobe nearest to the rock-mode resonance of models.modal), refined by the parabola through
+lobe (the lobe nearest to the rock-mode resonance of models.drill.modal), refined by the parabola through
 the best point and its neighbours (studies.scan.curve_optima); the global maximum is given beside it, so that a
 sub-harmonic lobe as high as the main one is never taken for it silently. ``variants`` repeat every case
 on another drill (another upper string: bodies and connectors added, paths overridden), to show what

@@ -1,12 +1,12 @@
 """Resource budgets, checked before anything runs: the steps and memory of every run
-(models.cost), and the CPU time and memory of a command's many runs.
+(models.solvers.cost), and the CPU time and memory of a command's many runs.
 
 A run or a command beyond its budget stops with exit status 1 and one message: the file, the key
 that causes the cost, its value, the estimate and the option that allows it (``--max-steps``,
 ``--max-memory-gb``, ``--yes``). The limits are stated here:
 
 * DEFAULT_MAX_STEPS steps per run (Exudyn on the paper drill takes about 6 microseconds a step,
-  models.cost: a minute);
+  models.solvers.cost: a minute);
 * DEFAULT_MAX_MEMORY_GB of memory per run, and for a study's prepared points together
   (PREPARED_POINT_BYTES each);
 * MAX_CPU_HOURS of CPU for a command's runs together (their preparation included), unless
@@ -18,8 +18,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from ...models.cost import Cause, RunCost, run_cost
-from ...models.simulation import Simulation
+from ...models.solvers.cost import Cause, RunCost, run_cost
+from ...models.solvers.simulation import Simulation
 from ..inputs.reading import InputError
 from .point_runs import prepare_point
 
@@ -56,7 +56,7 @@ class Budget:
     accept_long: bool = False
 
     def check_run(self, simulation: Simulation, source: str, where: str = "", resampled: Cause | None = None) -> RunCost:
-        """The run's cost (models.cost, histories resampled at the interval ``resampled`` names);
+        """The run's cost (models.solvers.cost, histories resampled at the interval ``resampled`` names);
         BudgetError naming ``source``, ``where`` (a scan point, a setting), the key and value that cause
         it when it is beyond the steps or memory budget."""
         cost = run_cost(simulation, resampled)

@@ -1,6 +1,6 @@
 """One scene of a study, an accuracy study or a calibration: prepared once, run by a worker.
 
-Every point is validated and prepared where it is made (models.simulation.prepare: the chain, the
+Every point is validated and prepared where it is made (models.solvers.simulation.prepare: the chain, the
 rock law, the solver settings, the initial state); workers receive the prepared simulation and
 build the formulation's model themselves (Exudyn systems cannot be pickled). A point's problems
 are tied to the scan axis that caused them when there is one.
@@ -13,10 +13,10 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from ...models.metrics import summary_metrics
-from ...models.scene import Scene
-from ...models.simulation import Simulation
-from ...models.validation import problem
+from ...models.definition.scene import Scene
+from ...models.definition.validation import problem
+from ...models.evaluation.metrics import summary_metrics
+from ...models.solvers.simulation import Simulation
 from ..inputs.reading import InputError, prepare_scene
 
 

@@ -46,7 +46,7 @@ Row = dict[str, str]
 class TablePoint(Protocol):
     index: int
     parameters: dict[str, Any]
-    cpu_s: float  # estimated (models.cost)
+    cpu_s: float  # estimated (models.solvers.cost)
 
 
 class ResumableStudy(Protocol):

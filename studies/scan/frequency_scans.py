@@ -3,7 +3,7 @@ sensitivity study varies.
 
 A :class:`Scan` is the base scene with ``overrides`` scanned over impact frequency; its ``metric``'s
 optimum is the maximum of its main lobe (studies.scan.curve_optima: the lobe nearest to the rock-mode
-resonance of models.modal, refined by the parabola through the best point and its neighbours),
+resonance of models.drill.modal, refined by the parabola through the best point and its neighbours),
 reported beside the global maximum. Many scans (every scan of many parameter sets) go to a runner
 together, one task per scan, each distinct scan once; ``rising`` lists of labels are trends the
 optima must follow (the paper's 3.1 b: the optimum rises with the impulse).
@@ -21,7 +21,7 @@ from typing import Any
 
 from pydantic import Field
 
-from ...models.modal import rock_mode_frequency_hz
+from ...models.drill.modal import rock_mode_frequency_hz
 from ..inputs.reading import InputError
 from ..inputs.specs import MetricName, StrictSpec, set_path
 from ..runtime.point_runs import prepare_point, run_point

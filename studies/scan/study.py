@@ -41,8 +41,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
-from ...models.scene import Scene, switch_formulation
-from ...models.simulation import Simulation
+from ...models.definition.scene import Scene, switch_formulation
+from ...models.solvers.simulation import Simulation
 from ..inputs.reading import InputError, parse, read_yaml
 from ..inputs.specs import (
     METRIC_NAMES,
@@ -99,7 +99,7 @@ class StudySpec(SceneSpec):
 @dataclass(frozen=True)
 class StudyPoint:
     """One scene of a study: its index, its scan parameters, the prepared simulation and its
-    estimated CPU seconds (models.cost)."""
+    estimated CPU seconds (models.solvers.cost)."""
 
     index: int
     parameters: dict[str, Any]
@@ -129,7 +129,7 @@ class Study:
 
     @cached_property
     def scene_keys(self) -> list[str]:
-        """Each point's resolved scene (models.simulation.Simulation.resolved_scene: with its outputs and
+        """Each point's resolved scene (models.solvers.simulation.Simulation.resolved_scene: with its outputs and
         solver settings) as canonical JSON: equal keys, equal results."""
         return [json.dumps(p.simulation.resolved_scene(), sort_keys=True) for p in self.points]
 

@@ -10,7 +10,7 @@ every other axis. For each curve and each collected figure of merit (studies.dis
   where the metric stays at or above 80 % and 50 % of that peak, with whether the peak is the
   first or last point of the curve (the optimum may then lie beyond the scan);
 * the main lobe: along the frequency, the lobe nearest to the rock-mode resonance of the curve's
-  scene (models.modal.rock_mode_frequency_hz: sub-harmonic lobes near f_r/2 can be as high); along
+  scene (models.drill.modal.rock_mode_frequency_hz: sub-harmonic lobes near f_r/2 can be as high); along
   another axis, the highest lobe.
 
 A failed point counts as 0 (no band reaches across a failed run). Records are in SI units, the
@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections import defaultdict
 from typing import Any
 
-from ...models.modal import rock_mode_frequency_hz
+from ...models.drill.modal import rock_mode_frequency_hz
 from ..display.catalogue import metric, quantity
 from ..display.text_tables import text_table
 from .curve_optima import curve_optimum

@@ -32,7 +32,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from ...models.scene import Scene
+from ...models.definition.scene import Scene
 from ..inputs.reading import InputError, parse, read_yaml
 from ..inputs.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, base_estimate_s

@@ -10,18 +10,18 @@ import numpy as np
 import pytest
 from scenes import simulate
 
-from rpdrill.models.cost import run_cost
-from rpdrill.models.metrics import summary_metrics
-from rpdrill.models.results import SimulationResult
-from rpdrill.models.simulation import prepare
-from rpdrill.models.solver_settings import EXUDYN_PRESETS
-from rpdrill.models.stability import (
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.evaluation.results import SimulationResult
+from rpdrill.models.evaluation.solver_settings import EXUDYN_PRESETS
+from rpdrill.models.evaluation.stability import (
     STABLE_STEP_FACTOR,
     SimulationFailed,
     StepLimitWarning,
     largest_stable_step_s,
     step_scales,
 )
+from rpdrill.models.solvers.cost import run_cost
+from rpdrill.models.solvers.simulation import prepare
 from stability.hard_scenes import HARD_SCENES, LONG_RUN, hard_scene
 
 

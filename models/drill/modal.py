@@ -3,7 +3,7 @@
 With the bit in contact, the rock acts as a spring k_n and a damper c_n on the bit, so the
 chain moves as M q'' + C_r q' + K_r q = 0 with K_r = K + k_n e_b e_b^T, C_r = C + c_n e_b e_b^T
 (e_b the unit vector of the bit; every link at its full stiffness). Its modes are the eigenpairs
-of the chain's first-order matrix (models.chain.AxialChain.first_order_matrix)
+of the chain's first-order matrix (models.drill.chain.AxialChain.first_order_matrix)
 
     A = [[0, I], [-M^-1 K_r, -M^-1 C_r]],   A (phi, lambda phi) = lambda (phi, lambda phi),
 
@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from ..rocklaw import RockLaw
+from ...rocklaw import RockLaw
 from .chain import AxialChain
 
 

@@ -4,7 +4,7 @@ Symbols refer to the paper (Eq. 4, Table 1). The scene knows nothing of files: b
 plain dictionary with :func:`Scene.model_validate`; errors are pydantic ``ValidationError``s
 whose locations are the key paths. Validation checks the data for consistency and runs no
 physics; what a run derives from it (the effects built, the solver step of a preset, the chain,
-the rock law, the initial state) is resolved once per run by :mod:`rpdrill.models.simulation`.
+the rock law, the initial state) is resolved once per run by :mod:`rpdrill.models.solvers.simulation`.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
-from ..rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
-from ..rocklaw.catalog import TABLE_1
+from ...rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
+from ...rocklaw.catalog import TABLE_1
 from .formulations import (
     COMMON_SOLVER_KEYS,
     EXUDYN_SOLVERS,
@@ -58,7 +58,7 @@ class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
 
-# The formulations assemble dense matrices of the whole chain (models.chain): 1000 lumped bodies is
+# The formulations assemble dense matrices of the whole chain (models.drill.chain): 1000 lumped bodies is
 # a 2000 x 2000 first-order matrix.
 MAX_CHAIN_BODIES = 1000
 STEEL_YOUNGS_MODULUS_PA = 210e9
@@ -137,7 +137,7 @@ class Body(Strict):
 
 class Connector(Strict):
     """A link from body ``from`` (nearer the hammer, or ``ground``) to body ``to``, of a ``type`` of
-    :data:`models.links.LINK_TYPES`: ``spring_damper`` (bonded, F = k delta + c delta') or
+    :data:`models.definition.links.LINK_TYPES`: ``spring_damper`` (bonded, F = k delta + c delta') or
     ``coupling`` (compression only once its ``gap_m`` has closed). Without ``stiffness_n_per_m`` the
     stiffness follows from the rods it joins (:class:`Body`).
     """
@@ -281,7 +281,7 @@ class Torsion(Strict):
 
 
 class Bit(Strict):
-    """The bit face as the indexing model sees it (models.indexing): bit diameter D, the gauge
+    """The bit face as the indexing model sees it (models.drill.indexing): bit diameter D, the gauge
     (outermost) buttons' diameter d and count, and the width of the crater one button leaves
     (default d: a crater as wide as the button that made it, the model's assumption)."""
 
@@ -433,7 +433,7 @@ def _refuse_foreign_keys(model: BaseModel, what: str, chosen: str, keys: dict[st
 
 
 class Solver(Strict):
-    """How the scene is integrated: the ``formulation`` (models.formulations), an accuracy
+    """How the scene is integrated: the ``formulation`` (models.definition.formulations), an accuracy
     ``preset`` (fast, standard, reference) and/or that formulation's explicit options, the end time
     and the output interval.
 
@@ -443,7 +443,7 @@ class Solver(Strict):
     of the state), ``sample_interval_s`` (dense-output sampling); exact ``sample_interval_s``,
     ``min_switch_interval_s``, ``max_switches_per_blow``. A preset fills the options not given;
     without a preset and without explicit accuracy options the ``standard`` preset applies
-    (models.solver_settings resolves them once per run).
+    (models.evaluation.solver_settings resolves them once per run).
     """
 
     formulation: Literal[tuple(FORMULATIONS)] = "exudyn"  # type: ignore[valid-type]
@@ -486,7 +486,7 @@ class Effects(Strict):
     scene gives parameters for (the full model); :func:`built_effects` resolves them for a run.
     ``reasons`` is informational (a resolved scene file says there why each effect was built).
     ``rock_plasticity`` off gives an elastic rock that never crushes. ``indexing`` couples rotation
-    to penetration (models.indexing): the angle the bit turned between two blows (``rotation`` or the
+    to penetration (models.drill.indexing): the angle the bit turned between two blows (``rotation`` or the
     torsion line) and the ``bit`` geometry set how each blow meets the rock.
     """
 
@@ -539,7 +539,7 @@ class Scene(Strict):
     def with_(self, changes: dict[str, Any], source: str = "Scene.with_") -> Scene:
         """A validated copy with ``changes``: dotted key paths of the scene file -> values
         (``{"impact.frequency_hz": 70.0, "solver.formulation": "exact"}``; None removes a key). A bad
-        value raises :class:`~rpdrill.models.validation.InputError` naming the key path, the value and
+        value raises :class:`~rpdrill.models.definition.validation.InputError` naming the key path, the value and
         what is allowed, as the command line reports a scene file."""
         return with_changes(self, changes, source)
 

@@ -7,11 +7,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .chain import AxialChain
-from .scene import Scene
+from ..definition.scene import Scene
+from ..drill.chain import AxialChain
 
 if TYPE_CHECKING:
-    from .simulation import Simulation
+    from ..solvers.simulation import Simulation
 
 
 @dataclass

@@ -39,8 +39,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
-from ..rocklaw import RockLaw, State
-from .scene import Bit
+from ...rocklaw import RockLaw, State
+from ..definition.scene import Bit
 
 MIN_FRESH_FRACTION = 0.01  # a blow into its own crater still deepens it (the threshold stays finite)
 FRESH, CRATER, RIDGES = "fresh surface", "partly crushed crater", "ridges"

@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from ..rocklaw.backends import NUMERIC, Backend
-from .scene import Impact
+from ...rocklaw.backends import NUMERIC, Backend
+from ..definition.scene import Impact
 
 OFF, ON, RISING, FALLING = PHASES = ("off", "on", "rising", "falling")
 

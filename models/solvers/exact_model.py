@@ -2,15 +2,15 @@
 
 Between two switches the model is linear and autonomous in the augmented state
 w = (x (n bodies), v (n bodies), rock states, [phi, phi'], 1, u1, u2) (phi, phi' with the torsion
-effect; u1, u2 the pulse generator of models.pulse, the constant 1 carrying the feed forces, the
+effect; u1, u2 the pulse generator of models.drill.pulse, the constant 1 carrying the feed forces, the
 laws' constants and the net torque):
 
     w' = A_(modes, phase) w
 
-``modes`` holds the mode of every piecewise element (models.piecewise: the rock law and each
+``modes`` holds the mode of every piecewise element (models.drill.piecewise: the rock law and each
 nonlinear connector), ``phase`` the pulse phase. A is generated, never written by hand: the chain's
-first-order matrix (models.chain, the linear links and the feed), the torsion line, the pulse
-phase's force row and generator (models.pulse), and for each element its mode's force row acting
+first-order matrix (models.drill.chain, the linear links and the feed), the torsion line, the pulse
+phase's force row and generator (models.drill.pulse), and for each element its mode's force row acting
 along the element's load and its state-rate rows (rocklaw.modes: the laws' own declarations).
 The mode is left at the first zero crossing, in its direction, of one of the current modes' exit
 rows; the next mode starts from the element's entry values (Jenkins: x_n = x_bit - F_th / k_n on
@@ -30,23 +30,23 @@ first interval where g goes from its side to the crossed side, or where g' turns
 away from it and the maximum of g between the points is on the crossed side (a crossing and its
 return within one sub-step), brackets the switch, which Brent's method (as ``scipy.optimize.brentq``)
 locates on the Taylor polynomial g(s) of the exact solution. The event
-loop runs compiled (models.exact_kernels); the operators of a key are built when the run first
+loop runs compiled (models.solvers.exact_kernels); the operators of a key are built when the run first
 reaches it.
 
 Works (with the energy outputs): the impact work and the work the links, the rock and the torsion
 line absorb are quadratic forms w^T Q w integrated exactly between the samples,
 int_0^s w^T Q w = w^T G(s) w with G(s) = int_0^s expm(A^T u) Q expm(A u) du per key, a series in s
-(models.exact_kernels.power_integrals and integrate_powers), so the samples stay at the output
+(models.solvers.exact_kernels.power_integrals and integrate_powers), so the samples stay at the output
 interval.
 
 Zero-length modes: a mode lasts at least ``min_switch_interval_s``. Its start is taken as not
 crossed for every exit function; if an exit function is on its crossed side already at
 t_start + min_switch_interval_s, the switch is placed there. More than ``max_switches_per_blow``
 switches per blow on average raise :class:`SimulationFailed`, and so does a diverged state
-(models.stability's criterion, checked at every switch, pulse switch and batch end; the message
+(models.evaluation.stability's criterion, checked at every switch, pulse switch and batch end; the message
 names the first diverged sample).
 
-Blow starts. A law that resets at blow starts (the state the next blow meets: models.indexing) is
+Blow starts. A law that resets at blow starts (the state the next blow meets: models.drill.indexing) is
 linear between blows; the compiled loop stops at each blow start, the rock states are set here
 (any function of the state, e.g. of the torsion angle turned since the last blow) and the rock's
 mode found again, and the loop goes on.
@@ -63,6 +63,16 @@ import numpy as np
 from scipy.linalg import expm
 from threadpoolctl import ThreadpoolController
 
+from ..definition.scene import Scene
+from ..drill.pulse import (
+    PHASES,
+    blow_start_times,
+    generator_states,
+    phase_pieces,
+    phase_row,
+)
+from ..evaluation.results import SimulationResult
+from ..evaluation.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
 from .exact_kernels import (
     BLOW_START,
     DIVERGED,
@@ -74,17 +84,7 @@ from .exact_kernels import (
     run_events,
 )
 from .exact_system import Model, Modes, balance, sub_step, unsupported
-from .pulse import (
-    PHASES,
-    blow_start_times,
-    generator_states,
-    phase_pieces,
-    phase_row,
-)
-from .results import SimulationResult
-from .scene import Scene
 from .simulation import SceneError, Simulation, as_simulation
-from .stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
 
 ANCHORS, PER_ANCHOR = 16, 16  # A, B: a batch is J = A B sub-grid points from one state (module doc)
 TAYLOR_REMAINDER = 1e-20  # relative truncation of the Taylor series on pieces shorter than h
@@ -136,7 +136,7 @@ def taylor_order(norm_times_step: float) -> int:
 
 
 class Operators:
-    """The per-key (modes, phase) arrays of models.exact_kernels.run_events, stacked over the keys and
+    """The per-key (modes, phase) arrays of models.solvers.exact_kernels.run_events, stacked over the keys and
     filled when the kernel first reaches a key (``add``); mode combinations get ids as they are
     first named, key_of[mode id, phase id] -> key (-1: not built), arrays growing as needed.
     R = (I, F_r row, F_d row, exit rows c_e, their slopes c_e A) gives a point's outputs."""
@@ -353,7 +353,7 @@ def _switch_counts(model: Model, before: Modes, entered: list[Modes]) -> dict[st
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Exact solution of the simulation from its start to its end time (formulation "exact").
 
-    Samples: a uniform grid of the settings' ``sample_interval_s`` (models.solver_settings) plus both
+    Samples: a uniform grid of the settings' ``sample_interval_s`` (models.evaluation.solver_settings) plus both
     sides of every switch and pulse switch (repeated times, the rock and piston forces of each side).
     ``min_switch_interval_s`` and ``max_switches_per_blow``: module doc. ``progress(t)`` is called once,
     at the end (a run takes milliseconds).

@@ -1,12 +1,12 @@
 """One scene prepared for a run: everything a formulation needs, resolved once.
 
-:func:`prepare` turns a validated :class:`~rpdrill.models.scene.Scene` (data only) into a
+:func:`prepare` turns a validated :class:`~rpdrill.models.definition.scene.Scene` (data only) into a
 :class:`Simulation`: the effects built and why, the outputs asked for, the axial chain, the rock law
 as built, the solver settings of the scene's formulation (an accuracy preset resolved into a step
 or tolerances), the initial state (rest, or the static preload), and the indexing model (the
-``indexing`` effect: models.indexing) whose blow starts every formulation applies. Every formulation, the metrics,
+``indexing`` effect: models.drill.indexing) whose blow starts every formulation applies. Every formulation, the metrics,
 the energy account and the stability checks read these fields; nothing derives them again.
-:meth:`Simulation.run` dispatches through the formulation registry (models.formulations).
+:meth:`Simulation.run` dispatches through the formulation registry (models.definition.formulations).
 """
 
 from __future__ import annotations
@@ -19,13 +19,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..rocklaw import RockLaw, State
-from .chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
-from .formulations import simulate
-from .indexing import BlowStarts, Indexing
-from .outputs import needs
-from .pulse import impulse_per_blow_n_s
-from .scene import (
+from ...rocklaw import RockLaw, State
+from ..definition.formulations import simulate
+from ..definition.outputs import needs
+from ..definition.scene import (
     BuiltEffects,
     Impact,
     Outputs,
@@ -34,11 +31,14 @@ from .scene import (
     built_effects,
     requested_outputs,
 )
-from .solver_settings import Settings, resolve_settings
-from .stability import FastestElement, StepScales, fastest_element, step_scales
+from ..drill.chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
+from ..drill.indexing import BlowStarts, Indexing
+from ..drill.pulse import impulse_per_blow_n_s
+from ..evaluation.solver_settings import Settings, resolve_settings
+from ..evaluation.stability import FastestElement, StepScales, fastest_element, step_scales
 
 if TYPE_CHECKING:
-    from .results import SimulationResult
+    from ..evaluation.results import SimulationResult
 
 
 class SceneError(ValueError):

@@ -1,14 +1,14 @@
 """What a prepared run will cost, estimated before it runs: steps, memory and CPU time, and the
 scene key that makes it cost that much.
 
-With T = ``solver.end_time_s``, r the rate of the fastest element (models.stability.fastest_element,
+With T = ``solver.end_time_s``, r the rate of the fastest element (models.evaluation.stability.fastest_element,
 of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2 n + rock states
 + 2 (torsion) + 3 (the constant and the pulse generator) values:
 
 * exudyn: T / ``step_s`` steps (for dopri5 and ode23 ``step_s`` is the largest step: a lower
   bound); it stores every step when an energy output is asked for, else every
   ``output_interval_s``, two values (time, value) per sensor of 2 n + 4;
-* exact: T / h sub-grid points, h the exact solver's own sub-step (models.exact_system.sub_step:
+* exact: T / h sub-grid points, h the exact solver's own sub-step (models.solvers.exact_system.sub_step:
   the sample interval over ceil(sample interval x ||A_bal||_1)); it stores m + 2 values per
   sample and per allowed switch, and about OPERATOR_VALUES m^2 values per (mode, pulse phase) of
   the rock law;
@@ -29,12 +29,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ..definition.formulations import DEFAULT_PRESET
+from ..drill.pulse import phase_pieces
+from ..evaluation.solver_settings import EXUDYN_PRESETS
+from ..evaluation.stability import element_rates
 from .exact_system import sub_step
-from .formulations import DEFAULT_PRESET
-from .pulse import phase_pieces
 from .simulation import Simulation
-from .solver_settings import EXUDYN_PRESETS
-from .stability import element_rates
 
 # Measured by benchmarks/bench_budgets.py (one BLAS thread, shared 2-core machine):
 # (a, b, p) of a + b n^p; the exact formulation with its energy works (an energy output asked for), and

@@ -4,7 +4,7 @@ Window: blows ``transient_blows`` .. N of the run (N whole periods that fit), cu
 blocks of ``block_blows`` blows (a trailing partial block is dropped).
 Penetration rate = (x_n(end) - x_n(start)) / window length; its spread is the standard
 deviation of the block rates. Penetration per impact energy = (x_n(end) - x_n(start)) / W_impact
-over the window (= penetration rate / mean impact power; W_impact = int F_d v dt, models.energy,
+over the window (= penetration rate / mean impact power; W_impact = int F_d v dt, models.evaluation.energy,
 without the rest of the energy account). Only the metrics the scene's outputs ask for are computed.
 """
 

@@ -4,20 +4,20 @@ State y = [x (n bodies), v (n bodies), rock law states (, phi, omega)] of the pr
 simulation's chain and rock law:
 
     (x, v)' = A (x, v, 1) + (F_d(t) e_shank / m_shank) - F_rock e_bit / m_bit
-              + sum over nonlinear links of F_link (e_a - e_b) / m     (couplings, models.links)
+              + sum over nonlinear links of F_link (e_a - e_b) / m     (couplings, models.definition.links)
     state' = rates of the rock law's mode             (Jenkins: Eq. 2, x_n' = x_bit' while crushing)
     (phi, omega)' = T (phi, omega, 1)                 (Eq. 4, torsion line, if its effect is on)
 
-with A the chain's first-order matrix (models.chain: x' = v, M v' = -K x - C v + F_feed over the
+with A the chain's first-order matrix (models.drill.chain: x' = v, M v' = -K x - C v + F_feed over the
 linear links) and T its torsion matrix. F_rock is the law's closed-form ``force`` at (x_bit,
 x_bit', state) (Jenkins: Eq. 1 at d = x_bit - x_n), each nonlinear link's force its closed form.
 The laws are piecewise; the integration never steps over a switch. Each piece runs in one mode of
-every piecewise element (models.piecewise: the rock law and the nonlinear links, whose mode tables
+every piecewise element (models.drill.piecewise: the rock law and the nonlinear links, whose mode tables
 are the laws' own declarations) and stops at the first zero crossing of one of the current modes'
 exits; the next piece starts in the element's next mode from its entry state. The piston pulse's
-switch times (models.pulse.switch_times) are breakpoints: the run is integrated segment by segment
+switch times (models.drill.pulse.switch_times) are breakpoints: the run is integrated segment by segment
 between them, and the pulse is evaluated on the segment's own side of each switch. At a blow start
-the rock law's blow reset (models.indexing.BlowStarts: the state the blow meets) is applied to the
+the rock law's blow reset (models.drill.indexing.BlowStarts: the state the blow meets) is applied to the
 rock states when the law has one, and the rock's mode is found again.
 """
 
@@ -31,15 +31,15 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..rocklaw.backends import NUMERIC
-from .chain import link_load_n, torsion_first_order_matrix
-from .indexing import BlowStarts
-from .piecewise import Element, elements, rock_element, undeclared
-from .pulse import blow_start_times, impact_force, switch_times
-from .results import SimulationResult
-from .scene import Impact
+from ...rocklaw.backends import NUMERIC
+from ..definition.scene import Impact
+from ..drill.chain import link_load_n, torsion_first_order_matrix
+from ..drill.indexing import BlowStarts
+from ..drill.piecewise import Element, elements, rock_element, undeclared
+from ..drill.pulse import blow_start_times, impact_force, switch_times
+from ..evaluation.results import SimulationResult
+from ..evaluation.stability import SimulationFailed, diverged_index
 from .simulation import Scene, Simulation, as_simulation
-from .stability import SimulationFailed, diverged_index
 
 # Mode switches at one instant beyond this mean a law chatters: report instead of looping.
 MAX_SWITCHES_AT_ONE_TIME = 20
@@ -265,10 +265,10 @@ def _start_blow(system: _System, blows: BlowStarts, record: _Record, y: np.ndarr
 
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Integrate Eq. 4 from the simulation's start (rest or preloaded; the rock state consistent with
-    it) to its end time, with the scene's ODE settings (models.solver_settings: ``method``, a SciPy
+    it) to its end time, with the scene's ODE settings (models.evaluation.solver_settings: ``method``, a SciPy
     ``solve_ivp`` method, ``relative_tolerance``/``absolute_tolerance`` in the state's SI units). Every
     accepted step is stored, and the solver's dense output fills steps longer than
-    ``sample_interval_s``, so that the trapezoidal energy account (models.energy) balances."""
+    ``sample_interval_s``, so that the trapezoidal energy account (models.evaluation.energy) balances."""
     simulation = as_simulation(run)
     why = unsupported(simulation)
     if why:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..rocklaw.base import cumulative_trapezoid
+from ...rocklaw.base import cumulative_trapezoid
 from .results import SimulationResult
 
 

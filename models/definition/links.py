@@ -20,8 +20,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
-from ..rocklaw.backends import NUMERIC, Backend
-from ..rocklaw.modes import ONE, Mode, ModeTable, Switch
+from ...rocklaw.backends import NUMERIC, Backend
+from ...rocklaw.modes import ONE, Mode, ModeTable, Switch
 
 STRETCH, RATE = "stretch", "rate"  # a link's local variables in its mode table
 BONDED, OPEN, CLOSED, CLIPPED = "bonded", "open", "closed", "clipped"

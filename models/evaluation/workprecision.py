@@ -4,10 +4,10 @@ Formulation independent: a run is reduced to a :class:`Signature` (what the erro
 on) by :func:`signature`, and two signatures give the errors of :func:`errors`:
 
 * ``bottom_end_error_m`` / ``bottom_end_error_rel``: |x_n(end) - x_n,ref(end)| over the window,
-  absolute and relative to max(|x_n,ref(end)|, F_th / k_n) (the scale of models.compare: the
+  absolute and relative to max(|x_n,ref(end)|, F_th / k_n) (the scale of models.evaluation.compare: the
   crushing penetration keeps the figure meaningful when little is crushed);
 * ``penetration_rate_error_rel``: |r - r_ref| / |r_ref| of the mean penetration rate
-  (models.metrics, the scene's averaging window);
+  (models.evaluation.metrics, the scene's averaging window);
 * ``bit_velocity_rms_error_rel``: RMS over a uniform grid of [0, end] of the bit-velocity
   difference (each history linearly interpolated onto the grid), relative to the reference's range.
 

@@ -1,6 +1,6 @@
 """Stress waves in a segmented rod: arrival times and pulse shapes from a run's force histories.
 
-A rod of length L split into N lumped segments (models.chain) is a discrete wave-guide: its long
+A rod of length L split into N lumped segments (models.drill.chain) is a discrete wave-guide: its long
 waves travel at c = sqrt(E / rho) and its cut-off is omega_max = 2 c N / L, so a pulse of duration
 tau is carried faithfully once N >> L / (c tau). The travel time of a pulse from the struck end to
 the rock is measured between the instants the impact force and the rock force first reach half of

@@ -16,11 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..rocklaw import RockLaw
-from ..rocklaw.base import POSITION, VELOCITY
-from ..rocklaw.modes import ONE, Affine, ModeTable, Piecewise, evaluate, global_row
+from ...rocklaw import RockLaw
+from ...rocklaw.base import POSITION, VELOCITY
+from ...rocklaw.modes import ONE, Affine, ModeTable, Piecewise, evaluate, global_row
+from ..definition.links import RATE, STRETCH, Link
 from .chain import AxialChain
-from .links import RATE, STRETCH, Link
 
 
 @dataclass(frozen=True)

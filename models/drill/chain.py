@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..rocklaw import RockLaw
-from .links import LINK_TYPES, Link
-from .scene import EVERY_BODY, GROUND, Body, Connector, Scene, Torsion
+from ...rocklaw import RockLaw
+from ..definition.links import LINK_TYPES, Link
+from ..definition.scene import EVERY_BODY, GROUND, Body, Connector, Scene, Torsion
 
 
 @dataclass(frozen=True)

@@ -1,8 +1,8 @@
-"""The exact formulation's linear system (models.exact_model, its module doc): the augmented state's
+"""The exact formulation's linear system (models.solvers.exact_model, its module doc): the augmented state's
 layout, the generated matrix A of every (modes, phase) key with its exit rows, entry resets and power
 forms (:class:`Model`), LAPACK's balancing, and the sub-step h the balanced norms choose
 (:func:`sub_step`), and which scenes it cannot run (:func:`unsupported`). NumPy and LAPACK only, no
-compiled kernels: checking a study's points and estimating their cost (models.cost) need these, not
+compiled kernels: checking a study's points and estimating their cost (models.solvers.cost) need these, not
 the event loop, and do not load numba."""
 
 from __future__ import annotations
@@ -14,12 +14,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg.lapack import dgebal
 
-from ..rocklaw.base import VELOCITY
-from ..rocklaw.modes import Affine
-from .chain import torsion_first_order_matrix
-from .links import RATE
-from .piecewise import Element, elements, undeclared
-from .pulse import phase_generator, phase_row
+from ...rocklaw.base import VELOCITY
+from ...rocklaw.modes import Affine
+from ..definition.links import RATE
+from ..drill.chain import torsion_first_order_matrix
+from ..drill.piecewise import Element, elements, undeclared
+from ..drill.pulse import phase_generator, phase_row
 from .simulation import Simulation
 
 MAX_ENUMERATED_MODES = 256  # mode combinations whose norms are all measured to choose h

@@ -9,7 +9,7 @@ here; a key of another formulation is an error). Each implementation module is i
 use (the exact and ODE formulations never import Exudyn) and provides ``simulate(simulation,
 progress=None)`` (``progress(t)`` is called as simulated time advances) and, if it cannot run every
 scene, ``unsupported(simulation) -> str | None``, there or in a lighter ``checks`` module that the
-registry names (the exact formulation's, models.exact_system: a study checks its points before any
+registry names (the exact formulation's, models.solvers.exact_system: a study checks its points before any
 run without loading the compiled kernels).
 """
 
@@ -22,10 +22,10 @@ from types import ModuleType
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from .results import SimulationResult
-    from .simulation import Simulation
+    from ..evaluation.results import SimulationResult
+    from ..solvers.simulation import Simulation
 
-# accuracy tiers that every formulation resolves into its own settings (models.solver_settings)
+# accuracy tiers that every formulation resolves into its own settings (models.evaluation.solver_settings)
 PRESETS = ("fast", "standard", "reference")
 DEFAULT_PRESET = "standard"
 EXUDYN_SOLVERS = ("rk67", "rk44", "rk33", "explicit_midpoint", "explicit_euler", "generalized_alpha",
@@ -50,13 +50,13 @@ class Formulation:
 
 
 FORMULATIONS: dict[str, Formulation] = {f.name: f for f in (
-    Formulation("exudyn", ".exudyn_model",
+    Formulation("exudyn", "..solvers.exudyn_model",
                 ("type", "step_s", "spectral_radius", "relative_tolerance", "absolute_tolerance"),
                 "the Exudyn multibody model"),
-    Formulation("exact", ".exact_model",
+    Formulation("exact", "..solvers.exact_model",
                 ("sample_interval_s", "min_switch_interval_s", "max_switches_per_blow"),
-                "exact piecewise-linear propagation between located switches", checks=".exact_system"),
-    Formulation("ode", ".ode_model",
+                "exact piecewise-linear propagation between located switches", checks="..solvers.exact_system"),
+    Formulation("ode", "..solvers.ode_model",
                 ("method", "relative_tolerance", "absolute_tolerance", "sample_interval_s"),
                 "the paper's Eq. 4 as an event-located SciPy ODE"),
 )}

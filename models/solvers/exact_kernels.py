@@ -1,7 +1,7 @@
-"""Compiled event loop of the exact solver (models.exact_model): numba kernels on plain float arrays.
+"""Compiled event loop of the exact solver (models.solvers.exact_model): numba kernels on plain float arrays.
 
 The solution operators come from SciPy (``expm`` once per rock mode and pulse phase, in
-models.exact_model); these kernels only combine them. A batch of sub-grid points takes two matrix
+models.solvers.exact_model); these kernels only combine them. A batch of sub-grid points takes two matrix
 products (BLAS through ``np.dot``): the anchor states expm(A a B h) s0 (a < A), then the outputs
 R expm(A b h) of every point a B + b from its anchor, in chunks of CHUNK anchors up to the first
 crossing; R stacks the identity, the rock and piston force rows and the exit rows, so a point's
@@ -197,7 +197,7 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
                min_switch_interval_s: float, max_switches: int, bodies: int, position_limit_m: float,
                progress: np.ndarray, clock: np.ndarray, w: np.ndarray, time_out: np.ndarray, rows: np.ndarray,
                row_keys: np.ndarray, switch_times_s: np.ndarray, switch_modes: np.ndarray) -> int:
-    """The event loop of models.exact_model (its module doc), from pulse phase progress[0] on.
+    """The event loop of models.solvers.exact_model (its module doc), from pulse phase progress[0] on.
 
     Per key (rock mode, pulse phase), with R = (I_m, rock row, piston row, exit rows c_e, their slope
     rows c_e A), r rows, and
@@ -411,7 +411,7 @@ def assemble(one_step: np.ndarray, matrix: np.ndarray, readout_rows: np.ndarray,
 def power_integrals(one_step: np.ndarray, balanced: np.ndarray, scale: np.ndarray, forms: np.ndarray, step_s: float,
                     step_powers: np.ndarray, step_grams: np.ndarray, series: np.ndarray) -> None:
     """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of one key's power forms Q_q (power w^T Q w,
-    models.exact_system.Model.power_forms): ``step_powers`` [j] = E^j (E = expm(A h), j <= p, the sub-steps
+    models.solvers.exact_system.Model.power_forms): ``step_powers`` [j] = E^j (E = expm(A h), j <= p, the sub-steps
     of a sample); ``series`` [q, k] = S_k / (k + 1), the integrand's Taylor coefficients S_0 = Q,
     S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on the balanced matrix
     A_b = D^-1 A D (S_k = D^-1 S_k,b(D Q D) D^-1), so that G(s) = sum_k s^(k+1) series[q, k] for s <= h (the

@@ -8,7 +8,7 @@ a preset and without explicit accuracy options the ``standard`` preset applies.
   1/|lambda|_max (the stiffest or fastest mode: stability), a smaller multiple of 1/|lambda| of the
   fastest mode still ringing at the next blow (accuracy where errors add up blow by blow) and, for
   the presets that resolve it, a share of m_bit / c_n (the rock damper's force jump at contact:
-  models.stability.StepScales); explicit ``type`` or ``step_s`` win (a step or tolerances without a
+  models.evaluation.stability.StepScales); explicit ``type`` or ``step_s`` win (a step or tolerances without a
   preset and without a type: RK44). The stated errors (penetration rate relative to the exact
   formulation, energy balance relative to the impact work) are the largest measured on the hard
   scenes of tests/stability, rounded up (docs/stability.md); the suite checks them.
@@ -24,8 +24,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .formulations import DEFAULT_PRESET
-from .scene import Solver
+from ..definition.formulations import DEFAULT_PRESET
+from ..definition.scene import Solver
 from .stability import StepScales
 
 

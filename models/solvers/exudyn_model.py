@@ -2,7 +2,7 @@
 
 Every axial body is a ``Node1D`` + ``ObjectMass1D``; every link of the chain an
 ``ObjectConnectorCoordinateSpringDamper``; the feed a constant ``LoadCoordinate`` per body; the
-piston a ``LoadCoordinate`` with a symbolic load function (models.pulse); the rock the
+piston a ``LoadCoordinate`` with a symbolic load function (models.drill.pulse); the rock the
 :class:`rocklaw.exudyn_element.ExudynRockContact` on the bit. Torsion, when its effect is on, is
 a ``Node1D`` + ``ObjectRotationalMass1D`` with its own spring-damper to ground and a constant
 torque. Only what the scene's effects and outputs need is built: no torsion node, no rock
@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled module
+from ...rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled module
 
 # isort: split
 from exudyn.itemInterface import (
@@ -38,16 +38,16 @@ from exudyn.itemInterface import (
     SensorObject,
 )
 
-from ..rocklaw.backends import SCALAR, SymbolicBackend
-from ..rocklaw.exudyn_element import ExudynRockContact, attach_user_function
-from .chain import AxialChain, Link
-from .formulations import AUTOMATIC_STEP_SOLVERS
-from .indexing import BlowStarts
-from .pulse import impact_force
-from .results import SimulationResult
-from .scene import Scene
+from ...rocklaw.backends import SCALAR, SymbolicBackend
+from ...rocklaw.exudyn_element import ExudynRockContact, attach_user_function
+from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
+from ..definition.scene import Scene
+from ..drill.chain import AxialChain, Link
+from ..drill.indexing import BlowStarts
+from ..drill.pulse import impact_force
+from ..evaluation.results import SimulationResult
+from ..evaluation.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
 from .simulation import Simulation, as_simulation
-from .stability import SimulationFailed, StepLimitWarning, check_result, step_warning
 
 SOLVER_TYPES = {
     "rk67": exu.DynamicSolverType.RK67,
@@ -76,7 +76,7 @@ class ExudynDrill:
     sensors: dict[str, Any]
     settings: Any
     symbolic_functions: list[Any] = field(default_factory=list)  # kept alive with the system
-    blows: BlowStarts | None = None  # the blow starts of this run (models.indexing)
+    blows: BlowStarts | None = None  # the blow starts of this run (models.drill.indexing)
 
     @property
     def coordinate_count(self) -> int:

@@ -17,15 +17,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.linalg import block_diag
 
-from ..rocklaw import RockLaw
-from .chain import AxialChain, torsion_first_order_matrix
+from ...rocklaw import RockLaw
+from ..definition.scene import Scene, Torsion
+from ..drill.chain import AxialChain, torsion_first_order_matrix
+from ..drill.pulse import impulse_per_blow_n_s
 from .energy import energy_account
-from .pulse import impulse_per_blow_n_s
-from .scene import Scene, Torsion
 
 if TYPE_CHECKING:
+    from ..solvers.simulation import Simulation
     from .results import SimulationResult
-    from .simulation import Simulation
 
 # Positions beyond this are not drilling: the solver has blown up (states near 1e300 seen with
 # explicit solvers at too large a step, reported as success by the solver).
@@ -74,7 +74,7 @@ def spectral_radius_per_s(chain: AxialChain, law: RockLaw, torsion: Torsion | No
 
 @dataclass(frozen=True)
 class StepScales:
-    """The rates, in 1/s, a fixed explicit step must resolve (models.solver_settings):
+    """The rates, in 1/s, a fixed explicit step must resolve (models.evaluation.solver_settings):
 
     * ``spectral_radius_per_s``: |lambda|_max, for stability;
     * ``ringing_radius_per_s``: the largest |lambda| of the modes that still ring when the next blow

@@ -60,7 +60,7 @@ def compare_bottom_at(reference: SimulationResult, other: SimulationResult, at_s
 
 
 def compare_metrics(reference: SimulationResult, other: SimulationResult) -> dict[str, dict[str, float]]:
-    """Each summary metric (models.metrics) of both runs and the absolute and relative difference."""
+    """Each summary metric (models.evaluation.metrics) of both runs and the absolute and relative difference."""
     r_metrics, a_metrics = summary_metrics(reference), summary_metrics(other)
     out = {}
     for name, r in r_metrics.items():
