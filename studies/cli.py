@@ -22,6 +22,7 @@ import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
+from ..rocklaw.exudyn_build import use_fast_build
 from .interrupts import Terminated, raise_if_stopped, stops_handled
 from .runners import start_worker_server
 
@@ -121,9 +122,12 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def console() -> None:
-    """The ``rpdrill`` program: :func:`main`, then exit with its status. What the command leaves is
-    frozen first (``gc.freeze``): the interpreter's exit then skips its last collection over every
-    object of the loaded libraries (SciPy, matplotlib, numba: 0.2 s). Tests call :func:`main`."""
+    """The ``rpdrill`` program: :func:`main`, then exit with its status. The program and its workers load
+    Exudyn's build without range checks (rocklaw.exudyn_module: a process rpdrill owns; a user's process
+    that imports rpdrill does not). What the command leaves is frozen first (``gc.freeze``): the
+    interpreter's exit then skips its last collection over every object of the loaded libraries (SciPy,
+    matplotlib, numba: 0.2 s). Tests call :func:`main`."""
+    use_fast_build()  # before anything imports Exudyn; the workers inherit it (rocklaw.exudyn_build)
     status = main()
     gc.freeze()
     sys.exit(status)
