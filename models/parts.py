@@ -19,8 +19,8 @@ def link_series(chain: AxialChain, position_m: np.ndarray, velocity_m_per_s: np.
     positions, velocities = position_m.T, velocity_m_per_s.T
     for link in chain.links:
         stretch, rate = link.stretch(positions), link.stretch(velocities)
-        out[f"{link.name}_force_n"] = -np.broadcast_to(link.force_n(stretch, rate), stretch.shape)
-        out[f"{link.name}_compression_m"] = -stretch
+        out[f"{link.name}_force_n"] = 0.0 - np.broadcast_to(link.force_n(stretch, rate), stretch.shape)  # no -0
+        out[f"{link.name}_compression_m"] = 0.0 - stretch
         if hasattr(link, "gap_opening_m"):
             out[f"{link.name}_gap_opening_m"] = link.gap_opening_m(stretch)
     return out

@@ -181,7 +181,8 @@ def test_exudyn_fast_module_only_where_rpdrill_owns_the_process_quietly_and_agre
     assert lines == lines[-1:], lines  # only the probe's own line
     assert fast["fast"] is avx2 and fast["loaded"][0] == ("exudyn.exudynCPPfast" if avx2 else "exudyn.exudynCPP")
     _, regular = _probe({})
-    assert regular["fast"] is False and regular["loaded"] == ["exudyn.exudynCPP"]
+    assert regular["fast"] is False and regular["loaded"][0] == "exudyn.exudynCPP"
+    assert not any(name.startswith("exudyn.exudynCPPfast") for name in regular["loaded"])
     assert fast["rate"] > 0 and abs(fast["rate"] - regular["rate"]) <= 1e-12 * abs(regular["rate"])
 
 
@@ -213,7 +214,8 @@ def test_importing_rpdrill_leaves_a_users_exudyn_the_regular_build():
     env = {k: v for k, v in os.environ.items() if k != "EXUDYN_MODULE"}
     user = json.loads(subprocess.run([sys.executable, "-c", USER_PROCESS], env=env, check=True, capture_output=True,
                                      text=True).stdout.splitlines()[-1])
-    assert user["before"] == [] and user["loaded"] == ["exudyn.exudynCPP"], user
+    assert user["before"] == [] and user["loaded"][0] == "exudyn.exudynCPP", user
+    assert not any(name.startswith("exudyn.exudynCPPfast") for name in user["loaded"]), user
     owned = json.loads(subprocess.run([sys.executable, "-c", OWNED_PROCESS], env=env, check=True, capture_output=True,
                                       text=True).stdout.splitlines()[-1])
-    assert owned["loaded"] == ["exudyn.exudynCPPfast" if _has_avx2() else "exudyn.exudynCPP"]
+    assert owned["loaded"][0] == ("exudyn.exudynCPPfast" if _has_avx2() else "exudyn.exudynCPP")
