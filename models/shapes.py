@@ -6,7 +6,8 @@ other body is a solid cylinder of its ``diameter_m`` (a rigid body may state one
 as that mass of its density (steel unless given) makes it: L = m / (rho pi D^2 / 4). The shapes do
 not enter the dynamics (the chain's masses and stiffnesses do).
 
-At rest the bodies follow one another along +x (into the rock) in the scene's order, a rod's
+At rest the bodies follow one another along +x (into the rock) from the hammer to the rock
+(:func:`axial_order`: along the connectors, whatever order a file lists them in), a rod's
 segments end to end, other neighbours :attr:`Layout.joint_gap_m` apart (room to draw the connector
 between them); the rock face is at the far end of the rock body.
 """
@@ -67,18 +68,35 @@ def body_size_m(body: Body) -> tuple[float, float, float]:
     return body.total_mass_kg / (body.density_kg_per_m3 * math.pi * diameter**2 / 4), diameter, 0.0
 
 
+def axial_order(scene: Scene) -> list[str]:
+    """The scene's bodies from the hammer to the rock: every connector's ``from`` before its ``to`` (the
+    scene's order where the connectors leave it open), whatever order the file lists them in."""
+    names = list(scene.drill_string.bodies)
+    before = {name: set() for name in names}
+    for connector in scene.drill_string.connectors.values():
+        if connector.from_body in before:
+            before[connector.to_body].add(connector.from_body)
+    order: list[str] = []
+    while len(order) < len(names):
+        ready = next(name for name in names if name not in order and before[name] <= set(order))
+        order.append(ready)
+    return order
+
+
 def layout(scene: Scene) -> Layout:
-    """The cylinders of ``scene``'s drill string at rest (module doc)."""
+    """The cylinders of ``scene``'s drill string at rest, in chain order (module doc)."""
     bodies = scene.drill_string.bodies
     sizes = {name: body_size_m(body) for name, body in bodies.items()}
     gap = max(diameter for _, diameter, _ in sizes.values())
-    cylinders, x = [], 0.0
-    for name, body in bodies.items():
+    placed: dict[str, list[Cylinder]] = {}
+    x = 0.0
+    for name in axial_order(scene):
         length, diameter, bore = sizes[name]
-        n = body.segments
+        n = bodies[name].segments
+        placed[name] = []
         for i in range(n):
-            cylinders.append(Cylinder(name if n == 1 else f"{name}[{i}]", name, x, length / n, diameter, bore))
+            placed[name].append(Cylinder(name if n == 1 else f"{name}[{i}]", name, x, length / n, diameter, bore))
             x += length / n
         x += gap
-    rock_body = [c for c in cylinders if c.group == scene.drill_string.rock_body][-1]
-    return Layout(tuple(cylinders), gap, rock_body.end_m)
+    cylinders = tuple(cylinder for name in bodies for cylinder in placed[name])  # the chain's order
+    return Layout(cylinders, gap, placed[scene.drill_string.rock_body][-1].end_m)

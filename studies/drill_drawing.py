@@ -24,7 +24,7 @@ from matplotlib.patches import FancyArrowPatch, Rectangle
 
 from ..models.links import Link
 from ..models.scene import EVERY_BODY, GROUND, Scene
-from ..models.shapes import DEFAULT_DIAMETER_M, Layout, layout
+from ..models.shapes import DEFAULT_DIAMETER_M, Layout, axial_order, layout
 from .plots.style import OKABE_ITO, plt
 
 BREAK_SHARE = 0.35  # the most of the drawing's length one body takes; longer ones are drawn shortened
@@ -62,7 +62,11 @@ class DrawnLayout:
 
     @property
     def start(self) -> float:
-        return self.bodies[0].start
+        return min(b.start for b in self.bodies)
+
+    @property
+    def end(self) -> float:
+        return max(b.end for b in self.bodies)
 
 
 def _group_lengths(shapes: Layout) -> dict[str, float]:
@@ -87,17 +91,17 @@ def drawn_layout(scene: Scene) -> DrawnLayout:
     total = sum(drawn.values())
     gap = GAP_SHARE * total
     widest = max(c.diameter_m for c in shapes.cylinders)
-    bodies, x, previous = [], 0.0, None
-    for cylinder in shapes.cylinders:
-        if previous is not None and cylinder.group != previous:
-            x += gap
-        scale = drawn[cylinder.group] / lengths[cylinder.group]
-        bodies.append(DrawnBody(cylinder.name, cylinder.group, x, cylinder.length_m * scale,
-                                BODY_HEIGHT * cylinder.diameter_m / widest, scale < 1 - 1e-9))
-        x += cylinder.length_m * scale
-        previous = cylinder.group
-    rock_body = [b for b in bodies if b.group == scene.drill_string.rock_body][-1]
-    return DrawnLayout(tuple(bodies), gap, rock_body.end, shapes)
+    placed: dict[str, DrawnBody] = {}
+    x = 0.0
+    for group in axial_order(scene):
+        scale = drawn[group] / lengths[group]
+        for cylinder in (c for c in shapes.cylinders if c.group == group):
+            placed[cylinder.name] = DrawnBody(cylinder.name, group, x, cylinder.length_m * scale,
+                                              BODY_HEIGHT * cylinder.diameter_m / widest, scale < 1 - 1e-9)
+            x += cylinder.length_m * scale
+        x += gap
+    rock_body = [b for b in placed.values() if b.group == scene.drill_string.rock_body][-1]
+    return DrawnLayout(tuple(placed[c.name] for c in shapes.cylinders), gap, rock_body.end, shapes)
 
 
 def _zigzag(x0: float, x1: float, y: float, amplitude: float, turns: int = 5) -> tuple[np.ndarray, np.ndarray]:
@@ -205,11 +209,11 @@ def draw_string(ax: Axes, scene: Scene, drawing: DrawnLayout | None = None, offs
         if body.broken:  # a break mark across the middle
             middle, h = body.start + 0.5 * body.length, 0.5 * body.height
             for dx in (-0.01, 0.01):
-                shift = dx * moved.bodies[-1].end
+                shift = dx * drawing.end
                 ax.plot([middle + shift - 0.15 * h, middle + shift + 0.15 * h], [-1.3 * h, 1.3 * h],
                         color="0.2", lw=1.2, zorder=4)
-            ax.add_patch(Rectangle((middle - 0.01 * moved.bodies[-1].end, -0.5 * body.height),
-                                   0.02 * moved.bodies[-1].end, body.height, facecolor="white", edgecolor="none",
+            ax.add_patch(Rectangle((middle - 0.01 * drawing.end, -0.5 * body.height),
+                                   0.02 * drawing.end, body.height, facecolor="white", edgecolor="none",
                                    zorder=3))
     # the rock: a hatched block from the rock face (a connector's gap deep on the drawing)
     depth = 2.5 * drawing.gap
