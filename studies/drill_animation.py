@@ -17,15 +17,21 @@ from __future__ import annotations
 
 import math
 import shutil
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 
 from ..models.results import SimulationResult
+from ..models.simulation import Simulation
 from .drill_drawing import BODY_HEIGHT, draw_string, drawn_layout, figure_title
 from .loading import load_scene
 from .plots.style import plt
+
+if TYPE_CHECKING:
+    from ..models.exudyn_model import ExudynModel
 
 SOLUTION_FILE = "solution.txt"
 RESOLVED_SCENE = "scene.resolved.yaml"
@@ -86,13 +92,34 @@ def write_animation(result: SimulationResult, path: str | Path, blows: int = 3,
     return factor
 
 
-def view_solution(run_dir: str | Path) -> None:
-    """Play a run folder's ``solution.txt`` on its scene's Exudyn model in Exudyn's SolutionViewer (module doc)."""
-    import exudyn.interactive
+def run_with_solution(simulation: Simulation, progress: Callable[[float], None] | None = None,
+                      solution: Path | None = None) -> SimulationResult:
+    """Run ``simulation``; with ``solution`` and the Exudyn formulation, write Exudyn's coordinates solution
+    file there during the run (every output interval). The other formulations write none."""
+    if solution is None or simulation.settings.formulation != "exudyn":
+        return simulation.run(progress)
+    from ..models.exudyn_model import build_exudyn
+
+    model = build_exudyn(simulation)
+    model.write_solution(solution)
+    return model.run(progress)
+
+
+def load_solution(run_dir: str | Path) -> tuple[ExudynModel, dict]:
+    """The run folder's scene rebuilt as an Exudyn model and its solution file as Exudyn reads it."""
     from exudyn.utilities import LoadSolutionFile
 
     from ..models.exudyn_model import build_exudyn
 
     run_dir = Path(run_dir)
     model = build_exudyn(load_scene(run_dir / RESOLVED_SCENE))
-    exudyn.interactive.SolutionViewer(model.mbs, LoadSolutionFile(str(run_dir / SOLUTION_FILE), verbose=False))
+    return model, LoadSolutionFile(str(run_dir / SOLUTION_FILE), verbose=False)
+
+
+def view_solution(run_dir: str | Path) -> None:
+    """Play a run folder's ``solution.txt`` on its scene's Exudyn model in Exudyn's SolutionViewer (module doc;
+    it needs a display: without one Exudyn's renderer aborts the process)."""
+    import exudyn.interactive
+
+    model, solution = load_solution(run_dir)
+    exudyn.interactive.SolutionViewer(model.mbs, solution)

@@ -1,7 +1,9 @@
 """Run one scene: time histories, summary figures and a plot.
 
-Writes DIR/timeseries.csv, DIR/summary.json, DIR/scene.resolved.yaml and DIR/timeseries.png (and
-.svg): the whole run beside its last blows. DIR must be new or empty (``--overwrite``: write over
+Writes DIR/timeseries.csv, DIR/summary.json, DIR/scene.resolved.yaml, DIR/timeseries.png (and
+.svg): the whole run beside its last blows, and DIR/drill.png: the drill string (studies.drill_drawing).
+``--animate``: DIR/drill.gif, the last blows magnified, and for the Exudyn formulation Exudyn's
+solution file DIR/solution.txt (studies.drill_animation.view_solution opens it in Exudyn's SolutionViewer). DIR must be new or empty (``--overwrite``: write over
 what it holds). The run's steps and memory are checked against the budgets (studies.budgets)
 before it starts.
 """
@@ -10,12 +12,16 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
+from pathlib import Path
 
 from ...models.cost import Cause
 from ...models.formulations import FORMULATIONS
 from ...models.metrics import summary_metrics
 from ...models.stability import SimulationFailed
 from ..catalogue import metric
+from ..drill_animation import SOLUTION_FILE, run_with_solution, write_animation
+from ..drill_drawing import draw
 from . import add_budget_arguments, budget
 from ..interrupts import raise_if_stopped
 from ..loading import load_scene, prepare_scene
@@ -41,6 +47,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="run with this formulation (default: the scene's solver.formulation; the scene's "
                              "options of another formulation are dropped)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--animate", action="store_true",
+                        help="also drill.gif (the last blows, displacements magnified) and, with the exudyn formulation, "
+                             "Exudyn's solution file solution.txt for its SolutionViewer")
     add_budget_arguments(parser, many_runs=False)
 
 
@@ -52,8 +61,11 @@ def run(args: argparse.Namespace) -> int:
     simulation = prepare_scene(scene, args.scene)
     budget(args).check_run(simulation, args.scene, resampled=Cause("solver.output_interval_s", scene.solver.output_interval_s))
     try:
-        with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
-            result = simulation.run(progress)
+        with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress, \
+                tempfile.TemporaryDirectory() as scratch:
+            solution = Path(scratch) / SOLUTION_FILE if args.animate else None
+            result = run_with_solution(simulation, progress, solution)
+            solution = solution.read_bytes() if solution is not None and solution.exists() else None
     except SimulationFailed as err:
         raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
         print(f"{args.scene}: {err}", file=sys.stderr)
@@ -66,7 +78,15 @@ def run(args: argparse.Namespace) -> int:
                                             "metrics": summary, "run": result.info})
         write_resolved(stage / "scene.resolved.yaml", simulation.resolved_scene())
         plot_timeseries(columns, scene, stage / "timeseries.png")
+        draw(scene, stage / "drill.png")
+        if args.animate:
+            write_animation(result, stage / "drill.gif")
+        if solution is not None:
+            (stage / SOLUTION_FILE).write_bytes(solution)
     shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}" for name, value in summary.items()
                       if name in HEADLINE)
     print(f"{scene.name} ({result.formulation}): {shown}; wrote {args.out}")
+    if solution is not None:
+        print(f"Exudyn's viewer: python -c \"from rpdrill.studies.drill_animation import view_solution; "
+              f"view_solution('{args.out}')\"")
     return 0
