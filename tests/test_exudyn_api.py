@@ -93,6 +93,9 @@ def test_every_body_is_drawn_to_scale_and_every_connector_drawn():
     assert len(bodies) == model.chain.size and all(item["VgraphicsData"] for item in bodies)
     drawn = model.graphics.links(np.zeros(model.chain.size))
     assert set(drawn) == set(model.connectors) and all(drawn.values())
+    ground = [mbs.GetObject(i) for i in range(mbs.systemData.NumberOfObjects())]
+    assert any(item["objectType"] == "Ground" and item["VgraphicsDataUserFunction"] != 0 for item in ground)
+    assert len(model.graphics(mbs, 0)) == len(model.connectors)  # what the renderer calls: one spring a link
     shapes = layout(s)
     assert shapes["rod1[0]"].length_m == pytest.approx(3.66 / 4) and shapes["rod1[0]"].diameter_m == 0.045
     bit = s.drill_string.bodies["bit"].mass_kg  # a rigid body: a steel cylinder of the default diameter
