@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/bench_presets.py [--repeats N] [--presets fast,standard,reference] [--front [--sweeps S,...] | --modules]
 With ``--modules``: each preset's CPU seconds per simulated second on the paper scene with Exudyn's
-regular compiled module (``EXUDYN_MODULE=regular``) and with the fast one rpdrill loads
+regular compiled module (``EXUDYN_MODULE=regular``) and with the fast one the rpdrill command loads
 (rocklaw.exudyn_module), each in its own child process, alternated three times; the medians, their
 ratio and the largest relative difference of the penetration rate between the two.
 With ``--front``: the work-precision fronts the presets are picked from, one per bound of their step
@@ -160,8 +160,7 @@ def modules(presets: list[str], repeats: int, rounds: int = 3) -> None:
     for _ in range(rounds):
         for module, runs in measured.items():
             environment = {k: v for k, v in os.environ.items() if k != "EXUDYN_MODULE"}
-            if module == "regular":
-                environment["EXUDYN_MODULE"] = "regular"
+            environment["EXUDYN_MODULE"] = module  # "fast": as the rpdrill command runs (rocklaw.exudyn_build)
             child = subprocess.run([sys.executable, __file__, "--presets", ",".join(presets), "--repeats",
                                     str(repeats), "--one-module"], env=environment, check=True,
                                    capture_output=True, text=True)

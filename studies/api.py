@@ -56,10 +56,13 @@ class Result:
     def formulation(self) -> str:
         return self.raw.formulation
 
-    def save(self, folder: str | Path) -> list[Path]:
+    def save(self, folder: str | Path, animate: bool = False) -> list[Path]:
         """What ``rpdrill simulate`` writes into ``folder`` (made if missing): ``timeseries.csv``,
-        ``summary.json``, ``scene.resolved.yaml`` and the ``timeseries.png``/``.svg`` figure."""
-        from .figures.timeseries_figure import plot_timeseries  # matplotlib only when saving
+        ``summary.json``, ``scene.resolved.yaml``, the ``timeseries.png``/``.svg`` figure, the drawing
+        of the drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified."""
+        from .figures.drill_animation import write_animation  # matplotlib only when saving
+        from .figures.drill_drawing import draw
+        from .figures.timeseries_figure import plot_timeseries
 
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
@@ -69,7 +72,11 @@ class Result:
                                              "metrics": self.metrics, "run": self.raw.info,
                                              "provenance": self.provenance})
         write_resolved(folder / "scene.resolved.yaml", self.raw.simulation.resolved_scene())
-        figures = plot_timeseries(columns, self.scene, folder / "timeseries.png")
+        figures = [*plot_timeseries(columns, self.scene, folder / "timeseries.png"),
+                   draw(self.scene, folder / "drill.png")]
+        if animate:
+            write_animation(self.raw, folder / "drill.gif")
+            figures.append(folder / "drill.gif")
         return [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml", *figures]
 
 
@@ -81,11 +88,16 @@ def _scene(scene: Scene | str | Path) -> tuple[Scene, str]:
 
 
 def simulate(scene: Scene | str | Path, formulation: str | None = None,
-             progress: Callable[[float], None] | None = None, budget: Budget | None = DEFAULT_BUDGET) -> Result:
+             progress: Callable[[float], None] | None = None, budget: Budget | None = DEFAULT_BUDGET,
+             solution_file: Path | None = None) -> Result:
     """Run a scene (or a scene file) with its formulation, or ``formulation`` (``exudyn``, ``exact``,
     ``ode``; the scene's options of another formulation dropped). InputError when it cannot run as
     given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
-    it starts; models.evaluation.stability.SimulationFailed when the run diverges."""
+    it starts; models.evaluation.stability.SimulationFailed when the run diverges. ``solution_file``:
+    with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
+    (for its SolutionViewer: studies.figures.drill_animation.view_solution)."""
+    from .figures.drill_animation import run_with_solution
+
     scene, source = _scene(scene)
     if formulation is not None:
         scene = scene.with_solver(formulation)
@@ -93,7 +105,7 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     if budget is not None:
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
-    raw = simulation.run(progress)
+    raw = run_with_solution(simulation, progress, solution_file)
     return Result(scene, raw, summary_metrics(raw), {"source": source, "formulation": raw.formulation})
 
 

@@ -25,7 +25,7 @@ def test_simulate_writes_all_outputs(tmp_path):
     out = tmp_path / "out"
     assert main(["simulate", str(path), "--out", str(out), "--quiet"]) == 0
     assert {p.name for p in out.iterdir()} == {"timeseries.csv", "summary.json", "scene.resolved.yaml",
-                                              "timeseries.png", "timeseries.svg"}
+                                              "timeseries.png", "timeseries.svg", "drill.png"}
     header = (out / "timeseries.csv").read_text().splitlines()[0].split(",")
     assert header[0] == "time_s" and "bit_velocity_m_per_s" in header and "rock_force_n" in header
     assert len((out / "timeseries.csv").read_text().splitlines()) == 1 + 1001  # 0.1 s every 1e-4 s

@@ -166,15 +166,56 @@ def _probe(environment: dict[str, str]) -> tuple[list[str], dict]:
     return lines, json.loads(lines[-1])
 
 
-def test_exudyn_fast_module_is_loaded_quietly_and_agrees_with_the_regular_one():
-    """rocklaw.exudyn_module: the build without range checks where the CPU has AVX2 (Exudyn's own
-    condition), nothing printed on standard output; EXUDYN_MODULE=regular keeps the regular module, and
-    the two give the same penetration rate to round-off."""
+def _has_avx2() -> bool:
     with open("/proc/cpuinfo", encoding="utf-8") as info:
-        avx2 = any(line.startswith("flags") and "avx2" in line.split() for line in info)
-    lines, fast = _probe({})
+        return any(line.startswith("flags") and "avx2" in line.split() for line in info)
+
+
+def test_exudyn_fast_module_only_where_rpdrill_owns_the_process_quietly_and_agreeing():
+    """rocklaw.exudyn_module: importing rpdrill loads Exudyn's regular build; a process that opted in
+    (the command line: use_fast_build, inherited as EXUDYN_MODULE=fast) the build without range checks where
+    the CPU has AVX2 (Exudyn's own condition), nothing printed on standard output; the two give the same
+    penetration rate to round-off."""
+    avx2 = _has_avx2()
+    lines, fast = _probe({"EXUDYN_MODULE": "fast"})
     assert lines == lines[-1:], lines  # only the probe's own line
     assert fast["fast"] is avx2 and fast["loaded"][0] == ("exudyn.exudynCPPfast" if avx2 else "exudyn.exudynCPP")
-    _, regular = _probe({"EXUDYN_MODULE": "regular"})
+    _, regular = _probe({})
     assert regular["fast"] is False and regular["loaded"][0] == "exudyn.exudynCPP"
+    assert not any(name.startswith("exudyn.exudynCPPfast") for name in regular["loaded"])
     assert fast["rate"] > 0 and abs(fast["rate"] - regular["rate"]) <= 1e-12 * abs(regular["rate"])
+
+
+USER_PROCESS = """
+import json, sys
+import rpdrill.studies.cli  # the command line's module imports no Exudyn: its entry point can still choose
+before = sorted(m for m in sys.modules if m.split(".")[0] == "exudyn")
+import rpdrill.models.solvers.exudyn_model
+import exudyn
+print(json.dumps({"before": before, "file": exudyn.__file__,
+                  "loaded": sorted(m for m in sys.modules if m.startswith("exudyn.exudynCPP"))}))
+"""
+
+OWNED_PROCESS = """
+import json, sys
+from rpdrill.rocklaw.exudyn_build import use_fast_build
+use_fast_build()
+import rpdrill.models.solvers.exudyn_model
+print(json.dumps({"loaded": sorted(m for m in sys.modules if m.startswith("exudyn.exudynCPP"))}))
+"""
+
+
+def test_importing_rpdrill_leaves_a_users_exudyn_the_regular_build():
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "EXUDYN_MODULE"}
+    user = json.loads(subprocess.run([sys.executable, "-c", USER_PROCESS], env=env, check=True, capture_output=True,
+                                     text=True).stdout.splitlines()[-1])
+    assert user["before"] == [] and user["loaded"][0] == "exudyn.exudynCPP", user
+    assert not any(name.startswith("exudyn.exudynCPPfast") for name in user["loaded"]), user
+    owned = json.loads(subprocess.run([sys.executable, "-c", OWNED_PROCESS], env=env, check=True, capture_output=True,
+                                      text=True).stdout.splitlines()[-1])
+    assert owned["loaded"][0] == ("exudyn.exudynCPPfast" if _has_avx2() else "exudyn.exudynCPP")

@@ -84,6 +84,10 @@ class Coupling(Link):
         total = backend.minimum(self.stiffness_n_per_m * closure + self.damping_n_s_per_m * rate_m_per_s, 0.0)
         return backend.where(closure < 0, total, 0.0)
 
+    def gap_opening_m(self, stretch_m: Any, backend: Backend = NUMERIC) -> Any:
+        """The open gap, delta + g while positive (0 once it has closed)."""
+        return backend.maximum(stretch_m + self.gap_m, 0.0)
+
     def modes(self) -> ModeTable:
         """open (F = 0) until the closure delta + g falls through 0; closed, F = k (delta + g) + c delta',
         until it rises through 0 again or F rises through 0 (the damper would pull: clipped, F = 0)."""

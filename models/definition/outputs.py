@@ -1,7 +1,7 @@
 """The outputs a scene can ask for, and what each needs built.
 
 Each metric and time history names the effects it depends on (``torsion``, ``rock_plasticity``),
-the bodies of the drill string it reads (``collar``) and the data it needs recorded: ``forces`` (rock and impact force sensors) or ``energy``
+the bodies of the drill string it reads (``collar``; any body's ``<body>_velocity_peak_m_per_s``) and the data it needs recorded: ``forces`` (rock and impact force sensors) or ``energy``
 (the works integrated: Exudyn stores every solver step, the exact formulation integrates them from
 its propagators). Asking for an output pulls in
 what it needs; asking for nothing more builds nothing more.
@@ -65,7 +65,35 @@ SERIES: dict[str, Need] = {
 }
 
 
+# Outputs of one part, named "<part><suffix>". Metrics of any body of the drill string by name (a rod's
+# name: its last segment; a segment by its own name, ``rod[0]``): ``collar_velocity_peak_m_per_s`` above is one.
+BODY_METRICS: dict[str, Need] = {"_velocity_peak_m_per_s": PLAIN, "_velocity_rms_m_per_s": PLAIN}
+# Histories every link of the chain (the scene's connectors, a rod's inner links ``rod[0-1]``) always has, from
+# the bodies' positions and velocities (models.evaluation.parts): its force, positive in compression, and its compression
+# x_a - x_b (ground: x = 0); a coupling also the opening of its gap.
+LINK_SERIES = ("_force_n", "_compression_m")
+COUPLING_SERIES = ("_gap_opening_m",)
+
+
+def body_metric(name: str) -> tuple[str, str] | None:
+    """(body, suffix) of a per-body metric name (BODY_METRICS), None for another name."""
+    for suffix in BODY_METRICS:
+        if name.endswith(suffix) and len(name) > len(suffix):
+            return name.removesuffix(suffix), suffix
+    return None
+
+
+def metric_need(name: str) -> Need:
+    """What the metric ``name`` needs (KeyError for an unknown name)."""
+    if name in METRICS:
+        return METRICS[name]
+    part = body_metric(name)
+    if part is None:
+        raise KeyError(name)
+    return Need(BODY_METRICS[part[1]].effects, BODY_METRICS[part[1]].data, frozenset({part[0]}))
+
+
 def needs(metrics: list[str], series: list[str]) -> Need:
     """Union of what the requested outputs need."""
-    wanted = [METRICS[m] for m in metrics] + [SERIES[s] for s in series]
+    wanted = [metric_need(m) for m in metrics] + [SERIES[s] for s in series]
     return Need(*(frozenset().union(*(getattr(w, part) for w in wanted)) for part in ("effects", "data", "bodies")))

@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, field_validator, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
 from ...rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
@@ -28,7 +28,7 @@ from .formulations import (
     PRESETS,
 )
 from .links import LINK_TYPES
-from .outputs import METRICS, SERIES, Need, needs
+from .outputs import BODY_METRICS, LINK_SERIES, METRICS, SERIES, Need, body_metric, metric_need, needs
 from .validation import with_changes
 
 Positive = Annotated[float, Field(gt=0)]
@@ -77,7 +77,8 @@ class Body(Strict):
     joining it gets the series stiffness of the two half-rods it joins, 1/k = sum L_i / (2 E_i A_i)
     (two identical rods: k = E A / L). ``segments`` > 1 splits the rod into that many equal lumped
     masses joined by springs E A N / L (a discrete wave-guide, docs/extending.md). A pipe given by
-    ``length_m`` and ``mass_per_length_kg_per_m`` alone is a rigid body of that mass (no E A).
+    ``length_m`` and ``mass_per_length_kg_per_m`` alone is a rigid body of that mass (no E A). A rigid
+    ``mass_kg`` may state its ``diameter_m``: only its drawings use it (models.drill.shapes).
     """
 
     mass_kg: Positive | None = Field(None, description="rigid body mass; not with a rod geometry")
@@ -92,9 +93,9 @@ class Body(Strict):
     @model_validator(mode="after")
     def _mass_or_geometry(self) -> Body:
         sized = [key for key in ("length_m", "diameter_m", "mass_per_length_kg_per_m") if getattr(self, key) is not None]
-        if self.mass_kg is not None and sized:
-            raise ValueError(f"give mass_kg (a rigid body) or a length with a diameter or a mass per length, "
-                             f"not both (mass_kg with {', '.join(sized)})")
+        if self.mass_kg is not None and set(sized) - {"diameter_m"}:
+            raise ValueError(f"give mass_kg (a rigid body, with a diameter_m to draw it) or a length with a diameter "
+                             f"or a mass per length, not both (mass_kg with {', '.join(sized)})")
         if self.mass_kg is None and (self.length_m is None or len(sized) < 2):
             raise ValueError("give mass_kg, or length_m with diameter_m (a steel rod) and/or "
                              "mass_per_length_kg_per_m (a pipe)")
@@ -182,6 +183,10 @@ class DrillString(Strict):
             if getattr(self, role) not in names:
                 raise ValueError(f"{role} {getattr(self, role)!r} is not a body; bodies: {', '.join(names)}")
         for name, connector in self.connectors.items():
+            taken = [column for column in (f"{name}{suffix}" for suffix in LINK_SERIES) if column in SERIES]
+            if taken:
+                raise _key_error("DrillString", ("connectors", name), name, "its history {column} would be the "
+                                 "model's own; give the connector another name", column=taken[0])
             for end, body in (("from", connector.from_body), ("to", connector.to_body)):
                 if body not in names and not (end == "from" and body == GROUND):
                     allowed = ", ".join([GROUND, *names] if end == "from" else names)
@@ -505,8 +510,17 @@ class Outputs(Strict):
     out of a given section is empty.
     """
 
-    metrics: list[Literal[tuple(METRICS)]] = Field(default_factory=list)  # type: ignore[valid-type]
+    metrics: list[str] = Field(default_factory=list)
     timeseries: list[Literal[tuple(SERIES)]] = Field(default_factory=list)  # type: ignore[valid-type]
+
+    @field_validator("metrics")
+    @classmethod
+    def _known_metrics(cls, names: list[str]) -> list[str]:
+        for name in names:
+            if name not in METRICS and body_metric(name) is None:
+                raise ValueError(f"{name!r} is not a metric: one of {', '.join(METRICS)}, or a body's "
+                                 f"<body>{', <body>'.join(BODY_METRICS)}")
+        return names
 
 
 class Metrics(Strict):
@@ -575,7 +589,8 @@ class Scene(Strict):
             raise _key_error("Scene", ("effects", "rock_damping"), True,
                              "rock law 'bilinear' has no rock damping; set it false or use law: jenkins")
         outputs = self.outputs or Outputs()
-        bodies = set(self.drill_string.bodies)
+        bodies = {f"{name}[{i}]" if body.segments > 1 else name for name, body in self.drill_string.bodies.items()
+                  for i in range(body.segments)} | set(self.drill_string.bodies)
         missing = [o for o in outputs.metrics + outputs.timeseries if not _need(o).bodies <= bodies]
         if missing:
             absent = set().union(*(_need(o).bodies for o in missing)) - bodies
@@ -603,7 +618,7 @@ class Scene(Strict):
 
 
 def _need(output: str) -> Need:
-    return METRICS.get(output) or SERIES[output]
+    return SERIES[output] if output in SERIES else metric_need(output)
 
 
 @dataclass(frozen=True)

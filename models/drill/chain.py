@@ -46,10 +46,14 @@ class AxialChain:
         return all(link.linear for link in self.links)
 
     def index(self, name: str) -> int:
-        """Chain index of a drill-string body (the last segment of a segmented rod)."""
-        if name not in self.groups:
-            raise KeyError(f"no body {name!r} in the drill string; bodies: {', '.join(self.groups)}")
-        return self.groups[name][1]
+        """Chain index of a drill-string body (the last segment of a segmented rod) or of a rod segment
+        (``rod[0]``)."""
+        if name in self.groups:
+            return self.groups[name][1]
+        for i, body in enumerate(self.bodies):
+            if body.name == name:
+                return i
+        raise KeyError(f"no body {name!r} in the drill string; bodies: {', '.join(b.name for b in self.bodies)}")
 
     def mass_matrix(self) -> np.ndarray:
         return np.diag([b.mass_kg for b in self.bodies])

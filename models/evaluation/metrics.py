@@ -5,7 +5,8 @@ blocks of ``block_blows`` blows (a trailing partial block is dropped).
 Penetration rate = (x_n(end) - x_n(start)) / window length; its spread is the standard
 deviation of the block rates. Penetration per impact energy = (x_n(end) - x_n(start)) / W_impact
 over the window (= penetration rate / mean impact power; W_impact = int F_d v dt, models.evaluation.energy,
-without the rest of the energy account). Only the metrics the scene's outputs ask for are computed.
+without the rest of the energy account). A body's metrics by its name: peak and RMS velocity
+(``<body>_velocity_peak_m_per_s``). Only the metrics the scene's outputs ask for are computed.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ..definition.outputs import body_metric
 from .energy import EnergyAccount, energy_account, impact_work_j
 from .results import SimulationResult
 
@@ -88,8 +90,6 @@ METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
     "borehole_bottom_final_m": lambda w: float(w.result.bottom_at(w.result.time_s[-1:])[0]),
     "bit_velocity_peak_m_per_s": lambda w: w.peak(w.result.bit_velocity_m_per_s),
     "bit_velocity_rms_m_per_s": lambda w: w.rms(w.result.bit_velocity_m_per_s),
-    "collar_velocity_peak_m_per_s": lambda w: w.peak(w.result.body_velocity_m_per_s("collar")),
-    "collar_velocity_rms_m_per_s": lambda w: w.rms(w.result.body_velocity_m_per_s("collar")),
     "rock_force_max_n": lambda w: float(np.max(w.result.rock_force_n[w.mask])),
     "impact_energy_j": lambda w: w.impact_work,
     "feed_energy_j": lambda w: w.work(w.energy.feed_work_j),
@@ -103,7 +103,21 @@ METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
 }
 
 
+# a body's metrics by name (models.definition.outputs.BODY_METRICS), "<body>_velocity_peak_m_per_s": collar_... among them
+BODY_METRIC_FUNCTIONS: dict[str, Callable[[_Window, str], float]] = {
+    "_velocity_peak_m_per_s": lambda w, body: w.peak(w.result.body_velocity_m_per_s(body)),
+    "_velocity_rms_m_per_s": lambda w, body: w.rms(w.result.body_velocity_m_per_s(body)),
+}
+
+
+def _metric(window: _Window, name: str) -> float:
+    if name in METRIC_FUNCTIONS:
+        return METRIC_FUNCTIONS[name](window)
+    body, suffix = body_metric(name)
+    return BODY_METRIC_FUNCTIONS[suffix](window, body)
+
+
 def summary_metrics(result: SimulationResult, energy: EnergyAccount | None = None) -> dict[str, float]:
     """The metrics the scene's outputs ask for (SI units in the keys), in their order."""
     window = _Window(result, energy)
-    return {name: METRIC_FUNCTIONS[name](window) for name in result.simulation.outputs.metrics}
+    return {name: _metric(window, name) for name in result.simulation.outputs.metrics}

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..definition.scene import Scene
 from ..drill.chain import AxialChain
+from .parts import link_series
 
 if TYPE_CHECKING:
     from ..solvers.simulation import Simulation
@@ -86,15 +87,21 @@ class SimulationResult:
         return self.velocity_m_per_s[:, self.chain.bit_body]
 
     def body_velocity_m_per_s(self, name: str) -> np.ndarray:
-        """Velocity of the body ``name`` (the last segment of a segmented rod)."""
+        """Velocity of the body ``name`` (the last segment of a segmented rod; a segment by its name, ``rod[0]``)."""
         return self.velocity_m_per_s[:, self.chain.index(name)]
 
+    def body_position_m(self, name: str) -> np.ndarray:
+        """Position of the body ``name`` (as :meth:`body_velocity_m_per_s`)."""
+        return self.position_m[:, self.chain.index(name)]
+
     def columns(self) -> dict[str, np.ndarray]:
-        """Named histories the scene asked for (time, positions, velocities always), units in the names."""
+        """Named histories the scene asked for, units in the names: time, every body's position and
+        velocity and every link's force and compression always (models.evaluation.parts)."""
         out = {"time_s": self.time_s}
         for i, body in enumerate(self.chain.bodies):
             out[f"{body.name}_position_m"] = self.position_m[:, i]
             out[f"{body.name}_velocity_m_per_s"] = self.velocity_m_per_s[:, i]
+        out.update(link_series(self.chain, self.position_m, self.velocity_m_per_s))
         optional = {
             "borehole_bottom_m": self.bottom_m,
             "rock_force_n": self.rock_force_n,

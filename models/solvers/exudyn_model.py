@@ -7,7 +7,12 @@ piston a ``LoadCoordinate`` with a symbolic load function (models.drill.pulse); 
 a ``Node1D`` + ``ObjectRotationalMass1D`` with its own spring-damper to ground and a constant
 torque. Only what the scene's effects and outputs need is built: no torsion node, no rock
 damping term, no per-step hook for an elastic rock, no force sensors and no per-step storage
-unless an output asks for them.
+unless an output asks for them. Every body carries its graphics to scale (models.solvers.exudyn_graphics).
+
+:func:`build_exudyn` returns the assembled system before it runs (:class:`ExudynModel`: ``SC``,
+``mbs``, ``bodies[name]`` with their node, object and markers, ``connectors[name]``) for a user to
+add Exudyn items of their own; ``model.run()`` runs it. A normal run is the same build and run
+(:func:`simulate`).
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import time
 import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -27,15 +33,21 @@ from ...rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled 
 # isort: split
 from exudyn.itemInterface import (
     LoadCoordinate,
+    MarkerBodyPosition,
     MarkerNodeCoordinate,
     Node1D,
     NodePointGround,
     ObjectConnectorCoordinateSpringDamper,
+    ObjectGround,
     ObjectMass1D,
     ObjectRotationalMass1D,
     SensorLoad,
     SensorNode,
     SensorObject,
+    VObjectConnectorCoordinateSpringDamper,
+    VObjectGround,
+    VObjectMass1D,
+    VObjectRotationalMass1D,
 )
 
 from ...rocklaw.backends import SCALAR, SymbolicBackend
@@ -45,9 +57,11 @@ from ..definition.scene import Scene
 from ..drill.chain import AxialChain, Link
 from ..drill.indexing import BlowStarts
 from ..drill.pulse import impact_force
+from ..drill.shapes import layout
 from ..evaluation.results import SimulationResult
 from ..evaluation.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
-from .simulation import Simulation, as_simulation
+from .exudyn_graphics import DrillGraphics, body_graphics, torsion_graphics
+from .simulation import Simulation, as_simulation, prepare
 
 SOLVER_TYPES = {
     "rk67": exu.DynamicSolverType.RK67,
@@ -62,31 +76,107 @@ SOLVER_TYPES = {
 }
 COORDINATE = exu.OutputVariableType.Coordinates
 RATE = exu.OutputVariableType.Coordinates_t
+AXIS_X_FROM_Z = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]  # a rotational node's local z onto the drilling axis
+
+
+@dataclass(frozen=True)
+class ExudynBody:
+    """One axial body (a rod segment ``rod[0]`` too), or the torsion line, as Exudyn items."""
+
+    name: str
+    node: Any  # Node1D: the body's axial displacement (the torsion line: its angle)
+    object: Any  # ObjectMass1D (torsion: ObjectRotationalMass1D)
+    marker_coordinate: Any  # MarkerNodeCoordinate: for coordinate connectors and loads
+    marker_position: Any  # MarkerBodyPosition at the body's centre: a 3-D point for Exudyn's spatial connectors
+
+
+@dataclass(frozen=True)
+class ExudynConnector:
+    """One link of the chain (a scene connector, a rod's inner link ``rod[0-1]``) as its Exudyn object."""
+
+    name: str
+    object: Any  # ObjectConnectorCoordinateSpringDamper
+    link: Link
 
 
 @dataclass
-class ExudynDrill:
-    """A built, assembled system and the handles needed to run and read it."""
+class ExudynModel:
+    """The drill as an assembled Exudyn system, not yet run (:func:`build_exudyn`).
+
+    ``mbs`` is open to any Exudyn item of a user's own: join it to ``bodies[name].marker_position``
+    (spatial connectors) or ``.marker_coordinate`` (coordinate connectors, loads); ``run()`` assembles
+    what was added and runs it with the scene's solver settings. ``add_pre_step(function)`` adds a
+    per-step hook (``mbs.SetPreStepUserFunction`` would replace the model's own).
+    """
 
     simulation: Simulation
     chain: AxialChain
-    system_container: Any
+    SC: Any
     mbs: Any
+    bodies: dict[str, ExudynBody]
+    connectors: dict[str, ExudynConnector]
     rock: ExudynRockContact
+    torsion: ExudynBody | None
+    graphics: DrillGraphics
     sensors: dict[str, Any]
     settings: Any
     symbolic_functions: list[Any] = field(default_factory=list)  # kept alive with the system
     blows: BlowStarts | None = None  # the blow starts of this run (models.drill.indexing)
+    scene_formulation: str = "exudyn"  # the formulation the scene named (the model is always Exudyn's)
+    symbolic: bool = True
+    pre_steps: list[Callable[[Any, float], bool]] = field(default_factory=list)
+    _built_items: dict[str, int] = field(default_factory=dict)
+    _ran: bool = False
+
+    @property
+    def system_container(self) -> Any:
+        return self.SC
 
     @property
     def coordinate_count(self) -> int:
         return len(self.mbs.systemData.GetODE2Coordinates())
 
+    def add_pre_step(self, function: Callable[[Any, float], bool]) -> None:
+        """Call ``function(mbs, t)`` before every step, after the model's own hooks (False stops the run)."""
+        self.pre_steps.append(function)
 
-def _add_coordinate_body(mbs: Any, make_object: Callable[[Any], Any], initial: float = 0.0) -> tuple[Any, Any]:
+    def write_solution(self, path: str | Path, period_s: float | None = None) -> None:
+        """Have the run write Exudyn's coordinates solution file to ``path`` every ``period_s`` (default: the
+        output interval), for ``exudyn.interactive.SolutionViewer`` (``exudyn.utilities.LoadSolutionFile``)."""
+        solution = self.settings.solution.file
+        solution.write = True
+        solution.name = str(path)
+        solution.writePeriod = period_s or self.simulation.settings.output_interval_s
+        solution.export.velocities = solution.export.accelerations = False
+
+    def user_items(self) -> dict[str, int]:
+        """The Exudyn items added to ``mbs`` since the model was built, by kind (none: empty)."""
+        counts = _item_counts(self.mbs)
+        return {kind: counts[kind] - self._built_items[kind] for kind in counts if counts[kind] != self._built_items[kind]}
+
+    def run(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
+        """Run the system (with any items added) by the scene's solver settings; ``progress(t)`` about
+        100 times. The result is the one :func:`simulate` returns; a model runs once."""
+        if self._ran:
+            raise RuntimeError("an ExudynModel runs once (its rock state has moved on): build_exudyn(scene) again")
+        self._ran = True
+        added = self.user_items()
+        if added:
+            self.mbs.Assemble()
+        return _run(self, progress, added)
+
+
+def _item_counts(mbs: Any) -> dict[str, int]:
+    data = mbs.systemData
+    return {"nodes": data.NumberOfNodes(), "objects": data.NumberOfObjects(), "markers": data.NumberOfMarkers(),
+            "loads": data.NumberOfLoads(), "sensors": data.NumberOfSensors()}
+
+
+def _add_body(mbs: Any, name: str, make_object: Callable[[Any], Any], initial: float = 0.0) -> ExudynBody:
     node = mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[initial], initialVelocities=[0.0]))
-    make_object(node)
-    return node, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0))
+    body = make_object(node)
+    return ExudynBody(name, node, body, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0)),
+                      mbs.AddMarker(MarkerBodyPosition(bodyNumber=body, localPosition=[0.0, 0.0, 0.0])))
 
 
 def _store(mbs: Any, sensor: Any) -> Any:
@@ -127,28 +217,43 @@ def _link_force_function(link: Link, backend: Any) -> Callable[..., Any]:
     return link_force
 
 
-def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
-    """Build and assemble the Exudyn system of a prepared simulation.
+def _exudyn_simulation(run: Scene | Simulation) -> tuple[Simulation, str]:
+    """The prepared simulation to build, and the formulation the scene named: a scene of another
+    formulation is run by Exudyn with its common solver keys (end time, preset, output interval)."""
+    simulation = as_simulation(run)
+    named = simulation.settings.formulation
+    if named != "exudyn":
+        simulation = prepare(simulation.scene.with_solver("exudyn"))
+    return simulation, named
+
+
+def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
+    """The drill of a scene (or prepared simulation) as an assembled Exudyn system, not yet run
+    (:class:`ExudynModel`); ``model.run()`` runs it. A scene of another formulation is built for Exudyn.
 
     ``symbolic=False`` uses Python callbacks for the impact and rock forces (same law, slower:
     kept for the benchmark that measures what the symbolic functions save).
     """
+    simulation, named = _exudyn_simulation(run)
     chain, impact = simulation.chain, simulation.impact
+    shapes = layout(simulation.scene)
     container = exu.SystemContainer()
     mbs = container.AddSystem()
     ground = mbs.AddNode(NodePointGround())
     ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
 
-    nodes, markers = [], []
-    for body, initial in zip(chain.bodies, simulation.initial_positions_m, strict=True):
-        node, marker = _add_coordinate_body(
-            mbs, lambda n, m=body.mass_kg: mbs.AddObject(ObjectMass1D(nodeNumber=n, mass=m)), initial)
-        nodes.append(node)
-        markers.append(marker)
+    bodies: list[ExudynBody] = []
+    rods = {name for name, body in simulation.scene.drill_string.bodies.items() if body.is_rod}
+    for body, cylinder, initial in zip(chain.bodies, shapes.cylinders, simulation.initial_positions_m, strict=True):
+        shown = VObjectMass1D(graphicsData=body_graphics(cylinder, cylinder.group in rods))
+        bodies.append(_add_body(mbs, body.name, lambda n, m=body.mass_kg, x=cylinder.centre_m, v=shown: mbs.AddObject(
+            ObjectMass1D(nodeNumber=n, mass=m, referencePosition=[x, 0.0, 0.0], visualization=v)), initial))
         if body.constant_force_n:
-            mbs.AddLoad(LoadCoordinate(markerNumber=marker, load=body.constant_force_n))
+            mbs.AddLoad(LoadCoordinate(markerNumber=bodies[-1].marker_coordinate, load=body.constant_force_n))
+    markers = [body.marker_coordinate for body in bodies]
     backend = SymbolicBackend() if symbolic else SCALAR
     user_functions = []
+    connectors: dict[str, ExudynConnector] = {}
     for link in chain.links:
         base = ground_marker if link.body_a is None else markers[link.body_a]
         connector = mbs.AddObject(
@@ -156,8 +261,10 @@ def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
                 markerNumbers=[base, markers[link.body_b]],
                 stiffness=link.stiffness_n_per_m,
                 damping=link.damping_n_s_per_m,
+                visualization=VObjectConnectorCoordinateSpringDamper(show=False),  # drawn by DrillGraphics
             )
         )
+        connectors[link.name] = ExudynConnector(link.name, connector, link)
         if not link.linear:
             user_functions.append(attach_user_function(
                 mbs, connector, "springForceUserFunction", _link_force_function(link, backend), symbolic))
@@ -169,50 +276,58 @@ def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
 
     impact_function = attach_user_function(mbs, impact_load, "loadUserFunction", piston_force, symbolic)
     tor = simulation.torsion
-    torsion_node = None
+    torsion = None
     if tor is not None:  # before the rock: the blow start reads its angle
-        torsion_node, torsion_marker = _add_coordinate_body(
-            mbs, lambda n: mbs.AddObject(ObjectRotationalMass1D(nodeNumber=n, inertia=tor.inertia_kg_m2)),
-            simulation.initial_torsion_angle_rad,
-        )
+        bit = shapes.cylinders[chain.bit_body]
+        shown = VObjectRotationalMass1D(graphicsData=torsion_graphics(bit.diameter_m))
+        torsion = _add_body(mbs, "torsion", lambda n: mbs.AddObject(ObjectRotationalMass1D(
+            nodeNumber=n, inertia=tor.inertia_kg_m2, referencePosition=[bit.centre_m, 0.0, 0.0],
+            referenceRotation=AXIS_X_FROM_Z, visualization=shown)), simulation.initial_torsion_angle_rad)
     blows = simulation.blow_starts()
     start_blow = None
     if blows is not None:
         def start_blow(position: float, state: tuple[float, ...]) -> tuple[float, ...]:
             """The state the blow meets; the contact's return map takes the blow's law."""
-            angle = mbs.GetNodeOutput(torsion_node, COORDINATE) if torsion_node is not None else 0.0
+            angle = mbs.GetNodeOutput(torsion.node, COORDINATE) if torsion is not None else 0.0
             law, state = blows(position, state, angle)
             rock.set_law(law)
             return state
-    rock = ExudynRockContact(mbs, ground_marker, markers[chain.bit_body], nodes[chain.bit_body], simulation.rock,
+    rock = ExudynRockContact(mbs, ground_marker, markers[chain.bit_body], bodies[chain.bit_body].node, simulation.rock,
                              symbolic=symbolic, initial_state=simulation.initial_rock_state, start_blow=start_blow,
                              blow_period_s=impact.period_s)
+    mbs.SetObjectParameter(rock.object, "Vshow", False)  # drawn as the rock block of DrillGraphics
 
     sensors: dict[str, Any] = {}
-    for i, node in enumerate(nodes):
-        sensors[f"x{i}"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=COORDINATE))
-        sensors[f"v{i}"] = _store(mbs, SensorNode(nodeNumber=node, storeInternal=True, outputVariableType=RATE))
+    for i, body in enumerate(bodies):
+        sensors[f"x{i}"] = _store(mbs, SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=COORDINATE))
+        sensors[f"v{i}"] = _store(mbs, SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=RATE))
     if "forces" in simulation.needed_data:
         sensors["rock"] = _store(mbs, SensorObject(objectNumber=rock.object, storeInternal=True,
                                                    outputVariableType=exu.OutputVariableType.Force))
         sensors["impact"] = _store(mbs, SensorLoad(loadNumber=impact_load, storeInternal=True))
 
-    if tor is not None:
+    if torsion is not None:
         mbs.AddObject(
             ObjectConnectorCoordinateSpringDamper(
-                markerNumbers=[ground_marker, torsion_marker],
+                markerNumbers=[ground_marker, torsion.marker_coordinate],
                 stiffness=tor.stiffness_n_m_per_rad,
                 damping=tor.damping_n_m_s_per_rad,
+                visualization=VObjectConnectorCoordinateSpringDamper(show=False),
             )
         )
-        mbs.AddLoad(LoadCoordinate(markerNumber=torsion_marker, load=tor.drive_torque_n_m - tor.resisting_torque_n_m))
-        sensors["phi"] = _store(mbs, SensorNode(nodeNumber=torsion_node, storeInternal=True,
+        mbs.AddLoad(LoadCoordinate(markerNumber=torsion.marker_coordinate,
+                                   load=tor.drive_torque_n_m - tor.resisting_torque_n_m))
+        sensors["phi"] = _store(mbs, SensorNode(nodeNumber=torsion.node, storeInternal=True,
                                                 outputVariableType=COORDINATE))
-        sensors["omega"] = _store(mbs, SensorNode(nodeNumber=torsion_node, storeInternal=True, outputVariableType=RATE))
+        sensors["omega"] = _store(mbs, SensorNode(nodeNumber=torsion.node, storeInternal=True, outputVariableType=RATE))
 
+    drawn = DrillGraphics(chain, shapes, [body.node for body in bodies], COORDINATE)
+    mbs.AddObject(ObjectGround(visualization=VObjectGround(graphicsData=drawn.static(),
+                                                           graphicsDataUserFunction=drawn)))
     mbs.Assemble()
-    return ExudynDrill(simulation, chain, container, mbs, rock, sensors, _simulation_settings(simulation),
-                       [impact_function, *user_functions], blows)
+    return ExudynModel(simulation, chain, container, mbs, {body.name: body for body in bodies}, connectors, rock,
+                       torsion, drawn, sensors, _simulation_settings(simulation), [impact_function, *user_functions],
+                       blows, named, symbolic, _built_items=_item_counts(mbs))
 
 
 class _MinimumStepGuard:
@@ -271,50 +386,62 @@ def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
 
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None,
              symbolic: bool = True) -> SimulationResult:
-    """Build and run the Exudyn model; ``progress(t)`` is called about 100 times during the run."""
-    simulation = as_simulation(run)
+    """Build and run the Exudyn model (:func:`build_exudyn`, :meth:`ExudynModel.run`)."""
+    return build_exudyn(run, symbolic).run(progress)
+
+
+USER_ITEMS_NOTE = ("items added to model.mbs are seen only by the Exudyn formulation (the exact and ODE "
+                   "formulations and the energy account know the scene's drill only)")
+
+
+def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: dict[str, int]) -> SimulationResult:
+    """Solve the built system and read its sensors into a result (module doc)."""
+    simulation = model.simulation
     settings = simulation.settings
     warning = step_warning(simulation)
     if warning:
-        warnings.warn(warning, StepLimitWarning, stacklevel=2)
-    drill = build_exudyn(simulation, symbolic)
-    mbs = drill.mbs
-    actions = [drill.rock.update_bottom] if drill.rock.rock.crushes else []
+        warnings.warn(warning, StepLimitWarning, stacklevel=3)
+    mbs = model.mbs
+    actions = [model.rock.update_bottom] if model.rock.rock.crushes else []
     guard = None
     if settings.type in AUTOMATIC_STEP_SOLVERS:
-        guard = _MinimumStepGuard(drill.settings.timeIntegration.minimumStepSize)
+        guard = _MinimumStepGuard(model.settings.timeIntegration.minimumStepSize)
         actions.append(guard)
     if progress is not None:
         actions.append(_progress_reporter(settings.end_time_s, progress))
-    pre_step = _pre_step(actions)
+    pre_step = _pre_step(actions + model.pre_steps)
     if pre_step is not None:
         mbs.SetPreStepUserFunction(pre_step)
     with _no_cyclic_gc():
         start = time.process_time()
-        ok = mbs.SolveDynamic(drill.settings, solverType=SOLVER_TYPES[settings.type])
+        ok = mbs.SolveDynamic(model.settings, solverType=SOLVER_TYPES[settings.type])
         cpu = time.process_time() - start
     reached_s = mbs.systemData.GetTime()
-    data = {name: _sensor(mbs, sensor) for name, sensor in drill.sensors.items()}
+    data = {name: _sensor(mbs, sensor) for name, sensor in model.sensors.items()}
     time_s = data["x0"][:, 0]
-    n = drill.chain.size
+    n = model.chain.size
     position = np.column_stack([data[f"x{i}"][:, 1] for i in range(n)])
     velocity = np.column_stack([data[f"v{i}"][:, 1] for i in range(n)])
-    history = np.array(drill.rock.bottom_history)
-    rock_state = drill.rock.state_at(time_s)
+    history = np.array(model.rock.bottom_history)
+    rock_state = model.rock.state_at(time_s)
+    info: dict[str, Any] = {"solver_success": bool(ok), "coordinates": model.coordinate_count,
+                            **({"fresh_fractions": model.blows.fresh_fractions} if model.blows else {})}
+    if added or model.scene_formulation != "exudyn":
+        info["exudyn_model"] = {"scene_formulation": model.scene_formulation, "user_items": added,
+                                "note": USER_ITEMS_NOTE}
     result = SimulationResult(
         simulation=simulation,
         formulation="exudyn",
         time_s=time_s,
         position_m=position,
         velocity_m_per_s=velocity,
-        bottom_m=rock_state[:, drill.rock.rock.bottom_index],
+        bottom_m=rock_state[:, model.rock.rock.bottom_index],
         rock_force_n=data["rock"][:, 1] if "rock" in data else None,
         impact_force_n=data["impact"][:, 1] if "impact" in data else None,
         torsion_angle_rad=data["phi"][:, 1] if "phi" in data else None,
         torsion_rate_rad_per_s=data["omega"][:, 1] if "omega" in data else None,
         cpu_time_s=cpu,
-        info={"solver_success": bool(ok), "coordinates": drill.coordinate_count,
-              **({"fresh_fractions": drill.blows.fresh_fractions} if drill.blows else {})},
+        info=info,
         bottom_events=(history[:, 0], history[:, 1]),
         rock_state_m=rock_state,
     )

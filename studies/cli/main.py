@@ -19,6 +19,7 @@ import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
+from ...rocklaw.exudyn_build import use_fast_build
 from ..inputs.reading import InputError
 from ..runtime.budgets import BudgetError
 from ..runtime.interrupts import Terminated, raise_if_stopped, stops_handled
@@ -111,7 +112,10 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def console() -> None:
-    """The ``rpdrill`` program: :func:`main`, then exit with its status. Tests call :func:`main`."""
+    """The ``rpdrill`` program: :func:`main`, then exit with its status. The program and its workers load
+    Exudyn's build without range checks (rocklaw.exudyn_build: a process rpdrill owns; a user's process
+    that imports rpdrill does not). Tests call :func:`main`."""
+    use_fast_build()  # before anything imports Exudyn; the workers inherit it (rocklaw.exudyn_build)
     sys.exit(main())
 
 

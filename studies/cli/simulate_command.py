@@ -1,7 +1,9 @@
 """Run one scene: time histories, summary figures and a plot.
 
-Writes DIR/timeseries.csv, DIR/summary.json, DIR/scene.resolved.yaml and DIR/timeseries.png (and
-.svg): the whole run beside its last blows. DIR must be new or empty (``--overwrite``: write over
+Writes DIR/timeseries.csv, DIR/summary.json, DIR/scene.resolved.yaml, DIR/timeseries.png (and
+.svg): the whole run beside its last blows, and DIR/drill.png: the drill string (studies.figures.drill_drawing).
+``--animate``: DIR/drill.gif, the last blows magnified, and for the Exudyn formulation Exudyn's
+solution file DIR/solution.txt (studies.figures.drill_animation.view_solution opens it in Exudyn's SolutionViewer). DIR must be new or empty (``--overwrite``: write over
 what it holds). The run's steps and memory are checked against the budgets (studies.runtime.budgets)
 before it starts.
 """
@@ -10,11 +12,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
+from pathlib import Path
 
 from ...models.definition.formulations import FORMULATIONS
 from ...models.evaluation.stability import SimulationFailed
 from ..api import simulate
 from ..display.catalogue import metric
+from ..figures.drill_animation import SOLUTION_FILE
 from ..inputs.reading import load_scene
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import (
@@ -36,6 +41,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="run with this formulation (default: the scene's solver.formulation; the scene's "
                              "options of another formulation are dropped)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--animate", action="store_true",
+                        help="also drill.gif (the last blows, displacements magnified) and, with the exudyn formulation, "
+                             "Exudyn's solution file solution.txt for its SolutionViewer")
     add_budget_arguments(parser, many_runs=False)
 
 
@@ -43,15 +51,23 @@ def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite)
     scene = load_scene(args.scene)
     try:
-        with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
-            result = simulate(args.scene, args.formulation, progress, budget(args))
+        with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress, \
+                tempfile.TemporaryDirectory() as scratch:
+            solution = Path(scratch) / SOLUTION_FILE if args.animate else None
+            result = simulate(args.scene, args.formulation, progress, budget(args), solution_file=solution)
+            solution = solution.read_bytes() if solution is not None and solution.exists() else None
     except SimulationFailed as err:
         raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
         print(f"{args.scene}: {err}", file=sys.stderr)
         return 1
     with staged_directory(args.out) as stage:
-        result.save(stage)
+        result.save(stage, animate=args.animate)
+        if solution is not None:
+            (stage / SOLUTION_FILE).write_bytes(solution)
     shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}"
                       for name, value in result.metrics.items() if name in HEADLINE)
     print(f"{result.scene.name} ({result.formulation}): {shown}; wrote {args.out}")
+    if solution is not None:
+        print(f"Exudyn's viewer: python -c \"from rpdrill.studies.figures.drill_animation import view_solution; "
+              f"view_solution('{args.out}')\"")
     return 0

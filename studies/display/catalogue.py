@@ -103,6 +103,14 @@ SERIES: dict[str, Quantity] = {
     "impact_force_n": _q("impact force", "F_d", "kN", 1e-3, "N"),
     "torsion_angle_rad": _q("torsion angle", r"\varphi", "rad"),
     "torsion_rate_rad_per_s": _q("torsion rate", r"\dot{\varphi}", "rad/s"),
+    "*_force_n": _q("{name} force (compression)", "F", "kN", 1e-3, "N"),
+    "*_compression_m": _q("{name} compression", r"\delta", "mm", 1e3, "m"),
+    "*_gap_opening_m": _q("{name} gap opening", "g", "mm", 1e3, "m"),
+}
+# a body's metrics by its name (models.definition.outputs.BODY_METRICS)
+BODY_METRICS: dict[str, Quantity] = {
+    "*_velocity_peak_m_per_s": _q("peak {name} velocity", r"\hat{v}", "m/s", merit=True),
+    "*_velocity_rms_m_per_s": _q("RMS {name} velocity", r"\tilde{v}", "m/s", merit=True),
 }
 
 PARAMETERS: dict[str, Quantity] = {
@@ -179,20 +187,31 @@ def _named(found: Quantity, name: str) -> Quantity:
     return replace(found, name=found.name.format(name=name))
 
 
+def _matched(entries: dict[str, Quantity], key: str) -> Quantity | None:
+    """The entry of ``key``, or of the pattern '*<suffix>' it matches, named after the part it names."""
+    if key in entries:
+        return entries[key]
+    for pattern, found in entries.items():
+        suffix = pattern.removeprefix("*")
+        if pattern.startswith("*") and key.endswith(suffix) and len(key) > len(suffix):
+            return _named(found, key.removesuffix(suffix))
+    return None
+
+
 def metric(name: str) -> Quantity:
-    """The catalogue entry of a metric (KeyError for a metric without one)."""
-    return METRICS[name]
+    """The catalogue entry of a metric, a body's by its name too (KeyError for a metric without one)."""
+    found = METRICS.get(name) or _matched(BODY_METRICS, name)
+    if found is None:
+        raise KeyError(name)
+    return found
 
 
 def series(column: str) -> Quantity:
     """The entry of a time-history column ('bit_velocity_m_per_s': the velocity of the body 'bit')."""
-    if column in SERIES:
-        return SERIES[column]
-    for pattern, found in SERIES.items():
-        suffix = pattern.removeprefix("*")
-        if pattern.startswith("*") and column.endswith(suffix) and len(column) > len(suffix):
-            return _named(found, column.removesuffix(suffix))
-    raise KeyError(f"studies.display.catalogue has no time history {column!r}")
+    found = _matched(SERIES, column)
+    if found is None:
+        raise KeyError(f"studies.display.catalogue has no time history {column!r}")
+    return found
 
 
 def parameter(path: str) -> Quantity:
