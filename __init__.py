@@ -14,6 +14,8 @@ three formulations), ``studies`` (YAML inputs, scans, analyses, reports and the 
 dependencies run one way, studies -> models -> rocklaw (``docs/architecture.md``).
 """
 
+from typing import Any
+
 from .models.definition.scene import Scene
 from .models.definition.validation import InputError
 from .models.evaluation.stability import SimulationFailed
@@ -21,5 +23,25 @@ from .studies.api import Result, load_scene, load_study, run_study, simulate, ta
 from .studies.runtime.budgets import BudgetError
 from .studies.scan.study import Study
 
-__all__ = ["BudgetError", "InputError", "Result", "Scene", "SimulationFailed", "Study", "load_scene", "load_study",
-           "run_study", "simulate", "table_frame"]
+# Names that load Exudyn (or matplotlib) when first used, not at ``import rpdrill``: so that the command
+# line can still choose Exudyn's build (rocklaw.exudyn_build) and a user's ``import exudyn`` gets the
+# regular one.
+_LAZY = {"build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
+         "ExudynModel": ("models.solvers.exudyn_model", "ExudynModel"),
+         "draw": ("studies.figures.drill_drawing", "draw"),
+         "write_animation": ("studies.figures.drill_animation", "write_animation"),
+         "view_solution": ("studies.figures.drill_animation", "view_solution")}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        module, attribute = _LAZY[name]
+        return getattr(importlib.import_module(f".{module}", __name__), attribute)
+    raise AttributeError(f"module 'rpdrill' has no attribute {name!r}")
+
+
+__all__ = ["BudgetError", "ExudynModel", "InputError", "Result", "Scene", "SimulationFailed", "Study", "build_exudyn",
+           "draw", "load_scene", "load_study", "run_study", "simulate", "table_frame", "view_solution",
+           "write_animation"]

@@ -188,9 +188,9 @@ def test_exudyn_fast_module_only_where_rpdrill_owns_the_process_quietly_and_agre
 
 USER_PROCESS = """
 import json, sys
-import rpdrill.studies.cli  # the command line's module imports no Exudyn: its entry point can still choose
+import rpdrill, rpdrill.studies.cli.main  # the API and the command line import no Exudyn: its entry point chooses
 before = sorted(m for m in sys.modules if m.split(".")[0] == "exudyn")
-import rpdrill.models.solvers.exudyn_model
+rpdrill.build_exudyn  # a name of the API that needs Exudyn: loaded when first used
 import exudyn
 print(json.dumps({"before": before, "file": exudyn.__file__,
                   "loaded": sorted(m for m in sys.modules if m.startswith("exudyn.exudynCPP"))}))
