@@ -18,8 +18,9 @@ from typing import Any
 
 from .models.definition.scene import Scene
 from .models.definition.validation import InputError
+from .models.evaluation.run_result import Result
 from .models.evaluation.stability import SimulationFailed
-from .studies.api import Result, load_scene, load_study, run_study, simulate, table_frame
+from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
 from .studies.runtime.budgets import BudgetError
 from .studies.scan.study import Study
 
@@ -43,5 +44,5 @@ def __getattr__(name: str) -> Any:
 
 
 __all__ = ["BudgetError", "ExudynModel", "InputError", "Result", "Scene", "SimulationFailed", "Study", "build_exudyn",
-           "draw", "load_scene", "load_study", "run_study", "simulate", "table_frame", "view_solution",
+           "draw", "load_scene", "load_study", "run_study", "save_result", "simulate", "table_frame", "view_solution",
            "write_animation"]

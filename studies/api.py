@@ -12,16 +12,12 @@ from __future__ import annotations
 import dataclasses
 import tempfile
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from functools import cached_property
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
 from ..models.definition.scene import Scene
-from ..models.evaluation.metrics import summary_metrics
-from ..models.evaluation.results import SimulationResult
+from ..models.evaluation.run_result import Result
 from ..models.solvers.cost import Cause
 from .inputs.reading import InputError, load_scene, prepare_scene
 from .runtime.budgets import DEFAULT_BUDGET, Budget
@@ -29,55 +25,33 @@ from .runtime.output_files import write_columns_csv, write_json, write_resolved
 from .scan.study import Study, load_study
 from .study_runs import Outcome, run_studies, run_study_files, study_folders
 
-__all__ = ["InputError", "Result", "load_scene", "load_study", "run_study", "run_study_files", "simulate",
-           "table_frame"]
+__all__ = ["InputError", "Result", "load_scene", "load_study", "run_study", "run_study_files", "save_result",
+           "simulate", "table_frame"]
 
 
-@dataclass(frozen=True)
-class Result:
-    """One run of a scene: its metrics (SI units in the names), its time series as a DataFrame
-    (resampled every ``solver.output_interval_s``; columns with units in their names, as
-    ``timeseries.csv``), the formulation's raw result (``raw``: every sample, the chain, the run info)
-    and where it came from (``provenance``)."""
+def save_result(result: Result, folder: str | Path, animate: bool = False) -> list[Path]:
+    """What ``rpdrill simulate`` writes into ``folder`` (made if missing): ``timeseries.csv``,
+    ``summary.json``, ``scene.resolved.yaml``, the ``timeseries.png``/``.svg`` figure, the drawing of the
+    drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified. The files written."""
+    from .figures.drill_animation import write_animation  # matplotlib only when saving
+    from .figures.drill_drawing import draw
+    from .figures.timeseries_figure import plot_timeseries
 
-    scene: Scene
-    raw: SimulationResult
-    metrics: dict[str, float]
-    provenance: dict[str, Any] = field(default_factory=dict)
-
-    @cached_property
-    def timeseries(self) -> pd.DataFrame:
-        """Time series every ``solver.output_interval_s`` (x_n held between its changes, the rest
-        interpolated), columns with units in their names; ``time_s`` the index."""
-        columns = self.raw.resampled(self.scene.solver.output_interval_s)
-        return pd.DataFrame(columns).set_index("time_s", drop=False)
-
-    @property
-    def formulation(self) -> str:
-        return self.raw.formulation
-
-    def save(self, folder: str | Path, animate: bool = False) -> list[Path]:
-        """What ``rpdrill simulate`` writes into ``folder`` (made if missing): ``timeseries.csv``,
-        ``summary.json``, ``scene.resolved.yaml``, the ``timeseries.png``/``.svg`` figure, the drawing
-        of the drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified."""
-        from .figures.drill_animation import write_animation  # matplotlib only when saving
-        from .figures.drill_drawing import draw
-        from .figures.timeseries_figure import plot_timeseries
-
-        folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        columns = {name: values.to_numpy() for name, values in self.timeseries.items()}
-        write_columns_csv(folder / "timeseries.csv", columns)
-        write_json(folder / "summary.json", {"scene": self.scene.name, "formulation": self.formulation,
-                                             "metrics": self.metrics, "run": self.raw.info,
-                                             "provenance": self.provenance})
-        write_resolved(folder / "scene.resolved.yaml", self.raw.simulation.resolved_scene())
-        figures = [*plot_timeseries(columns, self.scene, folder / "timeseries.png"),
-                   draw(self.scene, folder / "drill.png")]
-        if animate:
-            write_animation(self.raw, folder / "drill.gif")
-            figures.append(folder / "drill.gif")
-        return [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml", *figures]
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    columns = {name: values.to_numpy() for name, values in result.timeseries.items()}
+    write_columns_csv(folder / "timeseries.csv", columns)
+    write_json(folder / "summary.json", {"scene": result.scene.name, "formulation": result.formulation,
+                                         "metrics": result.metrics, "run": result.raw.info,
+                                         "provenance": result.provenance})
+    write_resolved(folder / "scene.resolved.yaml", result.raw.simulation.resolved_scene())
+    written = [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml",
+               *plot_timeseries(columns, result.scene, folder / "timeseries.png"),
+               draw(result.scene, folder / "drill.png")]
+    if animate:
+        write_animation(result.raw, folder / "drill.gif")
+        written.append(folder / "drill.gif")
+    return written
 
 
 def _scene(scene: Scene | str | Path) -> tuple[Scene, str]:
@@ -106,7 +80,7 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
     raw = run_with_solution(simulation, progress, solution_file)
-    return Result(scene, raw, summary_metrics(raw), {"source": source, "formulation": raw.formulation})
+    return Result(scene, raw, {"source": source})
 
 
 def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:

@@ -17,7 +17,6 @@ from scenes import crushing_scene, scene
 
 from rpdrill.models.definition.scene import STEEL_DENSITY_KG_PER_M3
 from rpdrill.models.drill.shapes import DEFAULT_DIAMETER_M, layout
-from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.exudyn_model import build_exudyn, simulate
 from rpdrill.studies.inputs.reading import load_scene
 
@@ -40,13 +39,13 @@ def _tuned_absorber(model, mass_kg: float = 200.0, damping_ratio: float = 0.1):
 
 def test_a_tuned_absorber_added_by_the_user_changes_the_penetration_rate():
     s = crushing_scene(**SHORT)
-    plain = summary_metrics(build_exudyn(s).run())["penetration_rate_m_per_s"]
+    plain = build_exudyn(s).run().metrics["penetration_rate_m_per_s"]
     model = build_exudyn(s)
     node = _tuned_absorber(model)
     sensor = model.mbs.AddSensor(SensorNode(nodeNumber=node, storeInternal=True,
                                              outputVariableType=exudyn.OutputVariableType.Displacement))
     result = model.run()
-    tuned = summary_metrics(result)["penetration_rate_m_per_s"]
+    tuned = result.metrics["penetration_rate_m_per_s"]
     assert plain > 0 and abs(tuned - plain) > 0.2 * plain, (plain, tuned)
     swing = model.mbs.GetSensorStoredData(sensor)[:, 1]  # the user's sensor, read back through mbs
     assert np.ptp(swing) > 1e-5

@@ -59,6 +59,7 @@ from ..drill.indexing import BlowStarts
 from ..drill.pulse import impact_force
 from ..drill.shapes import layout
 from ..evaluation.results import SimulationResult
+from ..evaluation.run_result import Result
 from ..evaluation.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
 from .exudyn_graphics import DrillGraphics, body_graphics, torsion_graphics
 from .simulation import Simulation, as_simulation, prepare
@@ -154,9 +155,13 @@ class ExudynModel:
         counts = _item_counts(self.mbs)
         return {kind: counts[kind] - self._built_items[kind] for kind in counts if counts[kind] != self._built_items[kind]}
 
-    def run(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
+    def run(self, progress: Callable[[float], None] | None = None) -> Result:
         """Run the system (with any items added) by the scene's solver settings; ``progress(t)`` about
-        100 times. The result is the one :func:`simulate` returns; a model runs once."""
+        100 times. The result is ``rpdrill.Result``, as ``rpdrill.simulate`` returns; a model runs once."""
+        return Result(self.simulation.scene, self.solve(progress), {"source": "build_exudyn"})
+
+    def solve(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
+        """Run the system and return the formulation's raw result (:meth:`run` wraps it)."""
         if self._ran:
             raise RuntimeError("an ExudynModel runs once (its rock state has moved on): build_exudyn(scene) again")
         self._ran = True
@@ -387,7 +392,7 @@ def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None,
              symbolic: bool = True) -> SimulationResult:
     """Build and run the Exudyn model (:func:`build_exudyn`, :meth:`ExudynModel.run`)."""
-    return build_exudyn(run, symbolic).run(progress)
+    return build_exudyn(run, symbolic).solve(progress)
 
 
 USER_ITEMS_NOTE = ("items added to model.mbs are seen only by the Exudyn formulation (the exact and ODE "

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ...models.definition.formulations import FORMULATIONS
 from ...models.evaluation.stability import SimulationFailed
-from ..api import simulate
+from ..api import save_result, simulate
 from ..display.catalogue import metric
 from ..figures.drill_animation import SOLUTION_FILE
 from ..inputs.reading import load_scene
@@ -61,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"{args.scene}: {err}", file=sys.stderr)
         return 1
     with staged_directory(args.out) as stage:
-        result.save(stage, animate=args.animate)
+        save_result(result, stage, animate=args.animate)
         if solution is not None:
             (stage / SOLUTION_FILE).write_bytes(solution)
     shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}"

@@ -102,7 +102,7 @@ def run_with_solution(simulation: Simulation, progress: Callable[[float], None] 
 
     model = build_exudyn(simulation)
     model.write_solution(solution)
-    return model.run(progress)
+    return model.solve(progress)
 
 
 def load_solution(run_dir: str | Path) -> tuple[ExudynModel, dict]:

@@ -1,0 +1,43 @@
+"""One run of a scene as a user holds it (``rpdrill.Result``): its metrics, its time series as a
+pandas table, the formulation's raw result and where the run came from."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
+
+import pandas as pd
+
+from ..definition.scene import Scene
+from .metrics import summary_metrics
+from .results import SimulationResult
+
+
+@dataclass(frozen=True)
+class Result:
+    """One run: ``metrics`` (the scene's outputs' metrics, SI units in the names), ``timeseries`` (a
+    DataFrame every ``solver.output_interval_s``, columns with units in their names, as
+    ``timeseries.csv``), ``raw`` (the formulation's result: every sample, the chain, the run info) and
+    ``provenance``. The raw result's attributes read through (``result.time_s``, ``result.position_m``,
+    ``result.info``)."""
+
+    scene: Scene
+    raw: SimulationResult
+    provenance: dict[str, Any] = field(default_factory=dict)
+
+    @cached_property
+    def metrics(self) -> dict[str, float]:
+        return summary_metrics(self.raw)
+
+    @cached_property
+    def timeseries(self) -> pd.DataFrame:
+        """Time series every ``solver.output_interval_s`` (x_n held between its changes, the rest
+        interpolated), columns with units in their names; ``time_s`` the index and a column."""
+        columns = self.raw.resampled(self.scene.solver.output_interval_s)
+        return pd.DataFrame(columns).set_index("time_s", drop=False)
+
+    def __getattr__(self, name: str) -> Any:  # only for names the Result itself lacks
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(self.raw, name)
