@@ -1,0 +1,43 @@
+"""Every example in examples/ runs as a user runs it (a new process, from another folder) and shows
+what its header says."""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def run(name: str, *args: str, cwd: Path) -> str:
+    done = subprocess.run([sys.executable, str(EXAMPLES / name), *args], cwd=cwd, capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr and "Warning" not in done.stderr, done.stderr
+    return done.stdout
+
+
+def test_every_example_has_a_test():
+    tested = {"tuned_absorber.py", "geometry_crosscheck.py", "study_to_pandas.py"}
+    assert {path.name for path in EXAMPLES.glob("*.py")} == tested
+
+
+def test_a_tuned_absorber_on_the_collar_changes_the_penetration_rate(tmp_path):
+    out = run("tuned_absorber.py", "--end-time-s", "0.5", cwd=tmp_path)
+    without, with_ = map(float, re.findall(r"([0-9.]+) mm/s", out))
+    assert without > 0 and abs(with_ - without) > 0.2 * without, out
+
+
+def test_a_changed_geometry_agrees_between_exudyn_and_the_exact_formulation(tmp_path):
+    out = run("geometry_crosscheck.py", "--end-time-s", "0.5", cwd=tmp_path)
+    assert "refused as it should be" in out and "collar.mass_kg" in out
+    relative = float(re.search(r"relative difference ([0-9.e+-]+)\)", out).group(1))
+    velocity = float(re.search(r"largest difference ([0-9.e+-]+) of its peak", out).group(1))
+    assert relative < 1e-4 and velocity < 1e-3, out  # the reference preset's stated error (docs/stability.md)
+
+
+def test_a_study_from_python_into_pandas_and_a_plot(tmp_path):
+    out = run("study_to_pandas.py", "--out", "scan.png", "--workers", "2", cwd=tmp_path)
+    best = float(re.search(r"best grid point: ([0-9.]+) Hz", out).group(1))
+    assert 50 <= best <= 70, out  # the paper's 3.1 a) band
+    assert (tmp_path / "scan.png").stat().st_size > 10_000
