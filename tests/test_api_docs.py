@@ -27,3 +27,13 @@ def test_every_public_name_is_on_the_page():
 
     page = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
     assert not [name for name in rpdrill.__all__ if f"`{name}" not in page]
+
+
+def test_the_study_format_page_names_every_key_of_a_study_file():
+    from rpdrill.studies.inputs.specs import Axis
+    from rpdrill.studies.scan.study import Plot, StudySpec
+
+    page = (ROOT / "docs" / "studies.md").read_text(encoding="utf-8")
+    keys = {field.alias or name for model in (StudySpec, Plot, Axis) for name, field in model.model_fields.items()}
+    assert not [key for key in keys - {"values", "start"} if f"`{key}`" not in page]  # a list; from
+    assert "`from`" in page or "{from," in page
