@@ -1,6 +1,7 @@
 """The paper's figures redrawn from a reproduction's cases (studies.reproduction.paper_reproduction): one panel per metric
 against impact frequency, one line per case, each case's main-lobe optimum marked (a filled star; an
-open one at a global maximum elsewhere)."""
+open one at a global maximum elsewhere); a flat curve names why in its legend entry, a flat panel on
+the panel (studies.scan.flat_curves)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 from ..reproduction.paper_reproduction import CaseResult, Figure, Reproduction
+from ..scan.flat_curves import why_no_optimum
 
 # Okabe-Ito: distinct for colour-blind readers
 PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
@@ -33,10 +35,13 @@ def draw_figure(reproduction: Reproduction, results: list[CaseResult], figure: F
                              squeeze=False)
     for ax, metric in zip(axes[:, 0], figure.metrics, strict=True):
         scale, label = DISPLAY[metric]
+        reasons = []
         for k, case in enumerate(figure.cases):
             result, colour = by_label[case], PALETTE[k % len(PALETTE)]
             values = [v * scale for v in result.curves[metric]]
-            ax.plot(frequencies, values, lw=1.2, color=colour, label=case)
+            reasons.append(why_no_optimum(metric, result.curves[metric]))
+            ax.plot(frequencies, values, lw=1.2, color=colour,
+                    label=case + (f" ({reasons[-1].split(':')[0]})" if reasons[-1] else ""))
             if metric == result.metric:
                 optimum = result.optimum
                 marks = [(optimum["main_hz"], optimum["main_value"], colour)]
@@ -45,6 +50,9 @@ def draw_figure(reproduction: Reproduction, results: list[CaseResult], figure: F
                 for frequency, value, fill in marks:
                     if frequency is not None:
                         ax.plot(frequency, value * scale, marker="*", ms=13, color=colour, mfc=fill, ls="none")
+        if all(reasons) and len(set(reasons)) == 1:  # a flat panel says why on the panel
+            ax.text(0.5, 0.5, reasons[0], transform=ax.transAxes, ha="center", va="center", fontsize=10,
+                    bbox={"boxstyle": "round", "fc": "white", "ec": "0.6"})
         ax.set_ylabel(label, fontsize=9)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("impact frequency [Hz]")

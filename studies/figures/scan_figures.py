@@ -10,7 +10,8 @@ study's optima (studies.scan.study_optima) run along x, each curve's refined opt
 on the x axis. ``map``: a metric over two axes as discrete cells, one per scan point (studies.figures.cell_maps:
 nothing interpolated; few values are labelled rows); the optimum of each row (refined, as in the
 curves) is marked; one panel per combination of the other axes. A plot whose metrics have no finite
-value anywhere (every point failed) is not drawn.
+value anywhere (every point failed) is not drawn; a panel whose curves (or cells) are all zero says why
+on the panel (studies.scan.flat_curves: no crushing), and a flat curve says it in its legend entry.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import numpy as np
 
 from ...models.definition.scene import Scene
 from ..display.catalogue import Quantity, describe_scene, metric, quantity
+from ..scan.flat_curves import why_no_optimum
 from ..scan.study import Plot, Study
 from ..scan.study_optima import Record, Row, curves, metric_value, number_or_text
 from .cell_maps import cell_map, no_result_patch
@@ -72,17 +74,24 @@ def _curves(plot: Plot, study: Study, rows: list[Row], optima: list[Record], pat
                              squeeze=False, layout="constrained")
     for ax, name in zip(axes[:, 0], plot.metrics):
         yq = metric(name)
+        reasons = []
         for style, (key, members) in zip(styles, groups.items()):
             curve = dict(zip(others, key, strict=True))
             x = np.array([xq.display(float(r[plot.x])) for r in members])
-            y = np.array([yq.display(metric_value(r, name)) for r in members])
+            values = [metric_value(r, name) for r in members]
+            y = np.array([yq.display(v) for v in values])
             leading = {plot.curves: curve[plot.curves]} if plot.curves else {}  # the plot's own axis first
-            ax.plot(x, y, lw=1.2, ms=4, label=curve_label({**leading, **curve}) or None, **style.kwargs())
+            reasons.append(why_no_optimum(name, values))
+            label = curve_label({**leading, **curve}) + (f" ({reasons[-1].split(':')[0]})" if reasons[-1] else "")
+            ax.plot(x, y, lw=1.2, ms=4, label=label or None, **style.kwargs())
             _mark_optimum(ax, _optimum(optima, name, plot.x, curve), x, y, xq, yq, style.color)
             failed = x[[r["status"] != "ok" for r in members]]
             if failed.size:
                 ax.plot(failed, np.zeros_like(failed), "x", color=style.color, ms=7, mew=1.5,
                         clip_on=False, transform=ax.get_xaxis_transform())
+        if all(reasons) and len(set(reasons)) == 1:  # a flat panel says why on the panel
+            ax.text(0.5, 0.5, reasons[0], transform=ax.transAxes, ha="center", va="center", fontsize=10,
+                    bbox={"boxstyle": "round", "fc": "white", "ec": "0.6"})
         ax.set_ylabel(yq.label(), fontsize=9)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel(xq.label())
@@ -134,6 +143,10 @@ def _map(plot: Plot, study: Study, rows: list[Row], optima: list[Record], path: 
                               label="optimum of each row" + (" (refined)" if optima else ""))
             handles = [line]
         handles += [h for h in no_result_patch(z) if h.get_label() not in {x.get_label() for x in handles}]
+        flat = why_no_optimum(plot.z, list(z.ravel()))
+        if flat:  # a map of zeros (or of failed runs) says why on the panel
+            ax.text(0.5, 0.5, flat, transform=ax.transAxes, ha="center", va="center", fontsize=10,
+                    bbox={"boxstyle": "round", "fc": "white", "ec": "0.6"})
         ax.set_title(title(study, zq.name) + (f"\n{curve_label(fixed)}" if fixed else ""), fontsize=9)
     if handles:
         axes[-1, 0].legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(0, -0.12), ncols=2,

@@ -27,6 +27,7 @@ from ...models.drill.modal import rock_mode_frequency_hz
 from ..display.catalogue import metric, quantity
 from ..display.text_tables import text_table
 from .curve_optima import curve_optimum
+from .flat_curves import why_no_optimum
 from .study import Study
 
 FREQUENCY = "impact.frequency_hz"
@@ -96,6 +97,7 @@ def study_optima(study: Study, rows: list[Row]) -> list[Record]:
                 "band_80": None if main is None else list(main.band_80_hz),
                 "band_50": None if main is None else list(main.band_50_hz),
                 "resonance_hz": resonance, "lobes": len(found.lobes), "value_unit": metric(name).si_unit,
+                "no_optimum_reason": why_no_optimum(name, values) if main is None else None,
             })
     return records
 
@@ -113,7 +115,7 @@ def csv_rows(records: list[Record]) -> list[dict[str, Any]]:
                      f"band_80_low_{along}": band_80[0], f"band_80_high_{along}": band_80[1],
                      f"band_50_low_{along}": band_50[0], f"band_50_high_{along}": band_50[1],
                      "main_lobe_resonance_hz": record["resonance_hz"], "lobes": record["lobes"],
-                     "value_unit": record["value_unit"]})
+                     "value_unit": record["value_unit"], "no_optimum_reason": record.get("no_optimum_reason") or ""})
     return rows
 
 
@@ -133,13 +135,17 @@ def optima_table(records: list[Record]) -> str:
         f"80 % band [{x.unit}]", f"50 % band [{x.unit}]"]
     lines = []
     for record in (r for r in records if r["metric"] == first):
-        optimum = "none" if record["optimum"] is None else \
+        optimum = ("none" + (f" ({record['no_optimum_reason'].split(':')[0]})" if record.get("no_optimum_reason")
+                             else "")) if record["optimum"] is None else \
             x.show(record["optimum"]) + (" (scan end)" if record["peak_at_scan_end"] else "")
         lines.append([quantity(a).show(number_or_text(v)) for a, v in record["curve"].items()] + [
             "-" if record["best"] is None else x.show(record["best"]), y.show(record["best_value"] or 0.0),
             optimum, _band(record["band_80"], along), _band(record["band_50"], along)])
     lobe = "the lobe nearest to the rock mode" if records[0]["resonance_hz"] else "the highest lobe"
-    return f"{y.name} along {x.name}; optimum: refined peak of {lobe}\n" + text_table(headings, lines)
+    reasons = sorted({r["no_optimum_reason"] for r in records if r["metric"] == first and r.get("no_optimum_reason")})
+    notes = "".join(f"\nno optimum on {sum(r.get('no_optimum_reason') == reason for r in records if r['metric'] == first)}"
+                    f" curve(s): {reason}" for reason in reasons)
+    return f"{y.name} along {x.name}; optimum: refined peak of {lobe}\n" + text_table(headings, lines) + notes
 
 
 def number_or_text(value: str) -> float | str:
