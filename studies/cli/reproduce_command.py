@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.metadata
+import shlex
 import shutil
 import sys
 from pathlib import Path
@@ -24,7 +25,7 @@ from ..calibration.calibration_spec import load_calibration
 from ..figures.paper_figures import draw_figure
 from ..inputs.reading import InputError
 from ..pages.paper_pages import figures_page, parameters_page, reproduction_page, sensitivity_page
-from ..reproduction.paper_reproduction import load_reproduction, reproduce, trend_checks, within
+from ..reproduction.paper_reproduction import Reproduction, load_reproduction, reproduce, trend_checks, within
 from ..runtime.output_files import check_out, staged_directory, write_json, write_rows_csv
 from ..runtime.pools import pool
 from .options import add_runner_arguments
@@ -43,6 +44,36 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_runner_arguments(parser)
 
 
+def _shown(path: str | Path) -> str:
+    """A path as a page shows it: relative to the working folder where it lies below it."""
+    path = Path(path)
+    try:
+        return str(path.resolve().relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)
+
+
+def made_by(args: argparse.Namespace, reproduction: Reproduction) -> str:
+    """The command line that made the pages and the input files it read, as the pages state them."""
+    words = ["rpdrill", "reproduce"]
+    if Path(args.reproduction).resolve() != (PAPER / "reproduction.yaml").resolve():
+        words.append(_shown(args.reproduction))
+    words += ["--out", _shown(args.out)]
+    for option in ("calibration", "sensitivity", "docs"):
+        if getattr(args, option) is not None:
+            words += [f"--{option}", _shown(getattr(args, option))]
+    inputs = [_shown(args.reproduction)]
+    if isinstance(reproduction.spec.base_scene, str):
+        inputs.append(_shown(Path(args.reproduction).parent / reproduction.spec.base_scene))
+    if reproduction.calibration_file is not None:
+        inputs.append(_shown(reproduction.calibration_file))
+    if args.calibration is not None:
+        inputs.append(_shown(args.calibration / "calibration.json"))
+    if args.sensitivity is not None:
+        inputs.append(_shown(args.sensitivity / "summary.json"))
+    return f"`{shlex.join(words)}` (inputs: {', '.join(f'`{name}`' for name in inputs)})"
+
+
 def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite, "reproduction.json")
     for option, command in (("calibration", "calibrate"), ("sensitivity", "sensitivity")):
@@ -58,20 +89,22 @@ def run(args: argparse.Namespace) -> int:
     results = by_variant[None]
     provenance = {"cases": len(results), **cost, "rpdrill_version": importlib.metadata.version("rpdrill"),
                   "exudyn_version": importlib.metadata.version("exudyn")}
-    pages = {"reproduction.md": reproduction_page(reproduction, by_variant, provenance),
-             "parameters.md": parameters_page(reproduction, results, calibration, args.calibration)}
+    stated = made_by(args, reproduction)
+    pages = {"reproduction.md": reproduction_page(reproduction, by_variant, provenance, stated),
+             "parameters.md": parameters_page(reproduction, results, calibration, args.calibration, stated)}
     with staged_directory(args.out) as stage:
         (stage / "figures").mkdir()
         figures = []
         for figure in reproduction.spec.figures:
             draw_figure(reproduction, results, figure, stage / "figures" / f"fig{figure.number}")
             figures.append((figure.number, figure.title, f"figures/fig{figure.number}.svg"))
-        pages["figures.md"] = figures_page(figures)
+        pages["figures.md"] = figures_page(figures, stated)
         if args.sensitivity is not None:
             tornados = sorted(args.sensitivity.glob("tornado_*.svg"))
             for image in tornados:
                 shutil.copy(image, stage / "figures" / image.name)
-            pages["sensitivity.md"] = sensitivity_page(args.sensitivity, [f"figures/{i.name}" for i in tornados])
+            pages["sensitivity.md"] = sensitivity_page(args.sensitivity, [f"figures/{i.name}" for i in tornados],
+                                                       stated)
         for name, text in pages.items():
             (stage / name).write_text(text, encoding="utf-8")
         write_rows_csv(stage / "cases.csv", [

@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import argparse
+import shlex
 import shutil
 import sys
 from pathlib import Path
@@ -22,11 +23,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--docs", type=Path, help="also copy the note and its figure into this folder (e.g. docs)")
 
 
+def made_by(args: argparse.Namespace) -> str:
+    """The command line that made the note, as the note states it."""
+    words = ["rpdrill", "rotation-report", str(args.runs), "--out", str(args.out)]
+    words += ["--rock", args.rock] if args.rock != "sandstone" else []
+    words += ["--docs", str(args.docs)] if args.docs is not None else []
+    return f"`{shlex.join(words)}`"
+
+
 def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite, "rotation.md")
     check_runs(args.runs, args.rock)
     with staged_directory(args.out) as stage:
-        written = [args.out / p.name for p in write_report(args.runs, stage, args.rock)]
+        written = [args.out / p.name for p in write_report(args.runs, stage, args.rock, made_by(args))]
     if args.docs is not None:
         args.docs.mkdir(parents=True, exist_ok=True)
         for path in written:
