@@ -13,7 +13,7 @@ import pytest
 import yaml
 from scenes import PAPER_BASE
 
-from rpdrill.studies.calibration.calibration_report import non_dominated
+from rpdrill.models.evaluation.workprecision import non_dominated
 from rpdrill.studies.calibration.calibration_search import objective, refined_frequencies_hz
 from rpdrill.studies.calibration.calibration_spec import Parameter, load_calibration
 from rpdrill.studies.cli.main import main

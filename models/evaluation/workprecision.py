@@ -89,17 +89,21 @@ def errors(reference: Signature, other: Signature) -> dict[str, float]:
     }
 
 
+def non_dominated(points: Sequence[Sequence[float]]) -> list[int]:
+    """Indices of the rows of ``points`` (one cost per column, lower is better) that no other row
+    dominates (at most as large in every column and smaller in one): the Pareto front, in row order."""
+    table = np.asarray(points, dtype=float)
+    return [i for i, point in enumerate(table)
+            if not (np.all(table <= point, axis=1) & np.any(table < point, axis=1)).any()]
+
+
 def pareto_front(cost: Sequence[float], error: Sequence[float]) -> list[int]:
-    """Indices of the non-dominated points (no other is both cheaper and at least as accurate),
-    by increasing cost and so decreasing error; NaN or infinite points are left out."""
-    order = sorted((i for i in range(len(cost)) if math.isfinite(cost[i]) and math.isfinite(error[i])),
-                   key=lambda i: (cost[i], error[i]))
-    front, best = [], math.inf
-    for i in order:
-        if error[i] < best:
-            front.append(i)
-            best = error[i]
-    return front
+    """Indices of the non-dominated points of (cost, error) (:func:`non_dominated`; of equal points the
+    first), by increasing cost and so decreasing error; NaN or infinite points are left out."""
+    finite = [i for i in range(len(cost)) if math.isfinite(cost[i]) and math.isfinite(error[i])]
+    front = [finite[j] for j in non_dominated([(cost[i], error[i]) for i in finite])]
+    unique = {(cost[i], error[i]): i for i in reversed(front)}  # of equal points the first
+    return sorted(unique.values(), key=lambda i: (cost[i], error[i]))
 
 
 def cost_at_error(cost: Sequence[float], error: Sequence[float], level: float) -> float:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ...models.evaluation.workprecision import non_dominated
 from ..runtime.output_files import write_json, write_rows_csv
 from .calibration_search import CalibrationResult
 from .calibration_spec import Calibration
@@ -74,17 +75,6 @@ def targets_markdown(calibration: Calibration, rows: list[dict[str, str]], refin
                      f"| {miss} | {row['within_tolerance']} (±{float(row['tolerance']):.0%}) "
                      f"| {row['main_lobe_peak_value'] or '0'} |")
     return "\n".join(lines) + "\n"
-
-
-def non_dominated(points: np.ndarray) -> list[int]:
-    """Indices of the rows of ``points`` (one cost per column, lower is better) that no other row
-    dominates (at most as large in every column and smaller in one)."""
-    kept = []
-    for i, point in enumerate(points):
-        dominated = np.all(points <= point, axis=1) & np.any(points < point, axis=1)
-        if not dominated.any():
-            kept.append(i)
-    return kept
 
 
 def pareto_rows(calibration: Calibration, records: list[Record]) -> list[dict[str, Any]]:
