@@ -15,11 +15,16 @@ and F = 0 for s >= tau.
   generator states (u1, u2) (half-sine: u1 = sin(pi s/tau), u2 = cos(pi s/tau); triangle: u1 = s;
   rectangle: none), F_d = :func:`phase_row` . (1, u1, u2) and (1, u1, u2)' = :func:`phase_generator`
   (1, u1, u2); :func:`generator_states` gives (u1, u2) at the start of a piece.
+
+Each shape is one entry of SHAPES (a :class:`Shape`: its closed form, impulse, pieces, generator states,
+rows and generator); the functions above look the scene's shape up there. A new shape is a new entry.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -28,32 +33,87 @@ from ...rocklaw.backends import NUMERIC, Backend
 from ..definition.scene import Impact
 
 OFF, ON, RISING, FALLING = PHASES = ("off", "on", "rising", "falling")
+ZERO_ROW, ZERO_GENERATOR = np.zeros(3), np.zeros((3, 3))
+
+
+@dataclass(frozen=True)
+class Shape:
+    """One pulse shape, everything of it in one place: F(s) for 0 <= s < tau of amplitude I (``force``,
+    against a backend), the impulse per blow / (I tau) (``impulse_factor``), the pieces of [0, tau]
+    with one formula (``pieces``: fractions of tau and the phase), the generator states (u1, u2) at s
+    (``states``), and per phase the row r with F = r . (1, u1, u2) and the generator G with
+    (1, u1, u2)' = G (1, u1, u2) (``row``, ``generator``: functions of (I, tau))."""
+
+    force: Callable[[float, float, Any, Backend], Any]
+    impulse_factor: float
+    pieces: tuple[tuple[float, float, str], ...]
+    states: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray]]
+    row: Callable[[str, float, float], np.ndarray]
+    generator: Callable[[str, float], np.ndarray]
+
+
+def _no_states(local_s: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray]:
+    return np.zeros_like(local_s), np.zeros_like(local_s)
+
+
+def _oscillator(tau: float) -> np.ndarray:
+    """u1 = sin(omega s), u2 = cos(omega s), omega = pi / tau: u1' = omega u2, u2' = -omega u1."""
+    generator = np.zeros((3, 3))
+    generator[1, 2], generator[2, 1] = math.pi / tau, -math.pi / tau
+    return generator
+
+
+def _ramp(tau: float) -> np.ndarray:
+    """u1 = s: u1' = 1."""
+    generator = np.zeros((3, 3))
+    generator[1, 0] = 1.0
+    return generator
+
+
+SHAPES: dict[str, Shape] = {
+    "half_sine": Shape(
+        force=lambda amplitude, tau, s, backend: amplitude * backend.sin((math.pi / tau) * s),
+        impulse_factor=2.0 / math.pi,
+        pieces=((0.0, 1.0, ON),),
+        states=lambda s, tau: (np.sin(np.pi * s / tau), np.cos(np.pi * s / tau)),
+        row=lambda phase, amplitude, tau: np.array([0.0, amplitude, 0.0]),
+        generator=lambda phase, tau: _oscillator(tau)),
+    "rectangular": Shape(
+        force=lambda amplitude, tau, s, backend: amplitude + 0.0 * s,
+        impulse_factor=1.0,
+        pieces=((0.0, 1.0, ON),),
+        states=_no_states,
+        row=lambda phase, amplitude, tau: np.array([amplitude, 0.0, 0.0]),
+        generator=lambda phase, tau: np.zeros((3, 3))),
+    "triangular": Shape(
+        force=lambda amplitude, tau, s, backend: backend.minimum((2.0 * amplitude / tau) * s,
+                                                                 2.0 * amplitude - (2.0 * amplitude / tau) * s),
+        impulse_factor=0.5,
+        pieces=((0.0, 0.5, RISING), (0.5, 1.0, FALLING)),
+        states=lambda s, tau: (s, np.zeros_like(s)),
+        row=lambda phase, amplitude, tau: (np.array([0.0, 2.0 * amplitude / tau, 0.0]) if phase == RISING
+                                           else np.array([2.0 * amplitude, -2.0 * amplitude / tau, 0.0])),
+        generator=lambda phase, tau: _ramp(tau)),
+}
 
 
 def impact_force(impact: Impact, t: Any, backend: Backend = NUMERIC) -> Any:
     """F_d(t) [N] on the shank."""
     tau = impact.duration_s
     s = backend.mod(t, impact.period_s)
-    if impact.shape == "half_sine":
-        pulse = impact.amplitude_n * backend.sin((math.pi / tau) * s)
-    elif impact.shape == "rectangular":
-        pulse = impact.amplitude_n + 0.0 * s
-    else:
-        rising = (2.0 * impact.amplitude_n / tau) * s
-        pulse = backend.minimum(rising, 2.0 * impact.amplitude_n - rising)
+    pulse = SHAPES[impact.shape].force(impact.amplitude_n, tau, s, backend)
     return backend.where(s < tau, pulse, 0.0)
 
 
 def impulse_per_blow_n_s(impact: Impact) -> float:
     """Integral of F_d over one pulse [N s]."""
-    factor = {"half_sine": 2.0 / math.pi, "rectangular": 1.0, "triangular": 0.5}[impact.shape]
-    return factor * impact.amplitude_n * impact.duration_s
+    return SHAPES[impact.shape].impulse_factor * impact.amplitude_n * impact.duration_s
 
 
 def _pieces_of_a_period(impact: Impact) -> tuple[tuple[float, float, str], ...]:
     """(start, end, phase) within one period, times after the blow's start."""
     tau = impact.duration_s
-    inner = ((0.0, 0.5 * tau, RISING), (0.5 * tau, tau, FALLING)) if impact.shape == "triangular" else ((0.0, tau, ON),)
+    inner = tuple((low * tau, high * tau, phase) for low, high, phase in SHAPES[impact.shape].pieces)
     return (*inner, (tau, impact.period_s, OFF))
 
 
@@ -82,35 +142,19 @@ def blow_start_times(impact: Impact, end_time_s: float) -> np.ndarray:
 def generator_states(impact: Impact, local_s: np.ndarray) -> np.ndarray:
     """(u1, u2) at times ``local_s`` after the blow's start (rows): (sin, cos)(pi s / tau) for the
     half-sine, (s, 0) for the triangle, zeros for the rectangle."""
-    states = np.zeros((len(local_s), 2))
-    if impact.shape == "half_sine":
-        states[:, 0] = np.sin(np.pi * local_s / impact.duration_s)
-        states[:, 1] = np.cos(np.pi * local_s / impact.duration_s)
-    elif impact.shape == "triangular":
-        states[:, 0] = local_s
-    return states
+    local_s = np.asarray(local_s, dtype=float)
+    return np.column_stack(SHAPES[impact.shape].states(local_s, impact.duration_s)).reshape(len(local_s), 2)
 
 
 def phase_row(impact: Impact, phase: str) -> np.ndarray:
     """F_d = row . (1, u1, u2) in ``phase``."""
-    amplitude, slope = impact.amplitude_n, 2.0 * impact.amplitude_n / impact.duration_s
     if phase == OFF:
-        return np.zeros(3)
-    if impact.shape == "half_sine":
-        return np.array([0.0, amplitude, 0.0])
-    if impact.shape == "rectangular":
-        return np.array([amplitude, 0.0, 0.0])
-    return np.array([0.0, slope, 0.0]) if phase == RISING else np.array([2.0 * amplitude, -slope, 0.0])
+        return ZERO_ROW.copy()
+    return SHAPES[impact.shape].row(phase, impact.amplitude_n, impact.duration_s)
 
 
 def phase_generator(impact: Impact, phase: str) -> np.ndarray:
     """G with (1, u1, u2)' = G (1, u1, u2): the oscillator of the half-sine, the ramp s' = 1."""
-    generator = np.zeros((3, 3))
     if phase == OFF:
-        return generator
-    if impact.shape == "half_sine":
-        omega = math.pi / impact.duration_s
-        generator[1, 2], generator[2, 1] = omega, -omega
-    elif impact.shape == "triangular":
-        generator[1, 0] = 1.0
-    return generator
+        return ZERO_GENERATOR.copy()
+    return SHAPES[impact.shape].generator(phase, impact.duration_s)
