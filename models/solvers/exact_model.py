@@ -79,10 +79,9 @@ from .exact_kernels import (
     MISSING_KEY,
     TOO_MANY_SWITCHES,
     assemble,
-    integrate_powers,
-    power_integrals,
     run_events,
 )
+from .exact_power_kernels import integrate_powers, power_integrals
 from .exact_system import Model, Modes, balance, sub_step, unsupported
 from .simulation import SceneError, Simulation, as_simulation
 
