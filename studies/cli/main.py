@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib.metadata
+import shlex
 import sys
 import traceback
 import warnings
@@ -22,6 +23,7 @@ from pathlib import Path
 from ..inputs.reading import InputError
 from ..runtime.budgets import BudgetError
 from ..runtime.interrupts import Terminated, raise_if_stopped, stops_handled
+from ..runtime.out_lock import out_locked
 from . import (
     accuracy_command,
     advise_command,
@@ -87,7 +89,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     module = COMMANDS[args.command][0]
     try:
-        with one_line_warnings(), stops_handled():
+        command = shlex.join(["rpdrill", *argv])
+        with one_line_warnings(), stops_handled(), out_locked(getattr(args, "out", None), command):
             status = int(module.run(args))
             raise_if_stopped()
             return status

@@ -33,20 +33,32 @@ YAML_12_FLOAT = re.compile(r"^[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[
 MERGE = "tag:yaml.org,2002:merge"
 
 
+LONG_QUOTED = re.compile(r"(['\"])([^'\"\n]{78})[^'\"\n]{3,}\1")  # a quoted value beyond 80 characters
+
+
 class InputError(Exception):
-    """Bad user input; the message is complete and meant for the user."""
+    """Bad user input; the message is complete and meant for the user (a quoted value in it beyond 80
+    characters is shortened, :func:`shortened`)."""
+
+    def __str__(self) -> str:
+        return shortened(super().__str__())
+
+
+def shortened(message: str) -> str:
+    """``message`` with every quoted value longer than 80 characters cut to 77 and '...'."""
+    return LONG_QUOTED.sub(lambda m: f"{m[1]}{m[2][:74]}...{m[1]}", message)
 
 
 def read_text(path: str | Path) -> str:
     """The UTF-8 text of a regular file, or InputError naming the file and what is wrong with it."""
     path = Path(path)
-    if not path.exists():
-        raise InputError(f"{path}: no such file")
-    if path.is_dir():
-        raise InputError(f"{path}: is a directory; give a YAML file")
-    if not path.is_file():
-        raise InputError(f"{path}: not a regular file (a device, pipe or socket); give a YAML file")
     try:
+        if not path.exists():
+            raise InputError(f"{path}: no such file")
+        if path.is_dir():
+            raise InputError(f"{path}: is a directory; give a YAML file")
+        if not path.is_file():
+            raise InputError(f"{path}: not a regular file (a device, pipe or socket); give a YAML file")
         size = path.stat().st_size
         if size > MAX_FILE_BYTES:
             raise InputError(f"{path}: {size} bytes; an input file is at most {MAX_FILE_BYTES} bytes of YAML text")
@@ -158,7 +170,7 @@ def _hidden_text(data: Any) -> str | None:
             stack += [(item, _join(where, i)) for i, item in enumerate(value)]
         elif isinstance(value, str) and (hidden := _hidden_character(value)) is not None:
             name = unicodedata.name(hidden, "")
-            return (f"{where or '(top level)'}: {_short(value)}: holds the control or invisible character "
+            return (f"{where or '(top level)'}: {short(value)}: holds the control or invisible character "
                     f"U+{ord(hidden):04X}{f' ({name})' if name else ''}; text here is printable characters only")
     return None
 
@@ -192,7 +204,7 @@ def parse_yaml(text: str, source: str) -> dict[str, Any]:
             loader.dispose()
     if not isinstance(data, dict):
         raise InputError(f"{source}: expected a mapping of keys at the top level, found "
-                         f"{'a list' if isinstance(data, list) else _short(data)}")
+                         f"{'a list' if isinstance(data, list) else short(data)}")
     hidden = _hidden_text(data)
     if hidden:
         raise InputError(f"{source}: {hidden}")
@@ -252,7 +264,8 @@ def field_at(model: type[BaseModel], location: tuple[Any, ...]) -> Any:
     return None if parent is None else _field(parent, location[-1])
 
 
-def _short(value: Any) -> str:
+def short(value: Any) -> str:
+    """``value`` as shown in a message: its repr, at most 80 characters."""
     text = "null" if value is None else repr(value)
     return text if len(text) <= 80 else text[:77] + "..."
 
@@ -264,6 +277,8 @@ STRICT_TYPES = {
     "bool_type": "true or false is required",
     "string_type": "text is required",
     "dict_type": "a mapping of keys is required",
+    "model_type": "a mapping of keys is required (a section, not null, a value or a list)",
+    "model_attributes_type": "a mapping of keys is required (a section, not null, a value or a list)",
     "list_type": "a list [..] is required",
 }
 
@@ -285,13 +300,13 @@ def describe_validation_error(source: str, error: ValidationError, model: type[B
         if item["type"] == "extra_forbidden":
             allowed = allowed_keys(model, location)
             hint = f"unknown key; allowed keys here: {', '.join(allowed)}" if allowed else "unknown key"
-            lines.append(f"{source}: {path}: {_short(item['input'])}: {hint}")
+            lines.append(f"{source}: {path}: {short(item['input'])}: {hint}")
         elif item["type"] == "missing":
             lines.append(f"{source}: {path}: missing: a value is required")
         elif item["type"] == "value_error":
             lines.append(f"{source}: {path}: {problem(item)}")
         else:
-            lines.append(f"{source}: {path}: {_short(item['input'])}: {problem(item)}")
+            lines.append(f"{source}: {path}: {short(item['input'])}: {problem(item)}")
     return "\n".join(lines)
 
 
@@ -315,7 +330,7 @@ def prepare_scene(scene: Scene, source: str, where: str = "") -> Simulation:
     try:
         simulation = prepare(scene)
     except SceneError as err:
-        raise InputError(f"{source}: {where}{'.'.join(err.location)}: {_short(err.value)}: {err}") from None
+        raise InputError(f"{source}: {where}{'.'.join(err.location)}: {short(err.value)}: {err}") from None
     formulation = simulation.settings.formulation
     why = unsupported(formulation, simulation)
     if why:

@@ -122,14 +122,21 @@ def set_path(data: dict[str, Any], path: str, value: Any) -> None:
     data[leaf] = copy.deepcopy(value)
 
 
-def check_scene_path(source: str, key: str, path: str, base: dict[str, Any] | None = None) -> None:
+def check_scene_path(source: str, key: str, path: str, base: dict[str, Any] | None = None,
+                     value_only: bool = False) -> None:
     """A scan or override path must name a scene key; a name in a mapping (``drill_string.bodies.X``)
-    must exist in the ``base`` scene (a typo there would add a body, not change one)."""
+    must exist in the ``base`` scene (a typo there would add a body, not change one); ``value_only``
+    (a scan axis): the key must hold a value, not a whole section."""
     parts = tuple(path.split("."))
     allowed = allowed_keys(Scene, parts)
     if allowed is None or parts[-1] not in allowed:
         hint = f"allowed keys here: {', '.join(allowed)}" if allowed else "not a path to a scene key"
         raise InputError(f"{source}: {key}.{path}: unknown scene key path; {hint}")
+    inner = allowed_keys(Scene, (*parts, "?"))
+    if value_only and (inner is not None or allowed_keys(Scene, (*parts, "?", "?")) is not None):
+        keys = f"; its keys: {', '.join(inner)}" if inner else ""
+        raise InputError(f"{source}: {key}.{path}: a whole section, not a value; scan one of its keys "
+                         f"({path}.KEY){keys}")
     node: Any = base
     for depth, part in enumerate(parts[:-1]):
         if not isinstance(node, dict):

@@ -16,7 +16,7 @@ from pydantic import ValidationError
 from ...models.metrics import summary_metrics
 from ...models.scene import Scene
 from ...models.simulation import Simulation
-from ..inputs.reading import InputError, prepare_scene, problem
+from ..inputs.reading import InputError, prepare_scene, problem, short
 
 
 def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]) -> list[str]:
@@ -27,7 +27,7 @@ def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]
         related = [a for a in parameters if a == loc or a.startswith(loc + ".") or loc.startswith(a + ".")]
         message = problem(item)
         if len(related) == 1:
-            lines.append(f"{source}: scan.{related[0]}: {parameters[related[0]]!r}: {message}")
+            lines.append(f"{source}: scan.{related[0]}: {short(parameters[related[0]])}: {message}")
         else:
             lines.append(f"{source}: {_point(parameters)}{loc or 'scene'}: {message}")
     return lines
