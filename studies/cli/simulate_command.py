@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 
 from ...models.cost import Cause
 from ...models.formulations import FORMULATIONS
 from ...models.metrics import summary_metrics
+from ...models.run_status import UnsettledWarning, run_status
 from ...models.stability import SimulationFailed
 from ..display.catalogue import metric
 from ..figures.timeseries_figure import plot_timeseries
@@ -59,11 +61,14 @@ def run(args: argparse.Namespace) -> int:
         print(f"{args.scene}: {err}", file=sys.stderr)
         return 1
     summary = summary_metrics(result)
+    status, why = run_status(result)
+    if status == "unsettled":  # (an unstable step was said as the run started: models.exudyn_model)
+        warnings.warn(why, UnsettledWarning, stacklevel=1)
     columns = result.resampled(scene.solver.output_interval_s)
     with staged_directory(args.out) as stage:
         write_columns_csv(stage / "timeseries.csv", columns)
         write_json(stage / "summary.json", {"scene": scene.name, "formulation": result.formulation,
-                                            "metrics": summary, "run": result.info})
+                                            "status": status, "metrics": summary, "run": result.info})
         write_resolved(stage / "scene.resolved.yaml", simulation.resolved_scene())
         plot_timeseries(columns, scene, stage / "timeseries.png")
     shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}" for name, value in summary.items()

@@ -72,14 +72,18 @@ def study_folders(paths: list[str], out: str) -> list[Path]:
 def report(study: Study, out: Path, rows: list[Row], optima: list[Record], written: list[Path],
            skipped: list[str]) -> None:
     """What a study wrote and its failed points (stderr), its optima table (stdout)."""
-    failed = [row for row in rows if row["status"] != "ok"]
-    print(f"{study.spec.name}: {len(rows) - len(failed)} points ok, {len(failed)} failed; wrote "
+    failed = [row for row in rows if row["status"] == "failed"]
+    flagged = [row for row in rows if row["status"] not in ("ok", "failed")]
+    kinds = ", ".join(f"{sum(r['status'] == kind for r in flagged)} {kind}" for kind in ("unstable", "unsettled")
+                      if any(r["status"] == kind for r in flagged))
+    print(f"{study.spec.name}: {len(rows) - len(failed) - len(flagged)} points ok, {kinds + ', ' if kinds else ''}"
+          f"{len(failed)} failed; wrote "
           f"{out / 'results.csv'}, {out / 'study.json'}, {out / 'optima.csv'}" + "".join(f", {p}" for p in written),
           file=sys.stderr)
     if skipped:
         print(f"  no plot {', '.join(skipped)}: no point has a result for its metrics", file=sys.stderr)
-    for row in failed[:5]:
-        print(f"  point {row['point']}: {row['error']}", file=sys.stderr)
+    for row in (failed + flagged)[:5]:
+        print(f"  point {row['point']} ({row['status']}): {row['error']}", file=sys.stderr)
     table = optima_table(optima)
     print(table or f"{study.spec.name}: no optima (no figure of merit collected, or no numeric axis with "
                     "three or more values)")
@@ -116,4 +120,4 @@ def run(args: argparse.Namespace) -> int:
         outcomes = run_studies(studies, folders, runner, args.dask is not None, args.quiet)
     for outcome in outcomes:
         report(*outcome)
-    return 1 if any(row["status"] != "ok" for outcome in outcomes for row in outcome[2]) else 0
+    return 1 if any(row["status"] == "failed" for outcome in outcomes for row in outcome[2]) else 0

@@ -14,6 +14,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from ...models.metrics import summary_metrics
+from ...models.run_status import run_status
 from ...models.scene import Scene
 from ...models.simulation import Simulation
 from ..inputs.reading import InputError, prepare_scene, problem, short
@@ -48,13 +49,17 @@ def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]
 
 
 def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
-    """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics; a
-    failure is returned, not raised."""
+    """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics and its
+    status (models.run_status: ok, unstable or unsettled, the reason in ``error``); a failure is
+    returned, not raised."""
     key, simulation = task
     start = time.perf_counter()
     try:
-        metrics = summary_metrics(simulation.run())
+        result = simulation.run()
+        metrics = summary_metrics(result)
+        status, why = run_status(result)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
         return {"point": key, "status": "failed", "error": f"{type(err).__name__}: {err}",
                 "wall_time_s": time.perf_counter() - start, "metrics": {}}
-    return {"point": key, "status": "ok", "error": "", "wall_time_s": time.perf_counter() - start, "metrics": metrics}
+    return {"point": key, "status": status, "error": why, "wall_time_s": time.perf_counter() - start,
+            "metrics": metrics}
