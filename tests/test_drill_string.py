@@ -194,13 +194,3 @@ def test_preloaded_string_with_a_gapped_coupling_is_in_exact_static_equilibrium(
     coupling = next(link for link in chain.links if link.name == "coupling")
     assert coupling.stretch(q0) + gap_m < 0  # closed under the feed
 
-
-def test_preloaded_string_above_an_open_gap_rests_on_it():
-    """The feed on the bit only: the string above the gapped coupling carries no load; it rests with
-    the gap just closed (no force through it), the bit on the rock under the feed."""
-    s = gapped(1e-3, feed={"force_n": 30e3, "acts_on": "bit"})
-    prepared = prepare(s)
-    chain, q0 = prepared.chain, prepared.initial_positions_m
-    coupling = next(link for link in chain.links if link.name == "coupling")
-    assert coupling.force_n(coupling.stretch(q0), 0.0) == pytest.approx(0.0, abs=1e-6)
-    assert s.rock.stiffness_n_per_m * q0[chain.bit_body] == pytest.approx(30e3)
