@@ -76,22 +76,57 @@ def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> I
     return ([function(argument)] for argument in arguments)
 
 
-def _completed(futures: list[Any], as_done: Callable[[list[Any]], Iterator[Any]],
-               cancel: Callable[[list[Any]], None], registry: dict[Any, Any]) -> Iterator[list[Any]]:
+class Completed(Iterator[list[Any]]):
     """Each future's batch of results as it completes, after issuing its warnings here (``registry``:
-    those issued already); the rest cancelled when the caller stops early."""
-    try:
-        for future in as_done(futures):
-            try:
-                results, caught = future.result()
-            except BrokenProcessPool:  # a worker was killed: by a signal to all (a stop) or alone
-                raise_if_stopped()
-                raise Terminated() from None
-            for text, category, filename, lineno in caught:
-                warnings.warn_explicit(text, category, filename, lineno, registry=registry)
-            yield results
-    finally:
-        cancel(futures)
+    those issued already); the rest cancelled when the caller stops early (:meth:`close`).
+    ``finished_before_stop``: whether results that completed but were not yet handed out when a stop
+    came are results (a process pool's workers ignore Ctrl-C: what they finish is whole), given by
+    :meth:`finished_now`."""
+
+    def __init__(self, futures: list[Any], as_done: Callable[[list[Any]], Iterator[Any]],
+                 cancel: Callable[[list[Any]], None], registry: dict[Any, Any], finished_before_stop: bool) -> None:
+        self.futures, self.cancel, self.registry = futures, cancel, registry
+        self.finished_before_stop = finished_before_stop
+        self.pending = as_done(futures)
+        self.given: set[Any] = set()
+
+    def __next__(self) -> list[Any]:
+        try:
+            future = next(self.pending)
+        except StopIteration:
+            self.close()
+            raise
+        except BaseException:
+            self.close()
+            raise
+        self.given.add(future)
+        return self._results(future)
+
+    def _results(self, future: Any) -> list[Any]:
+        try:
+            results, caught = future.result()
+        except BrokenProcessPool:  # a worker was killed: by a signal to all (a stop) or alone
+            raise_if_stopped()
+            raise Terminated() from None
+        for text, category, filename, lineno in caught:
+            warnings.warn_explicit(text, category, filename, lineno, registry=self.registry)
+        return results
+
+    def finished_now(self) -> list[list[Any]]:
+        """The batches that have completed but were not handed out (none unless ``finished_before_stop``)."""
+        if not self.finished_before_stop:
+            return []
+        done = [f for f in self.futures if f not in self.given and f.done() and not f.cancelled()
+                and f.exception() is None]
+        self.given.update(done)
+        return [f.result()[0] for f in done]
+
+    def close(self) -> None:
+        self.cancel(self.futures)
+
+    def __del__(self) -> None:  # as a generator's finally: a caller that stops early leaves nothing queued
+        with contextlib.suppress(Exception):
+            self.close()
 
 
 @contextlib.contextmanager
@@ -106,7 +141,7 @@ def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
         if not executors:
             executors.append(ProcessPoolExecutor(max_workers=workers, initializer=start_process_worker))
         futures = [executors[0].submit(run_batch, (function, [argument])) for argument in arguments]
-        return _completed(futures, as_completed, lambda pending: [f.cancel() for f in pending], registry)
+        return Completed(futures, as_completed, lambda pending: [f.cancel() for f in pending], registry, True)
 
     stopped = True
     try:
@@ -150,7 +185,7 @@ def dask_pool(address: str | None = None, workers: int | None = None) -> Iterato
 
         def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
             futures = client.map(run_batch, [(function, batch) for batch in batches(arguments, slots)], pure=False)
-            return _completed(futures, dask_completed, client.cancel, registry)
+            return Completed(futures, dask_completed, client.cancel, registry, False)
 
         yield run
 

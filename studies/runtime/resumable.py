@@ -250,8 +250,8 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
                 complete(i)
         names = ", ".join(job.study.spec.name for job in tables)
         with tqdm(total=sum(remaining), desc=names, unit="point", disable=quiet) as bar:
-            for batch in run(run_tagged, tasks) if tasks else ():
-                raise_if_stopped()  # points cut by the interrupt are not results
+            def record(batch: list[tuple[int, dict[str, Any]]]) -> None:
+                """Append a batch's rows to their tables."""
                 by_table: dict[int, list[dict[str, Any]]] = {}
                 first: dict[int, int] = {}  # per table: the outcomes of points run for it (the others copied)
                 for tag, outcome in batch:
@@ -268,6 +268,16 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
                     bar.update(len(outcomes))
                     if remaining[i] == 0:
                         complete(i)
+
+            outcomes = run(run_tagged, tasks) if tasks else iter(())
+            try:
+                for batch in outcomes:
+                    raise_if_stopped()  # points cut by the interrupt are not results
+                    record(batch)
+            except KeyboardInterrupt:  # points the workers finished before the stop are (studies.runtime.pools)
+                for batch in getattr(outcomes, "finished_now", list)():
+                    record(batch)
+                raise
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (studies.cli.main): the finished rows stay, the sessions are recorded
         for i in range(len(tables)):
             if rows[i] is None:
