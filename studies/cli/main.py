@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib.metadata
+import os
 import shlex
 import sys
 import traceback
@@ -114,8 +115,15 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def console() -> None:
-    """The ``rpdrill`` program: :func:`main`, then exit with its status. Tests call :func:`main`."""
-    sys.exit(main())
+    """The ``rpdrill`` program: :func:`main`, then exit with its status. Tests call :func:`main`. A
+    stopped command (130, 143) has written what it keeps and ended its workers: it exits at once,
+    without the interpreter's teardown of its modules (a second or more on a busy machine)."""
+    status = main()
+    if status in (130, 143):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    sys.exit(status)
 
 
 if __name__ == "__main__":
