@@ -1,7 +1,8 @@
 """The ``rpdrill`` command line: one subcommand per module, each with ``add_arguments`` and ``run``.
 
 Exit status: 0 success, 1 a run failed, a check did not pass or a budget was exceeded
-(studies.runtime.budgets), 2 bad input, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM: stopped as for
+(studies.runtime.budgets), 2 bad input (also: another command writes into ``--out``, whose lock it
+holds: studies.runtime.out_lock), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM: stopped as for
 Ctrl-C, finished results kept). An unexpected exception is a bug: one line naming the input and
 where it was raised, exit status 1, no traceback. While a command runs, a warning prints as one
 line, ``rpdrill: warning: ...`` (warnings of worker processes come back to this process and print
