@@ -37,10 +37,11 @@ def command(*args: str) -> list[str]:
     return [sys.executable, "-m", "rpdrill.studies.cli", *args]
 
 
-def stop(args: list[str], finished: Callable[[], int], signum: int, group: bool = True, at_least: int = 1,
+def stop(args: list[str], finished: Callable[[], int], signum: int, group: bool | None = True, at_least: int = 1,
          timeout_s: float = 240) -> Stopped:
     """Run ``args`` in a session of its own; once ``finished()`` reaches ``at_least``, send ``signum`` to
-    the command (or its whole process group); how it ended."""
+    its whole process group (``group``), the command alone, or one of its workers alone (None); how it
+    ended."""
     process = subprocess.Popen(args, cwd=ROOT, start_new_session=True, stdout=subprocess.DEVNULL,
                                stderr=subprocess.PIPE, text=True)
     try:
@@ -50,7 +51,11 @@ def stop(args: list[str], finished: Callable[[], int], signum: int, group: bool 
         assert process.poll() is None, "the command ended before the signal"
         kept = finished()
         sent = time.monotonic()
-        (os.killpg if group else os.kill)(process.pid, signum)
+        if group is None:  # one of its workers alone
+            children = Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text().split()
+            os.kill(int(children[0]), signum)
+        else:
+            (os.killpg if group else os.kill)(process.pid, signum)
         _, err = process.communicate(timeout=60)
         after = time.monotonic() - sent
         time.sleep(2)
@@ -114,6 +119,15 @@ def test_a_killed_study_leaves_no_worker(tmp_path):
     stopped = stop(command("study", str(study_file(tmp_path)), "--out", str(out), "--workers", "2", "--quiet"),
                    lambda: len(csv_rows(out / "results.csv")), signal.SIGKILL, group=False, at_least=1)
     assert stopped.status == -signal.SIGKILL and not stopped.left, stopped
+
+
+def test_a_worker_killed_alone_stops_the_run_keeping_its_finished_points(tmp_path):
+    out = tmp_path / "out"
+    stopped = stop(command("study", str(study_file(tmp_path)), "--out", str(out), "--workers", "2", "--quiet"),
+                   lambda: len(csv_rows(out / "results.csv")), signal.SIGTERM, group=None, at_least=1)
+    assert stopped.status == 143 and "worker process ended" in stopped.err, stopped
+    assert stopped.exit_after_s < 5 and not stopped.left, stopped
+    assert len(csv_rows(out / "results.csv")) >= stopped.kept_at_signal
 
 
 @pytest.mark.slow

@@ -24,7 +24,7 @@ from pathlib import Path
 
 from ..inputs.reading import InputError
 from ..runtime.budgets import BudgetError
-from ..runtime.interrupts import Terminated, raise_if_stopped, stops_handled
+from ..runtime.interrupts import Terminated, WorkerLost, raise_if_stopped, stops_handled
 from ..runtime.out_lock import out_locked
 from . import (
     accuracy_command,
@@ -104,8 +104,9 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except KeyboardInterrupt as stop:
         terminated = isinstance(stop, Terminated)
-        print(f"rpdrill: {'terminated (SIGTERM)' if terminated else 'interrupted'}; finished results are kept",
-              file=sys.stderr)
+        why = "a worker process ended (killed or crashed)" if isinstance(stop, WorkerLost) else \
+            "terminated (SIGTERM)" if terminated else "interrupted"
+        print(f"rpdrill: {why}; finished results are kept", file=sys.stderr)
         return 143 if terminated else 130
     except Exception as err:  # noqa: BLE001 - a bug, not bad input: one line naming the input, no traceback
         where = traceback.extract_tb(err.__traceback__)[-1]

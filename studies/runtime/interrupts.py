@@ -30,6 +30,10 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM: stop as for Ctrl-C."""
 
 
+class WorkerLost(Terminated):
+    """A pool worker ended in the middle of the run (killed alone, or crashed): stop as for SIGTERM."""
+
+
 def _stop(signum: int, frame: FrameType | None) -> None:
     _received.append(signum)
     raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()

@@ -32,7 +32,7 @@ from typing import Any, TypeVar
 
 from threadpoolctl import threadpool_limits
 
-from .interrupts import Terminated, raise_if_stopped, worker_ends_with_its_command
+from .interrupts import WorkerLost, raise_if_stopped, worker_ends_with_its_command
 
 Arg = TypeVar("Arg")
 Result = TypeVar("Result")
@@ -107,7 +107,7 @@ class Completed(Iterator[list[Any]]):
             results, caught = future.result()
         except BrokenProcessPool:  # a worker was killed: by a signal to all (a stop) or alone
             raise_if_stopped()
-            raise Terminated() from None
+            raise WorkerLost() from None
         for text, category, filename, lineno in caught:
             warnings.warn_explicit(text, category, filename, lineno, registry=self.registry)
         return results
