@@ -123,11 +123,18 @@ def test_a_study_row_of_a_run_the_stability_check_flags_is_not_ok(tmp_path, caps
     assert "1 unstable" in capsys.readouterr().err
 
 
-def test_what_exudyn_prints_comes_out_as_a_warning_line(capsys):
-    from rpdrill.models.exudyn_model import ExudynMessage, _exudyn_messages_as_warnings
-    from rpdrill.rocklaw.exudyn_module import exu
-
-    with pytest.warns(ExudynMessage) as caught, _exudyn_messages_as_warnings("drill"):
-        exu.Print("Python WARNING [file '/x/exudyn_model.py', line 294]: step size reached minStepSize")
-    assert capsys.readouterr().out == ""
-    assert [str(w.message) for w in caught] == ["scene 'drill': Exudyn: step size reached minStepSize"]
+def test_what_exudyn_prints_comes_out_as_a_warning_line(tmp_path):
+    """An automatic-step run at a tolerance Exudyn cannot reach: Exudyn's own warning (reached
+    minStepSize) comes out as one rpdrill warning line, not raw; the run is refused as failed."""
+    scene = yaml.safe_load((CORPUS / "valid" / "drill.yaml").read_text())
+    scene["solver"] = {"type": "dopri5", "relative_tolerance": 1e-14, "absolute_tolerance": 1e-16,
+                       "end_time_s": 0.05}
+    scene["metrics"] = {"transient_blows": 1, "block_blows": 1}
+    path = tmp_path / "tight.yaml"
+    path.write_text(yaml.safe_dump(scene), encoding="utf-8")
+    done = subprocess.run(command("simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"), cwd=ROOT,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 1, done.stderr
+    assert "Python WARNING" not in done.stdout + done.stderr
+    warned = [line for line in done.stderr.splitlines() if "minStepSize" in line]
+    assert len(warned) == 1 and warned[0].startswith("rpdrill: warning: scene 'bad_input_base': Exudyn: ")
