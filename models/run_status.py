@@ -17,6 +17,7 @@ from .metrics import block_rates_m_per_s
 from .results import SimulationResult
 from .stability import step_warning
 
+
 class UnsettledWarning(UserWarning):
     """The penetration rate of a run has not settled (module doc)."""
 

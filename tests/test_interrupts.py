@@ -59,7 +59,7 @@ def stop(args: list[str], finished: Callable[[], int], signum: int, group: bool 
         _, err = process.communicate(timeout=60)
         after = time.monotonic() - sent
         time.sleep(2)
-        left = subprocess.run(["pgrep", "-s", str(process.pid)], capture_output=True, text=True).stdout.split()
+        left = subprocess.run(["pgrep", "-s", str(process.pid)], capture_output=True, text=True, check=False).stdout.split()
         return Stopped(process.returncode, after, kept, left, err)
     finally:
         with contextlib.suppress(ProcessLookupError):

@@ -43,8 +43,8 @@ from scipy import optimize
 
 from ...models.formulations import unsupported
 from ...models.scene import Scene
-from ...rocklaw.catalog import TABLE_1
 from ...models.simulation import SceneError, Simulation, prepare
+from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter
 from ..inputs.reading import InputError, describe_validation_error
 from ..inputs.specs import set_path
