@@ -18,6 +18,7 @@ import pandas as pd
 
 from ..models.definition.scene import Scene
 from ..models.evaluation.run_result import Result
+from ..models.evaluation.run_status import run_status
 from ..models.solvers.cost import Cause
 from .inputs.reading import InputError, load_scene, prepare_scene
 from .runtime.budgets import DEFAULT_BUDGET, Budget
@@ -42,7 +43,8 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     columns = {name: values.to_numpy() for name, values in result.timeseries.items()}
     write_columns_csv(folder / "timeseries.csv", columns)
     write_json(folder / "summary.json", {"scene": result.scene.name, "formulation": result.formulation,
-                                         "metrics": result.metrics, "run": result.raw.info,
+                                         "status": run_status(result.raw)[0], "metrics": result.metrics,
+                                         "run": result.raw.info,
                                          "provenance": result.provenance})
     write_resolved(folder / "scene.resolved.yaml", result.raw.simulation.resolved_scene())
     written = [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml",

@@ -102,15 +102,17 @@ def write_study(path: Path, **changes) -> Path:
     return path
 
 
-def test_accuracy_study_end_to_end(tmp_path):
+def test_accuracy_study_end_to_end(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["accuracy", str(write_study(tmp_path / "s.yaml")), "--out", str(out), "--workers", "1",
                  "--quiet"]) == 0
+    err = capsys.readouterr().err
     with (out / "workprecision.csv").open() as handle:
         rows = list(csv.DictReader(handle))
     assert [r["family"] for r in rows] == ["rk44", "rk44", "midpoint", "DOP853"]
     failed = [r for r in rows if r["status"] == "failed"]
     assert [r["family"] for r in failed] == ["midpoint"] and "diverged" in failed[0]["error"]
+    assert failed[0]["error"] in err  # printed whole, not cut mid-number
     ok = [r for r in rows if r["status"] == "ok"]
     assert all(float(r["cpu_time_s"]) > 0 and float(r["penetration_rate_error_rel"]) >= 0 for r in ok)
     assert float(ok[1]["bit_velocity_rms_error_rel"]) < float(ok[0]["bit_velocity_rms_error_rel"])

@@ -170,3 +170,26 @@ def test_declared_link_modes_agree_with_the_closed_form(link):
     samples = [{STRETCH: s, RATE: r} for s, r in zip(rng.uniform(-3e-4, 1e-4, 400), rng.uniform(-20.0, 20.0, 400))]
     assert check_mode_forces(link, samples, lambda v: link.force_n(v[STRETCH], v[RATE])) == []
     assert {link.initial_mode(v) for v in samples} == set(link.modes())
+
+
+def gapped(gap_m: float, **changes) -> Scene:
+    """The rod string preloaded, its middle coupling with a gap."""
+    data = rod_string(segments=3).model_dump(by_alias=True, exclude_none=True)
+    data["drill_string"]["connectors"]["coupling"]["gap_m"] = gap_m
+    return Scene.model_validate({**data, "start": "preloaded", **changes})
+
+
+@pytest.mark.parametrize("gap_m", [1e-4, 1e-3, 0.05])
+def test_preloaded_string_with_a_gapped_coupling_is_in_exact_static_equilibrium(gap_m):
+    """The equilibrium of a chain with gaps is piecewise linear: found exactly, the gap closed."""
+    s = gapped(gap_m)
+    prepared = prepare(s)
+    chain, q0 = prepared.chain, prepared.initial_positions_m
+    rock = np.zeros(chain.size)
+    rock[chain.bit_body] = s.rock.stiffness_n_per_m * q0[chain.bit_body]
+    residual = chain.constant_forces() + link_load_n(chain, q0, np.zeros_like(q0)) - rock
+    np.testing.assert_allclose(residual, 0.0, atol=1e-9 * s.feed.force_n)
+    assert rock[chain.bit_body] == pytest.approx(s.feed.force_n)
+    coupling = next(link for link in chain.links if link.name == "coupling")
+    assert coupling.stretch(q0) + gap_m < 0  # closed under the feed
+

@@ -9,6 +9,7 @@ file format of the studies use it.
 from __future__ import annotations
 
 import copy
+import re
 from typing import Any, TypeVar, get_args, get_origin
 
 from pydantic import BaseModel, ValidationError
@@ -17,8 +18,20 @@ ModelT = TypeVar("ModelT", bound=BaseModel)
 SHORT_VALUE_CHARS = 80  # a value longer than this is shortened in a message
 
 
+LONG_QUOTED = re.compile(r"(['\"])([^'\"\n]{78})[^'\"\n]{3,}\1")  # a quoted value beyond 80 characters
+
+
 class InputError(ValueError):
-    """Bad user input; the message is complete and meant for the user."""
+    """Bad user input; the message is complete and meant for the user (a quoted value in it beyond 80
+    characters is shortened, :func:`shortened`)."""
+
+    def __str__(self) -> str:
+        return shortened(super().__str__())
+
+
+def shortened(message: str) -> str:
+    """``message`` with every quoted value longer than 80 characters cut to 77 and '...'."""
+    return LONG_QUOTED.sub(lambda m: f"{m[1]}{m[2][:74]}...{m[1]}", message)
 
 
 def _inner_model(annotation: Any) -> tuple[type[BaseModel] | None, bool]:
@@ -82,6 +95,8 @@ STRICT_TYPES = {
     "string_type": "text is required",
     "dict_type": "a mapping of keys is required",
     "list_type": "a list [..] is required",
+    "model_type": "a mapping of keys is required (a section, not null, a value or a list)",
+    "model_attributes_type": "a mapping of keys is required (a section, not null, a value or a list)",
 }
 
 
@@ -129,17 +144,23 @@ def set_path(data: dict[str, Any], path: str, value: Any) -> None:
 
 
 def check_path(model: type[BaseModel], source: str, key: str, path: str, base: dict[str, Any] | None = None,
-               base_name: str = "the base scene") -> None:
+               base_name: str = "the base scene", value_only: bool = False) -> None:
     """``path`` must name a key of ``model`` (a scene key path); a name in a mapping of models
     (``drill_string.bodies.X``) must exist in ``base`` (a typo there would add a body, not change one).
     ``key``: where the path was given (``scan``, ``base_overrides``), prefixed to it in the message;
-    ``base_name``: what the message calls ``base``."""
+    ``base_name``: what the message calls ``base``; ``value_only`` (a scan axis): the key must hold a
+    value, not a whole section."""
     parts = tuple(path.split("."))
     where = f"{key}.{path}" if key else path
     allowed = allowed_keys(model, parts)
     if allowed is None or parts[-1] not in allowed:
         hint = f"allowed keys here: {', '.join(allowed)}" if allowed else "not a path to a scene key"
         raise InputError(f"{source}: {where}: unknown scene key path; {hint}")
+    inner = allowed_keys(model, (*parts, "?"))
+    if value_only and (inner is not None or allowed_keys(model, (*parts, "?", "?")) is not None):
+        keys = f"; its keys: {', '.join(inner)}" if inner else ""
+        raise InputError(f"{source}: {where}: a whole section, not a value; scan one of its keys "
+                         f"({path}.KEY){keys}")
     node: Any = base
     for depth, part in enumerate(parts[:-1]):
         if not isinstance(node, dict):

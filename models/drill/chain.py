@@ -10,12 +10,15 @@ segment (``to``) and last segment (``from``).
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
 from ...rocklaw import RockLaw
-from ..definition.links import LINK_TYPES, Link
+from ...rocklaw.modes import ONE
+from ..definition.links import CLOSED as CLOSED_MODE
+from ..definition.links import LINK_TYPES, RATE, STRETCH, Link
 from ..definition.scene import EVERY_BODY, GROUND, Body, Connector, Scene, Torsion
 
 
@@ -195,30 +198,77 @@ def torsion_first_order_matrix(torsion: Torsion) -> np.ndarray:
                       (torsion.drive_torque_n_m - torsion.resisting_torque_n_m) / inertia]])
 
 
+Modes = tuple[str, ...]  # a mode of each nonlinear link, in chain order
+
+
+def _static_system(chain: AxialChain, law: RockLaw, modes: Modes, contact: bool) -> tuple[np.ndarray, np.ndarray]:
+    """K and F of the static equilibrium K q = F with each nonlinear link in its mode of ``modes`` (its
+    force at rest a delta + b, linear in that mode: rocklaw.modes) and the bit on the rock (``contact``:
+    k_load) or off it."""
+    stiffness = chain.stiffness_matrix(linear_only=True)
+    forces = chain.constant_forces().astype(float)
+    for link, mode in zip(chain.nonlinear_links(), modes, strict=True):
+        force = link.modes()[mode].force
+        a, b = force.get(STRETCH, 0.0), force.get(ONE, 0.0)
+        direction = np.zeros(chain.size)
+        direction[link.body_b] = 1.0
+        if link.body_a is not None:
+            direction[link.body_a] = -1.0
+        stiffness += a * np.outer(direction, direction)
+        forces -= b * direction
+    if contact:
+        stiffness[chain.bit_body, chain.bit_body] += law.loading_stiffness_n_per_m
+    return stiffness, forces
+
+
+def _consistent(chain: AxialChain, positions: np.ndarray, modes: Modes, contact: bool) -> tuple[Modes, bool]:
+    """The modes and contact that the state ``positions`` at rest implies."""
+    implied = tuple(link.initial_mode({STRETCH: float(link.stretch(positions)), RATE: 0.0})
+                    for link in chain.nonlinear_links())
+    return implied, bool(positions[chain.bit_body] > 0.0)
+
+
+def _solve_static(chain: AxialChain, law: RockLaw, modes: Modes, contact: bool) -> np.ndarray | None:
+    stiffness, forces = _static_system(chain, law, modes, contact)
+    if np.linalg.cond(stiffness) > 1e14:  # a body with no rest position (held by an open coupling only)
+        return None
+    return np.linalg.solve(stiffness, forces)
+
+
 def static_preload_m(chain: AxialChain, law: RockLaw) -> np.ndarray:
     """The static equilibrium under the feed with the bit pressed on the rock (loading stiffness
-    k_load): F_feed + F_links(q0) - k_load q0_bit e_bit = 0, solved from the linear guess
-    (K + k_load e_bit e_bit^T) q = F_feed (exact when every link is linear). ValueError when there
-    is none or when the feed alone would crush the rock."""
-    stiffness = chain.stiffness_matrix()
-    stiffness[chain.bit_body, chain.bit_body] += law.loading_stiffness_n_per_m
-    positions = np.linalg.solve(stiffness, chain.constant_forces())
-    feed_n = float(np.sum(chain.constant_forces()))
-    if not chain.is_linear:
-        from scipy.optimize import root  # deferred: scipy.optimize takes ~0.4 s to import, only this needs it
-
-        rest = np.zeros(chain.size)
-
-        def residual(q: np.ndarray) -> np.ndarray:
-            rock = np.zeros(chain.size)
-            rock[chain.bit_body] = law.loading_stiffness_n_per_m * max(q[chain.bit_body], 0.0)
-            return chain.constant_forces() + link_load_n(chain, q, rest) - rock
-
-        solution = root(residual, positions, method="hybr", options={"xtol": 1e-13})
-        if not solution.success or np.max(np.abs(residual(solution.x))) > 1e-8 * max(feed_n, 1.0):
-            raise ValueError(f"no static equilibrium under the feed ({solution.message}); use start: rest")
-        positions = solution.x
-    rock_force = law.loading_stiffness_n_per_m * positions[chain.bit_body]
+    k_load): F_feed + F_links(q0) - k_load max(q0_bit, 0) = 0. Every link is linear within its mode
+    (a coupling open or closed), so the equilibrium is exact: the modes are iterated from those of the
+    linear guess (every coupling closed) until the solution implies the modes it was solved with,
+    then every combination is tried. ValueError naming the couplings when there is none, or when the
+    feed alone would crush the rock."""
+    nonlinear = chain.nonlinear_links()
+    contact, modes = True, tuple(CLOSED_MODE if CLOSED_MODE in link.modes() else link.initial_mode(
+        {STRETCH: 0.0, RATE: 0.0}) for link in nonlinear)
+    positions = None
+    tried: set[tuple[Modes, bool]] = set()
+    while (modes, contact) not in tried:  # iterate: converges in a step or two on a drill string
+        tried.add((modes, contact))
+        positions = _solve_static(chain, law, modes, contact)
+        if positions is None:
+            break
+        implied = _consistent(chain, positions, modes, contact)
+        if implied == (modes, contact):
+            break
+        modes, contact = implied
+    else:
+        positions = None
+    if positions is None or _consistent(chain, positions, modes, contact) != (modes, contact):
+        positions = next((q for candidate in itertools.product(*(tuple(link.modes()) for link in nonlinear))
+                          for touching in (True, False)
+                          if (q := _solve_static(chain, law, candidate, touching)) is not None
+                          and _consistent(chain, q, candidate, touching) == (candidate, touching)), None)
+    if positions is None:
+        names = ", ".join(link.name for link in nonlinear) or "none"
+        raise ValueError(f"no static equilibrium under the feed: no state of the couplings ({names}; each open or "
+                         "closed) is at rest (a body held only by an open coupling has no rest position); "
+                         "use start: rest")
+    rock_force = law.loading_stiffness_n_per_m * max(float(positions[chain.bit_body]), 0.0)
     if rock_force >= law.threshold_n:
         raise ValueError(f"the static feed alone crushes the rock (rock force {rock_force:.4g} N >= rock "
                          f"threshold {law.threshold_n:.4g} N); lower feed.force_n or use start: rest")

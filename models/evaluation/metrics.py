@@ -121,3 +121,8 @@ def summary_metrics(result: SimulationResult, energy: EnergyAccount | None = Non
     """The metrics the scene's outputs ask for (SI units in the keys), in their order."""
     window = _Window(result, energy)
     return {name: _metric(window, name) for name in result.simulation.outputs.metrics}
+
+
+def block_rates_m_per_s(result: SimulationResult) -> np.ndarray:
+    """The penetration rate of each block of the averaging window (module doc)."""
+    return _Window(result, None).block_rates

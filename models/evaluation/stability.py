@@ -156,17 +156,17 @@ def element_rates(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsio
         inverse_mass = sum(1.0 / masses[i] for i in moved)
         rate = math.sqrt(value * inverse_mass) if spring else value * inverse_mass
         lightest = min(moved, key=lambda i: masses[i])
-        departs = math.log10(value / typical[spring]) if value > 0 else -math.inf
+        departs = math.log10(value) - math.log10(typical[spring]) if value > 0 else -math.inf
         pair = ((key, value), _mass_key(scene, owner[lightest]))
-        first, second = pair if departs >= math.log10(typical_mass / masses[lightest]) else pair[::-1]
+        first, second = pair if departs >= math.log10(typical_mass) - math.log10(masses[lightest]) else pair[::-1]
         candidates.append(FastestElement(rate, *first, *second))
     if torsion is not None:
         for key, spring in (("stiffness_n_m_per_rad", True), ("damping_n_m_s_per_rad", False)):
             value, inertia = getattr(torsion, key), torsion.inertia_kg_m2
             rate = math.sqrt(value / inertia) if spring else value / inertia
             pair = ((f"torsion.{key}", value), ("torsion.inertia_kg_m2", inertia))
-            departs = math.log10(value / TORSION_REFERENCE[key]) if value > 0 else -math.inf
-            first, second = pair if departs >= math.log10(TORSION_REFERENCE["inertia_kg_m2"] / inertia) else pair[::-1]
+            departs = math.log10(value) - math.log10(TORSION_REFERENCE[key]) if value > 0 else -math.inf
+            first, second = pair if departs >= math.log10(TORSION_REFERENCE["inertia_kg_m2"]) - math.log10(inertia) else pair[::-1]
             candidates.append(FastestElement(rate, *first, *second))
     return candidates
 

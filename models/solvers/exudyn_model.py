@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import contextlib
 import gc
+import io
+import re
 import time
 import warnings
 from collections.abc import Callable, Iterator
@@ -385,6 +387,27 @@ def _no_cyclic_gc() -> Iterator[None]:
             gc.enable()
 
 
+class ExudynMessage(UserWarning):
+    """What Exudyn printed during a run (its warnings), issued as a warning instead."""
+
+
+EXUDYN_PREFIX = re.compile(r"^\s*Python WARNING \[file '[^']*', line \d+\]:\s*")
+
+
+@contextlib.contextmanager
+def _exudyn_messages_as_warnings(name: str) -> Iterator[None]:
+    """What Exudyn prints while the block runs (it prints through sys.stdout) comes out as one
+    :class:`ExudynMessage` warning per distinct line, without Exudyn's file and line prefix."""
+    printed = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(printed):
+            yield
+    finally:
+        lines = [EXUDYN_PREFIX.sub("", line).strip() for line in printed.getvalue().splitlines()]
+        for line in dict.fromkeys(line for line in lines if line):
+            warnings.warn(f"scene '{name}': Exudyn: {line}", ExudynMessage, stacklevel=3)
+
+
 def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
     return mbs.GetSensorStoredData(sensor)
 
@@ -417,7 +440,7 @@ def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: di
     pre_step = _pre_step(actions + model.pre_steps)
     if pre_step is not None:
         mbs.SetPreStepUserFunction(pre_step)
-    with _no_cyclic_gc():
+    with _no_cyclic_gc(), _exudyn_messages_as_warnings(simulation.name):
         start = time.process_time()
         ok = mbs.SolveDynamic(model.settings, solverType=SOLVER_TYPES[settings.type])
         cpu = time.process_time() - start

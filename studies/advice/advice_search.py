@@ -45,6 +45,7 @@ from ...models.definition.formulations import unsupported
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, describe_validation_error
 from ...models.solvers.simulation import SceneError, Simulation, prepare
+from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter
 from ..inputs.specs import set_path
 from ..runtime.pools import Runner
@@ -55,6 +56,7 @@ FREQUENCY, FEED = "impact.frequency_hz", "feed.force_n"
 METRICS = ("penetration_rate_m_per_s", "penetration_per_impact_energy_m_per_j")
 SLICE_POINTS = 15
 MAP_POINTS = 12
+IMPLAUSIBLE = 10  # a feed bound this many times every rock's threshold force is a unit mistake (N for kN)
 Bounds = dict[str, tuple[float, float]]  # scene path -> (low, high), SI
 Point = dict[str, float]  # scene path -> SI value
 
@@ -76,9 +78,23 @@ class AdviseParameter:
     def si_bounds(self, given: tuple[float, float]) -> tuple[float, float]:
         """Bounds given in display units as SI values; InputError unless low < high."""
         low, high = given
+        shown = f"{self.option} {low:g} {high:g}"
+        if not (math.isfinite(low) and math.isfinite(high)):
+            raise InputError(f"{shown}: the bounds must be finite numbers")
         if not low < high:
-            raise InputError(f"{self.option} {low:g} {high:g}: the lower bound must be below the upper bound")
-        return low / parameter(self.path).scale, high / parameter(self.path).scale
+            raise InputError(f"{shown}: the lower bound must be below the upper bound")
+        if low < 0 or (low == 0 and self.path != FEED):
+            allowed = "zero or above" if self.path == FEED else "above zero"
+            raise InputError(f"{shown}: the lower bound must be {allowed}")
+        scale = parameter(self.path).scale
+        if self.path == FEED and low / scale > IMPLAUSIBLE * max(r.threshold_n for r in TABLE_1.values()):
+            raise InputError(f"{shown}: beyond the threshold force of every rock ({_rocks_kn()}) by an order of "
+                             f"magnitude or more; the bounds are in {parameter(self.path).unit} (e.g. {self.option} 5 20)")
+        return low / scale, high / scale
+
+
+def _rocks_kn() -> str:
+    return ", ".join(f"{name} {rock.threshold_n / 1e3:g} kN" for name, rock in TABLE_1.items())
 
 
 PARAMETERS = (AdviseParameter("frequency", FREQUENCY, True), AdviseParameter("feed", FEED, True),
@@ -163,6 +179,13 @@ def runnable_scene(scene: dict[str, Any], rock: str | None, request: Request, so
             problem = describe_validation_error(source, error, Scene) if isinstance(error, ValidationError) else \
                 f"{source}: {'.'.join(error.location)}: {error}"
             raise InputError(f"{source}: the scene cannot run at the corner {where} of the bounds:\n{problem}") from None
+    lowest = {path: low for path, (low, _) in request.bounds.items()}
+    ratio = thrust_ratio(at_point(data, lowest))
+    if not ratio < request.max_thrust_ratio:
+        where = " ".join(f"{options[path]} {parameter(path).show(value)}" for path, value in lowest.items())
+        raise InputError(f"{source}: every point of the bounds is beyond the static limit: at their lowest corner "
+                         f"({where}{f', rock {rock}' if rock else ''}) the mean thrust is {ratio:.3g} x the rock's "
+                         f"threshold force (--max-thrust-ratio {request.max_thrust_ratio:g}); lower the bounds")
     return data
 
 

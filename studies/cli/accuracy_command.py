@@ -83,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"{spec.name}: {len(rows) - len(failed)} settings ok, {len(failed)} failed; wrote {out / 'workprecision.csv'}, "
           f"{out / 'pareto.csv'}, {out / 'reference.json'}, {', '.join(map(str, plots))}", file=sys.stderr)
     for row in failed[:5]:
-        print(f"  {row['family']} {row['setting']} {row['value']}: {row['error'][:160]}", file=sys.stderr)
+        print(f"  {row['family']} {row['setting']} {row['value']}: {row['error']}", file=sys.stderr)
     below = report.get("agreement_below_smallest_error", {})
     for measure, ok in below.items():
         print(f"  references agree to {report['agreement'][measure]:.3g} in {measure}; smallest plotted error "

@@ -28,7 +28,7 @@ from ..advice.advice_search import (
 from ..display.catalogue import metric, parameter
 from ..figures.advice_figures import plot_curves, plot_feed_map
 from ..inputs.reading import load_scene
-from ..runtime.output_files import check_out, staged_directory, write_json
+from ..runtime.output_files import check_file_target, check_out, staged_directory, write_json
 from ..runtime.pools import pool
 from .options import add_runner_arguments, positive_count, positive_number
 
@@ -90,6 +90,8 @@ def command_line(args: argparse.Namespace) -> str:
 
 def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite, "advice.json")
+    if args.markdown:
+        check_file_target("--markdown", args.markdown)
     scene = load_scene(args.scene).model_dump(by_alias=True, exclude_none=True)
     bounds = {e.path: e.si_bounds(_given(args, e)) for e in PARAMETERS if _given(args, e) is not None}
     request = Request(args.metric, bounds, args.max_thrust_ratio,
@@ -118,5 +120,6 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {args.out}" + (f", {args.markdown}" if args.markdown else ""), file=sys.stderr)
     failed = [a for a in advices if a.failed_runs == a.runs]
     for advice in failed:
-        print(f"advise: every run failed for {advice.rock or advice.scene}: {advice.first_error}", file=sys.stderr)
+        why = advice.first_error or f"no point was run ({advice.beyond_limit} beyond the thrust limit)"
+        print(f"advise: every run failed for {advice.rock or advice.scene}: {why}", file=sys.stderr)
     return 1 if failed else 0

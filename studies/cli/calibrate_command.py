@@ -39,7 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     out = check_out(args.out, args.overwrite, CHECKPOINT)
     calibration = load_calibration(args.calibration, budget(args))
-    new = not out.exists()
+    new = not out.exists() or all(p.name.startswith(".") for p in out.iterdir())  # (its lock: studies.runtime.out_lock)
     spec = calibration.spec
     with contextlib.closing(EvaluationLog(out, calibration, args.overwrite)) as log, \
             pool(args.dask, args.workers) as (label, runner), \

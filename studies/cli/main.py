@@ -1,7 +1,8 @@
 """The ``rpdrill`` command line: one subcommand per module, each with ``add_arguments`` and ``run``.
 
 Exit status: 0 success, 1 a run failed, a check did not pass or a budget was exceeded
-(studies.runtime.budgets), 2 bad input, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM: stopped as for
+(studies.runtime.budgets), 2 bad input (also: another command writes into ``--out``, whose lock it
+holds: studies.runtime.out_lock), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM: stopped as for
 Ctrl-C, finished results kept). An unexpected exception is a bug: one line naming the input and
 where it was raised, exit status 1, no traceback. While a command runs, a warning prints as one
 line, ``rpdrill: warning: ...`` (warnings of worker processes come back to this process and print
@@ -13,6 +14,8 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib.metadata
+import os
+import shlex
 import sys
 import traceback
 import warnings
@@ -22,7 +25,8 @@ from pathlib import Path
 from ...rocklaw.exudyn_build import use_fast_build
 from ..inputs.reading import InputError
 from ..runtime.budgets import BudgetError
-from ..runtime.interrupts import Terminated, raise_if_stopped, stops_handled
+from ..runtime.interrupts import Terminated, WorkerLost, raise_if_stopped, stops_handled
+from ..runtime.out_lock import out_locked
 from . import (
     accuracy_command,
     advise_command,
@@ -88,7 +92,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     module = COMMANDS[args.command][0]
     try:
-        with one_line_warnings(), stops_handled():
+        command = shlex.join(["rpdrill", *argv])
+        with one_line_warnings(), stops_handled(), out_locked(getattr(args, "out", None), command):
             status = int(module.run(args))
             raise_if_stopped()
             return status
@@ -100,8 +105,9 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except KeyboardInterrupt as stop:
         terminated = isinstance(stop, Terminated)
-        print(f"rpdrill: {'terminated (SIGTERM)' if terminated else 'interrupted'}; finished results are kept",
-              file=sys.stderr)
+        why = "a worker process ended (killed or crashed)" if isinstance(stop, WorkerLost) else \
+            "terminated (SIGTERM)" if terminated else "interrupted"
+        print(f"rpdrill: {why}; finished results are kept", file=sys.stderr)
         return 143 if terminated else 130
     except Exception as err:  # noqa: BLE001 - a bug, not bad input: one line naming the input, no traceback
         where = traceback.extract_tb(err.__traceback__)[-1]
@@ -112,11 +118,18 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def console() -> None:
-    """The ``rpdrill`` program: :func:`main`, then exit with its status. The program and its workers load
-    Exudyn's build without range checks (rocklaw.exudyn_build: a process rpdrill owns; a user's process
-    that imports rpdrill does not). Tests call :func:`main`."""
+    """The ``rpdrill`` program: :func:`main`, then exit with its status. Tests call :func:`main`. The
+    program and its workers load Exudyn's build without range checks (rocklaw.exudyn_build: a process
+    rpdrill owns; a user's process that imports rpdrill does not). A stopped command (130, 143) has
+    written what it keeps and ended its workers: it exits at once, without the interpreter's teardown
+    of its modules (a second or more on a busy machine)."""
     use_fast_build()  # before anything imports Exudyn; the workers inherit it (rocklaw.exudyn_build)
-    sys.exit(main())
+    status = main()
+    if status in (130, 143):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    sys.exit(status)
 
 
 if __name__ == "__main__":

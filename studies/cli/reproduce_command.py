@@ -76,6 +76,8 @@ def made_by(args: argparse.Namespace, reproduction: Reproduction) -> str:
 
 def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite, "reproduction.json")
+    if args.docs is not None:
+        check_out(args.docs, True, option="--docs")
     for option, command in (("calibration", "calibrate"), ("sensitivity", "sensitivity")):
         folder = getattr(args, option)
         if folder is not None and not folder.is_dir():

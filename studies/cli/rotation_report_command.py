@@ -33,6 +33,8 @@ def made_by(args: argparse.Namespace) -> str:
 
 def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite, "rotation.md")
+    if args.docs is not None:
+        check_out(args.docs, True, option="--docs")
     check_runs(args.runs, args.rock)
     with staged_directory(args.out) as stage:
         written = [args.out / p.name for p in write_report(args.runs, stage, args.rock, made_by(args))]

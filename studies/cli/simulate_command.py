@@ -13,9 +13,11 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
+import warnings
 from pathlib import Path
 
 from ...models.definition.formulations import FORMULATIONS
+from ...models.evaluation.run_status import UnsettledWarning, run_status
 from ...models.evaluation.stability import SimulationFailed
 from ..api import save_result, simulate
 from ..display.catalogue import metric
@@ -60,6 +62,9 @@ def run(args: argparse.Namespace) -> int:
         raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
         print(f"{args.scene}: {err}", file=sys.stderr)
         return 1
+    status, why = run_status(result.raw)
+    if status == "unsettled":  # (an unstable step was said as the run started: models.solvers.exudyn_model)
+        warnings.warn(why, UnsettledWarning, stacklevel=1)
     with staged_directory(args.out) as stage:
         save_result(result, stage, animate=args.animate)
         if solution is not None:

@@ -44,14 +44,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def report(study: Study, out: Path, rows: list[Row], optima: list[Record], written: list[Path],
            skipped: list[str]) -> None:
     """What a study wrote and its failed points (stderr), its optima table (stdout)."""
-    failed = [row for row in rows if row["status"] != "ok"]
-    print(f"{study.spec.name}: {len(rows) - len(failed)} points ok, {len(failed)} failed; wrote "
+    failed = [row for row in rows if row["status"] == "failed"]
+    flagged = [row for row in rows if row["status"] not in ("ok", "failed")]
+    kinds = ", ".join(f"{sum(r['status'] == kind for r in flagged)} {kind}" for kind in ("unstable", "unsettled")
+                      if any(r["status"] == kind for r in flagged))
+    print(f"{study.spec.name}: {len(rows) - len(failed) - len(flagged)} points ok, {kinds + ', ' if kinds else ''}"
+          f"{len(failed)} failed; wrote "
           f"{out / 'results.csv'}, {out / 'study.json'}, {out / 'optima.csv'}" + "".join(f", {p}" for p in written),
           file=sys.stderr)
     if skipped:
         print(f"  no plot {', '.join(skipped)}: no point has a result for its metrics", file=sys.stderr)
-    for row in failed[:5]:
-        print(f"  point {row['point']}: {row['error']}", file=sys.stderr)
+    for row in (failed + flagged)[:5]:
+        print(f"  point {row['point']} ({row['status']}): {row['error']}", file=sys.stderr)
     table = optima_table(optima)
     print(table or f"{study.spec.name}: no optima (no figure of merit collected, or no numeric axis with "
                     "three or more values)")
@@ -62,4 +66,4 @@ def run(args: argparse.Namespace) -> int:
                                workers=args.workers, dask=args.dask, quiet=args.quiet)
     for outcome in outcomes:
         report(*outcome)
-    return 1 if any(row["status"] != "ok" for outcome in outcomes for row in outcome[2]) else 0
+    return 1 if any(row["status"] == "failed" for outcome in outcomes for row in outcome[2]) else 0

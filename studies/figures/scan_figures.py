@@ -85,7 +85,7 @@ def _curves(plot: Plot, study: Study, rows: list[Row], optima: list[Record], pat
             label = curve_label({**leading, **curve}) + (f" ({reasons[-1].split(':')[0]})" if reasons[-1] else "")
             ax.plot(x, y, lw=1.2, ms=4, label=label or None, **style.kwargs())
             _mark_optimum(ax, _optimum(optima, name, plot.x, curve), x, y, xq, yq, style.color)
-            failed = x[[r["status"] != "ok" for r in members]]
+            failed = x[[r["status"] == "failed" for r in members]]
             if failed.size:
                 ax.plot(failed, np.zeros_like(failed), "x", color=style.color, ms=7, mew=1.5,
                         clip_on=False, transform=ax.get_xaxis_transform())
@@ -97,7 +97,7 @@ def _curves(plot: Plot, study: Study, rows: list[Row], optima: list[Record], pat
     axes[-1, 0].set_xlabel(xq.label())
     marks = "star: refined optimum, bar: 80 % band" if any(r["along"] == plot.x for r in optima) else "star: maximum"
     axes[0, 0].set_title(title(study, marks + (", x on the axis: failed run" if any(
-        r["status"] != "ok" for r in rows) else "")), fontsize=9)
+        r["status"] == "failed" for r in rows) else "")), fontsize=9)
     if len(groups) > 1:
         fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside right upper", fontsize=8)
     return save(fig, path)

@@ -37,13 +37,13 @@ MERGE = "tag:yaml.org,2002:merge"
 def read_text(path: str | Path) -> str:
     """The UTF-8 text of a regular file, or InputError naming the file and what is wrong with it."""
     path = Path(path)
-    if not path.exists():
-        raise InputError(f"{path}: no such file")
-    if path.is_dir():
-        raise InputError(f"{path}: is a directory; give a YAML file")
-    if not path.is_file():
-        raise InputError(f"{path}: not a regular file (a device, pipe or socket); give a YAML file")
     try:
+        if not path.exists():
+            raise InputError(f"{path}: no such file")
+        if path.is_dir():
+            raise InputError(f"{path}: is a directory; give a YAML file")
+        if not path.is_file():
+            raise InputError(f"{path}: not a regular file (a device, pipe or socket); give a YAML file")
         size = path.stat().st_size
         if size > MAX_FILE_BYTES:
             raise InputError(f"{path}: {size} bytes; an input file is at most {MAX_FILE_BYTES} bytes of YAML text")

@@ -115,7 +115,9 @@ class Axis(StrictSpec):
         return [float(f"{v:.12g}") for v in raw]
 
 
-def check_scene_path(source: str, key: str, path: str, base: dict[str, Any] | None = None) -> None:
+def check_scene_path(source: str, key: str, path: str, base: dict[str, Any] | None = None,
+                     value_only: bool = False) -> None:
     """A scan or override path must name a scene key; a name in a mapping (``drill_string.bodies.X``)
-    must exist in the ``base`` scene (models.definition.validation.check_path)."""
-    check_path(Scene, source, key, path, base)
+    must exist in the ``base`` scene; ``value_only`` (a scan axis): a value, not a whole section
+    (models.definition.validation.check_path)."""
+    check_path(Scene, source, key, path, base, value_only=value_only)

@@ -3,23 +3,35 @@
 In the main process both signals raise KeyboardInterrupt (:class:`Terminated` for SIGTERM) and are
 remembered: a Python callback inside Exudyn (the rock's return map) swallows the exception and the
 run ends as a failed one, so a command asks :func:`raise_if_stopped` before it records a result,
-and an interrupted run is never recorded as a failed point or evaluation. Pool workers take
-SIGTERM as SIGINT (:func:`worker_stops_like_ctrl_c`), so that a SIGTERM to the whole process group
-stops them as Ctrl-C does.
+and an interrupted run is never recorded as a failed point or evaluation. Pool workers leave the
+stopping to the command's process: they ignore Ctrl-C and end at SIGTERM or when that process ends
+(:func:`worker_ends_with_its_command`); the command ends them on a stop instead of waiting for the
+points they run (studies.runtime.pools), so that it exits within a second or two with every point
+finished before the signal kept.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import ctypes.util
+import multiprocessing
+import os
 import signal
+import sys
 from collections.abc import Iterator
 from types import FrameType
 
+PR_SET_PDEATHSIG = 1  # prctl(2): the signal a process gets when its parent ends
 _received: list[int] = []  # the signals received in this process while handled
 
 
 class Terminated(KeyboardInterrupt):
     """SIGTERM: stop as for Ctrl-C."""
+
+
+class WorkerLost(Terminated):
+    """A pool worker ended in the middle of the run (killed alone, or crashed): stop as for SIGTERM."""
 
 
 def _stop(signum: int, frame: FrameType | None) -> None:
@@ -45,6 +57,16 @@ def raise_if_stopped() -> None:
         raise Terminated() if signal.SIGTERM in _received else KeyboardInterrupt()
 
 
-def worker_stops_like_ctrl_c() -> None:
-    """In a pool worker: SIGTERM raises KeyboardInterrupt, as SIGINT does."""
-    signal.signal(signal.SIGTERM, signal.default_int_handler)
+def worker_ends_with_its_command() -> None:
+    """In a pool worker: Ctrl-C is ignored (the command's process stops the run and ends its workers),
+    SIGTERM ends it at once, and so does the end of the command's process however it ends (Linux:
+    PR_SET_PDEATHSIG), so that no worker outlives its run."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+            libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+        parent = multiprocessing.parent_process()
+        if parent is not None and os.getppid() != parent.pid:  # the command ended before the line above
+            os._exit(1)

@@ -19,25 +19,53 @@ import yaml
 from ..inputs.reading import InputError
 
 
-def check_out(out: str | Path, overwrite: bool | None = False, record: str | None = None) -> Path:
+def check_out(out: str | Path, overwrite: bool | None = False, record: str | None = None,
+              option: str = "--out") -> Path:
     """``--out`` as a folder that can take a run's files, checked before any work; InputError if it
     is a file, lies below a file, cannot be written, or is a folder that holds another run's files
     (anything but names starting with '.') unless ``overwrite`` (None: the command has no
     ``--overwrite``), or unless it holds ``record`` (a resumable command's own record, which the
     command checks itself)."""
     out = Path(out)
-    existing = next(p for p in (out, *out.parents) if p.exists())
-    if not existing.is_dir():
-        where = "is a file" if existing == out else f"lies below the file {existing}"
-        raise InputError(f"--out: {out}: {where}; give a folder")
-    if not os.access(existing, os.W_OK | os.X_OK):
-        raise InputError(f"--out: {out}: cannot write in {existing}; give a folder you can write")
-    held = sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) if existing == out else []
+    try:
+        dangling = next((p for p in (out, *out.parents) if p.is_symlink() and not p.exists()), None)
+        if dangling is not None:
+            raise InputError(f"{option}: {out}: {'' if dangling == out else f'{dangling}, on its path, is '}a symbolic "
+                             f"link to {os.readlink(dangling)}, which does not exist; give a folder")
+        existing = next(p for p in (out, *out.parents) if p.exists())
+        if not existing.is_dir():
+            where = "is a file" if existing == out else f"lies below the file {existing}"
+            raise InputError(f"{option}: {out}: {where}; give a folder")
+        if not os.access(existing, os.W_OK | os.X_OK):
+            raise InputError(f"{option}: {out}: cannot write in {existing}; give a folder you can write")
+        held = sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) if existing == out else []
+    except OSError as error:
+        raise InputError(f"{option}: {out}: cannot be used: {error.strerror or error}; give a folder you can write") \
+            from None
     if held and not overwrite and (record is None or record not in held):
         shown = ", ".join(held[:6]) + (f" and {len(held) - 6} more" if len(held) > 6 else "")
         hint = "give a new folder" + ("" if overwrite is None else ", or --overwrite to write over them")
-        raise InputError(f"--out: {out}: holds {shown} (another run's files); {hint}")
+        why = f"but no {record} (another run's files, or an earlier run's whose {record} was deleted)" if record \
+            else "(another run's files)"
+        raise InputError(f"{option}: {out}: holds {shown} {why}; {hint}")
     return out
+
+
+def check_file_target(option: str, path: str | Path) -> Path:
+    """A file a command will write (``option`` names it), checked before any work: InputError unless its
+    folder exists and can be written, and it is not a folder itself."""
+    path = Path(path)
+    try:
+        if path.is_dir():
+            raise InputError(f"{option}: {path}: is a folder; give a file name")
+        folder = path.parent
+        if not folder.is_dir():
+            raise InputError(f"{option}: {path}: no folder {folder}; create it or give a file in an existing folder")
+        if not os.access(folder, os.W_OK | os.X_OK) or (path.exists() and not os.access(path, os.W_OK)):
+            raise InputError(f"{option}: {path}: cannot be written; give a file you can write")
+    except OSError as error:
+        raise InputError(f"{option}: {path}: cannot be used: {error.strerror or error}") from None
+    return path
 
 
 @contextlib.contextmanager

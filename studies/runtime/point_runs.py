@@ -14,8 +14,9 @@ from typing import Any
 from pydantic import ValidationError
 
 from ...models.definition.scene import Scene
-from ...models.definition.validation import problem
+from ...models.definition.validation import problem, short
 from ...models.evaluation.metrics import summary_metrics
+from ...models.evaluation.run_status import run_status
 from ...models.solvers.simulation import Simulation
 from ..inputs.reading import InputError, prepare_scene
 
@@ -31,7 +32,7 @@ def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]
             related = [a for a in parameters if a.startswith(parent + ".")]
         message = problem(item)
         if len(related) == 1:
-            lines.append(f"{source}: scan.{related[0]}: {parameters[related[0]]!r}: {message}")
+            lines.append(f"{source}: scan.{related[0]}: {short(parameters[related[0]])}: {message}")
         else:
             lines.append(f"{source}: {_point(parameters)}{loc or 'scene'}: {message}")
     return lines
@@ -52,13 +53,17 @@ def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]
 
 
 def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
-    """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics; a
-    failure is returned, not raised."""
+    """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics and its
+    status (models.evaluation.run_status: ok, unstable or unsettled, the reason in ``error``); a failure is
+    returned, not raised."""
     key, simulation = task
     start = time.perf_counter()
     try:
-        metrics = summary_metrics(simulation.run())
+        result = simulation.run()
+        metrics = summary_metrics(result)
+        status, why = run_status(result)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
         return {"point": key, "status": "failed", "error": f"{type(err).__name__}: {err}",
                 "wall_time_s": time.perf_counter() - start, "metrics": {}}
-    return {"point": key, "status": "ok", "error": "", "wall_time_s": time.perf_counter() - start, "metrics": metrics}
+    return {"point": key, "status": status, "error": why, "wall_time_s": time.perf_counter() - start,
+            "metrics": metrics}

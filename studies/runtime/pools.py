@@ -6,14 +6,17 @@ process, one argument per batch), or one bound to a pool that lives for many cal
 :func:`process_pool` (local worker processes, all cores by default) and :func:`dask_pool` (a Dask
 cluster or a LocalCluster); :func:`pool` picks one for the command line options. A pool's workers
 start and import rpdrill once (a process pool's with its first call, so that a study refused before
-it runs starts none) and take batches of arguments (:func:`batches`): a run pays the process
-machinery once per pool and once per batch, not per argument. Results come in completion order, so
-the function's result must say which argument it belongs to. Workers run one BLAS thread each (so that
-two workers on two cores do not run four threads); process-pool workers are started the standard
-library's way for the platform (forked from the command's process on Linux, which has imported what
-they run) and stop on SIGTERM as on Ctrl-C (studies.runtime.interrupts). A worker's
-warnings come back with its batch and are issued again in this process (its filters and formatting
-apply; each distinct warning once per pool), so that workers print nothing themselves.
+it runs starts none). A process pool's workers take one argument at a time, so that each result
+comes back (and is kept: studies.runtime.resumable) as soon as it is finished; on a stop (Ctrl-C,
+SIGTERM, an error) the command ends its workers rather than waiting for what they run, and the
+workers end with the command however it ends (studies.runtime.interrupts). Dask workers take
+batches of arguments (:func:`batches`), which pay the scheduler's cost once per batch. Results come
+in completion order, so the function's result must say which argument it belongs to. Workers run one
+BLAS thread each (so that two workers on two cores do not run four threads); process-pool workers are
+started the standard library's way for the platform (forked from the command's process on Linux,
+which has imported what they run). A worker's warnings come back with its results and are issued
+again in this process (its filters and formatting apply; each distinct warning once per pool), so
+that workers print nothing themselves.
 """
 from __future__ import annotations
 
@@ -24,11 +27,12 @@ import os
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
 
 from threadpoolctl import threadpool_limits
 
-from .interrupts import worker_stops_like_ctrl_c
+from .interrupts import WorkerLost, raise_if_stopped, worker_ends_with_its_command
 
 Arg = TypeVar("Arg")
 Result = TypeVar("Result")
@@ -61,9 +65,9 @@ def run_batch(task: tuple[Callable[[Arg], Result], list[Arg]]) -> tuple[list[Res
 
 
 def start_process_worker() -> None:
-    """Process-pool worker initializer: SIGTERM stops it as Ctrl-C does (studies.runtime.interrupts), and
-    BLAS runs one thread."""
-    worker_stops_like_ctrl_c()
+    """Process-pool worker initializer: the command's process stops the run (studies.runtime.interrupts),
+    so a worker ignores Ctrl-C, ends at SIGTERM and when that process ends, and runs one BLAS thread."""
+    worker_ends_with_its_command()
     threadpool_limits(1)
 
 
@@ -72,18 +76,57 @@ def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> I
     return ([function(argument)] for argument in arguments)
 
 
-def _completed(futures: list[Any], as_done: Callable[[list[Any]], Iterator[Any]],
-               cancel: Callable[[list[Any]], None], registry: dict[Any, Any]) -> Iterator[list[Any]]:
+class Completed(Iterator[list[Any]]):
     """Each future's batch of results as it completes, after issuing its warnings here (``registry``:
-    those issued already); the rest cancelled when the caller stops early."""
-    try:
-        for future in as_done(futures):
+    those issued already); the rest cancelled when the caller stops early (:meth:`close`).
+    ``finished_before_stop``: whether results that completed but were not yet handed out when a stop
+    came are results (a process pool's workers ignore Ctrl-C: what they finish is whole), given by
+    :meth:`finished_now`."""
+
+    def __init__(self, futures: list[Any], as_done: Callable[[list[Any]], Iterator[Any]],
+                 cancel: Callable[[list[Any]], None], registry: dict[Any, Any], finished_before_stop: bool) -> None:
+        self.futures, self.cancel, self.registry = futures, cancel, registry
+        self.finished_before_stop = finished_before_stop
+        self.pending = as_done(futures)
+        self.given: set[Any] = set()
+
+    def __next__(self) -> list[Any]:
+        try:
+            future = next(self.pending)
+        except StopIteration:
+            self.close()
+            raise
+        except BaseException:
+            self.close()
+            raise
+        self.given.add(future)
+        return self._results(future)
+
+    def _results(self, future: Any) -> list[Any]:
+        try:
             results, caught = future.result()
-            for text, category, filename, lineno in caught:
-                warnings.warn_explicit(text, category, filename, lineno, registry=registry)
-            yield results
-    finally:
-        cancel(futures)
+        except BrokenProcessPool:  # a worker was killed: by a signal to all (a stop) or alone
+            raise_if_stopped()
+            raise WorkerLost() from None
+        for text, category, filename, lineno in caught:
+            warnings.warn_explicit(text, category, filename, lineno, registry=self.registry)
+        return results
+
+    def finished_now(self) -> list[list[Any]]:
+        """The batches that have completed but were not handed out (none unless ``finished_before_stop``)."""
+        if not self.finished_before_stop:
+            return []
+        done = [f for f in self.futures if f not in self.given and f.done() and not f.cancelled()
+                and f.exception() is None]
+        self.given.update(done)
+        return [f.result()[0] for f in done]
+
+    def close(self) -> None:
+        self.cancel(self.futures)
+
+    def __del__(self) -> None:  # as a generator's finally: a caller that stops early leaves nothing queued
+        with contextlib.suppress(Exception):
+            self.close()
 
 
 @contextlib.contextmanager
@@ -97,14 +140,29 @@ def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
     def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
         if not executors:
             executors.append(ProcessPoolExecutor(max_workers=workers, initializer=start_process_worker))
-        futures = [executors[0].submit(run_batch, (function, batch)) for batch in batches(arguments, workers)]
-        return _completed(futures, as_completed, lambda pending: [f.cancel() for f in pending], registry)
+        futures = [executors[0].submit(run_batch, (function, [argument])) for argument in arguments]
+        return Completed(futures, as_completed, lambda pending: [f.cancel() for f in pending], registry, True)
 
+    stopped = True
     try:
         yield run
+        stopped = False
     finally:
         for executor in executors:
+            if stopped:  # an interrupt or an error: the points under way are not waited for
+                _terminate_workers(executor)
             executor.shutdown(wait=True, cancel_futures=True)
+
+
+def _terminate_workers(executor: ProcessPoolExecutor) -> None:
+    """End the executor's worker processes now (SIGTERM), whatever they run."""
+    terminate = getattr(executor, "terminate_workers", None)  # Python 3.14
+    if terminate is not None:
+        terminate()
+        return
+    for process in list((getattr(executor, "_processes", None) or {}).values()):
+        with contextlib.suppress(OSError, ValueError):
+            process.terminate()
 
 
 @contextlib.contextmanager
@@ -127,7 +185,7 @@ def dask_pool(address: str | None = None, workers: int | None = None) -> Iterato
 
         def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
             futures = client.map(run_batch, [(function, batch) for batch in batches(arguments, slots)], pure=False)
-            return _completed(futures, dask_completed, client.cancel, registry)
+            return Completed(futures, dask_completed, client.cancel, registry, False)
 
         yield run
 

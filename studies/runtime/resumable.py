@@ -24,6 +24,7 @@ import json
 import os
 import sys
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timezone
@@ -32,13 +33,16 @@ from typing import Any, Protocol
 
 from tqdm import tqdm
 
-from ..inputs.reading import InputError
+from ..inputs.reading import InputError, short
 from .budgets import duration
 from .interrupts import raise_if_stopped
 from .output_files import write_json
 from .pools import Runner
 
 STATUS_COLUMNS = ("status", "error", "wall_time_s")
+# a finished point's status: ok; failed (its error says why); unstable or unsettled (metrics written,
+# but the stability check flags the run, or its blocks have not settled: models.evaluation.metrics)
+FINISHED = ("ok", "failed", "unstable", "unsettled")
 RECORD = "study.json"
 Row = dict[str, str]
 
@@ -104,18 +108,54 @@ def provenance(study: ResumableStudy, out: Path, table: str) -> dict[str, Any]:
     return checked_record(out / RECORD, fresh, study.source, [out / table])
 
 
-def finished_rows(path: Path, columns: list[str], count: int) -> dict[int, Row]:
-    """Complete rows of earlier runs by point index; the file is rewritten with just those."""
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def damage(row: Row, columns: list[str], points: Sequence[TablePoint]) -> str | None:
+    """Why a finished row of a table is not one rpdrill wrote for its point (None: it is): its columns,
+    status and point index; its parameters those of the point; its wall time and every column after it
+    (the metrics) a number, or empty."""
+    if list(row) != columns or None in row.values():
+        return "not the table's columns"
+    if not row["point"].isdigit() or int(row["point"]) >= len(points):
+        return f"point {short(row['point'])}: not a point of the study"
+    if row["status"] not in FINISHED:
+        return f"status {short(row['status'])}: not one of {', '.join(FINISHED)}"
+    point = points[int(row["point"])]
+    for name in columns:
+        if name in point.parameters and row[name] != str(point.parameters[name]):
+            return f"{name} {short(row[name])}: the point's is {short(point.parameters[name])}"
+    numeric = columns[columns.index("wall_time_s"):] if "wall_time_s" in columns else []
+    bad = next((name for name in numeric if row[name] != "" and not _is_number(row[name])), None)
+    return None if bad is None else f"{bad} {short(row[bad])}: not a number"
+
+
+def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint]) -> dict[int, Row]:
+    """Complete rows of earlier runs by point index; the file is rewritten with just those. A row cut
+    by a kill is dropped; a damaged or edited row (:func:`damage`) too, said once in a warning (its
+    point runs again)."""
     rows: dict[int, Row] = {}
+    damaged: list[str] = []
     try:
         text = path.read_text(encoding="utf-8") if path.exists() else ""
-        for row in csv.DictReader(io.StringIO(text[: text.rfind("\n") + 1], newline="")):  # drop a cut last line
-            if list(row) == columns and None not in row.values() and row["status"] in ("ok", "failed") \
-                    and row["point"].isdigit() and int(row["point"]) < count:
+        for line, row in enumerate(csv.DictReader(io.StringIO(text[: text.rfind("\n") + 1], newline="")), 2):
+            why = damage(row, columns, points)
+            if why is None:
                 rows.setdefault(int(row["point"]), row)
+            else:
+                damaged.append(f"line {line}: {why}")
     except (UnicodeDecodeError, csv.Error) as error:
         raise InputError(f"--out: {path}: not a results table rpdrill wrote ({error}); use a new --out directory") \
             from None
+    if damaged:
+        more = f" and {len(damaged) - 3} more" if len(damaged) > 3 else ""
+        warnings.warn(f"{path}: {len(damaged)} row(s) damaged or edited, dropped and their points run again "
+                      f"({'; '.join(damaged[:3])}{more})", stacklevel=2)
     temporary = path.with_suffix(".csv.tmp")
     with temporary.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.DictWriter(handle, columns)
@@ -179,7 +219,7 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
         job.out.mkdir(parents=True, exist_ok=True)
         records.append(provenance(job.study, job.out, job.table))
         write_json(job.out / RECORD, records[-1])
-        done = finished_rows(job.out / job.table, job.columns, len(job.study.points))
+        done = finished_rows(job.out / job.table, job.columns, job.study.points)
         todo = [p for p in job.study.points if p.index not in done]
         runs = []
         for point in todo:
@@ -210,8 +250,8 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
                 complete(i)
         names = ", ".join(job.study.spec.name for job in tables)
         with tqdm(total=sum(remaining), desc=names, unit="point", disable=quiet) as bar:
-            for batch in run(run_tagged, tasks) if tasks else ():
-                raise_if_stopped()  # points cut by the interrupt are not results
+            def record(batch: list[tuple[int, dict[str, Any]]]) -> None:
+                """Append a batch's rows to their tables."""
                 by_table: dict[int, list[dict[str, Any]]] = {}
                 first: dict[int, int] = {}  # per table: the outcomes of points run for it (the others copied)
                 for tag, outcome in batch:
@@ -228,6 +268,16 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
                     bar.update(len(outcomes))
                     if remaining[i] == 0:
                         complete(i)
+
+            outcomes = run(run_tagged, tasks) if tasks else iter(())
+            try:
+                for batch in outcomes:
+                    raise_if_stopped()  # points cut by the interrupt are not results
+                    record(batch)
+            except KeyboardInterrupt:  # points the workers finished before the stop are (studies.runtime.pools)
+                for batch in getattr(outcomes, "finished_now", list)():
+                    record(batch)
+                raise
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (studies.cli.main): the finished rows stay, the sessions are recorded
         for i in range(len(tables)):
             if rows[i] is None:

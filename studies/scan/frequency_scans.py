@@ -72,7 +72,7 @@ def scan_target(task: ScanTask) -> dict[str, Any]:
             outcome = run_point((key, simulation))
         for metric in metrics:
             values[metric].append(outcome["metrics"].get(metric, math.nan))
-        if outcome["status"] != "ok":
+        if outcome["status"] == "failed":  # (an unsettled or unstable run has its values: models.evaluation.run_status)
             errors.append(outcome["error"])
     return {"key": key, "values": values, "resonance_hz": resonance, "failed_runs": len(errors),
             "error": errors[0] if errors else "", "cpu_time_s": time.process_time() - start}

@@ -42,6 +42,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, model_validator
 
 from ...models.definition.scene import Scene, switch_formulation
+from ...models.definition.validation import short
 from ...models.solvers.simulation import Simulation
 from ..inputs.reading import InputError, parse, read_yaml
 from ..inputs.specs import (
@@ -200,7 +201,7 @@ def load_study(path: str | Path, formulation: str | None = None, budget: Budget 
     if formulation is not None:
         base["solver"] = switch_formulation(base.get("solver", {}), formulation)
     for axis in spec.scan:
-        check_scene_path(source, "scan", axis, base)
+        check_scene_path(source, "scan", axis, base, value_only=True)
     _check_rock_name_axis(spec, base, source)
     groups = _groups(spec, source)
     count = _point_count(groups, spec, source)
@@ -208,6 +209,7 @@ def load_study(path: str | Path, formulation: str | None = None, budget: Budget 
     what = f"scan: {count:.6g} points (" + ", ".join(f"scan.{n}: {a.count:.6g} values" for n, a in spec.scan.items()) + ")"
     check_size(budget, source, what, count, base_estimate_s(source, {**base, **outputs}))
     axes = {name: axis.expand() for name, axis in spec.scan.items()}
+    _check_distinct(axes, source)
     points, problems, bad_input = [], [], False
     for index, parameters in enumerate(_combine(groups, axes)):
         scene = copy.deepcopy(base)
@@ -238,3 +240,13 @@ def _check_rock_name_axis(spec: StudySpec, base: dict[str, Any], source: str) ->
                          "base_overrides: {rock: {name: sandstone}}")
 
 
+
+
+def _check_distinct(axes: dict[str, list[Any]], source: str) -> None:
+    """Each axis gives each value once (a value twice would give two points of one scene)."""
+    for name, values in axes.items():
+        seen: list[Any] = []
+        for value in values:
+            if value in seen:
+                raise InputError(f"{source}: scan.{name}: {short(value)}: given twice; each value of an axis once")
+            seen.append(value)

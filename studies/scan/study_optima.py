@@ -53,7 +53,7 @@ def merit_metrics(study: Study) -> list[str]:
 def metric_value(row: Row, name: str) -> float:
     """A metric of a results row; NaN for a failed point."""
 
-    return float(row[name]) if row["status"] == "ok" and row[name] != "" else float("nan")
+    return float(row[name]) if row["status"] != "failed" and row[name] != "" else float("nan")
 
 
 def curves(study: Study, rows: list[Row], along: str) -> dict[tuple[str, ...], list[Row]]:
@@ -88,7 +88,7 @@ def study_optima(study: Study, rows: list[Row]) -> list[Record]:
             main, highest = found.main_lobe, found.global_lobe
             records.append({
                 "metric": name, "curve": dict(zip(others, key, strict=True)), "along": along,
-                "points": len(members), "failed": sum(r["status"] != "ok" for r in members),
+                "points": len(members), "failed": sum(r["status"] == "failed" for r in members),
                 "best": None if highest is None else x[values.index(highest.peak_value)],
                 "best_value": None if highest is None else highest.peak_value,
                 "optimum": None if main is None else main.peak_hz,

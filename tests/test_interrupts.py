@@ -1,0 +1,201 @@
+"""Interrupts with real processes (issue #30): a command sent SIGINT or SIGTERM (to it alone or to its
+whole process group), or killed, exits within 2 s keeping every point finished before the signal, no
+process of its run is left 2 s later, and a rerun completes with the rows of an uninterrupted run."""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+import yaml
+from scenes import PAPER_BASE
+
+ROOT = Path(__file__).resolve().parents[1]
+EXIT_WITHIN_S = 2.0
+
+
+@dataclass
+class Stopped:
+    status: int
+    exit_after_s: float  # from the signal to the exit
+    kept_at_signal: int  # points finished when the signal was sent
+    left: list[str]  # processes of the run's session alive 2 s after it exited
+    err: str
+
+
+def command(*args: str) -> list[str]:
+    return [sys.executable, "-m", "rpdrill.studies.cli", *args]
+
+
+def stop(args: list[str], finished: Callable[[], int], signum: int, group: bool | None = True, at_least: int = 1,
+         timeout_s: float = 240) -> Stopped:
+    """Run ``args`` in a session of its own; once ``finished()`` reaches ``at_least``, send ``signum`` to
+    its whole process group (``group``), the command alone, or one of its workers alone (None); how it
+    ended."""
+    process = subprocess.Popen(args, cwd=ROOT, start_new_session=True, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline and process.poll() is None and finished() < at_least:
+            time.sleep(0.05)
+        assert process.poll() is None, "the command ended before the signal"
+        kept = finished()
+        sent = time.monotonic()
+        if group is None:  # one of its workers alone
+            children = Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text().split()
+            os.kill(int(children[0]), signum)
+        else:
+            (os.killpg if group else os.kill)(process.pid, signum)
+        _, err = process.communicate(timeout=60)
+        after = time.monotonic() - sent
+        time.sleep(2)
+        left = subprocess.run(["pgrep", "-s", str(process.pid)], capture_output=True, text=True, check=False).stdout.split()
+        return Stopped(process.returncode, after, kept, left, err)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)  # whatever of the run is left (its own process group)
+
+
+def csv_rows(path: Path) -> list[dict[str, str]]:
+    if not path.exists():
+        return []
+    with path.open(newline="", encoding="utf-8") as handle:
+        return [r for r in csv.DictReader(handle) if None not in r.values()]
+
+
+def lines(path: Path) -> int:
+    return len([line for line in path.read_text().splitlines() if line.strip()]) if path.exists() else 0
+
+
+def without_times(rows: list[dict[str, str]]) -> list[dict[str, str]]:
+    return sorted(({k: v for k, v in r.items() if k not in ("wall_time_s", "cpu_time_s")} for r in rows),
+                  key=lambda r: int(r["point"]))
+
+
+def write(path: Path, data: dict) -> Path:
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def study_file(tmp_path: Path) -> Path:
+    """12 points of about 0.5 s each (3 s of the test drill on Exudyn)."""
+    return write(tmp_path / "long.yaml", {
+        "name": "long", "base_scene": str(PAPER_BASE), "base_overrides": {"solver.end_time_s": 3.0},
+        "scan": {"impact.frequency_hz": [40, 42, 44, 46, 48, 50, 52, 54, 56, 58, 60, 62]},
+        "metrics": ["penetration_rate_m_per_s", "bit_velocity_peak_m_per_s"]})
+
+
+def assert_stopped_cleanly(stopped: Stopped, status: int, kept: int) -> None:
+    assert stopped.status == status, stopped.err
+    assert stopped.exit_after_s < EXIT_WITHIN_S, stopped
+    assert not stopped.left, stopped
+    assert "Traceback" not in stopped.err and "internal error" not in stopped.err
+    assert kept >= stopped.kept_at_signal  # every point finished before the signal is kept
+
+
+@pytest.mark.parametrize("signum, group", [(signal.SIGINT, True), (signal.SIGTERM, True), (signal.SIGTERM, False)])
+def test_a_study_stops_within_2_s_keeping_its_finished_points(tmp_path, signum, group):
+    out = tmp_path / "out"
+    stopped = stop(command("study", str(study_file(tmp_path)), "--out", str(out), "--workers", "2", "--quiet"),
+                   lambda: len(csv_rows(out / "results.csv")), signum, group, at_least=2)
+    kept = csv_rows(out / "results.csv")
+    assert_stopped_cleanly(stopped, 130 if signum == signal.SIGINT else 143, len(kept))
+    assert len(kept) < 12 and all(r["status"] != "failed" for r in kept)
+    assert json.loads((out / "study.json").read_text())["sessions"][-1]["interrupted"] is True
+
+
+def test_a_killed_study_leaves_no_worker(tmp_path):
+    out = tmp_path / "out"
+    stopped = stop(command("study", str(study_file(tmp_path)), "--out", str(out), "--workers", "2", "--quiet"),
+                   lambda: len(csv_rows(out / "results.csv")), signal.SIGKILL, group=False, at_least=1)
+    assert stopped.status == -signal.SIGKILL and not stopped.left, stopped
+
+
+def test_a_worker_killed_alone_stops_the_run_keeping_its_finished_points(tmp_path):
+    out = tmp_path / "out"
+    stopped = stop(command("study", str(study_file(tmp_path)), "--out", str(out), "--workers", "2", "--quiet"),
+                   lambda: len(csv_rows(out / "results.csv")), signal.SIGTERM, group=None, at_least=1)
+    assert stopped.status == 143 and "worker process ended" in stopped.err, stopped
+    assert stopped.exit_after_s < 5 and not stopped.left, stopped
+    assert len(csv_rows(out / "results.csv")) >= stopped.kept_at_signal
+
+
+@pytest.mark.slow
+def test_an_interrupted_study_resumes_to_the_rows_of_an_uninterrupted_run(tmp_path):
+    study, out, whole = study_file(tmp_path), tmp_path / "out", tmp_path / "whole"
+    stopped = stop(command("study", str(study), "--out", str(out), "--workers", "2", "--quiet"),
+                   lambda: len(csv_rows(out / "results.csv")), signal.SIGINT, at_least=3)
+    assert_stopped_cleanly(stopped, 130, len(csv_rows(out / "results.csv")))
+    for folder in (out, whole):
+        subprocess.run(command("study", str(study), "--out", str(folder), "--workers", "2", "--quiet"), cwd=ROOT,
+                       check=True, capture_output=True)
+    assert without_times(csv_rows(out / "results.csv")) == without_times(csv_rows(whole / "results.csv"))
+
+
+def sensitivity_file(tmp_path: Path) -> Path:
+    """The tiny sensitivity study of test_sensitivity on Exudyn (each point a scan of about 2 s)."""
+    return write(tmp_path / "sensitivity.yaml", {
+        "name": "tiny", "base_scene": str(PAPER_BASE),
+        "base_overrides": {"solver": {"end_time_s": 0.6}, "metrics": {"transient_blows": 10, "block_blows": 5},
+                           "rock.threshold_n": 60e3, "feed.force_n": 20e3},
+        "frequency_hz": {"from": 35, "to": 70, "step": 5},
+        "metrics": ["penetration_rate_m_per_s", "collar_velocity_peak_m_per_s"],
+        "scans": [{"label": "160 kN", "overrides": {"impact.amplitude_n": 160e3}},
+                  {"label": "220 kN", "overrides": {"impact.amplitude_n": 220e3}}],
+        "parameters": ["drill_string.bodies.collar.mass_kg", "rock.stiffness_n_per_m"]})
+
+
+@pytest.mark.slow
+def test_a_sensitivity_study_stops_within_2_s_and_resumes_to_the_same_rows(tmp_path):
+    study, out, whole = sensitivity_file(tmp_path), tmp_path / "out", tmp_path / "whole"
+    stopped = stop(command("sensitivity", str(study), "--out", str(out), "--workers", "2", "--quiet"),
+                   lambda: len(csv_rows(out / "results.csv")), signal.SIGINT, at_least=1)
+    kept = csv_rows(out / "results.csv")
+    assert_stopped_cleanly(stopped, 130, len(kept))
+    assert 1 <= len(kept) < 10
+    for folder in (out, whole):
+        subprocess.run(command("sensitivity", str(study), "--out", str(folder), "--workers", "2", "--quiet"),
+                       cwd=ROOT, check=True, capture_output=True)
+    assert without_times(csv_rows(out / "results.csv")) == without_times(csv_rows(whole / "results.csv"))
+
+
+def calibration_file(tmp_path: Path) -> Path:
+    """The tiny calibration of test_calibrate on Exudyn: 10 evaluations of 3 scans of 6 frequencies."""
+    return write(tmp_path / "calibration.yaml", {
+        "name": "tiny", "base_scene": str(PAPER_BASE),
+        "base_overrides": {"solver": {"end_time_s": 0.4}, "metrics": {"transient_blows": 5, "block_blows": 5}},
+        "frequency_hz": {"from": 40, "to": 90, "step": 10}, "refine_hz": 2,
+        "parameters": {"drill_string.bodies.collar.mass_kg": {"bounds": [2000.0, 4000.0], "scale": "log",
+                                                              "reason": "sets the rock mode"},
+                       "impact.duration_s": {"bounds": [0.8e-3, 1.4e-3], "reason": "piston length"}},
+        "targets": [{"label": "a", "optimum_hz": 60, "band_hz": [55, 65], "overrides": {"impact.amplitude_n": 400e3}},
+                    {"label": "b", "optimum_hz": 70, "metric": "collar_velocity_peak_m_per_s"}],
+        "search": {"popsize": 2, "max_generations": 1, "seed": 3}})
+
+
+@pytest.mark.slow
+def test_a_calibration_stops_within_2_s_and_resumes_to_the_same_evaluations(tmp_path):
+    spec, out, whole = calibration_file(tmp_path), tmp_path / "out", tmp_path / "whole"
+    stopped = stop(command("calibrate", str(spec), "--out", str(out), "--workers", "2", "--quiet"),
+                   lambda: lines(out / "evaluations.jsonl"), signal.SIGINT, at_least=1)
+    assert_stopped_cleanly(stopped, 130, lines(out / "evaluations.jsonl"))
+    for folder in (out, whole):
+        subprocess.run(command("calibrate", str(spec), "--out", str(folder), "--workers", "2", "--quiet"),
+                       cwd=ROOT, check=True, capture_output=True)
+
+    def by_unit(folder: Path) -> dict[tuple[float, ...], float]:
+        records = [json.loads(line) for line in (folder / "evaluations.jsonl").read_text().splitlines()]
+        return {tuple(r["unit"]): r["objective"] for r in records}
+
+    assert by_unit(out) == by_unit(whole)
+    assert (out / "calibrated_scene.yaml").read_text() == (whole / "calibrated_scene.yaml").read_text()
