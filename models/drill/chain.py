@@ -62,14 +62,15 @@ class AxialChain:
         return np.diag([b.mass_kg for b in self.bodies])
 
     def _assemble(self, attribute: str, links: tuple[Link, ...]) -> np.ndarray:
-        matrix = np.zeros((self.size, self.size))
-        for link in links:
-            value = getattr(link, attribute)
-            matrix[link.body_b, link.body_b] += value
-            if link.body_a is not None:
-                matrix[link.body_a, link.body_a] += value
-                matrix[link.body_a, link.body_b] -= value
-                matrix[link.body_b, link.body_a] -= value
+        """D^T diag(values) D: the links' stiffness or damping matrix, from their incidence D."""
+        incidence = self.incidence(links)
+        values = np.array([getattr(link, attribute) for link in links])
+        return incidence.T @ (values[:, None] * incidence)
+
+    def with_rock(self, matrix: np.ndarray, rock_value: float) -> np.ndarray:
+        """``matrix`` + rock_value e_b e_b^T: a stiffness (or damping) with the rock's in contact on the bit."""
+        matrix = matrix.copy()
+        matrix[self.bit_body, self.bit_body] += rock_value
         return matrix
 
     def linear_links(self) -> tuple[Link, ...]:
@@ -99,9 +100,8 @@ class AxialChain:
         from their own laws) plus a spring and damper from the bit to ground (the rock in contact)."""
         links = self.linear_links() if links is None else links
         n = self.size
-        stiffness, damping = self._assemble("stiffness_n_per_m", links), self._assemble("damping_n_s_per_m", links)
-        stiffness[self.bit_body, self.bit_body] += bit_stiffness_n_per_m
-        damping[self.bit_body, self.bit_body] += bit_damping_n_s_per_m
+        stiffness = self.with_rock(self._assemble("stiffness_n_per_m", links), bit_stiffness_n_per_m)
+        damping = self.with_rock(self._assemble("damping_n_s_per_m", links), bit_damping_n_s_per_m)
         inverse_mass = 1.0 / np.array([b.mass_kg for b in self.bodies])
         matrix = np.zeros((2 * n, 2 * n + 1))
         matrix[:n, n:2 * n] = np.eye(n)
@@ -210,14 +210,11 @@ def _static_system(chain: AxialChain, law: RockLaw, modes: Modes, contact: bool)
     for link, mode in zip(chain.nonlinear_links(), modes, strict=True):
         force = link.modes()[mode].force
         a, b = force.get(STRETCH, 0.0), force.get(ONE, 0.0)
-        direction = np.zeros(chain.size)
-        direction[link.body_b] = 1.0
-        if link.body_a is not None:
-            direction[link.body_a] = -1.0
+        direction = chain.incidence((link,))[0]  # delta = direction . q
         stiffness += a * np.outer(direction, direction)
         forces -= b * direction
     if contact:
-        stiffness[chain.bit_body, chain.bit_body] += law.loading_stiffness_n_per_m
+        stiffness = chain.with_rock(stiffness, law.loading_stiffness_n_per_m)
     return stiffness, forces
 
 

@@ -29,8 +29,7 @@ def rock_mode_frequency_hz(chain: AxialChain, rock: RockLaw) -> float:
     system = chain.first_order_matrix(chain.links, rock_stiffness, rock.damping_n_s_per_m)[:, :-1]
     eigenvalues, eigenvectors = scipy.linalg.eig(system)
     shapes = eigenvectors[:size]
-    stiffness = chain.stiffness_matrix()
-    stiffness[bit, bit] += rock_stiffness
+    stiffness = chain.with_rock(chain.stiffness_matrix(), rock_stiffness)
     strain = np.real(np.einsum("im,ij,jm->m", shapes.conj(), stiffness, shapes))
     share = rock_stiffness * np.abs(shapes[bit]) ** 2 / strain
     return float(abs(eigenvalues[int(np.argmax(share))].imag) / (2 * np.pi))
