@@ -105,12 +105,13 @@ Part = tuple[Cause, float, float | None]
 def _exudyn(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     settings, scene, n = simulation.settings, simulation.scene, simulation.chain.size
     step = settings.step_s
-    limits = EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].step_limits(scene.impact.duration_s,
+    limits = EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].step_limits(simulation.pulse_duration_s,
                                                                           simulation.step_scales)
     if scene.solver.step_s is not None:
         cause = Cause("solver.step_s", step)
     elif math.isclose(step, limits["pulse"]):
-        cause = Cause("impact.duration_s", scene.impact.duration_s)
+        cause = Cause("impact.duration_s", scene.impact.duration_s) if simulation.piston is None else \
+            Cause("impact.piston", f"a contact of {simulation.pulse_duration_s:.3g} s")
     elif math.isclose(step, limits["damper"]):
         cause = _rock_damper(simulation)
     else:

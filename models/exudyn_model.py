@@ -41,6 +41,7 @@ from exudyn.itemInterface import (
 from ..rocklaw.backends import SCALAR, SymbolicBackend
 from ..rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 from .chain import AxialChain, Link
+from .exudyn_piston import ExudynPiston
 from .formulations import AUTOMATIC_STEP_SOLVERS
 from .indexing import BlowStarts
 from .pulse import impact_force
@@ -77,6 +78,7 @@ class ExudynDrill:
     settings: Any
     symbolic_functions: list[Any] = field(default_factory=list)  # kept alive with the system
     blows: BlowStarts | None = None  # the blow starts of this run (models.indexing)
+    piston: ExudynPiston | None = None  # the piston's strikes and catches (models.piston)
 
     @property
     def coordinate_count(self) -> int:
@@ -133,14 +135,16 @@ def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
     ``symbolic=False`` uses Python callbacks for the impact and rock forces (same law, slower:
     kept for the benchmark that measures what the symbolic functions save).
     """
-    chain, impact = simulation.chain, simulation.impact
+    chain, impact = simulation.dynamic_chain, simulation.impact
+    piston = simulation.piston
+    initial_positions = simulation.initial_positions_m if piston is None else piston.parked(simulation.initial_positions_m)
     container = exu.SystemContainer()
     mbs = container.AddSystem()
     ground = mbs.AddNode(NodePointGround())
     ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
 
     nodes, markers = [], []
-    for body, initial in zip(chain.bodies, simulation.initial_positions_m, strict=True):
+    for body, initial in zip(chain.bodies, initial_positions, strict=True):
         node, marker = _add_coordinate_body(
             mbs, lambda n, m=body.mass_kg: mbs.AddObject(ObjectMass1D(nodeNumber=n, mass=m)), initial)
         nodes.append(node)
@@ -211,8 +215,9 @@ def build_exudyn(simulation: Simulation, symbolic: bool = True) -> ExudynDrill:
         sensors["omega"] = _store(mbs, SensorNode(nodeNumber=torsion_node, storeInternal=True, outputVariableType=RATE))
 
     mbs.Assemble()
+    hook = None if piston is None else ExudynPiston(piston, nodes, mbs, impact.period_s)
     return ExudynDrill(simulation, chain, container, mbs, rock, sensors, _simulation_settings(simulation),
-                       [impact_function, *user_functions], blows)
+                       [impact_function, *user_functions], blows, hook)
 
 
 class _MinimumStepGuard:
@@ -280,6 +285,8 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     drill = build_exudyn(simulation, symbolic)
     mbs = drill.mbs
     actions = [drill.rock.update_bottom] if drill.rock.rock.crushes else []
+    if drill.piston is not None:
+        actions.insert(0, drill.piston)
     guard = None
     if settings.type in AUTOMATIC_STEP_SOLVERS:
         guard = _MinimumStepGuard(drill.settings.timeIntegration.minimumStepSize)
@@ -300,6 +307,8 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     position = np.column_stack([data[f"x{i}"][:, 1] for i in range(n)])
     velocity = np.column_stack([data[f"v{i}"][:, 1] for i in range(n)])
     history = np.array(drill.rock.bottom_history)
+    piston = None if drill.piston is None else drill.piston.history(time_s, position, velocity)
+    position, velocity = position[:, :simulation.chain.size], velocity[:, :simulation.chain.size]
     rock_state = drill.rock.state_at(time_s)
     result = SimulationResult(
         simulation=simulation,
@@ -309,7 +318,7 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
         velocity_m_per_s=velocity,
         bottom_m=rock_state[:, drill.rock.rock.bottom_index],
         rock_force_n=data["rock"][:, 1] if "rock" in data else None,
-        impact_force_n=data["impact"][:, 1] if "impact" in data else None,
+        impact_force_n=(data["impact"][:, 1] if piston is None else piston.contact_force_n) if "impact" in data else None,
         torsion_angle_rad=data["phi"][:, 1] if "phi" in data else None,
         torsion_rate_rad_per_s=data["omega"][:, 1] if "omega" in data else None,
         cpu_time_s=cpu,
@@ -317,6 +326,7 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
               **({"fresh_fractions": drill.blows.fresh_fractions} if drill.blows else {})},
         bottom_events=(history[:, 0], history[:, 1]),
         rock_state_m=rock_state,
+        piston=piston,
     )
     if guard is not None and guard.reached_at_s is not None:
         raise SimulationFailed(

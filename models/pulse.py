@@ -31,7 +31,9 @@ OFF, ON, RISING, FALLING = PHASES = ("off", "on", "rising", "falling")
 
 
 def impact_force(impact: Impact, t: Any, backend: Backend = NUMERIC) -> Any:
-    """F_d(t) [N] on the shank."""
+    """F_d(t) [N] on the shank (none with a piston: models.piston)."""
+    if impact.piston is not None:
+        return 0.0 * backend.mod(t, impact.period_s)
     tau = impact.duration_s
     s = backend.mod(t, impact.period_s)
     if impact.shape == "half_sine":
@@ -45,13 +47,17 @@ def impact_force(impact: Impact, t: Any, backend: Backend = NUMERIC) -> Any:
 
 
 def impulse_per_blow_n_s(impact: Impact) -> float:
-    """Integral of F_d over one pulse [N s]."""
+    """Integral of F_d over one pulse [N s]; with a piston its momentum m_p v_p (the most a blow gives)."""
+    if impact.piston is not None:
+        return impact.piston.total_mass_kg * impact.piston.strike_velocity_m_per_s
     factor = {"half_sine": 2.0 / math.pi, "rectangular": 1.0, "triangular": 0.5}[impact.shape]
     return factor * impact.amplitude_n * impact.duration_s
 
 
 def _pieces_of_a_period(impact: Impact) -> tuple[tuple[float, float, str], ...]:
-    """(start, end, phase) within one period, times after the blow's start."""
+    """(start, end, phase) within one period, times after the blow's start (a piston: no pulse phase)."""
+    if impact.piston is not None:
+        return ((0.0, impact.period_s, OFF),)
     tau = impact.duration_s
     inner = ((0.0, 0.5 * tau, RISING), (0.5 * tau, tau, FALLING)) if impact.shape == "triangular" else ((0.0, tau, ON),)
     return (*inner, (tau, impact.period_s, OFF))
@@ -93,9 +99,9 @@ def generator_states(impact: Impact, local_s: np.ndarray) -> np.ndarray:
 
 def phase_row(impact: Impact, phase: str) -> np.ndarray:
     """F_d = row . (1, u1, u2) in ``phase``."""
-    amplitude, slope = impact.amplitude_n, 2.0 * impact.amplitude_n / impact.duration_s
     if phase == OFF:
         return np.zeros(3)
+    amplitude, slope = impact.amplitude_n, 2.0 * impact.amplitude_n / impact.duration_s
     if impact.shape == "half_sine":
         return np.array([0.0, amplitude, 0.0])
     if impact.shape == "rectangular":
