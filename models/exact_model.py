@@ -259,9 +259,10 @@ class ExactSolver:
         blows = blow_start_times(self.impact, settings.end_time_s) if starts else np.empty(0)
         self.blow_phases = np.isin(self.phase_times[:, 0], blows).astype(np.int64)
 
-    def start_blow(self, w: np.ndarray, mode_id: int, time_s: float) -> int:
+    def start_blow(self, w: np.ndarray, mode_id: int, time_s: float, row: int) -> int:
         """Set the rock states of w to those the blow starting now meets, and strike with the piston
-        (models.piston); the mode id with the rock's mode found again and the piston's contact closing."""
+        (models.piston; ``row`` the first sample after it); the mode id with the rock's mode found again and
+        the piston's contact closing."""
         layout, rock = self.layout, self.model.pieces[0]
         modes = self.operators.modes[mode_id]
         if self.blows:
@@ -272,22 +273,20 @@ class ExactSolver:
             modes = (rock.initial_mode(w), *modes[1:])
         if self.piston is not None:
             n, setup = layout.n, self.piston.setup
-            self.piston.strike(time_s, w[:n], w[n:2 * n])
+            self.piston.strike(time_s, w[:n], w[n:2 * n], row)
             closing = w[n + setup.front] > w[n + setup.impact_body]
             modes = modes[:self.contact] + (CLOSED if closing else OPEN,) + modes[self.contact + 1:]
         return self.operators.mode_id(modes)
 
     def note_catches(self, time_s: np.ndarray, rows: np.ndarray, switch_times: np.ndarray,
-                     entered: list[Modes]) -> np.ndarray:
+                     entered: list[Modes]) -> None:
         """Note every catch (a switch into the contact's ``caught`` mode, its entry reset applied by the
-        kernel) from the row before it; whether each row lies after the jumps at its time (the last of
-        the rows of one time)."""
+        kernel) from the row recorded before it (the kernel records both sides of a switch)."""
         n = self.layout.n
         for t, modes in zip(switch_times, entered, strict=True):
             if modes[self.contact] == CAUGHT:
-                before = rows[int(np.searchsorted(time_s, t, side="left"))]
-                self.piston.noted_catch(float(t), before[:n], before[n:2 * n])
-        return np.append(time_s[1:] != time_s[:-1], True)
+                before = int(np.flatnonzero(time_s == t)[0])
+                self.piston.noted_catch(float(t), rows[before, :n], rows[before, n:2 * n], before + 1)
 
     def works_j(self, time_s: np.ndarray, rows: np.ndarray) -> dict[str, np.ndarray]:
         """Cumulative impact work int F_d v_shank dt and internal work (what the links, the rock and the
@@ -344,7 +343,7 @@ class ExactSolver:
                 self.per_sample, self.min_switch_interval_s, self.max_switches, n, POSITION_LIMIT_M, progress, clock,
                 w, time_s, rows, row_keys, switch_times, switch_modes)
             if status == BLOW_START:
-                progress[1] = self.start_blow(w, progress[1], float(clock[0]))
+                progress[1] = self.start_blow(w, progress[1], float(clock[0]), int(progress[2]))
             elif status == MISSING_KEY:
                 ops.add(ops.modes[progress[1]], self.phases[progress[0]])
             else:
@@ -397,8 +396,8 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     cpu = time.process_time() - start
     impact_force, piston = rows[:, layout.size + 1], None
     if solver.piston is not None:
-        after = solver.note_catches(time_s, rows, switch_times, entered)
-        piston = piston_history(simulation.piston, solver.piston, time_s, rows[:, :n], rows[:, n:2 * n], after)
+        solver.note_catches(time_s, rows, switch_times, entered)
+        piston = piston_history(simulation.piston, solver.piston, time_s, rows[:, :n], rows[:, n:2 * n], None)
         impact_force = piston.contact_force_n
     bodies = simulation.chain.size  # the drill string's (a piston's follow)
     if progress is not None:

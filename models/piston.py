@@ -253,21 +253,28 @@ class PistonJumps:
 
     setup: PistonSetup
     log: list[tuple[float, str, float, float]] = field(default_factory=list)
+    rows: list[int] = field(default_factory=list)  # per log entry, the first sample after it (if known)
     caught: bool = True  # no blow before the first strike
 
-    def _note(self, time_s: float, kind: str, position_m: np.ndarray, velocity_m_per_s: np.ndarray) -> None:
+    def _note(self, time_s: float, kind: str, position_m: np.ndarray, velocity_m_per_s: np.ndarray,
+              row: int | None) -> None:
         self.log.append((time_s, kind, float(self.setup.energy_j(position_m, velocity_m_per_s)),
                          float(self.setup.mean_velocity_m_per_s(velocity_m_per_s))))
+        if row is not None:
+            self.rows.append(row)
 
-    def strike(self, time_s: float, position_m: np.ndarray, velocity_m_per_s: np.ndarray) -> None:
-        """The strike at a blow start, in place on a state of the dynamic chain."""
-        self._note(time_s, "strike", position_m, velocity_m_per_s)
+    def strike(self, time_s: float, position_m: np.ndarray, velocity_m_per_s: np.ndarray,
+               row: int | None = None) -> None:
+        """The strike at a blow start, in place on a state of the dynamic chain; ``row`` the first sample
+        after it, where the formulation knows it (:meth:`input_by_row`)."""
+        self._note(time_s, "strike", position_m, velocity_m_per_s, row)
         self.setup.strike(position_m, velocity_m_per_s)
         self.caught = False
 
-    def noted_catch(self, time_s: float, position_m: np.ndarray, velocity_m_per_s: np.ndarray) -> None:
+    def noted_catch(self, time_s: float, position_m: np.ndarray, velocity_m_per_s: np.ndarray,
+                    row: int | None = None) -> None:
         """A catch that the formulation applies itself (the contact's mode table: PistonContact)."""
-        self._note(time_s, "catch", position_m, velocity_m_per_s)
+        self._note(time_s, "catch", position_m, velocity_m_per_s, row)
         self.caught = True
 
     def catch(self, time_s: float, position_m: np.ndarray, velocity_m_per_s: np.ndarray) -> None:
@@ -291,6 +298,15 @@ class PistonJumps:
                 rows.append((start, energy, velocity))
             start = t if kind == "strike" else None
         return rows
+
+    def input_by_row(self, samples: int) -> np.ndarray:
+        """The energy the jumps put in up to each of ``samples`` samples, from the first sample after each
+        jump (every jump noted with its ``row``)."""
+        blow = self.setup.blow_energy_j
+        put_in = np.zeros(samples + 1)
+        for (_, kind, energy, _), row in zip(self.log, self.rows, strict=True):
+            put_in[row] += blow - energy if kind == "strike" else -energy
+        return np.cumsum(put_in[:samples])
 
     def input_j(self, time_s: np.ndarray, after: np.ndarray) -> np.ndarray:
         """The energy the jumps put in up to each sample: ``after[i]`` True where sample i lies after
@@ -324,10 +340,12 @@ class PistonHistory:
 
 
 def piston_history(setup: PistonSetup, jumps: PistonJumps, time_s: np.ndarray, position_m: np.ndarray,
-                   velocity_m_per_s: np.ndarray, after: np.ndarray) -> PistonHistory:
-    """The piston's history from the dynamic chain's sampled states (samples x bodies)."""
+                   velocity_m_per_s: np.ndarray, after: np.ndarray | None) -> PistonHistory:
+    """The piston's history from the dynamic chain's sampled states (samples x bodies); ``after`` for
+    :meth:`PistonJumps.input_j`, None when every jump was noted with its row."""
+    put_in = jumps.input_by_row(len(time_s)) if after is None else jumps.input_j(time_s, after)
     return PistonHistory(setup, position_m[:, setup.bodies], velocity_m_per_s[:, setup.bodies],
-                         setup.contact_force_n(position_m), jumps.input_j(time_s, after),
+                         setup.contact_force_n(position_m), put_in,
                          np.array(jumps.rebounds).reshape(-1, 3))
 
 
