@@ -6,18 +6,31 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 from pydantic import ValidationError
-from scenes import scene_dict
+from scenes import PAPER_BASE, scene_dict
 
 from rpdrill.models.energy import energy_account
 from rpdrill.models.piston import rigid_piston_pulse_n
 from rpdrill.models.scene import Scene
 from rpdrill.models.simulation import SceneError, prepare
+from rpdrill.studies.advice.advice_search import (
+    FEED,
+    FREQUENCY,
+    AdviceEvaluator,
+    AdviceSearch,
+    Request,
+    advise,
+    at_point,
+    runnable_scene,
+)
 from rpdrill.studies.cli.main import main
+from rpdrill.studies.inputs.reading import load_scene
+from rpdrill.studies.runtime.pools import sequential
 
 E_PA, RHO, SPEED = 2.1e11, 7850.0, 9.0
 STEEL = {"diameter_m": 0.045, "youngs_modulus_pa": E_PA, "density_kg_per_m3": RHO}
@@ -167,3 +180,46 @@ def test_simulate_writes_the_pistons_outputs(tmp_path):
     assert metrics["energy_balance_relative_error"] < 1e-3
     resolved = yaml.safe_load((out / "scene.resolved.yaml").read_text())
     assert resolved["impact"]["piston"]["contact_stiffness_n_per_m"] == pytest.approx(E_PA * AREA * 16)
+
+
+def test_crosscheck_covers_a_piston_scene(tmp_path):
+    """rpdrill crosscheck: the Exudyn model against the ODE over two blows of the rod piston, its contact
+    force among the histories compared."""
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(one_blow(rod_piston(8), 4.0, 64)))
+    out = tmp_path / "out"
+    assert main(["crosscheck", str(path), "--blows", "2", "--step", "1e-6", "--out", str(out)]) == 0
+    report = json.loads((out / "crosscheck.json").read_text(encoding="utf-8"))
+    # pointwise on the coarser run's samples (the ODE's 2 us), the pulse's ringing at the rods' cut-off
+    # interpolated: 1.0 % of the force's range
+    assert report["passed"] and report["histories"]["piston_contact_force_n"]["max_rel_to_range"] < 2e-2
+
+
+# ---- advice at a fixed hammer power -----------------------------------------------------------------
+
+TOP_HAMMER = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "top_hammer_piston.yaml"
+
+
+def test_advise_at_a_fixed_power_needs_a_piston(tmp_path, capsys):
+    assert main(["advise", str(PAPER_BASE), "--power-kw", "15", "--frequency-hz", "40", "80", "--feed-kn", "50", "90",
+                 "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    assert "--power-kw needs a piston" in capsys.readouterr().err
+
+
+def test_at_a_fixed_power_the_blow_energy_follows_the_frequency():
+    data = load_scene(TOP_HAMMER).model_dump(by_alias=True, exclude_none=True)
+    scene = Scene.model_validate(at_point(data, {FREQUENCY: 60.0}, 15e3))
+    assert scene.impact.piston.blow_energy_j * scene.impact.frequency_hz == pytest.approx(15e3)
+
+
+@pytest.mark.slow
+def test_advise_at_a_fixed_power_is_not_beaten_by_a_frequency_grid():
+    """The issue's criterion on the shipped top hammer (a narrower box than benchmarks/bench_advise_power.py)."""
+    bounds = {FREQUENCY: (60.0, 80.0), FEED: (5e3, 15e3)}
+    request = Request("penetration_rate_m_per_s", bounds, power_w=15e3, search=AdviceSearch(popsize=6, max_generations=8))
+    data = runnable_scene(load_scene(TOP_HAMMER).model_dump(by_alias=True, exclude_none=True), None, request,
+                          str(TOP_HAMMER))
+    advice = advise(data, None, request, sequential)
+    grid = AdviceEvaluator(data, request, sequential)([{FREQUENCY: f, FEED: advice.best[FEED]}
+                                                       for f in np.arange(60.0, 80.01, 1.0)]).values
+    assert np.nanmax(grid) <= 1.01 * advice.best_value
