@@ -20,7 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.studies.advice.advice_search import FEED, FREQUENCY, AdviceEvaluator, Request, advise, runnable_scene
+from rpdrill.studies.advice.advice_search import (
+    FEED,
+    FREQUENCY,
+    AdviceEvaluator,
+    Request,
+    advise,
+    runnable_scene,
+)
 from rpdrill.studies.inputs.reading import load_scene
 from rpdrill.studies.runtime.pools import process_pool
 

@@ -106,6 +106,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--formulations", nargs="+", default=["exudyn"])
     parser.add_argument("--quick", action="store_true", help="the two coarser levels only")
     parser.add_argument("--rod-only", action="store_true", help="the rod piston only")
+    parser.add_argument("--rigid-only", action="store_true", help="the rigid piston only")
     parser.add_argument("--rigid-contact-per-segment", type=float, metavar="X",
                         help="the rigid piston's contact X times the rod segment's stiffness (default 100 Z^2 / m_p)")
     args = parser.parse_args(argv)
@@ -123,7 +124,8 @@ def main(argv: list[str] | None = None) -> None:
     for formulation in args.formulations:
         for piston_segments, rod_segments in levels:
             start = time.process_time()
-            a = rod_on_rod(piston_segments, formulation)
+            a = {key: math.nan for key in ("plateau", "length", "rebound")} if args.rigid_only \
+                else rod_on_rod(piston_segments, formulation)
             b = {key: math.nan for key in ("peak", "peak_closed_form", "shape", "impulse")} if args.rod_only \
                 else rigid(rod_segments, formulation, args.rigid_contact_per_segment)
             print(f"| {formulation} | {piston_segments} / {8 * piston_segments} | {a['plateau']:+.2%} | "

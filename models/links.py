@@ -21,6 +21,7 @@ from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
 import numpy as np
+
 from ..rocklaw.backends import NUMERIC, Backend
 from ..rocklaw.modes import ONE, Mode, ModeTable, Switch
 

@@ -5,7 +5,7 @@ The piston (scene ``impact.piston``: a rigid mass or a segmented rod, models.sce
 of lumped bodies outside the drill string proper, appended after the string's bodies in the
 *dynamic chain* the formulations integrate (:meth:`PistonSetup.dynamic_chain`): a rod piston's
 segments joined by springs E A N / L like the string's rods, its front segment joined to the
-impact body by a compression-only coupling (models.links.Coupling, gap 0, undamped) of stiffness
+impact body by a compression-only coupling (PistonContact, a models.links.Coupling: gap 0, undamped) of stiffness
 k_c. The contact force on the impact body is F_c = k_c max(x_front - x_impact, 0).
 
 Each blow is two state jumps at located times, the same in every formulation:
@@ -13,11 +13,12 @@ Each blow is two state jumps at located times, the same in every formulation:
 * strike, at every blow start t_k = k / f: every piston segment placed just touching the impact
   body (x_i = x_impact, unstressed) and moving at the strike speed v_p (the blow energy
   E_blow = m_p v_p^2 / 2 put in);
-* catch, when the contact opens after the strike (the first separation): the piston is caught by
-  the hammer and held away (x_i = x_impact - PARK_M, v_i = 0) until the next strike; the energy it
-  still had (kinetic and strain, the contact spring is relaxed at separation) is the blow's
-  rebound energy. So a piston that leaves the shank never strikes it again within the period.
-  A piston still in contact at the next blow start is reset there (its energy counted as rebound).
+* catch, when the contact is open and the piston moves back (its mean velocity below 0): the hammer
+  catches it and holds it away (x_i = x_impact - PARK_M, v_i = 0) until the next strike; the energy
+  it still has (kinetic and strain; the contact spring is relaxed) is the blow's rebound energy, its
+  velocity v_after. A piston that goes on forward after a separation strikes again, as a free piston
+  would (a rigid piston on a lumped rod chatters on the rod's face); a piston still out at the next
+  blow start is reset there (its energy counted as rebound). (PistonContact: the catch as a mode.)
 
 Energy: the piston subsystem (its bodies, its springs, the contact spring) has the energy
 E_p = sum m_i v_i^2 / 2 + sum k (x_i+1 - x_i)^2 / 2 + k_c max(x_front - x_impact, 0)^2 / 2; the jumps
@@ -35,11 +36,10 @@ energy (de Saint-Venant; Lundberg).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-
-from collections.abc import Mapping
 
 from ..rocklaw.modes import ONE, Mode, ModeTable, Switch
 from .chain import AxialChain, ChainBody

@@ -92,7 +92,7 @@ def test_the_contact_stiffness_comes_from_the_faces_and_is_stated(tmp_path):
     segment = E_PA * AREA * 64 / 4.0  # both rods' segments are 62.5 mm: the contact is one segment's spring
     assert simulation.piston.contact_stiffness_n_per_m == pytest.approx(segment)
     assert simulation.resolved_scene()["impact"]["piston"]["contact_stiffness_n_per_m"] == pytest.approx(segment)
-    rigid_on_rigid = scene_dict(**{"impact": {"frequency_hz": 50.0, "piston": {"mass_kg": 4.5, "velocity_m_per_s": 9.0}}})
+    rigid_on_rigid = scene_dict(impact={"frequency_hz": 50.0, "piston": {"mass_kg": 4.5, "velocity_m_per_s": 9.0}})
     with pytest.raises(SceneError, match="contact_stiffness_n_per_m"):
         prepare(Scene.model_validate(rigid_on_rigid))
 
