@@ -101,6 +101,11 @@ def _catch_time(result: Any) -> float:
     return float(result.time_s[parked[parked > 0][0]]) if np.any(parked > 0) else float(result.time_s[-1])
 
 
+def _percent(value: float, sign: str = "+") -> str:
+    """A relative error as a signed percentage, '-' for a check not run."""
+    return "-" if math.isnan(value) else f"{value:{sign}.2%}"
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--formulations", nargs="+", default=["exudyn"])
@@ -128,10 +133,11 @@ def main(argv: list[str] | None = None) -> None:
                 else rod_on_rod(piston_segments, formulation)
             b = {key: math.nan for key in ("peak", "peak_closed_form", "shape", "impulse")} if args.rod_only \
                 else rigid(rod_segments, formulation, args.rigid_contact_per_segment)
-            print(f"| {formulation} | {piston_segments} / {8 * piston_segments} | {a['plateau']:+.2%} | "
-                  f"{a['length']:+.2%} | {a['rebound']:.2%} | {rod_segments} | {b['peak']:+.2%} | "
-                  f"{b['peak_closed_form']:+.2%} | {b['shape']:.2%} | {b['impulse']:+.2%} | "
-                  f"{time.process_time() - start:.1f} |", flush=True)
+            cells = [_percent(a["plateau"]), _percent(a["length"]), _percent(a["rebound"], "")]
+            cells += [_percent(b["peak"]), _percent(b["peak_closed_form"]), _percent(b["shape"], ""),
+                      _percent(b["impulse"])]
+            print(f"| {formulation} | {piston_segments} / {8 * piston_segments} | {' | '.join(cells[:3])} | "
+                  f"{rod_segments} | {' | '.join(cells[3:])} | {time.process_time() - start:.1f} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ from rpdrill.studies.advice.advice_search import (
 from rpdrill.studies.cli.main import main
 from rpdrill.studies.inputs.reading import load_scene
 from rpdrill.studies.runtime.pools import sequential
+from rpdrill.studies.scan.study import load_study
 
 E_PA, RHO, SPEED = 2.1e11, 7850.0, 9.0
 STEEL = {"diameter_m": 0.045, "youngs_modulus_pa": E_PA, "density_kg_per_m3": RHO}
@@ -223,3 +224,11 @@ def test_advise_at_a_fixed_power_is_not_beaten_by_a_frequency_grid():
     grid = AdviceEvaluator(data, request, sequential)([{FREQUENCY: f, FEED: advice.best[FEED]}
                                                        for f in np.arange(60.0, 80.01, 1.0)]).values
     assert np.nanmax(grid) <= 1.01 * advice.best_value
+
+
+def test_a_study_scans_the_pistons_keys():
+    """studies/top_hammer/power_map.yaml: blow frequency x impact.piston.energy_j, every point a piston scene."""
+    study = load_study(TOP_HAMMER.parents[1] / "top_hammer" / "power_map.yaml")
+    assert len(study.points) == 13 * 9
+    energies = sorted({p.simulation.piston.blow_energy_j for p in study.points})
+    assert energies == pytest.approx(np.arange(100.0, 501.0, 50.0))
