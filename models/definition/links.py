@@ -20,6 +20,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
+import numpy as np
+
 from ...rocklaw.backends import NUMERIC, Backend
 from ...rocklaw.modes import ONE, Mode, ModeTable, Switch
 
@@ -59,6 +61,12 @@ class Link:
 
     def initial_mode(self, values: Mapping[str, float]) -> str:
         return BONDED
+
+    def placed(self, bodies: int, size: int) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+        """Local variables beyond the stretch and its rate (rows over a state (x, v, ...) of ``bodies``
+        bodies and ``size`` entries) and states (name -> index) that the modes read or reset: none for a
+        connector; the piston's contact reads and resets the piston (models.drill.piston.PistonContact)."""
+        return {}, {}
 
     @classmethod
     def parameters(cls) -> tuple[str, ...]:

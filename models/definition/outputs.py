@@ -28,6 +28,8 @@ PLAIN = _need()
 COLLAR = _need(bodies=("collar",))
 FORCES = _need(data=("forces",))
 ENERGY = _need(data=("forces", "energy"))
+# a piston scene's piston histories (models.drill.piston); an output that needs them needs impact.piston
+PISTON = _need(data=("forces", "piston"))
 
 METRICS: dict[str, Need] = {
     "penetration_rate_m_per_s": PENETRATION,
@@ -49,6 +51,9 @@ METRICS: dict[str, Need] = {
     "crushing_work_j": _need(("rock_plasticity",), ("forces", "energy")),
     "energy_transfer_efficiency": _need(("rock_plasticity",), ("forces", "energy")),
     "energy_balance_relative_error": ENERGY,
+    "piston_rebound_energy_j": PISTON,
+    # advance over the window / the blow energy of its blows (= penetration rate / hammer power E_blow f)
+    "penetration_per_blow_energy_m_per_j": _need(("rock_plasticity",), ("piston",)),
     "window_start_s": PLAIN,
     "window_end_s": PLAIN,
     "window_blows": PLAIN,
@@ -62,6 +67,8 @@ SERIES: dict[str, Need] = {
     "impact_force_n": FORCES,
     "torsion_angle_rad": _need(("torsion",)),
     "torsion_rate_rad_per_s": _need(("torsion",)),
+    "piston_contact_force_n": PISTON,
+    "piston_velocity_m_per_s": PISTON,
 }
 
 

@@ -325,20 +325,75 @@ class Feed(Strict):
     acts_on: Name = EVERY_BODY
 
 
-class Impact(Strict):
-    """Periodic piston force on the shank: one pulse of ``duration_s`` at the start of every period."""
+class Piston(Body):
+    """The hammer's piston as a body (models.drill.piston): a rigid ``mass_kg`` or a rod given by its
+    geometry (the rod keys of :class:`Body`, ``segments`` lumped masses like the string's rods),
+    striking the impact body at ``velocity_m_per_s`` (or with the blow energy ``energy_j`` = m v^2 / 2:
+    one of the two) through a compression-only contact of ``contact_stiffness_n_per_m`` (default: the
+    series stiffness of the half-segments of the faces in contact, 1/k = sum L / (2 E A N); a rigid
+    face adds nothing, so a rigid piston on a rigid impact body must give it)."""
 
-    amplitude_n: Positive = Field(description="I, the paper's impact 'impulse' (a force amplitude, N)")
+    velocity_m_per_s: Positive | None = Field(None, description="v_p, strike speed")
+    energy_j: Positive | None = Field(None, description="blow energy m_p v_p^2 / 2")
+    contact_stiffness_n_per_m: Positive | None = Field(None, description="piston-shank contact stiffness")
+
+    @model_validator(mode="after")
+    def _speed_or_energy(self) -> Piston:
+        if (self.velocity_m_per_s is None) == (self.energy_j is None):
+            raise ValueError("give the strike speed velocity_m_per_s or the blow energy energy_j (one of the two)")
+        return self
+
+    @property
+    def strike_velocity_m_per_s(self) -> float:
+        """v_p, given or from the blow energy: sqrt(2 E_blow / m_p)."""
+        if self.velocity_m_per_s is not None:
+            return self.velocity_m_per_s
+        return math.sqrt(2.0 * self.energy_j / self.total_mass_kg)
+
+    @property
+    def blow_energy_j(self) -> float:
+        """E_blow = m_p v_p^2 / 2."""
+        return self.energy_j if self.energy_j is not None else 0.5 * self.total_mass_kg * self.velocity_m_per_s**2
+
+
+PULSE_KEYS = ("amplitude_n", "duration_s", "shape")
+
+
+class Impact(Strict):
+    """The blows, ``frequency_hz`` per second: a prescribed force pulse on the shank (the paper's:
+    ``amplitude_n``, ``shape``, ``duration_s`` at the start of every period), or a ``piston`` that
+    strikes the impact body at the start of every period (models.drill.piston)."""
+
+    amplitude_n: Positive | None = Field(None, description="I, the paper's impact 'impulse' (a force amplitude, N)")
     frequency_hz: Positive = Field(description="f, blows per second")
-    shape: Literal["half_sine", "rectangular", "triangular"] = "half_sine"
-    duration_s: Positive = Field(description="tau, piston-shank contact time")
+    shape: Literal["half_sine", "rectangular", "triangular"] | None = Field(None, description="default half_sine")
+    duration_s: Positive | None = Field(None, description="tau, piston-shank contact time")
+    piston: Piston | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _default_shape(cls, data: Any) -> Any:
+        """A prescribed pulse is a half-sine unless its shape is given (a piston has no shape)."""
+        if isinstance(data, Mapping) and data.get("piston") is None and data.get("shape") is None:
+            return {**data, "shape": "half_sine"}
+        return data
 
     @property
     def period_s(self) -> float:
         return 1.0 / self.frequency_hz
 
     @model_validator(mode="after")
-    def _pulse_fits_period(self) -> Impact:
+    def _pulse_or_piston(self) -> Impact:
+        if self.piston is not None:
+            given = [key for key in PULSE_KEYS if getattr(self, key) is not None]
+            if given:
+                raise _key_error("Impact", (given[0],), getattr(self, given[0]),
+                                 "a key of the prescribed pulse; with a piston the pulse comes from the piston "
+                                 "(give amplitude_n, shape, duration_s or piston, not both)")
+            return self
+        missing = [key for key in ("amplitude_n", "duration_s") if getattr(self, key) is None]
+        if missing:
+            raise ValueError(f"give the pulse ({', '.join(missing)} missing) or a piston")
         if self.duration_s >= self.period_s:
             raise _key_error("Impact", ("duration_s",), self.duration_s, "must be shorter than the impact period "
                              "1/frequency_hz = {period_s} s", period_s=float(f"{self.period_s:.6g}"))
@@ -589,6 +644,9 @@ class Scene(Strict):
             raise _key_error("Scene", ("effects", "rock_damping"), True,
                              "rock law 'bilinear' has no rock damping; set it false or use law: jenkins")
         outputs = self.outputs or Outputs()
+        pistonless = [o for o in outputs.metrics + outputs.timeseries if not _has_piston_data(self, _need(o))]
+        if pistonless:
+            raise ValueError(f"outputs {', '.join(pistonless)} need a piston (impact.piston)")
         bodies = {f"{name}[{i}]" if body.segments > 1 else name for name, body in self.drill_string.bodies.items()
                   for i in range(body.segments)} | set(self.drill_string.bodies)
         missing = [o for o in outputs.metrics + outputs.timeseries if not _need(o).bodies <= bodies]
@@ -619,6 +677,11 @@ class Scene(Strict):
 
 def _need(output: str) -> Need:
     return SERIES[output] if output in SERIES else metric_need(output)
+
+
+def _has_piston_data(scene: Scene, need: Need) -> bool:
+    """Whether the scene has what an output's ``piston`` data need: a piston (impact.piston)."""
+    return "piston" not in need.data or scene.impact.piston is not None
 
 
 @dataclass(frozen=True)
@@ -679,5 +742,7 @@ def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
         return scene.outputs
     built = {effect for effect, on in effects.as_dict().items() if on}
     bodies = set(scene.drill_string.bodies)
-    return Outputs(metrics=[m for m, n in METRICS.items() if n.effects <= built and n.bodies <= bodies],
-                   timeseries=[s for s, n in SERIES.items() if n.effects <= built and n.bodies <= bodies])
+    def available(need: Need) -> bool:
+        return need.effects <= built and need.bodies <= bodies and _has_piston_data(scene, need)
+    return Outputs(metrics=[m for m, n in METRICS.items() if available(n)],
+                   timeseries=[s for s, n in SERIES.items() if available(n)])

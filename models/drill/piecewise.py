@@ -80,7 +80,8 @@ def link_element(chain: AxialChain, link: Link, size: int) -> Element:
     ends = _unit(size, link.body_b) - (0.0 if link.body_a is None else _unit(size, link.body_a))
     rates = _unit(size, n + link.body_b) - (0.0 if link.body_a is None else _unit(size, n + link.body_a))
     load = (0.0 if link.body_a is None else _unit(n, link.body_a)) - _unit(n, link.body_b)
-    return Element(link.name, link, link.modes(), {STRETCH: ends, RATE: rates}, {}, None, load)
+    more, states = link.placed(n, size)
+    return Element(link.name, link, link.modes(), {STRETCH: ends, RATE: rates, **more}, states, None, load)
 
 
 def undeclared(chain: AxialChain, rock: RockLaw) -> str | None:

@@ -98,7 +98,9 @@ SHAPES: dict[str, Shape] = {
 
 
 def impact_force(impact: Impact, t: Any, backend: Backend = NUMERIC) -> Any:
-    """F_d(t) [N] on the shank."""
+    """F_d(t) [N] on the shank (none with a piston: models.drill.piston)."""
+    if impact.piston is not None:
+        return 0.0 * backend.mod(t, impact.period_s)
     tau = impact.duration_s
     s = backend.mod(t, impact.period_s)
     pulse = SHAPES[impact.shape].force(impact.amplitude_n, tau, s, backend)
@@ -106,12 +108,16 @@ def impact_force(impact: Impact, t: Any, backend: Backend = NUMERIC) -> Any:
 
 
 def impulse_per_blow_n_s(impact: Impact) -> float:
-    """Integral of F_d over one pulse [N s]."""
+    """Integral of F_d over one pulse [N s]; with a piston its momentum m_p v_p (the most a blow gives)."""
+    if impact.piston is not None:
+        return impact.piston.total_mass_kg * impact.piston.strike_velocity_m_per_s
     return SHAPES[impact.shape].impulse_factor * impact.amplitude_n * impact.duration_s
 
 
 def _pieces_of_a_period(impact: Impact) -> tuple[tuple[float, float, str], ...]:
-    """(start, end, phase) within one period, times after the blow's start."""
+    """(start, end, phase) within one period, times after the blow's start (a piston: no pulse phase)."""
+    if impact.piston is not None:
+        return ((0.0, impact.period_s, OFF),)
     tau = impact.duration_s
     inner = tuple((low * tau, high * tau, phase) for low, high, phase in SHAPES[impact.shape].pieces)
     return (*inner, (tau, impact.period_s, OFF))
@@ -143,6 +149,8 @@ def generator_states(impact: Impact, local_s: np.ndarray) -> np.ndarray:
     """(u1, u2) at times ``local_s`` after the blow's start (rows): (sin, cos)(pi s / tau) for the
     half-sine, (s, 0) for the triangle, zeros for the rectangle."""
     local_s = np.asarray(local_s, dtype=float)
+    if impact.piston is not None:  # no prescribed pulse: no generator
+        return np.zeros((len(local_s), 2))
     return np.column_stack(SHAPES[impact.shape].states(local_s, impact.duration_s)).reshape(len(local_s), 2)
 
 

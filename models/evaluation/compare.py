@@ -42,7 +42,10 @@ def compare_histories(reference: SimulationResult, other: SimulationResult, end_
     coarse = min((reference, other), key=lambda r: int(_inside(r, end_s).sum()))
     grid = coarse.time_s[_inside(coarse, end_s)]
     out = {}
-    for name, history in HISTORIES.items():
+    histories = dict(HISTORIES)
+    if reference.piston is not None and other.piston is not None:  # a piston scene: its blow too
+        histories["piston_contact_force_n"] = lambda r: r.piston.contact_force_n
+    for name, history in histories.items():
         r = np.interp(grid, reference.time_s, history(reference))
         a = np.interp(grid, other.time_s, history(other))
         difference = float(np.max(np.abs(a - r)))

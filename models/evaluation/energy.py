@@ -6,6 +6,10 @@ with W_impact = int F_d v_shank dt, W_feed = sum_i F_i (x_i - x_i(0)) (+ (M_x - 
 E_elastic including what the rock stores, F_spring^2 / (2 k_unload) (rocklaw.base.RockLaw),
 D_damping = int of every damper's power (joints, shock absorber, the rock damper, c_x), and
 W_crushing the rock law's plastic work int F_spring d(x_n) (Jenkins: F_th (x_n - x_n(0))).
+With a piston (models.drill.piston) F_d is its contact force, and the balance takes the work in from the
+blows instead: W_piston = what the strikes and catches put in (blow energies less rebound energies)
+less the piston's energy E_piston held at the time, from its value at the start, in place of W_impact (the two agree
+when the contact's work is computed right: the balance then covers the piston too).
 The powers are integrated by the trapezoidal rule over every stored solver step, unless the
 formulation integrated the works exactly (``SimulationResult.works_j``, the exact formulation): then
 W_impact is its impact work and D_damping what the links, the rock and the torsion line absorb less
@@ -20,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...rocklaw.base import cumulative_trapezoid
+from ..drill.piston import piston_energy_j
 from .results import SimulationResult
 
 
@@ -34,12 +39,14 @@ class EnergyAccount:
     elastic_j: np.ndarray
     damping_j: np.ndarray
     crushing_work_j: np.ndarray
+    piston_work_j: np.ndarray | None = None  # W_piston (module doc), with a piston
 
     @property
     def residual_j(self) -> np.ndarray:
         """Work in minus energy accounted for; zero for an exact solution."""
         stored = (self.kinetic_j - self.kinetic_j[0]) + (self.elastic_j - self.elastic_j[0])
-        return self.impact_work_j + self.feed_work_j - stored - self.damping_j - self.crushing_work_j
+        work_in = self.impact_work_j if self.piston_work_j is None else self.piston_work_j
+        return work_in + self.feed_work_j - stored - self.damping_j - self.crushing_work_j
 
     def relative_residual(self) -> float:
         """Largest |residual| over the run divided by the total impact work."""
@@ -81,5 +88,9 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
     else:  # integrated exactly by the formulation: the dampers take what the internal forces absorb and
         # neither store nor crush
         damping = result.works_j["internal"] - (elastic - elastic[0]) - (crushing - crushing[0])
+    piston = None
+    if result.piston is not None:
+        net = result.piston.input_j - piston_energy_j(result.piston, x[:, chain.impact_body])
+        piston = net - net[0]
     return EnergyAccount(time_s=t, impact_work_j=impact_work_j(result), feed_work_j=feed, kinetic_j=kinetic,
-                         elastic_j=elastic, damping_j=damping, crushing_work_j=crushing)
+                         elastic_j=elastic, damping_j=damping, crushing_work_j=crushing, piston_work_j=piston)

@@ -75,6 +75,14 @@ class _Window:
         return self.work(self.energy.crushing_work_j) / put_in if put_in > 0 else float("nan")
 
 
+def _rebound_energy(w: _Window) -> float:
+    """The mean rebound energy of the blows that start in the window (models.drill.piston)."""
+    rebounds = w.result.piston.rebounds
+    starts = rebounds[:, 0] if len(rebounds) else np.empty(0)
+    inside = (starts >= w.boundaries[0] - 1e-9 * w.period) & (starts < w.boundaries[-1] - 1e-9 * w.period)
+    return float(np.mean(rebounds[inside, 1])) if inside.any() else float("nan")
+
+
 def _spread(values: np.ndarray) -> float:
     return float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
 
@@ -96,6 +104,9 @@ METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
     "crushing_work_j": lambda w: w.work(w.energy.crushing_work_j),
     "energy_transfer_efficiency": lambda w: w.efficiency(),
     "energy_balance_relative_error": lambda w: w.energy.relative_residual(),
+    "piston_rebound_energy_j": _rebound_energy,
+    "penetration_per_blow_energy_m_per_j": lambda w: float(
+        w.per_blow.sum() / (w.blows * w.result.simulation.piston.blow_energy_j)),
     "window_start_s": lambda w: float(w.boundaries[0]),
     "window_end_s": lambda w: float(w.boundaries[-1]),
     "window_blows": lambda w: w.blows,

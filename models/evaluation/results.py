@@ -12,6 +12,7 @@ from ..drill.chain import AxialChain
 from .parts import link_series
 
 if TYPE_CHECKING:
+    from ..drill.piston import PistonHistory
     from ..solvers.simulation import Simulation
 
 
@@ -45,6 +46,8 @@ class SimulationResult:
     # int F_d v_shank dt, and "internal", what the links, the rock and the torsion line absorb); None:
     # the energy account integrates the sampled powers
     works_j: dict[str, np.ndarray] | None = None
+    # a piston scene: the piston's states, contact force (also impact_force_n), jumps and rebounds (models.drill.piston)
+    piston: PistonHistory | None = None
 
     @property
     def scene(self) -> Scene:
@@ -109,6 +112,9 @@ class SimulationResult:
             "torsion_angle_rad": self.torsion_angle_rad,
             "torsion_rate_rad_per_s": self.torsion_rate_rad_per_s,
         }
+        if self.piston is not None:
+            optional.update(piston_contact_force_n=self.piston.contact_force_n,
+                            piston_velocity_m_per_s=self.piston.mean_velocity_m_per_s)
         wanted = self.simulation.outputs.timeseries
         out.update({name: values for name, values in optional.items() if name in wanted and values is not None})
         return out

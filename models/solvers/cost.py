@@ -103,14 +103,15 @@ Part = tuple[Cause, float, float | None]
 
 
 def _exudyn(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
-    settings, scene, n = simulation.settings, simulation.scene, simulation.chain.size
+    settings, scene, n = simulation.settings, simulation.scene, simulation.dynamic_chain.size
     step = settings.step_s
-    limits = EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].step_limits(scene.impact.duration_s,
+    limits = EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].step_limits(simulation.pulse_duration_s,
                                                                           simulation.step_scales)
     if scene.solver.step_s is not None:
         cause = Cause("solver.step_s", step)
     elif math.isclose(step, limits["pulse"]):
-        cause = Cause("impact.duration_s", scene.impact.duration_s)
+        cause = Cause("impact.duration_s", scene.impact.duration_s) if simulation.piston is None else \
+            Cause("impact.piston", f"a contact of {simulation.pulse_duration_s:.3g} s")
     elif math.isclose(step, limits["damper"]):
         cause = _rock_damper(simulation)
     else:
@@ -122,7 +123,7 @@ def _exudyn(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
 
 
 def _state_size(simulation: Simulation) -> int:
-    return 2 * simulation.chain.size + len(simulation.rock.state_names) + 2 * (simulation.torsion is not None) + 3
+    return 2 * simulation.dynamic_chain.size + len(simulation.rock.state_names) + 2 * (simulation.torsion is not None) + 3
 
 
 def _exact(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
@@ -134,7 +135,7 @@ def _exact(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     return step, sampled if step == settings.sample_interval_s else _fastest(simulation), [
         (sampled, settings.end_time_s / settings.sample_interval_s * (m + 2), settings.sample_interval_s),
         (Cause("solver.max_switches_per_blow", settings.max_switches_per_blow), 2 * switches * (m + 3), None),
-        (Cause("drill_string.bodies", f"{simulation.chain.size} lumped bodies"), keys * OPERATOR_VALUES * m**2, None)]
+        (Cause("drill_string.bodies", f"{simulation.dynamic_chain.size} lumped bodies"), keys * OPERATOR_VALUES * m**2, None)]
 
 
 def _ode(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
@@ -161,7 +162,7 @@ def cost_key(simulation: Simulation) -> str:
 def run_cost(simulation: Simulation, resampled: Cause | None = None) -> RunCost:
     """The estimated cost of running ``simulation`` (module doc), its histories then resampled at the
     interval ``resampled`` names (``rpdrill simulate``: ``solver.output_interval_s``) or not (None)."""
-    settings, n = simulation.settings, simulation.chain.size
+    settings, n = simulation.settings, simulation.dynamic_chain.size
     end = settings.end_time_s
     step, cause, parts = ESTIMATES[settings.formulation](simulation)
     values = sum(part[1] for part in parts) * MEMORY_COPIES[settings.formulation]

@@ -63,7 +63,9 @@ import numpy as np
 from scipy.linalg import expm
 from threadpoolctl import ThreadpoolController
 
+from ..definition.links import CLOSED, OPEN
 from ..definition.scene import Scene
+from ..drill.piston import CAUGHT, CONTACT, PistonJumps, piston_history
 from ..drill.pulse import (
     PHASES,
     blow_start_times,
@@ -250,19 +252,40 @@ class ExactSolver:
                                    len(self.model.pieces[0].table) * len(set(self.phases)),
                                    "energy" in simulation.needed_data)
         self.blows = simulation.blow_starts()
-        blows = blow_start_times(self.impact, settings.end_time_s) if self.blows else np.empty(0)
+        self.piston = None if simulation.piston is None else PistonJumps(simulation.piston)
+        self.contact = next((i for i, e in enumerate(self.model.pieces) if e.name == CONTACT), None)
+        starts = self.blows or self.piston  # the kernel stops at every blow start for them
+        blows = blow_start_times(self.impact, settings.end_time_s) if starts else np.empty(0)
         self.blow_phases = np.isin(self.phase_times[:, 0], blows).astype(np.int64)
 
-    def start_blow(self, w: np.ndarray, mode_id: int) -> int:
-        """Set the rock states of w to those the blow starting now meets; the mode id with the rock's
-        mode found again."""
+    def start_blow(self, w: np.ndarray, mode_id: int, time_s: float, row: int) -> int:
+        """Set the rock states of w to those the blow starting now meets, and strike with the piston
+        (models.drill.piston; ``row`` the first sample after it); the mode id with the rock's mode found again and
+        the piston's contact closing."""
         layout, rock = self.layout, self.model.pieces[0]
-        states = slice(2 * layout.n, 2 * layout.n + layout.rock_states)
-        angle = w[layout.angle] if layout.torsion else 0.0
-        # the law stays the one the matrices were built for: a law whose rows change per blow is unsupported()
-        _, w[states] = self.blows(w[self.simulation.chain.bit_body], tuple(w[states]), angle)
         modes = self.operators.modes[mode_id]
-        return self.operators.mode_id((rock.initial_mode(w), *modes[1:]))
+        if self.blows:
+            states = slice(2 * layout.n, 2 * layout.n + layout.rock_states)
+            angle = w[layout.angle] if layout.torsion else 0.0
+            # the law stays the one the matrices were built for: a law whose rows change per blow is unsupported()
+            _, w[states] = self.blows(w[self.simulation.chain.bit_body], tuple(w[states]), angle)
+            modes = (rock.initial_mode(w), *modes[1:])
+        if self.piston is not None:
+            n, setup = layout.n, self.piston.setup
+            self.piston.strike(time_s, w[:n], w[n:2 * n], row)
+            closing = w[n + setup.front] > w[n + setup.impact_body]
+            modes = modes[:self.contact] + (CLOSED if closing else OPEN,) + modes[self.contact + 1:]
+        return self.operators.mode_id(modes)
+
+    def note_catches(self, time_s: np.ndarray, rows: np.ndarray, switch_times: np.ndarray,
+                     entered: list[Modes]) -> None:
+        """Note every catch (a switch into the contact's ``caught`` mode, its entry reset applied by the
+        kernel) from the row recorded before it (the kernel records both sides of a switch)."""
+        n = self.layout.n
+        for t, modes in zip(switch_times, entered, strict=True):
+            if modes[self.contact] == CAUGHT:
+                before = int(np.flatnonzero(time_s == t)[0])
+                self.piston.noted_catch(float(t), rows[before, :n], rows[before, n:2 * n], before + 1)
 
     def works_j(self, time_s: np.ndarray, rows: np.ndarray) -> dict[str, np.ndarray]:
         """Cumulative impact work int F_d v_shank dt and internal work (what the links, the rock and the
@@ -294,7 +317,8 @@ class ExactSolver:
         n = layout.n
         w = np.zeros(layout.size)
         w[layout.one] = 1.0
-        w[:n] = simulation.initial_positions_m
+        setup = simulation.piston
+        w[:n] = simulation.initial_positions_m if setup is None else setup.parked(simulation.initial_positions_m)
         w[2 * n:2 * n + layout.rock_states] = simulation.initial_rock_state
         if layout.torsion:
             w[layout.angle] = simulation.initial_torsion_angle_rad
@@ -318,7 +342,7 @@ class ExactSolver:
                 self.per_sample, self.min_switch_interval_s, self.max_switches, n, POSITION_LIMIT_M, progress, clock,
                 w, time_s, rows, row_keys, switch_times, switch_modes)
             if status == BLOW_START:
-                progress[1] = self.start_blow(w, progress[1])
+                progress[1] = self.start_blow(w, progress[1], float(clock[0]), int(progress[2]))
             elif status == MISSING_KEY:
                 ops.add(ops.modes[progress[1]], self.phases[progress[0]])
             else:
@@ -369,6 +393,12 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     layout = solver.layout
     n, angle, states = layout.n, layout.angle, slice(2 * layout.n, 2 * layout.n + layout.rock_states)
     cpu = time.process_time() - start
+    impact_force, piston = rows[:, layout.size + 1], None
+    if solver.piston is not None:
+        solver.note_catches(time_s, rows, switch_times, entered)
+        piston = piston_history(simulation.piston, solver.piston, time_s, rows[:, :n], rows[:, n:2 * n], None)
+        impact_force = piston.contact_force_n
+    bodies = simulation.chain.size  # the drill string's (a piston's follow)
     if progress is not None:
         progress(simulation.settings.end_time_s)
     initial = tuple(element.initial_mode(rows[0, :layout.size]) for element in solver.model.pieces)
@@ -376,12 +406,12 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
         simulation=simulation,
         formulation="exact",
         time_s=time_s,
-        position_m=rows[:, :n],
-        velocity_m_per_s=rows[:, n:2 * n],
+        position_m=rows[:, :bodies],
+        velocity_m_per_s=rows[:, n:n + bodies],
         bottom_m=rows[:, states][:, simulation.rock.bottom_index],
         rock_state_m=rows[:, states],
         rock_force_n=rows[:, layout.size],
-        impact_force_n=rows[:, layout.size + 1],
+        impact_force_n=impact_force,
         torsion_angle_rad=rows[:, angle] if layout.torsion else None,
         torsion_rate_rad_per_s=rows[:, angle + 1] if layout.torsion else None,
         cpu_time_s=cpu,
@@ -399,4 +429,5 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
             "min_switch_interval_s": solver.min_switch_interval_s,
             **({"fresh_fractions": solver.blows.fresh_fractions} if solver.blows else {}),
         },
+        piston=piston,
     )

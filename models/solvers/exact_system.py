@@ -19,6 +19,7 @@ from ...rocklaw.modes import Affine
 from ..definition.links import RATE
 from ..drill.chain import torsion_first_order_matrix
 from ..drill.piecewise import Element, elements, undeclared
+from ..drill.piston import CONTACT
 from ..drill.pulse import phase_generator, phase_row
 from .simulation import Simulation
 
@@ -62,7 +63,7 @@ class Model:
     """The generated matrices, rows and resets of one simulation (module doc)."""
 
     def __init__(self, simulation: Simulation) -> None:
-        chain, rock = simulation.chain, simulation.rock
+        chain, rock = simulation.dynamic_chain, simulation.rock
         self.simulation, self.impact = simulation, simulation.impact
         self.layout = layout = Layout(chain.size, len(rock.state_names), simulation.torsion is not None)
         self.pieces: tuple[Element, ...] = elements(chain, rock, layout.size)
@@ -107,16 +108,23 @@ class Model:
         """(Q_impact, Q_internal) with power = w^T Q w: the piston's F_d v_shank, and the power every link,
         the rock and the torsion line absorb, sum of F u over them (F the force row of the element in its
         mode, u its stretch rate: a link's delta', the rock's v_bit, the torsion line's omega)."""
-        layout, chain = self.layout, self.simulation.chain
+        layout, chain = self.layout, self.simulation.dynamic_chain
         n, size = layout.n, layout.size
+        string = self.simulation.chain.size  # the drill string's bodies; a piston's follow (models.drill.piston)
         pairs = []  # (force row, rate row) over w
         for link in chain.linear_links():
+            if link.body_b >= string:  # the piston's own springs: not the string's
+                continue
             stretch, rate = np.zeros(size), np.zeros(size)
             stretch[link.body_b], rate[n + link.body_b] = 1.0, 1.0
             if link.body_a is not None:
                 stretch[link.body_a], rate[n + link.body_a] = -1.0, -1.0
             pairs.append((link.stiffness_n_per_m * stretch + link.damping_n_s_per_m * rate, rate))
+        contact = None
         for element, mode in zip(self.pieces, modes, strict=True):
+            if element.name == CONTACT:
+                contact = self.row(element, element.table[mode].force)
+                continue
             velocity = element.variables[VELOCITY if element is self.pieces[0] else RATE]
             pairs.append((self.row(element, element.table[mode].force), velocity))
         if self.simulation.torsion is not None:
@@ -126,6 +134,8 @@ class Model:
             pairs.append((force, rate))
         impact = np.zeros(size)
         impact[layout.one:] = phase_row(self.impact, phase)
+        if contact is not None:  # the piston's contact pushes the impact body with -F (F > 0 pulls)
+            impact = -contact
         shank = np.zeros(size)
         shank[n + chain.impact_body] = 1.0
         forces, rates = (np.array(rows) for rows in zip(*pairs, strict=True))

@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import io
+import math
 import re
 import time
 import warnings
@@ -55,15 +56,16 @@ from exudyn.itemInterface import (
 from ...rocklaw.backends import SCALAR, SymbolicBackend
 from ...rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
-from ..definition.scene import Scene
+from ..definition.scene import STEEL_DENSITY_KG_PER_M3, Scene
 from ..drill.chain import AxialChain, Link
 from ..drill.indexing import BlowStarts
 from ..drill.pulse import impact_force
-from ..drill.shapes import layout
+from ..drill.shapes import DEFAULT_DIAMETER_M, Cylinder, Layout, layout
 from ..evaluation.results import SimulationResult
 from ..evaluation.run_result import Result
 from ..evaluation.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
 from .exudyn_graphics import DrillGraphics, body_graphics, torsion_graphics
+from .exudyn_piston import ExudynPiston
 from .simulation import Simulation, as_simulation, prepare
 
 SOLVER_TYPES = {
@@ -125,6 +127,7 @@ class ExudynModel:
     settings: Any
     symbolic_functions: list[Any] = field(default_factory=list)  # kept alive with the system
     blows: BlowStarts | None = None  # the blow starts of this run (models.drill.indexing)
+    piston: ExudynPiston | None = None  # the piston's strikes and catches (models.drill.piston)
     scene_formulation: str = "exudyn"  # the formulation the scene named (the model is always Exudyn's)
     symbolic: bool = True
     pre_steps: list[Callable[[Any, float], bool]] = field(default_factory=list)
@@ -242,7 +245,8 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     kept for the benchmark that measures what the symbolic functions save).
     """
     simulation, named = _exudyn_simulation(run)
-    chain, impact = simulation.chain, simulation.impact
+    chain, impact, piston = simulation.dynamic_chain, simulation.impact, simulation.piston
+    initial_positions = simulation.initial_positions_m if piston is None else piston.parked(simulation.initial_positions_m)
     shapes = layout(simulation.scene)
     container = exu.SystemContainer()
     mbs = container.AddSystem()
@@ -251,7 +255,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
 
     bodies: list[ExudynBody] = []
     rods = {name for name, body in simulation.scene.drill_string.bodies.items() if body.is_rod}
-    for body, cylinder, initial in zip(chain.bodies, shapes.cylinders, simulation.initial_positions_m, strict=True):
+    for body, cylinder, initial in zip(chain.bodies, _cylinders(shapes, chain), initial_positions, strict=True):
         shown = VObjectMass1D(graphicsData=body_graphics(cylinder, cylinder.group in rods))
         bodies.append(_add_body(mbs, body.name, lambda n, m=body.mass_kg, x=cylinder.centre_m, v=shown: mbs.AddObject(
             ObjectMass1D(nodeNumber=n, mass=m, referencePosition=[x, 0.0, 0.0], visualization=v)), initial))
@@ -328,13 +332,26 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
                                                 outputVariableType=COORDINATE))
         sensors["omega"] = _store(mbs, SensorNode(nodeNumber=torsion.node, storeInternal=True, outputVariableType=RATE))
 
-    drawn = DrillGraphics(chain, shapes, [body.node for body in bodies], COORDINATE)
+    drawn = DrillGraphics(simulation.chain, shapes, [body.node for body in bodies[:simulation.chain.size]], COORDINATE)
     mbs.AddObject(ObjectGround(visualization=VObjectGround(graphicsData=drawn.static(),
                                                            graphicsDataUserFunction=drawn)))
     mbs.Assemble()
+    hook = None if piston is None else ExudynPiston(piston, [body.node for body in bodies], mbs, impact.period_s)
     return ExudynModel(simulation, chain, container, mbs, {body.name: body for body in bodies}, connectors, rock,
                        torsion, drawn, sensors, _simulation_settings(simulation), [impact_function, *user_functions],
-                       blows, named, symbolic, _built_items=_item_counts(mbs))
+                       blows, hook, named, symbolic, _built_items=_item_counts(mbs))
+
+
+def _cylinders(shapes: Layout, chain: AxialChain) -> list[Cylinder]:
+    """The drawn cylinder of every body of the dynamic chain: the string's from its layout, a piston's
+    bodies (after the string's) as steel cylinders of the default diameter behind the string."""
+    cylinders = list(shapes.cylinders)
+    start_m = min((c.start_m for c in cylinders), default=0.0)
+    for body in chain.bodies[len(cylinders):]:
+        length_m = body.mass_kg / (STEEL_DENSITY_KG_PER_M3 * math.pi * DEFAULT_DIAMETER_M**2 / 4)
+        start_m -= length_m + shapes.joint_gap_m
+        cylinders.append(Cylinder(body.name, "piston", start_m, length_m, DEFAULT_DIAMETER_M))
+    return cylinders
 
 
 class _MinimumStepGuard:
@@ -431,6 +448,8 @@ def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: di
         warnings.warn(warning, StepLimitWarning, stacklevel=3)
     mbs = model.mbs
     actions = [model.rock.update_bottom] if model.rock.rock.crushes else []
+    if model.piston is not None:
+        actions.insert(0, model.piston)
     guard = None
     if settings.type in AUTOMATIC_STEP_SOLVERS:
         guard = _MinimumStepGuard(model.settings.timeIntegration.minimumStepSize)
@@ -451,6 +470,8 @@ def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: di
     position = np.column_stack([data[f"x{i}"][:, 1] for i in range(n)])
     velocity = np.column_stack([data[f"v{i}"][:, 1] for i in range(n)])
     history = np.array(model.rock.bottom_history)
+    piston = None if model.piston is None else model.piston.history(time_s, position, velocity)
+    position, velocity = position[:, :simulation.chain.size], velocity[:, :simulation.chain.size]
     rock_state = model.rock.state_at(time_s)
     info: dict[str, Any] = {"solver_success": bool(ok), "coordinates": model.coordinate_count,
                             **({"fresh_fractions": model.blows.fresh_fractions} if model.blows else {})}
@@ -465,13 +486,15 @@ def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: di
         velocity_m_per_s=velocity,
         bottom_m=rock_state[:, model.rock.rock.bottom_index],
         rock_force_n=data["rock"][:, 1] if "rock" in data else None,
-        impact_force_n=data["impact"][:, 1] if "impact" in data else None,
+        impact_force_n=(data["impact"][:, 1] if piston is None else piston.contact_force_n) if "impact" in data
+        else None,
         torsion_angle_rad=data["phi"][:, 1] if "phi" in data else None,
         torsion_rate_rad_per_s=data["omega"][:, 1] if "omega" in data else None,
         cpu_time_s=cpu,
         info=info,
         bottom_events=(history[:, 0], history[:, 1]),
         rock_state_m=rock_state,
+        piston=piston,
     )
     if guard is not None and guard.reached_at_s is not None:
         raise SimulationFailed(

@@ -19,6 +19,11 @@ switch times (models.drill.pulse.switch_times) are breakpoints: the run is integ
 between them, and the pulse is evaluated on the segment's own side of each switch. At a blow start
 the rock law's blow reset (models.drill.indexing.BlowStarts: the state the blow meets) is applied to the
 rock states when the law has one, and the rock's mode is found again.
+
+A piston (models.drill.piston) adds its bodies to x and v (the dynamic chain) and its contact to the
+nonlinear links (models.drill.piston.PistonContact, whose modes carry the catch); its strike is a state
+jump at every blow start (a segment boundary). A jump replaces the last sample, so that every
+sample is after the jumps at its time.
 """
 
 from __future__ import annotations
@@ -32,10 +37,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ...rocklaw.backends import NUMERIC
+from ..definition.links import CLOSED, OPEN
 from ..definition.scene import Impact
-from ..drill.chain import link_load_n, torsion_first_order_matrix
+from ..drill.chain import AxialChain, link_load_n, torsion_first_order_matrix
 from ..drill.indexing import BlowStarts
 from ..drill.piecewise import Element, elements, rock_element, undeclared
+from ..drill.piston import CAUGHT, CONTACT, PistonJumps, PistonSetup, piston_history
 from ..drill.pulse import blow_start_times, impact_force, switch_times
 from ..evaluation.results import SimulationResult
 from ..evaluation.stability import SimulationFailed, diverged_index
@@ -59,6 +66,7 @@ class _System:
     bit: int
     impact: int
     masses_kg: np.ndarray
+    chain: AxialChain  # the dynamic chain (models.solvers.simulation.Simulation.dynamic_chain)
 
     @property
     def rock_states(self) -> slice:
@@ -81,7 +89,7 @@ class _System:
         acceleration[self.impact] += pulse_n(t_s) / self.masses_kg[self.impact]
         acceleration[self.bit] -= self.rock_force_n(y) / self.masses_kg[self.bit]
         if len(self.pieces) > 1:
-            acceleration += link_load_n(self.simulation.chain, x, v, self.simulation.chain.nonlinear_links()) \
+            acceleration += link_load_n(self.chain, x, v, self.chain.nonlinear_links()) \
                 / self.masses_kg
         rock = self.pieces[0]
         for state, affine in rock.table[modes[0]].rates.items():
@@ -128,7 +136,7 @@ def _strict(function: EventFunction, direction: int) -> EventFunction:
 
 
 def _system(simulation: Simulation) -> _System:
-    chain = simulation.chain
+    chain = simulation.dynamic_chain
     n = chain.size
     size = 2 * n + len(simulation.rock.state_names)
     torsion = simulation.torsion
@@ -141,6 +149,7 @@ def _system(simulation: Simulation) -> _System:
         bit=chain.bit_body,
         impact=chain.impact_body,
         masses_kg=np.array([b.mass_kg for b in chain.bodies]),
+        chain=chain,
     )
 
 
@@ -158,7 +167,7 @@ class _SegmentPulse:
         self.blow_start_s = np.floor(middle / impact.period_s) * impact.period_s
         self.low_s = max(start_s - self.blow_start_s, 0.0)
         self.high_s = float(np.nextafter(end_s - self.blow_start_s, -np.inf))
-        between = middle - self.blow_start_s >= impact.duration_s
+        between = impact.piston is not None or middle - self.blow_start_s >= impact.duration_s
         self.constant_n = impact_force(impact, middle - self.blow_start_s, NUMERIC) if between else None
 
     def __call__(self, t_s: float) -> float:
@@ -206,8 +215,32 @@ def _fail(simulation: Simulation, t_s: float, why: str) -> SimulationFailed:
     )
 
 
+class _Piston:
+    """The piston's strikes in the ODE, and the bookkeeping of its catches (module doc)."""
+
+    def __init__(self, system: _System, setup: PistonSetup) -> None:
+        self.setup, self.n, self.jumps = setup, system.n, PistonJumps(setup)
+        self.contact = next(i for i, element in enumerate(system.pieces) if element.name == CONTACT)
+
+    def strike(self, t_s: float, y: np.ndarray, modes: Modes) -> tuple[np.ndarray, Modes]:
+        """The strike; the contact closing (closed when the piston is faster than the impact body)."""
+        y = y.copy()
+        self.jumps.strike(t_s, y[:self.n], y[self.n:2 * self.n])
+        closing = y[self.n + self.setup.front] > y[self.n + self.setup.impact_body]
+        return y, modes[:self.contact] + (CLOSED if closing else OPEN,) + modes[self.contact + 1:]
+
+    def switched(self, t_s: float, y: np.ndarray, mode: str) -> str:
+        """The contact's next mode: caught at once when it opens with the piston moving back already (an
+        event function that starts on its crossed side would not fire); a catch noted before its entry."""
+        if mode == OPEN and self.setup.mean_velocity_m_per_s(y[self.n:2 * self.n]) < 0.0:
+            mode = CAUGHT
+        if mode == CAUGHT:
+            self.jumps.noted_catch(t_s, y[:self.n], y[self.n:2 * self.n])
+        return mode
+
+
 def _integrate_segment(system: _System, record: _Record, y: np.ndarray, modes: Modes, span: tuple[float, float],
-                       pulse_n: _SegmentPulse) -> tuple[np.ndarray, Modes]:
+                       pulse_n: _SegmentPulse, piston: _Piston | None = None) -> tuple[np.ndarray, Modes]:
     """Integrate one pulse segment piece by piece across mode switches; (end state, end modes)."""
     settings = system.simulation.settings
     t, end = span
@@ -236,6 +269,8 @@ def _integrate_segment(system: _System, record: _Record, y: np.ndarray, modes: M
             raise _fail(system.simulation, t_next, "chattered between modes")
         _, _, index, next_mode = events[fired]
         element = system.pieces[index]
+        if piston is not None and index == piston.contact:
+            next_mode = piston.switched(t_next, y, next_mode)
         modes = modes[:index] + (next_mode,) + modes[index + 1:]
         into = next_mode if index == 0 else f"{element.name}:{next_mode}"
         record.switches[into] = record.switches.get(into, 0) + 1
@@ -257,7 +292,7 @@ def _start_blow(system: _System, blows: BlowStarts, record: _Record, y: np.ndarr
     angle = y[-2] if system.torsion is not None else 0.0
     law, y[system.rock_states] = blows(y[system.bit], tuple(y[system.rock_states]), angle)
     if law != system.pieces[0].law:
-        system = replace(system, pieces=(rock_element(system.simulation.chain, law, system.state_size),
+        system = replace(system, pieces=(rock_element(system.chain, law, system.state_size),
                                          *system.pieces[1:]))
     if record.time_s:
         record.states[-1][:, -1] = y
@@ -275,7 +310,8 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
         raise ValueError(f"scene '{simulation.name}': the ODE formulation cannot run it: {why}")
     system = _system(simulation)
     y = np.zeros(system.state_size)
-    y[:system.n] = simulation.initial_positions_m
+    setup = simulation.piston
+    y[:system.n] = simulation.initial_positions_m if setup is None else setup.parked(simulation.initial_positions_m)
     y[system.rock_states] = simulation.initial_rock_state
     if system.torsion is not None:
         y[-2] = simulation.initial_torsion_angle_rad
@@ -283,11 +319,16 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     record = _Record([], [], [], {})
     start = time.process_time()
     impact, blows = simulation.impact, simulation.blow_starts()
-    blow_starts = set(blow_start_times(impact, simulation.settings.end_time_s)) if blows else set()
+    blow_starts = set(blow_start_times(impact, simulation.settings.end_time_s)) if blows or setup else set()
+    piston = None if setup is None else _Piston(system, setup)
     for span in itertools.pairwise(switch_times(impact, simulation.settings.end_time_s)):
-        if span[0] in blow_starts:
+        if span[0] in blow_starts and blows:
             system, y, modes = _start_blow(system, blows, record, y, modes)
-        y, modes = _integrate_segment(system, record, y, modes, span, _SegmentPulse(impact, *span))
+        if span[0] in blow_starts and piston:
+            y, modes = piston.strike(span[0], y, modes)
+            if record.time_s:
+                record.states[-1][:, -1] = y
+        y, modes = _integrate_segment(system, record, y, modes, span, _SegmentPulse(impact, *span), piston)
         if progress is not None:
             progress(span[1])
     cpu = time.process_time() - start
@@ -300,16 +341,21 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
         raise _fail(simulation, float(time_s[bad]), "diverged")
     torsion = system.torsion is not None
     settings = simulation.settings
+    history = None
+    if piston is not None:
+        history = piston_history(setup, piston.jumps, time_s, states[:, :n], states[:, n:2 * n],
+                                 np.ones(len(time_s), dtype=bool))
+        n = simulation.chain.size  # the drill string's bodies
     return SimulationResult(
         simulation=simulation,
         formulation="ode",
         time_s=time_s,
         position_m=states[:, :n],
-        velocity_m_per_s=states[:, n:2 * n],
+        velocity_m_per_s=states[:, system.n:system.n + n],
         bottom_m=states[:, system.rock_states][:, simulation.rock.bottom_index],
         rock_force_n=system.rock_force_n(states.T),
         rock_state_m=states[:, system.rock_states],
-        impact_force_n=np.concatenate(record.impact_n),
+        impact_force_n=np.concatenate(record.impact_n) if history is None else history.contact_force_n,
         torsion_angle_rad=states[:, -2] if torsion else None,
         torsion_rate_rad_per_s=states[:, -1] if torsion else None,
         cpu_time_s=cpu,
@@ -327,4 +373,5 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
             "switches_into": dict(record.switches),
             **({"fresh_fractions": blows.fresh_fractions} if blows else {}),
         },
+        piston=history,
     )

@@ -33,8 +33,9 @@ from ..definition.scene import (
 )
 from ..drill.chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
 from ..drill.indexing import BlowStarts, Indexing
+from ..drill.piston import PistonSetup, piston_setup
 from ..drill.pulse import impulse_per_blow_n_s
-from ..evaluation.solver_settings import Settings, resolve_settings
+from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_settings
 from ..evaluation.stability import FastestElement, StepScales, fastest_element, step_scales
 
 if TYPE_CHECKING:
@@ -65,6 +66,17 @@ class Simulation:
     step_scales: StepScales | None  # the rates a fixed step resolves, bit on the rock (Exudyn runs only)
     fastest: FastestElement  # the element of the highest rate and the keys that set it
     indexing: Indexing | None = None
+    piston: PistonSetup | None = None  # a piston striking the impact body (models.drill.piston), or the pulse
+
+    @property
+    def dynamic_chain(self) -> AxialChain:
+        """What the formulations integrate: the chain, with the piston's bodies appended when there is one."""
+        return self.chain if self.piston is None else self.piston.dynamic_chain(self.chain)
+
+    @property
+    def pulse_duration_s(self) -> float:
+        """The prescribed pulse's duration, or the piston's contact time (an estimate: models.drill.piston)."""
+        return self.impact.duration_s if self.piston is None else self.piston.pulse_duration_s
 
     @property
     def name(self) -> str:
@@ -121,6 +133,8 @@ class Simulation:
         data["effects"] = {**self.effects.as_dict(), "reasons": dict(self.effects.reasons)}
         data["outputs"] = self.outputs.model_dump(mode="json")
         data["solver"] = {key: value for key, value in vars(self.settings).items() if value is not None}
+        if self.piston is not None:  # the contact stiffness as run (given, or from the faces in contact)
+            data["impact"]["piston"]["contact_stiffness_n_per_m"] = self.piston.contact_stiffness_n_per_m
         return data
 
 
@@ -132,13 +146,23 @@ def prepare(scene: Scene) -> Simulation:
     rock = scene.rock.build(damping=effects.rock_damping, plasticity=effects.rock_plasticity,
                             indexed=effects.indexing)
     torsion = scene.torsion if effects.torsion else None
+    try:
+        piston = piston_setup(scene, chain)
+    except ValueError as err:
+        raise SceneError(("impact", "piston", "contact_stiffness_n_per_m"), None, str(err)) from None
+    dynamic = chain if piston is None else piston.dynamic_chain(chain)
     fastest = fastest_element(scene, chain, rock, torsion)
-    scales = step_scales(chain, rock, torsion, scene.impact.period_s) if scene.solver.formulation == "exudyn" else None
+    scales = step_scales(dynamic, rock, torsion, scene.impact.period_s) if scene.solver.formulation == "exudyn" else None
     if not math.isfinite(fastest.rate_per_s) or not math.isfinite(scales.spectral_radius_per_s if scales else 0.0):
         raise SceneError(tuple(fastest.key.split(".")), fastest.value,
                          f"with {fastest.other_key} {fastest.other_value:g} the model's fastest rate overflows "
                          f"(k/m or c/m beyond {sys.float_info.max:.3g}); give values of a physical drill")
-    settings = resolve_settings(scene.solver, scene.impact.duration_s, scales)
+    settings = resolve_settings(scene.solver, scene.impact.duration_s if piston is None else piston.pulse_duration_s,
+                                scales)
+    if piston is not None and isinstance(settings, ExudynSettings) and scene.solver.step_s is None:
+        # the strikes fall on step starts: a whole number of steps per period (a strike one step late
+        # shifts the blow against the string's ringing; 2 % in the rate of the top-hammer scene)
+        settings = replace(settings, step_s=scene.impact.period_s / math.ceil(scene.impact.period_s / settings.step_s))
     positions, angle = np.zeros(chain.size), 0.0
     if scene.start == "preloaded":
         try:
@@ -154,7 +178,7 @@ def prepare(scene: Scene) -> Simulation:
         if indexing.speed_rpm is not None:  # the same share every blow: the law has it from the start
             rock = replace(rock, fresh_fraction=indexing.fresh_fraction(indexing.prescribed_angle_rad))
     return Simulation(scene, effects, outputs, chain, rock, settings, positions, state, angle, scales, fastest,
-                      indexing)
+                      indexing, piston)
 
 
 def as_simulation(run: Scene | Simulation) -> Simulation:

@@ -25,12 +25,21 @@ def best_point(advice: Advice) -> str:
     """'sandstone: best penetration rate 23.1 mm/s at impact frequency 66.2 Hz, feed force 81 kN (...)'."""
     y = metric(advice.metric)
     at = ", ".join(f"{parameter(p).name} {parameter(p).show_with_unit(v)}" for p, v in advice.best.items())
+    if advice.power_w is not None:
+        at += f" ({blow_energy_text(advice)})"
     failed = f", {advice.failed_runs} failed" if advice.failed_runs else ""
     beyond = f", {advice.beyond_limit} points beyond the thrust limit not run" if advice.beyond_limit else ""
     return (f"{_rock(advice)}: best {y.name} {y.show_with_unit(advice.best_value)} at {at}, mean thrust "
             f"{advice.best_thrust_ratio:.0%} of F_th ({advice.formulation}, {advice.runs} runs{failed}{beyond}, "
             f"{advice.generations} generations{'' if advice.converged else ', not converged'}, "
             f"{advice.wall_time_s:.1f} s)")
+
+
+def blow_energy_text(advice: Advice) -> str:
+    """'blow energy 300 J at 15 kW': E_blow = P / f at the optimum's frequency (a fixed hammer power)."""
+    energy = parameter("impact.piston.energy_j")
+    return (f"{energy.name} {energy.show_with_unit(advice.power_w / advice.best[FREQUENCY])} at "
+            f"{advice.power_w / 1e3:.4g} kW")
 
 
 def curves_text(advice: Advice) -> str:
@@ -85,7 +94,12 @@ def best_table(advices: list[Advice], markdown: bool = False) -> str:
     headings = ["rock", *(parameter(p).heading() for p in paths), y.heading(),
                 *(f"80 % band, {parameter(p).heading()}" for p in paths), "mean thrust / F_th [%]", "runs",
                 "wall time [s]"]
-    rows = [[_rock(a), *(parameter(p).show(a.best[p]) for p in paths), y.show(a.best_value),
+    power = advices[0].power_w is not None
+    if power:  # the blow energy at the optimum, P / f
+        headings.insert(1 + len(paths), parameter("impact.piston.energy_j").heading())
+    rows = [[_rock(a), *(parameter(p).show(a.best[p]) for p in paths),
+             *([parameter("impact.piston.energy_j").show(a.power_w / a.best[FREQUENCY])] if power else []),
+             y.show(a.best_value),
              *(_band(a, p) for p in paths), f"{100 * a.best_thrust_ratio:.0f}", str(a.runs),
              f"{a.wall_time_s:.1f}"] for a in advices]
     return (markdown_table if markdown else text_table)(headings, rows)
@@ -149,7 +163,7 @@ The best {y.name} within the bounds, found by differential evolution on the {fir
 ({first.end_time_s:g} s runs; studies/advice/advice_search.py). The 80 % bands are the intervals, one parameter at a
 time with the others at the optimum, where the {y.name} stays at or above 80 % of its best value;
 the mean thrust is the feed plus the blow frequency times the impulse per blow, as a share of the
-rock's threshold F_th. Scene: {first.scene_description}.
+rock's threshold F_th. Scene: {first.scene_description}.{_power_sentence(first)}
 
 {best_table(advices, markdown=True)}
 
@@ -164,6 +178,13 @@ frequency, where it is highest along the feed at each frequency of a {len(first.
 
 {feed}
 """
+
+
+def _power_sentence(advice: Advice) -> str:
+    if advice.power_w is None:
+        return ""
+    return (f" At a fixed hammer power of {advice.power_w / 1e3:.4g} kW: at every point the piston's blow energy is "
+            "the power over the frequency, E_blow = P / f.")
 
 
 def advice_record(advices: list[Advice], command: str) -> dict[str, Any]:

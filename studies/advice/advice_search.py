@@ -3,7 +3,15 @@
 The point lies in the operating parameters of :data:`PARAMETERS` (data: a scene path each, shown
 through studies.display.catalogue; adding one, e.g. a rotation speed, is one entry): the impact frequency
 and the feed force, and optionally the impact amplitude. The metric is the penetration rate, or
-the penetration per joule of impact energy (models.evaluation.metrics).
+the penetration per joule of impact energy, or the penetration per joule of blow energy (a piston
+scene: the penetration rate per unit hammer power; models.evaluation.metrics).
+
+* **Fixed hammer power** (``power_w``, a piston scene): at every point the blow energy follows from
+  the frequency, E_blow = P / f (``impact.piston.energy_j``; the strike speed follows from it), so the
+  search trades frequency against blow energy at the hammer's rated power P = E_blow f. A top
+  hammer's rate is jagged along the frequency there (each blow meets the string's ringing from the
+  last at another phase), so the points of the curves and the map are candidates too: where one beats
+  the search's best it becomes the optimum, and the curves are run again through it.
 
 * **Runs**: the exact formulation where it can run the scene (models.definition.formulations.unsupported),
   the Exudyn model otherwise; the scene's end time, raised where needed so that the metrics'
@@ -53,7 +61,7 @@ from ..scan.curve_optima import band_hz
 from ..scan.frequency_scans import scan_target
 
 FREQUENCY, FEED = "impact.frequency_hz", "feed.force_n"
-METRICS = ("penetration_rate_m_per_s", "penetration_per_impact_energy_m_per_j")
+METRICS = ("penetration_rate_m_per_s", "penetration_per_impact_energy_m_per_j", "penetration_per_blow_energy_m_per_j")
 SLICE_POINTS = 15
 MAP_POINTS = 12
 IMPLAUSIBLE = 10  # a feed bound this many times every rock's threshold force is a unit mistake (N for kN)
@@ -120,6 +128,7 @@ class Request:
     bounds: Bounds
     max_thrust_ratio: float = 1.0
     search: AdviceSearch = AdviceSearch()
+    power_w: float | None = None  # a fixed hammer power: E_blow = P / f at every point (module doc)
 
 
 @dataclass
@@ -148,13 +157,19 @@ class Advice:
     slices: dict[str, dict[str, Any]] = field(default_factory=dict)
     feed_map: dict[str, Any] = field(default_factory=dict)
     wall_time_s: float = 0.0
+    power_w: float | None = None  # the fixed hammer power (module doc), or None
 
 
-def at_point(scene: dict[str, Any], point: Point) -> dict[str, Any]:
-    """The scene with the operating parameters of ``point`` set."""
+def at_point(scene: dict[str, Any], point: Point, power_w: float | None = None) -> dict[str, Any]:
+    """The scene with the operating parameters of ``point`` set, and at a fixed hammer power ``power_w``
+    the piston's blow energy P / f (in place of its strike speed)."""
     data = copy.deepcopy(scene)
     for path, value in point.items():
         set_path(data, path, float(value))
+    if power_w is not None:
+        piston = data["impact"]["piston"]
+        piston.pop("velocity_m_per_s", None)
+        piston["energy_j"] = power_w / data["impact"]["frequency_hz"]
     return data
 
 
@@ -162,7 +177,11 @@ def runnable_scene(scene: dict[str, Any], rock: str | None, request: Request, so
     """The scene as advise runs it: the Table 1 ``rock`` in place of its rock (None: its own), the exact
     formulation if it can run it, else Exudyn, the end time raised to fit the metrics' blows at the
     lowest frequency, only the metric computed. InputError (naming ``source`` and the options) when a
-    corner of the bounds gives a scene that cannot run."""
+    corner of the bounds gives a scene that cannot run, or a fixed power is asked of a scene without a
+    piston."""
+    if request.power_w is not None and "piston" not in scene.get("impact", {}):
+        raise InputError(f"{source}: --power-kw needs a piston (impact.piston): the blow energy at a fixed power "
+                         "is the piston's")
     checked = Scene.model_validate({**scene, **({"rock": {"name": rock}} if rock else {}),
                                     "outputs": {"metrics": [request.metric]}})
     formulation = "exact" if unsupported("exact", prepare(checked.with_solver("exact"))) is None else "exudyn"
@@ -173,7 +192,7 @@ def runnable_scene(scene: dict[str, Any], rock: str | None, request: Request, so
     for corner in itertools.product(*request.bounds.values()):
         point = dict(zip(request.bounds, corner, strict=True))
         try:
-            prepare(Scene.model_validate(at_point(data, point)))
+            prepare(Scene.model_validate(at_point(data, point, request.power_w)))
         except (ValidationError, SceneError) as error:
             where = " ".join(f"{options[path]} {parameter(path).show(value)}" for path, value in point.items())
             problem = describe_validation_error(source, error, Scene) if isinstance(error, ValidationError) else \
@@ -199,10 +218,10 @@ def thrust_ratio(scene: dict[str, Any]) -> float:
     return simulation.mean_thrust_n / simulation.rock.threshold_n
 
 
-def limit_feed_n(scene: dict[str, Any], frequency_hz: float, ratio: float) -> float:
+def limit_feed_n(scene: dict[str, Any], frequency_hz: float, ratio: float, power_w: float | None = None) -> float:
     """The feed force at which the mean thrust reaches ``ratio`` x F_th at ``frequency_hz`` (inf for a
     rock without a threshold, negative when the blows alone exceed it)."""
-    simulation = _prepared(at_point(scene, {FREQUENCY: frequency_hz}))
+    simulation = _prepared(at_point(scene, {FREQUENCY: frequency_hz}, power_w))
     share = simulation.feed_total_n / simulation.scene.feed.force_n  # 1, or the bodies the feed acts on
     return (ratio * simulation.rock.threshold_n - (simulation.mean_thrust_n - simulation.feed_total_n)) / share
 
@@ -232,9 +251,11 @@ class AdviceEvaluator:
         self.scene, self.request, self.runner, self.progress = scene, request, runner, progress
         self.runs = self.failed = self.beyond_limit = 0
         self.first_error = ""
+        self.best_point: Point = {}
+        self.best_value = -math.inf
 
     def __call__(self, points: list[Point]) -> Evaluation:
-        scenes = [at_point(self.scene, p) for p in points]
+        scenes = [at_point(self.scene, p, self.request.power_w) for p in points]
         ratios = np.array([thrust_ratio(scene) for scene in scenes])
         tasks = [(i, scene, [self.request.metric], [scene["impact"]["frequency_hz"]])
                  for i, scene in enumerate(scenes) if ratios[i] < self.request.max_thrust_ratio]
@@ -247,6 +268,9 @@ class AdviceEvaluator:
         self.beyond_limit += len(points) - len(tasks)
         if self.progress:
             self.progress(len(points))
+        below = np.where(ratios < self.request.max_thrust_ratio, np.nan_to_num(values, nan=-math.inf), -math.inf)
+        if len(points) and below.max() > self.best_value:
+            self.best_value, self.best_point = float(below.max()), dict(points[int(np.argmax(below))])
         return Evaluation(values, ratios, self.request.max_thrust_ratio)
 
 
@@ -289,9 +313,9 @@ def feed_map(evaluate: AdviceEvaluator, request: Request, best: Point, scene: di
     frequencies = [float(f) for f in np.linspace(*request.bounds[FREQUENCY], MAP_POINTS)]
     feeds = [float(f) for f in np.linspace(*request.bounds[FEED], MAP_POINTS)]
     values = evaluate([{**best, FREQUENCY: f, FEED: feed} for feed in feeds for f in frequencies]).values
-    at_best = at_point(scene, best)
+    at_best = at_point(scene, best, request.power_w)
     return {FREQUENCY: frequencies, FEED: feeds, "metric": values.reshape(len(feeds), len(frequencies)).tolist(),
-            "limit_feed_n": [limit_feed_n(at_best, f, request.max_thrust_ratio) for f in frequencies]}
+            "limit_feed_n": [limit_feed_n(at_best, f, request.max_thrust_ratio, request.power_w) for f in frequencies]}
 
 
 def peak_position(values: list[float]) -> str:
@@ -325,11 +349,15 @@ def advise(data: dict[str, Any], rock: str | None, request: Request, runner: Run
     advice = Advice(scene=data["name"], description=describe_scene(scene, request.bounds),
                     scene_description=describe_scene(scene, [*request.bounds, "rock.name"]), rock=rock, metric=request.metric, formulation=data["solver"]["formulation"],
                     end_time_s=data["solver"]["end_time_s"], bounds=request.bounds,
-                    max_thrust_ratio=request.max_thrust_ratio)
+                    max_thrust_ratio=request.max_thrust_ratio, power_w=request.power_w)
     advice.best, advice.best_value, advice.generations, advice.converged = search_best(evaluate, request)
-    advice.best_thrust_ratio = thrust_ratio(at_point(data, advice.best))
+    advice.best_thrust_ratio = thrust_ratio(at_point(data, advice.best, request.power_w))
     advice.slices = slices(evaluate, request.bounds, advice.best, advice.best_value)
     advice.feed_map = feed_map(evaluate, request, advice.best, data)
+    if request.power_w is not None and evaluate.best_value > advice.best_value:  # a curve or map point (module doc)
+        advice.best, advice.best_value = evaluate.best_point, evaluate.best_value
+        advice.best_thrust_ratio = thrust_ratio(at_point(data, advice.best, request.power_w))
+        advice.slices = slices(evaluate, request.bounds, advice.best, advice.best_value)
     advice.feed_map["response"] = feed_response(advice.feed_map)
     advice.runs, advice.failed_runs, advice.beyond_limit = evaluate.runs, evaluate.failed, evaluate.beyond_limit
     advice.first_error = evaluate.first_error

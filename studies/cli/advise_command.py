@@ -59,7 +59,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                             help=f"bounds of the {q.name} [{q.unit}]" + ("" if entry.required else
                                                                         " (default: fixed at the scene's value)"))
     parser.add_argument("--metric", choices=METRICS, default=METRICS[0],
-                        help=f"what to maximise (default {METRICS[0]}; {METRICS[1]}: penetration rate / impact power)")
+                        help=f"what to maximise (default {METRICS[0]}; {METRICS[1]}: penetration rate / impact power; "
+                             f"{METRICS[2]}: penetration rate / hammer power, a piston scene)")
+    parser.add_argument("--power-kw", type=positive_number, metavar="P",
+                        help="a fixed hammer power [kW] (a piston scene): at every point the blow energy is P / f, "
+                             "so the search trades frequency against blow energy")
     parser.add_argument("--rock", nargs="+", choices=tuple(TABLE_1), metavar="NAME",
                         help=f"search again for each Table 1 rock ({', '.join(TABLE_1)}; default: the scene's rock)")
     parser.add_argument("--max-thrust-ratio", type=positive_number, default=1.0,
@@ -81,6 +85,7 @@ def command_line(args: argparse.Namespace) -> str:
     for entry in PARAMETERS:
         if _given(args, entry) is not None:
             words += [entry.option, *(f"{v:g}" for v in _given(args, entry))]
+    words += ["--power-kw", f"{args.power_kw:g}"] if args.power_kw else []
     words += ["--metric", args.metric] + (["--rock", *args.rock] if args.rock else [])
     words += ["--max-thrust-ratio", f"{args.max_thrust_ratio:g}"]
     words += ["--popsize", str(args.popsize), "--generations", str(args.generations), "--seed", str(args.seed)]
@@ -95,7 +100,8 @@ def run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene).model_dump(by_alias=True, exclude_none=True)
     bounds = {e.path: e.si_bounds(_given(args, e)) for e in PARAMETERS if _given(args, e) is not None}
     request = Request(args.metric, bounds, args.max_thrust_ratio,
-                      AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed))
+                      AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed),
+                      power_w=args.power_kw * 1e3 if args.power_kw else None)
     rocks = args.rock or [None]
     scenes = [runnable_scene(scene, rock, request, args.scene) for rock in rocks]
     advices = []

@@ -88,6 +88,9 @@ METRICS: dict[str, Quantity] = {
     "crushing_work_j": _q("crushing work in the window", "W_c", "J"),
     "energy_transfer_efficiency": _q("energy transfer efficiency", r"\eta", "%", 100.0, "1", merit=True),
     "energy_balance_relative_error": _q("energy balance error", r"\epsilon_E", "%", 100.0, "1"),
+    "piston_rebound_energy_j": _q("piston rebound energy per blow", r"E_{reb}", "J"),
+    "penetration_per_blow_energy_m_per_j": _q("penetration per blow energy", r"v_p / (E_{blow} f)", "mm/kJ", 1e6,
+                                              "m/J", merit=True),
     "window_start_s": _q("averaging window start", "t_0", "s"),
     "window_end_s": _q("averaging window end", "t_1", "s"),
     "window_blows": _q("blows averaged", "N", "blows"),
@@ -103,6 +106,8 @@ SERIES: dict[str, Quantity] = {
     "impact_force_n": _q("impact force", "F_d", "kN", 1e-3, "N"),
     "torsion_angle_rad": _q("torsion angle", r"\varphi", "rad"),
     "torsion_rate_rad_per_s": _q("torsion rate", r"\dot{\varphi}", "rad/s"),
+    "piston_contact_force_n": _q("piston contact force", "F_c", "kN", 1e-3, "N"),
+    "piston_velocity_m_per_s": _q("piston velocity", "v_{piston}", "m/s"),
     "*_force_n": _q("{name} force (compression)", "F", "kN", 1e-3, "N"),
     "*_compression_m": _q("{name} compression", r"\delta", "mm", 1e3, "m"),
     "*_gap_opening_m": _q("{name} gap opening", "g", "mm", 1e3, "m"),
@@ -143,6 +148,17 @@ PARAMETERS: dict[str, Quantity] = {
     "impact.frequency_hz": _q("impact frequency", "f", "Hz"),
     "impact.shape": _category("pulse shape"),
     "impact.duration_s": _q("pulse duration", r"\tau", "ms", 1e3, "s"),
+    "impact.piston.mass_kg": _q("piston mass", "m_p", "kg"),
+    "impact.piston.length_m": _q("piston length", "L_p", "m"),
+    "impact.piston.diameter_m": _q("piston diameter", "D_p", "mm", 1e3, "m"),
+    "impact.piston.bore_diameter_m": _q("piston bore diameter", "d_p", "mm", 1e3, "m"),
+    "impact.piston.mass_per_length_kg_per_m": _q("piston mass per length", "m'_p", "kg/m"),
+    "impact.piston.youngs_modulus_pa": _q("piston Young's modulus", "E_p", "GPa", 1e-9, "Pa"),
+    "impact.piston.density_kg_per_m3": _q("piston density", r"\rho_p", "kg/m³"),
+    "impact.piston.segments": _q("piston segments", "N_p", "segments"),
+    "impact.piston.velocity_m_per_s": _q("strike speed", "v_p", "m/s"),
+    "impact.piston.energy_j": _q("blow energy", r"E_{blow}", "J"),
+    "impact.piston.contact_stiffness_n_per_m": _q("piston contact stiffness", "k_c", "MN/m", 1e-6, "N/m"),
     "rock.law": _category("rock law"),
     "rock.name": _category("rock"),
     "rock.stiffness_n_per_m": _q("rock stiffness", "k_n", "MN/m", 1e-6, "N/m"),
@@ -256,7 +272,14 @@ def describe_scene(scene: Scene, varied: Collection[str] = ()) -> str:
                   for v in _shown(filled, f"rock.{key}", varied, f"{symbol} {{}}")]
         rock_text = " ".join(["rock"] + ([rock.name] if rock.name else []) + ([f"({', '.join(values)})"] if values else
                                                                              [] if rock.name else ["varied"]))
-    impact = " ".join(["impact", *_shown(scene, "impact.amplitude_n", varied), scene.impact.shape.replace("_", "-"),
-                       *_shown(scene, "impact.duration_s", varied, "of {}"),
-                       *_shown(scene, "impact.frequency_hz", varied, "at {}")])
+    if scene.impact.piston is not None:  # 'piston 4.5 kg at 9 m/s, 60 Hz'
+        piston = scene.impact.piston
+        size = ["impact.piston.mass_kg"] if piston.mass_kg is not None else ["impact.piston.length_m"]
+        strike = "impact.piston.velocity_m_per_s" if piston.velocity_m_per_s is not None else "impact.piston.energy_j"
+        impact = " ".join(["piston", *[v for p in size for v in _shown(scene, p, varied)],
+                           *_shown(scene, strike, varied, "at {}"), *_shown(scene, "impact.frequency_hz", varied, "{}")])
+    else:
+        impact = " ".join(["impact", *_shown(scene, "impact.amplitude_n", varied), scene.impact.shape.replace("_", "-"),
+                           *_shown(scene, "impact.duration_s", varied, "of {}"),
+                           *_shown(scene, "impact.frequency_hz", varied, "at {}")])
     return f"{scene.name}: " + ", ".join([rock_text, impact, *_shown(scene, "feed.force_n", varied, "feed {}")])

@@ -246,8 +246,7 @@ def draw_string(ax: Axes, scene: Scene, drawing: DrawnLayout | None = None, offs
             fontsize=8, zorder=5, bbox={"facecolor": "white", "alpha": 0.7, "edgecolor": "none"})
     arrow = 0.8 * drawing.gap
     impact = drawing.bodies[chain.impact_body]
-    _arrow(ax, impact.start, 0.42 * BODY_HEIGHT, arrow, IMPACT_COLOUR,
-           f"impact {scene.impact.amplitude_n / 1e3:.4g} kN, {scene.impact.frequency_hz:.4g} Hz")
+    _arrow(ax, impact.start, 0.42 * BODY_HEIGHT, arrow, IMPACT_COLOUR, _impact_text(scene))
     fed = [parts for group, parts in groups.items() if scene.feed.acts_on in (EVERY_BODY, group)]
     for k, parts in enumerate(fed if scene.feed.force_n > 0 else []):
         body = parts[0]
@@ -275,6 +274,16 @@ class _Levels:
                 return level
         self.rows.append([(centre - half, centre + half)])
         return len(self.rows) - 1
+
+
+def _impact_text(scene: Scene) -> str:
+    """The impact arrow's label: the prescribed pulse's amplitude, or the piston's mass and strike speed."""
+    impact = scene.impact
+    if impact.piston is None:
+        return f"impact {impact.amplitude_n / 1e3:.4g} kN, {impact.frequency_hz:.4g} Hz"
+    piston = impact.piston
+    return (f"piston {piston.total_mass_kg:.3g} kg at {piston.strike_velocity_m_per_s:.3g} m/s, "
+            f"{impact.frequency_hz:.4g} Hz")
 
 
 def _rock_text(scene: Scene) -> str:
