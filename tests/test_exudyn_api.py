@@ -15,7 +15,7 @@ from exudyn.itemInterface import (
 )
 from scenes import crushing_scene, scene
 
-from rpdrill.models.definition.scene import STEEL_DENSITY_KG_PER_M3
+from rpdrill.models.definition.drill_string import STEEL_DENSITY_KG_PER_M3
 from rpdrill.models.drill.shapes import DEFAULT_DIAMETER_M, layout
 from rpdrill.models.solvers.exudyn_model import build_exudyn, simulate
 from rpdrill.studies.inputs.reading import load_scene

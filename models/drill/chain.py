@@ -17,9 +17,10 @@ import numpy as np
 
 from ...rocklaw import RockLaw
 from ...rocklaw.modes import ONE
+from ..definition.drill_string import EVERY_BODY, GROUND, Body, Connector
 from ..definition.links import CLOSED as CLOSED_MODE
 from ..definition.links import LINK_TYPES, RATE, STRETCH, Link
-from ..definition.scene import EVERY_BODY, GROUND, Body, Connector, Scene, Torsion
+from ..definition.scene import Scene, Torsion
 
 
 @dataclass(frozen=True)

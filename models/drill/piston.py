@@ -42,8 +42,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ...rocklaw.modes import ONE, Mode, ModeTable, Switch
+from ..definition.drill_string import Body
 from ..definition.links import CLOSED, OPEN, STRETCH, Coupling, Link
-from ..definition.scene import Body, Piston, Scene
+from ..definition.scene import Piston, Scene
 from .chain import AxialChain, ChainBody
 
 PISTON = "piston"

@@ -17,7 +17,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..definition.scene import Body, Scene
+from ..definition.drill_string import Body
+from ..definition.scene import Scene
 
 DEFAULT_DIAMETER_M = 0.15  # a rigid body without a stated diameter: about a 6 in drill collar
 

@@ -17,14 +17,10 @@ add Exudyn items of their own; ``model.run()`` runs it. A normal run is the same
 
 from __future__ import annotations
 
-import contextlib
-import gc
-import io
 import math
-import re
 import time
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -55,8 +51,9 @@ from exudyn.itemInterface import (
 
 from ...rocklaw.backends import SCALAR, SymbolicBackend
 from ...rocklaw.exudyn_element import ExudynRockContact, attach_user_function
+from ..definition.drill_string import STEEL_DENSITY_KG_PER_M3
 from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
-from ..definition.scene import STEEL_DENSITY_KG_PER_M3, Scene
+from ..definition.scene import Scene
 from ..drill.chain import AxialChain, Link
 from ..drill.indexing import BlowStarts
 from ..drill.pulse import impact_force
@@ -65,6 +62,7 @@ from ..evaluation.results import SimulationResult
 from ..evaluation.run_result import Result
 from ..evaluation.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
 from .exudyn_graphics import DrillGraphics, body_graphics, torsion_graphics
+from .exudyn_messages import exudyn_messages_as_warnings, no_cyclic_gc
 from .exudyn_piston import ExudynPiston
 from .simulation import Simulation, as_simulation, prepare
 
@@ -391,40 +389,6 @@ def _pre_step(actions: list[Callable[[Any, float], bool]]) -> Callable[[Any, flo
     return pre_step
 
 
-@contextlib.contextmanager
-def _no_cyclic_gc() -> Iterator[None]:
-    """Python's cyclic garbage collector paused: the per-step hooks allocate small objects without
-    cycles (freed by reference counting), and the collections they would trigger cost ~5 % of a run."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
-
-
-class ExudynMessage(UserWarning):
-    """What Exudyn printed during a run (its warnings), issued as a warning instead."""
-
-
-EXUDYN_PREFIX = re.compile(r"^\s*Python WARNING \[file '[^']*', line \d+\]:\s*")
-
-
-@contextlib.contextmanager
-def _exudyn_messages_as_warnings(name: str) -> Iterator[None]:
-    """What Exudyn prints while the block runs (it prints through sys.stdout) comes out as one
-    :class:`ExudynMessage` warning per distinct line, without Exudyn's file and line prefix."""
-    printed = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(printed):
-            yield
-    finally:
-        lines = [EXUDYN_PREFIX.sub("", line).strip() for line in printed.getvalue().splitlines()]
-        for line in dict.fromkeys(line for line in lines if line):
-            warnings.warn(f"scene '{name}': Exudyn: {line}", ExudynMessage, stacklevel=3)
-
-
 def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
     return mbs.GetSensorStoredData(sensor)
 
@@ -459,7 +423,7 @@ def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: di
     pre_step = _pre_step(actions + model.pre_steps)
     if pre_step is not None:
         mbs.SetPreStepUserFunction(pre_step)
-    with _no_cyclic_gc(), _exudyn_messages_as_warnings(simulation.name):
+    with no_cyclic_gc(), exudyn_messages_as_warnings(simulation.name):
         start = time.process_time()
         ok = mbs.SolveDynamic(model.settings, solverType=SOLVER_TYPES[settings.type])
         cpu = time.process_time() - start

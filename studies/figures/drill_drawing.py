@@ -22,8 +22,9 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.patches import FancyArrowPatch, Rectangle
 
+from ...models.definition.drill_string import EVERY_BODY, GROUND
 from ...models.definition.links import Link
-from ...models.definition.scene import EVERY_BODY, GROUND, Scene
+from ...models.definition.scene import Scene
 from ...models.drill.shapes import DEFAULT_DIAMETER_M, Layout, axial_order, layout
 from .figure_style import OKABE_ITO, plt
 
