@@ -21,6 +21,7 @@ import sys
 from pathlib import Path
 
 
+from ..budgets import Budget
 from ..calibration_spec import load_calibration
 from . import add_runner_arguments
 from ..loading import InputError
@@ -51,7 +52,9 @@ def run(args: argparse.Namespace) -> int:
         if folder is not None and not folder.is_dir():
             raise InputError(f"--{option}: {folder}: not a folder; give the --out of `rpdrill {command}`")
     reproduction = load_reproduction(args.reproduction)
-    calibration = None if reproduction.calibration_file is None else load_calibration(reproduction.calibration_file)
+    # only the calibration's bounds and reasons are read (its search is not run): no limit on its CPU estimate
+    calibration = None if reproduction.calibration_file is None else \
+        load_calibration(reproduction.calibration_file, Budget(accept_long=True))
     with pool(args.dask, args.workers) as (label, runner):
         print(f"{reproduction.spec.name}: {len(reproduction.spec.cases)} cases x {len(reproduction.frequencies_hz)} "
               f"frequencies on {label}", file=sys.stderr)
