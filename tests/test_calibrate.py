@@ -17,6 +17,7 @@ from rpdrill.models.evaluation.workprecision import non_dominated
 from rpdrill.studies.calibration.calibration_search import objective, refined_frequencies_hz
 from rpdrill.studies.calibration.calibration_spec import Parameter, load_calibration
 from rpdrill.studies.cli.main import main
+from rpdrill.studies.runtime.budgets import Budget
 from rpdrill.studies.scan import frequency_scans as targets
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -209,13 +210,37 @@ def test_every_simulation_failing_exits_1_without_a_scene(tmp_path, monkeypatch,
 
 
 def test_shipped_calibration_is_valid():
-    calibration = load_calibration(ROOT / "studies" / "paper" / "calibration.yaml")
+    # more than an hour of CPU (rpdrill calibrate needs --yes)
+    calibration = load_calibration(ROOT / "studies" / "paper" / "calibration.yaml", Budget(accept_long=True))
     spec_ = calibration.spec
     assert len(spec_.parameters) >= 8 and all(p.reason.strip() for p in spec_.parameters.values())
     assert calibration.base["solver"]["formulation"] == "exact" and spec_.search.method == "differential-evolution"
-    assert [t.optimum_hz for t in spec_.targets] == [65, 60, 65, 80, 32, 69]
-    assert spec_.rising == [["3.1 b) 160 kN", "3.1 b) 220 kN", "3.1 b) 280 kN"]]
+    assert [t.optimum_hz for t in spec_.targets] == [65, 60, 65, 80, 32, 69, 80, 83.7, 87.6, 90]
+    assert spec_.rising == [["3.1 b) 160 kN", "3.1 b) 220 kN", "3.1 b) 280 kN"],
+                            ["3.2 Fig. 6 k = 8.93e7", "3.2 Fig. 6 k = 2.1e8", "3.2 Fig. 6 k = 5.1e8",
+                             "3.2 Fig. 6 k = 8.4e8"]]
+    # section 3.2's one invariant impulse feeds all its scans, none of 3.1's
+    amplitudes = [calibration.scene({**calibration.values(calibration.start_unit()), "$impulse_3_2_n": 123e3}, t)
+                  ["impact"]["amplitude_n"] for t in range(len(spec_.targets))]
+    assert amplitudes[4:] == [123e3] * 6 and 123e3 not in amplitudes[:4]
     assert calibration.frequencies_hz[0] == 10 and calibration.frequencies_hz[-1] == 120
+
+
+def test_a_free_parameter_feeds_the_overrides_that_name_it_and_nothing_else(tmp_path):
+    free = {"bounds": [300e3, 500e3], "reason": "one impulse for two scans"}
+    calibration = load_calibration(write(tmp_path / "c.yaml", spec(
+        parameters=spec()["parameters"] | {"$impulse": free},
+        targets=[{"label": "a", "optimum_hz": 60, "overrides": {"impact.amplitude_n": "$impulse"}},
+                 {"label": "b", "optimum_hz": 70, "overrides": {"rock": {"stiffness_n_per_m": 5e8, "damping_n_s_per_m": 2e3,
+                                                                     "threshold_n": "$impulse"}}},
+                 {"label": "c", "optimum_hz": 62}])))
+    values = calibration.values(np.array([0.5, 0.5, 0.25]))
+    assert values["$impulse"] == pytest.approx(350e3)
+    assert calibration.scene(values, 0)["impact"]["amplitude_n"] == pytest.approx(350e3)
+    assert calibration.scene(values, 1)["rock"]["threshold_n"] == pytest.approx(350e3)
+    base = calibration.scene(values, 2)
+    assert base["impact"]["amplitude_n"] == calibration.base["impact"]["amplitude_n"] and "$impulse" not in base
+    assert calibration.start_unit()[2] == 0.5  # no base-scene value: the middle of its bounds
 
 
 # --- bad input ---------------------------------------------------------------------------------------
@@ -241,6 +266,11 @@ BAD = [
      [f"parameters.{PULSE}.bounds", "0.03", "shorter than"]),
     ("setting of another method", {"search": {"method": "nelder-mead", "popsize": 3}},
      ["search", "popsize", "max_evaluations"]),
+    ("free parameter no target uses", {"parameters": {"$unused": {"bounds": [1.0, 2.0], "reason": "r"}}},
+     ["parameters.$unused", "no target's overrides use"]),
+    ("override names an undeclared free parameter",
+     {"targets": [{"optimum_hz": 60, "overrides": {"impact.amplitude_n": "$nothing"}}]},
+     ["targets.0.overrides.impact.amplitude_n", "'$nothing'", "not a parameter"]),
 ]
 
 

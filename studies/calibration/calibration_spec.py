@@ -5,7 +5,10 @@ e.g. ``base_overrides: {solver.formulation: exact}``), the ``frequency_hz`` axis
 target, the default ``metric`` whose maximum is the optimum, and:
 
 * ``parameters``: dotted scene path -> ``{bounds: [lo, hi], scale: linear|log, reason: "..."}``;
-  a reason is required, bounds are finite with lo < hi (log scale: lo > 0);
+  a reason is required, bounds are finite with lo < hi (log scale: lo > 0). A name that starts with
+  ``$`` (``$impulse_n``) is a *free* parameter: no scene key of the base scene, it enters only the
+  targets whose ``overrides`` give it as a value (``{impact.amplitude_n: $impulse_n}``), so one
+  fitted value can feed several targets' overrides (the search starts it at the middle of its bounds);
 * ``targets``: scene ``overrides``, ``metric``, the paper's ``optimum_hz`` (centre of its band),
   optional ``band_hz: [lo, hi]``, ``label``, ``weight`` (1) and ``tolerance`` (0.15: within 15 %
   of the centre);
@@ -49,6 +52,7 @@ from ..runtime.point_runs import prepare_point
 from ..scan.frequency_scans import FREQUENCY, Scan, scan_scene
 
 PositiveFloat = Annotated[float, Field(gt=0)]
+FREE = "$"  # the first character of a free parameter's name (module docstring)
 # keys that do not change what an evaluation gives: a rerun may change them and continue
 BUDGET_KEYS = ("max_generations", "max_evaluations")
 
@@ -175,10 +179,12 @@ class Calibration:
                 for (name, parameter), u in zip(self.spec.parameters.items(), unit, strict=True)}
 
     def scene(self, values: dict[str, float], target: int | None = None, frequency_hz: float | None = None) -> dict:
-        """The base scene with parameter values, then a target's overrides and a frequency, set."""
+        """The base scene with parameter values, then a target's overrides (a free parameter's name
+        given as a value replaced by its value) and a frequency, set."""
         scene = copy.deepcopy(self.base)
         overrides = self.spec.targets[target].overrides if target is not None else {}
-        for path, value in {**values, **overrides}.items():
+        scene_values = {path: value for path, value in values.items() if not is_free(path)}
+        for path, value in {**scene_values, **resolve_free(overrides, values)}.items():
             set_path(scene, path, value)
         if frequency_hz is not None:
             set_path(scene, FREQUENCY, frequency_hz)
@@ -201,6 +207,33 @@ class Calibration:
         content = {"spec": spec, "base_scene": Scene.model_validate(self.base).model_dump(mode="json", by_alias=True),
                    "frequencies_hz": list(self.frequencies_hz), "labels": list(self.labels)}
         return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
+
+
+def is_free(name: str) -> bool:
+    """Whether a parameter name is a free parameter (no scene key; module docstring)."""
+    return name.startswith(FREE)
+
+
+def _free_references(value: Any) -> list[str]:
+    """The free parameter names a target override value gives (strings starting with ``$``, nested)."""
+    if isinstance(value, str):
+        return [value] if is_free(value) else []
+    if isinstance(value, dict):
+        return [name for item in value.values() for name in _free_references(item)]
+    if isinstance(value, list):
+        return [name for item in value for name in _free_references(item)]
+    return []
+
+
+def resolve_free(value: Any, values: dict[str, float]) -> Any:
+    """``value`` with every free parameter name in it (nested in dicts and lists) replaced by its value."""
+    if isinstance(value, str) and is_free(value):
+        return values[value]
+    if isinstance(value, dict):
+        return {key: resolve_free(item, values) for key, item in value.items()}
+    if isinstance(value, list):
+        return [resolve_free(item, values) for item in value]
+    return value
 
 
 def _get(data: Any, path: str) -> Any:
@@ -264,8 +297,19 @@ def _check_scenes(calibration: Calibration, budget: Budget) -> float:
 
 
 def _check_parameters(spec: CalibrationSpec, base: dict[str, Any], source: str) -> None:
-    """A parameter names a scene key that takes a number; a target's overrides name scene keys."""
+    """A parameter names a scene key that takes a number, or is a free parameter that some target's
+    overrides use; a target's overrides name scene keys and only declared free parameters."""
+    used = {name for target in spec.targets for name in _free_references(target.overrides)}
     for name in spec.parameters:
+        if is_free(name):
+            if not name[1:].isidentifier():
+                raise InputError(f"{source}: parameters.{name}: a free parameter is {FREE} and a name "
+                                 "(letters, digits, underscores)")
+            if name not in used:
+                raise InputError(f"{source}: parameters.{name}: a free parameter no target's overrides use, "
+                                 "so no scan depends on it; give it as an override value "
+                                 f"(e.g. {{impact.amplitude_n: {name}}}) or drop it")
+            continue
         check_scene_path(source, "parameters", name, base)
         if not _takes_numbers(field_at(Scene, tuple(name.split("."))).annotation):
             raise InputError(f"{source}: parameters.{name}: {_get(base, name)!r} in the base scene: a scene key "
@@ -274,8 +318,12 @@ def _check_parameters(spec: CalibrationSpec, base: dict[str, Any], source: str) 
             raise InputError(f"{source}: parameters.{name}: every target sets it (the scanned frequency or "
                              "its overrides), so no scan depends on it; fit a key the targets leave free")
     for i, target in enumerate(spec.targets):
-        for key in target.overrides:
+        for key, value in target.overrides.items():
             check_scene_path(source, f"targets.{i}.overrides", key, base)
+            for name in _free_references(value):
+                if name not in spec.parameters:
+                    raise InputError(f"{source}: targets.{i}.overrides.{key}: {name!r}: not a parameter; "
+                                     f"free parameters: {', '.join(p for p in spec.parameters if is_free(p)) or 'none'}")
 
 
 def _check_frequencies(spec: CalibrationSpec, frequencies: list[Any], source: str) -> None:

@@ -26,6 +26,7 @@ from ..figures.paper_figures import draw_figure
 from ..inputs.reading import InputError
 from ..pages.paper_pages import figures_page, parameters_page, reproduction_page, sensitivity_page
 from ..reproduction.paper_reproduction import Reproduction, load_reproduction, reproduce, trend_checks, within
+from ..runtime.budgets import Budget
 from ..runtime.output_files import check_out, staged_directory, write_json, write_rows_csv
 from ..runtime.pools import pool
 from .options import add_runner_arguments
@@ -83,7 +84,9 @@ def run(args: argparse.Namespace) -> int:
         if folder is not None and not folder.is_dir():
             raise InputError(f"--{option}: {folder}: not a folder; give the --out of `rpdrill {command}`")
     reproduction = load_reproduction(args.reproduction)
-    calibration = None if reproduction.calibration_file is None else load_calibration(reproduction.calibration_file)
+    # only the calibration's bounds and reasons are read (its search is not run): no limit on its CPU estimate
+    calibration = None if reproduction.calibration_file is None else \
+        load_calibration(reproduction.calibration_file, Budget(accept_long=True))
     with pool(args.dask, args.workers) as (label, runner):
         print(f"{reproduction.spec.name}: {len(reproduction.spec.cases)} cases x {len(reproduction.frequencies_hz)} "
               f"frequencies on {label}", file=sys.stderr)
