@@ -115,27 +115,39 @@ def test_no_result_number_is_typed_into_the_generated_page_templates():
     assert literals == []
 
 
+FIG6 = ("3.2 Fig. 6 k = 8.93e7", "3.2 Fig. 6 k = 8.4e8")
+
+
 @pytest.mark.slow
-def test_the_shipped_scene_reproduces_every_optimum_and_trend_the_paper_states(tmp_path):
+def test_the_shipped_scene_reproduces_the_headlines_but_fig_6_and_says_so(tmp_path, capsys):
     """The product's claim, on the shipped scene and cases as they are: every optimum the paper states
-    within the reproduction file's tolerance and both rising trends (exit 0), the run's record saying so.
-    The file's variants (other upper strings, three quarters of its runs) are left out of this copy of
-    it: they state no claim of the paper, and neither the exit status nor the shipped scene's optima
-    and trends depend on them (a variant's run is tested with the small file above)."""
+    within the reproduction file's tolerance and every rising trend, but Fig. 6's (docs/fig6.md: a global
+    search found none together with the rest); the command exits 1 and says how many it reached, and
+    the page gives the reason for Fig. 6's missing optima. The file's variants (other upper strings,
+    three quarters of its runs) are left out of this copy of it: they state no claim of the paper."""
     shipped = ROOT / "studies" / "paper" / "reproduction.yaml"
     data = yaml.safe_load(shipped.read_text(encoding="utf-8"))
     assert data.pop("variants")
     data["base_scene"] = str(shipped.parent / data["base_scene"])
     data["calibration"] = str(shipped.parent / data["calibration"])
     out = tmp_path / "out"
-    assert main(["reproduce", str(write(tmp_path / "reproduction.yaml", data)), "--out", str(out), "--quiet"]) == 0
+    assert main(["reproduce", str(write(tmp_path / "reproduction.yaml", data)), "--out", str(out), "--quiet"]) == 1
+    assert "6 of 8 optima the paper states reached" in capsys.readouterr().err
     record = json.loads((out / "reproduction.json").read_text())["variants"]
     assert list(record) == ["None"]
     record = record["None"]
-    assert len(record["trends"]) == 2 and all(t["rises"] for t in record["trends"])
+    rises = {tuple(t["cases"]): t["rises"] for t in record["trends"]}
+    assert len(rises) == 3 and sum(rises.values()) == 2 and not rises[tuple(data["rising"][2])]
     reproduction = load_reproduction(shipped)
     stated = {c.label: c.paper.optimum_hz for c in reproduction.spec.cases if c.paper.optimum_hz is not None}
     reached = {o["label"]: o["main_hz"] for o in record["optima"]}
-    assert len(stated) == 6
+    assert len(stated) == 8
     for label, paper_hz in stated.items():
-        assert abs(reached[label] / paper_hz - 1) <= reproduction.spec.tolerance, label
+        if label in FIG6:
+            assert reached[label] is None  # nothing crushes: no optimum, and the page says why
+        else:
+            assert abs(reached[label] / paper_hz - 1) <= reproduction.spec.tolerance, label
+    page = (out / "reproduction.md").read_text()
+    reason = "none (no crushing: the peak rock force stays below F_th at every point)"
+    rows = [line for line in page.splitlines() if line.startswith("| 3.2 Fig. 6 k = ") and " < " not in line]
+    assert len(rows) == 4 and all(reason in row for row in rows)

@@ -22,6 +22,7 @@ from ..reproduction.paper_reproduction import (
     trend_checks,
     within,
 )
+from ..scan.flat_curves import why_no_optimum
 from ..sensitivity.sensitivity_study import scene_values
 
 
@@ -64,7 +65,9 @@ def reproduction_page(reproduction: Reproduction, by_variant: dict[str | None, l
         scale, unit = (1e3, "mm/s") if r.metric == "penetration_rate_m_per_s" else (1.0, "m/s")
         global_note = "" if o["global_hz"] == o["main_hz"] else f" (global max {_hz(o['global_hz'])})"
         silent = "" if r.silent_from_hz is None else f"; none from {r.silent_from_hz:.0f} Hz up"
-        rows.append(f"| {r.case.label} | {r.metric} | {paper.says} | {_hz(o['main_hz'])}{global_note} "
+        why = why_no_optimum(r.metric, r.curves[r.metric]) if o["main_hz"] is None else None
+        rows.append(f"| {r.case.label} | {r.metric} | {paper.says} | {_hz(o['main_hz'])}{f' ({why})' if why else ''}"
+                    f"{global_note} "
                     f"| {_band(o['band_80_hz'])} / {_band(o['band_50_hz'])} | {peak * scale:.3g} {unit}{silent} "
                     f"| {_yes(within(o['main_hz'], paper, spec.tolerance))} |")
     trends = []
@@ -120,7 +123,8 @@ The same cases (main-lobe optima) on drills that differ only above the shock abs
 
 {_variants_section(reproduction, by_variant) if spec.variants else "(no variants in the reproduction file)"}
 
-Figures: [figures.md](figures.md). Parameters and why: [parameters.md](parameters.md).
+Figures: [figures.md](figures.md). Parameters and why: [parameters.md](parameters.md). Fig. 6 and the global
+search for it over the region the paper leaves open: [fig6.md](fig6.md).
 Sensitivity (the paper's section 3.3): [sensitivity.md](sensitivity.md).
 """
 
