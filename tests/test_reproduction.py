@@ -30,7 +30,11 @@ def test_the_paper_is_stated_once():
         if label == "3.1 a)":  # the 3.1 a) scan is the 220 kN case of 3.1 b) (docs/parameters.md)
             continue
         case = cases[label]
-        assert (case.paper.optimum_hz, case.paper.band_hz) == (target.optimum_hz, target.band_hz), label
+        if case.paper.optimum_hz is None:  # a centre the calibration interpolates where the paper gives none
+            assert target.weight < 1 and case.paper.says.startswith("not given") and \
+                f"{target.optimum_hz:g} Hz" in case.paper.says, label
+        else:
+            assert (case.paper.optimum_hz, case.paper.band_hz) == (target.optimum_hz, target.band_hz), label
         assert same_overrides(case.overrides, target.overrides) and case.metric == target.metric, label
 
 
