@@ -3,7 +3,7 @@
 Usage: python benchmarks/bench_studies.py [--workers N] [--formulations exact,fast] [--repeats N]
 For each formulation (``exact``: the exact formulation; ``fast``/``standard``: Exudyn at that preset),
 the three paper scans (studies/paper/{frequency,impulse,stiffness}_scan.yaml, 207 points of 1.5 s)
-run through the study command's own loop (studies.cli.study_command.run_studies: resumable results, the
+run through the study command's own loop (studies.study_runs.run_studies: resumable results, the
 scans' points as one run, a point two scans share run once, optima, each scan's plots drawn by the
 workers once its points are done) on one process pool,
 into a scratch directory, each formulation in a process of its own (its own pool), --repeats times. Prints, of the run of median wall time, the wall time from opening the pool to the last plot, the CPU seconds of that process,
@@ -37,7 +37,7 @@ from pathlib import Path
 
 import yaml
 
-from rpdrill.studies.cli.study_command import run_studies
+from rpdrill.studies.study_runs import run_studies
 from rpdrill.studies.figures.plot_tasks import draw_plot, plot_tasks
 from rpdrill.studies.inputs.reading import read_yaml
 from rpdrill.studies.runtime.pools import pool
@@ -83,7 +83,7 @@ def process_tree_cpu_s(pid: int) -> float:
 
 def three_scans(solver: str, workers: int, folder: Path) -> None:
     """The three scans on one pool in this process (a child of main: its own pool), through the
-    study command's own loop (studies.cli.study_command.run_studies), into new folders; its figures as
+    study command's own loop (studies.study_runs.run_studies), into new folders; its figures as
     one line of JSON."""
     studies = [load_study(study_file(scan, solver, folder)) for scan in SCANS]
     folders = [Path(tempfile.mkdtemp(prefix=f"{scan}_{solver}_", dir=folder)) for scan in SCANS]

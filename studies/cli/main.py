@@ -21,39 +21,52 @@ import traceback
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
+from types import ModuleType
 
 from ...rocklaw.exudyn_build import use_fast_build
 from ..inputs.reading import InputError
 from ..runtime.budgets import BudgetError
 from ..runtime.interrupts import Terminated, WorkerLost, raise_if_stopped, stops_handled
 from ..runtime.out_lock import out_locked
-from . import (
-    accuracy_command,
-    advise_command,
-    calibrate_command,
-    crosscheck_command,
-    reproduce_command,
-    rotation_report_command,
-    sensitivity_command,
-    simulate_command,
-    study_command,
-)
 
-# name: (module with add_arguments and run, one-line help)
+# name: one-line help; a command's module is imported only when it runs (:func:`command_module`)
 COMMANDS = {
-    "simulate": (simulate_command, "run one scene: time histories, summary, plot"),
-    "crosscheck": (crosscheck_command, "run the Exudyn model and the ODE of Eq. 4 and compare them"),
-    "study": (study_command, "run a YAML study (scan) on all cores or a Dask cluster"),
-    "accuracy": (accuracy_command, "work-precision study: error against CPU time of solver settings"),
-    "calibrate": (calibrate_command, "fit scene parameters to target optimum frequencies"),
-    "reproduce": (reproduce_command,
-                  "the paper's headline cases and figures on the shipped scene, and the generated docs"),
-    "sensitivity": (sensitivity_command,
-                    "how the frequency optima move with each scene parameter (+-10 %%, SALib global indices)"),
-    "rotation-report": (rotation_report_command,
-                        "the rotation-speed note (rpm x frequency map, best speed against the manual's rule)"),
-    "advise": (advise_command, "the operating point that maximises a metric within bounds"),
+    "simulate": "run one scene: time histories, summary, plot",
+    "crosscheck": "run the Exudyn model and the ODE of Eq. 4 and compare them",
+    "study": "run a YAML study (scan) on all cores or a Dask cluster",
+    "accuracy": "work-precision study: error against CPU time of solver settings",
+    "calibrate": "fit scene parameters to target optimum frequencies",
+    "reproduce": "the paper's headline cases and figures on the shipped scene, and the generated docs",
+    "sensitivity": "how the frequency optima move with each scene parameter (+-10 %%, SALib global indices)",
+    "rotation-report": "the rotation-speed note (rpm x frequency map, best speed against the manual's rule)",
+    "advise": "the operating point that maximises a metric within bounds",
 }
+
+
+def command_module(name: str) -> ModuleType:
+    """The module of command ``name`` (``add_arguments``, ``run``), imported now: each command loads only
+    the libraries it needs (the figures' matplotlib, SALib, SciPy's optimizers)."""
+    if name == "simulate":
+        from . import simulate_command as module
+    elif name == "crosscheck":
+        from . import crosscheck_command as module
+    elif name == "study":
+        from . import study_command as module
+    elif name == "accuracy":
+        from . import accuracy_command as module
+    elif name == "calibrate":
+        from . import calibrate_command as module
+    elif name == "reproduce":
+        from . import reproduce_command as module
+    elif name == "sensitivity":
+        from . import sensitivity_command as module
+    elif name == "rotation-report":
+        from . import rotation_report_command as module
+    elif name == "advise":
+        from . import advise_command as module
+    else:
+        raise KeyError(name)
+    return module
 
 
 class _Parser(argparse.ArgumentParser):
@@ -87,10 +100,13 @@ def main(argv: list[str] | None = None) -> int:
     parser = _Parser(prog="rpdrill", description="Rotary-percussive drilling simulator on Exudyn")
     parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for name, (module, help_text) in COMMANDS.items():
-        module.add_arguments(sub.add_parser(name, help=help_text, description=help_text))
+    chosen = argv[0] if argv and argv[0] in COMMANDS else None
+    for name, help_text in COMMANDS.items():
+        command_parser = sub.add_parser(name, help=help_text, description=help_text)
+        if name == chosen:
+            command_module(name).add_arguments(command_parser)
     args = parser.parse_args(argv)
-    module = COMMANDS[args.command][0]
+    module = command_module(args.command)
     try:
         command = shlex.join(["rpdrill", *argv])
         with one_line_warnings(), stops_handled(), out_locked(getattr(args, "out", None), command):

@@ -23,7 +23,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import find_peaks, peak_prominences
 
 DIP_TOLERANCE = 0.05
 
@@ -92,6 +91,8 @@ def band_hz(frequencies_hz: np.ndarray, values: np.ndarray, index: int, level: f
 def _split_points(values: np.ndarray, dip_tolerance: float) -> list[tuple[int, int]]:
     """(first, last) index ranges of the lobes: positive stretches split at the lowest point between
     neighbouring peaks of sufficient relative prominence (the split point ends both lobes)."""
+    from scipy.signal import find_peaks, peak_prominences  # 0.5 s to import: only where optima are found
+
     padded = np.concatenate([[0.0], values, [0.0]])
     peaks, _ = find_peaks(padded)
     prominences = peak_prominences(padded, peaks)[0]
