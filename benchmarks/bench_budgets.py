@@ -32,9 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rpdrill.models.definition.formulations import unsupported
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.solvers.cost import CPU_S_PER_STEP, Cause, cost_key, run_cost
+from rpdrill.models.solvers.dispatch import unsupported
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.calibration.calibration_search import target_result
 from rpdrill.studies.calibration.calibration_spec import load_calibration

@@ -37,11 +37,11 @@ from pathlib import Path
 
 import yaml
 
-from rpdrill.studies.study_runs import run_studies
 from rpdrill.studies.figures.plot_tasks import draw_plot, plot_tasks
 from rpdrill.studies.inputs.reading import read_yaml
 from rpdrill.studies.runtime.pools import pool
 from rpdrill.studies.scan.study import load_study
+from rpdrill.studies.study_runs import run_studies
 
 ROOT = Path(__file__).resolve().parents[1]
 SCANS = ("frequency_scan", "impulse_scan", "stiffness_scan")

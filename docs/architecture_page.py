@@ -173,8 +173,8 @@ def draw(graph: dict[str, set[str]], path: Path) -> None:
             position[package] = ((i + 1) / (len(packages) + 1), y)
     colours = {"rocklaw": "#cfe2f3", "models": "#d9ead3", "studies": "#fff2cc", "": "#f4cccc"}
     fig, ax = plt.subplots(figsize=(13, 1.3 * (max(rows) + 1)))
-    for source, targets in graph.items():
-        for target in targets:
+    for source, targets in sorted(graph.items()):
+        for target in sorted(targets):
             (x0, y0), (x1, y1) = position[source], position[target]
             ax.annotate("", xy=(x1, y1 + 0.18), xytext=(x0, y0 - 0.18),
                         arrowprops={"arrowstyle": "->", "color": "#888888", "lw": 0.7, "shrinkA": 2, "shrinkB": 2})
@@ -187,7 +187,8 @@ def draw(graph: dict[str, set[str]], path: Path) -> None:
     ax.set_title("rpdrill: packages and their imports (arrow: imports; blue rocklaw, green models, "
                  "yellow studies' subpackages, red the API), read from the files", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path)
+    with matplotlib.rc_context({"svg.hashsalt": "rpdrill"}):  # the same file for the same tree
+        fig.savefig(path, metadata={"Date": None})
     plt.close(fig)
 
 
@@ -204,14 +205,14 @@ def page(root: Path = ROOT) -> str:
     if missing:
         raise SystemExit(f"docs/architecture_page.py: no paragraph for the package(s) {', '.join(missing)}")
     lines = ["# Architecture", "",
-             "Generated from the files of the checkout by `python docs/architecture_page.py` (the import graph "
-             "read statically: every import of every module, relative imports resolved; nothing installed). "
-             "tests/test_architecture.py checks that this page matches the tree, that dependencies run one "
-             "way (studies -> models -> rocklaw, the API on top) and that no import forms a cycle.", "",
-             "The checkout is the package `rpdrill`: its `__init__.py` is the public API, its folders "
-             "`rocklaw/`, `models/` and `studies/` are the subpackages `rpdrill.rocklaw`, `rpdrill.models`, "
-             "`rpdrill.studies` (pyproject.toml maps them; every import inside the package is relative, so "
-             "an editor or an import-graph tool follows them without an install).", "",
+             ("Generated from the files of the checkout by `python docs/architecture_page.py` (the import graph "
+              "read statically: every import of every module, relative imports resolved; nothing installed). "
+              "tests/test_architecture.py checks that this page matches the tree, that dependencies run one "
+              "way (studies -> models -> rocklaw, the API on top) and that no import forms a cycle."), "",
+             ("The checkout is the package `rpdrill`: its `__init__.py` is the public API, its folders "
+              "`rocklaw/`, `models/` and `studies/` are the subpackages `rpdrill.rocklaw`, `rpdrill.models`, "
+              "`rpdrill.studies` (pyproject.toml maps them; every import inside the package is relative, so "
+              "an editor or an import-graph tool follows them without an install)."), "",
              "![packages and their imports](architecture.svg)", "",
              "Layer 0 imports no other package; each package imports only packages of lower layers.", ""]
     for package in sorted(graph, key=lambda p: (-level[p], p)):

@@ -16,9 +16,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-import rpdrill  # noqa: E402
+import rpdrill
 
 STUDY = Path(__file__).resolve().parents[1] / "studies" / "paper" / "frequency_scan.yaml"
 

@@ -35,7 +35,7 @@ def test_bodies_follow_the_connectors_from_hammer_to_rock_whatever_the_files_ord
     path = tmp_path / "sorted.yaml"
     path.write_text(yaml.safe_dump(scene_dict(**QUICK)))  # keys sorted: bit, carriage, collar, shank
     s = load_scene(path)
-    assert list(s.drill_string.bodies)[0] == "bit"
+    assert next(iter(s.drill_string.bodies)) == "bit"
     drawing, shapes = drawn_layout(s), layout(s)
     for placed in ({b.name: b.start for b in drawing.bodies}, {c.name: c.start_m for c in shapes.cylinders}):
         assert sorted(placed, key=placed.get) == ["carriage", "shank", "collar", "bit"]

@@ -105,7 +105,7 @@ def test_every_body_is_drawn_to_scale_and_every_connector_drawn():
     assert shapes["rod1[0]"].length_m == pytest.approx(3.66 / 4) and shapes["rod1[0]"].diameter_m == 0.045
     bit = s.drill_string.bodies["bit"].mass_kg  # a rigid body: a steel cylinder of the default diameter
     assert shapes["bit"].length_m == pytest.approx(bit / (STEEL_DENSITY_KG_PER_M3 * math.pi * DEFAULT_DIAMETER_M**2 / 4))
-    stated = layout(scene(**{"drill_string__bodies__collar": {"mass_kg": 3000.0, "diameter_m": 0.2}}))
+    stated = layout(scene(drill_string__bodies__collar={"mass_kg": 3000.0, "diameter_m": 0.2}))
     assert stated["collar"].diameter_m == 0.2
 
 

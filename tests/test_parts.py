@@ -52,8 +52,8 @@ def test_a_preloaded_string_carries_the_feed_through_every_connector_in_compress
 
 
 def test_a_coupling_reports_its_gap_opening():
-    s = crushing_scene(**SHORT, **{"drill_string__connectors__collar_bit_joint": {
-        "from": "collar", "to": "bit", "type": "coupling", "gap_m": 1e-4, "stiffness_n_per_m": 5e9}})
+    s = crushing_scene(**SHORT, drill_string__connectors__collar_bit_joint={
+        "from": "collar", "to": "bit", "type": "coupling", "gap_m": 1e-4, "stiffness_n_per_m": 5e9})
     columns = simulate(s, "exact").columns()
     opening = columns["collar_bit_joint_gap_opening_m"]
     compression = columns["collar_bit_joint_compression_m"]
@@ -101,5 +101,4 @@ def test_a_rod_segment_by_its_name_and_an_unknown_body_refused():
 
 def test_a_connector_name_that_would_shadow_a_model_history_is_refused():
     with pytest.raises(ValidationError, match="rock_force_n would be the model's own"):
-        scene(**{"drill_string__connectors__rock": {"from": "collar", "to": "bit", "stiffness_n_per_m": 1e9},
-                 "drill_string__connectors__collar_bit_joint": None})
+        scene(drill_string__connectors__rock={"from": "collar", "to": "bit", "stiffness_n_per_m": 1e9}, drill_string__connectors__collar_bit_joint=None)

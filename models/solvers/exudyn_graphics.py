@@ -14,7 +14,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-import exudyn.graphics as graphics  # rocklaw.exudyn_module imported it first (models.solvers.exudyn_model)
+from exudyn import graphics  # rocklaw.exudyn_module imported it first (models.solvers.exudyn_model)
 
 from ..drill.chain import AxialChain, Link
 from ..drill.shapes import Cylinder, Layout

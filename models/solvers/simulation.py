@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...rocklaw import RockLaw, State
-from ..definition.formulations import simulate
 from ..definition.outputs import needs
 from ..definition.scene import (
     BuiltEffects,
@@ -37,6 +36,7 @@ from ..drill.piston import PistonSetup, piston_setup
 from ..drill.pulse import impulse_per_blow_n_s
 from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_settings
 from ..evaluation.stability import FastestElement, StepScales, fastest_element, step_scales
+from .dispatch import simulate
 
 if TYPE_CHECKING:
     from ..evaluation.results import SimulationResult

@@ -49,9 +49,9 @@ import numpy as np
 from pydantic import ValidationError
 from scipy import optimize
 
-from ...models.definition.formulations import unsupported
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, describe_validation_error
+from ...models.solvers.dispatch import unsupported
 from ...models.solvers.simulation import SceneError, Simulation, prepare
 from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter

@@ -301,8 +301,8 @@ def figure_title(scene: Scene, drawing: DrawnLayout) -> str:
     broken = sorted({b.group for b in drawing.bodies if b.broken})
     parts = [f"{scene.name}: the drill string (hammer left, rock right); lengths to scale"
              + (f" except {', '.join(broken)} (shortened, break mark)" if broken else ""),
-             f"diameters to their own scale (thickest {widest * 1e3:.0f} mm); bodies without a stated diameter drawn as "
-             f"steel cylinders of {DEFAULT_DIAMETER_M * 1e3:.0f} mm; connectors schematic"]
+             (f"diameters to their own scale (thickest {widest * 1e3:.0f} mm); bodies without a stated diameter "
+              f"drawn as steel cylinders of {DEFAULT_DIAMETER_M * 1e3:.0f} mm; connectors schematic")]
     return "\n".join(parts)
 
 
@@ -324,4 +324,4 @@ def draw(scene: Scene, path: str | Path) -> Path:
     return path
 
 
-__all__ = ["DrawnLayout", "draw", "draw_string", "drawn_layout", "GROUND"]
+__all__ = ["GROUND", "DrawnLayout", "draw", "draw_string", "drawn_layout"]

@@ -20,9 +20,9 @@ from typing import Any
 
 import yaml
 
-from ...models.definition.formulations import unsupported
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, parse, short
+from ...models.solvers.dispatch import unsupported
 from ...models.solvers.simulation import SceneError, Simulation, prepare
 
 __all__ = ["InputError", "load_scene", "parse", "parse_yaml", "prepare_scene", "read_text", "read_yaml"]
