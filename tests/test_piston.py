@@ -92,7 +92,10 @@ def test_the_contact_stiffness_comes_from_the_faces_and_is_stated(tmp_path):
     simulation = prepare(Scene.model_validate(one_blow(rod_piston(8), 4.0, 64)))
     segment = E_PA * AREA * 64 / 4.0  # both rods' segments are 62.5 mm: the contact is one segment's spring
     assert simulation.piston.contact_stiffness_n_per_m == pytest.approx(segment)
-    assert simulation.resolved_scene()["impact"]["piston"]["contact_stiffness_n_per_m"] == pytest.approx(segment)
+    assert f"coupling {segment:.6g} N/m: rigid faces" in simulation.resolved_scene()["effects"]["reasons"]["piston_contact"]
+    given = prepare(Scene.model_validate(one_blow({**rod_piston(8), "contact_stiffness_n_per_m": segment}, 4.0, 64)))
+    assert given.piston.contact_stiffness_n_per_m == pytest.approx(segment / 2)  # the faces' contact in series
+    assert f"the faces' contact {segment:.6g} N/m" in given.resolved_scene()["effects"]["reasons"]["piston_contact"]
     rigid_on_rigid = scene_dict(impact={"frequency_hz": 50.0, "piston": {"mass_kg": 4.5, "velocity_m_per_s": 9.0}})
     with pytest.raises(SceneError, match="contact_stiffness_n_per_m"):
         prepare(Scene.model_validate(rigid_on_rigid))
@@ -146,15 +149,29 @@ def test_a_rigid_piston_sends_the_exponential_pulse():
     piston = {"mass_kg": 4.5, "contact_stiffness_n_per_m": RIGID_CONTACT}
     result = run(one_blow(piston, 0.5, 240, end_time_s=1e-3))
     t, force = result.time_s, result.piston.contact_force_n
-    assert force.max() == pytest.approx(Z * SPEED, rel=0.05)  # -2 % (the contact spring's closed form: -3.6 %)
+    assert force.max() == pytest.approx(Z * SPEED, rel=0.05)  # -3.4 % (the contact spring's closed form: -3.6 %)
     before_reflection = t < 2 * 0.5 / C
     closed = rigid_piston_pulse_n(t[before_reflection], 4.5, SPEED, Z, RIGID_CONTACT)
-    assert force.max() == pytest.approx(closed.max(), rel=0.03)
+    assert force.max() == pytest.approx(closed.max(), rel=0.01)  # +0.24 % (docs/model.md)
     # the blow ends when the piston, pushed back by the rock's reflection, is caught moving back
     v_after = result.piston.rebounds[0, 2]
     caught = t <= t[np.flatnonzero(result.piston.mean_velocity_m_per_s[1:] == 0.0)[0] + 1]
     impulse = np.trapezoid(force[caught], t[caught])
     assert v_after < 0 and impulse == pytest.approx(4.5 * (SPEED - v_after), rel=2e-3)
+
+
+def test_a_contact_far_stiffer_than_a_segment_does_not_chatter():
+    """k_c = 10 E A N / L: the rod's massless face in series, so no face mass rattles between two stiff
+    springs (a lumped face did: spikes of sqrt(10) Z v_p). What stays is the lumped rod's overshoot of
+    a front sharper than one segment (+35 % measured at 60-240 segments, docs/model.md): bounded, and
+    the contact stays closed until the rock's reflection pushes the piston back."""
+    segments = 60
+    piston = {"mass_kg": 4.5, "contact_stiffness_n_per_m": 10 * E_PA * AREA * segments / 0.5}
+    result = run(one_blow(piston, 0.5, segments, end_time_s=1e-3))
+    t, force = result.time_s, result.piston.contact_force_n
+    assert Z * SPEED < force.max() < 1.5 * Z * SPEED
+    first_opening = t[(t > 0) & (force == 0.0)][0]
+    assert first_opening > 0.9 * 2 * 0.5 / C  # not before the reflection from the rod's far end returns (at 0.97)
 
 
 @pytest.mark.slow
@@ -180,7 +197,8 @@ def test_simulate_writes_the_pistons_outputs(tmp_path):
     assert 0 < metrics["piston_rebound_energy_j"] < 0.03 * 0.5 * RHO * AREA * 0.5 * SPEED**2
     assert metrics["energy_balance_relative_error"] < 1e-3
     resolved = yaml.safe_load((out / "scene.resolved.yaml").read_text())
-    assert resolved["impact"]["piston"]["contact_stiffness_n_per_m"] == pytest.approx(E_PA * AREA * 16)
+    assert f"coupling {E_PA * AREA * 16:.6g} N/m: rigid faces" in resolved["effects"]["reasons"]["piston_contact"]
+    assert load_scene(out / "scene.resolved.yaml").impact == load_scene(path).impact  # runs again as it ran
 
 
 def test_crosscheck_covers_a_piston_scene(tmp_path):

@@ -49,13 +49,14 @@ class Piston(Body):
     """The hammer's piston as a body (models.drill.piston): a rigid ``mass_kg`` or a rod given by its
     geometry (the rod keys of :class:`Body`, ``segments`` lumped masses like the string's rods),
     striking the impact body at ``velocity_m_per_s`` (or with the blow energy ``energy_j`` = m v^2 / 2:
-    one of the two) through a compression-only contact of ``contact_stiffness_n_per_m`` (default: the
-    series stiffness of the half-segments of the faces in contact, 1/k = sum L / (2 E A N); a rigid
-    face adds nothing, so a rigid piston on a rigid impact body must give it)."""
+    one of the two) through a compression-only contact of ``contact_stiffness_n_per_m``, the stiffness
+    of the faces' contact itself (default: rigid faces). The run couples the two lumped bodies either
+    side through that contact in series with the half-segments behind the faces, 1/k = 1/k_c +
+    sum L / (2 E A N) (a rigid body adds none: a rigid piston on a rigid impact body must give k_c)."""
 
     velocity_m_per_s: Positive | None = Field(None, description="v_p, strike speed")
     energy_j: Positive | None = Field(None, description="blow energy m_p v_p^2 / 2")
-    contact_stiffness_n_per_m: Positive | None = Field(None, description="piston-shank contact stiffness")
+    contact_stiffness_n_per_m: Positive | None = Field(None, description="k_c, stiffness of the faces' contact (default: rigid faces)")
 
     @model_validator(mode="after")
     def _speed_or_energy(self) -> Piston:

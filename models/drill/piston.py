@@ -6,7 +6,10 @@ of lumped bodies outside the drill string proper, appended after the string's bo
 *dynamic chain* the formulations integrate (:meth:`PistonSetup.dynamic_chain`): a rod piston's
 segments joined by springs E A N / L like the string's rods, its front segment joined to the
 impact body by a compression-only coupling (PistonContact, a models.definition.links.Coupling: gap 0, undamped) of stiffness
-k_c. The contact force on the impact body is F_c = k_c max(x_front - x_impact, 0).
+k: the faces' contact stiffness k_c in series with the half-segments behind the two faces
+(:func:`contact_coupling_n_per_m`; a rod's faces are massless, its masses at the segments' centres, so
+a contact far stiffer than a segment does not trap the face's mass between two stiff springs). The
+contact force on the impact body is F_c = k max(x_front - x_impact, 0).
 
 Each blow is two state jumps at located times, the same in every formulation:
 
@@ -17,11 +20,11 @@ Each blow is two state jumps at located times, the same in every formulation:
   catches it and holds it away (x_i = x_impact - PARK_M, v_i = 0) until the next strike; the energy
   it still has (kinetic and strain; the contact spring is relaxed) is the blow's rebound energy, its
   velocity v_after. A piston that goes on forward after a separation strikes again, as a free piston
-  would (a rigid piston on a lumped rod chatters on the rod's face); a piston still out at the next
+  would (the struck face may run ahead of it for a moment); a piston still out at the next
   blow start is reset there (its energy counted as rebound). (PistonContact: the catch as a mode.)
 
 Energy: the piston subsystem (its bodies, its springs, the contact spring) has the energy
-E_p = sum m_i v_i^2 / 2 + sum k (x_i+1 - x_i)^2 / 2 + k_c max(x_front - x_impact, 0)^2 / 2; the jumps
+E_p = sum m_i v_i^2 / 2 + sum k_i (x_i+1 - x_i)^2 / 2 + k max(x_front - x_impact, 0)^2 / 2; the jumps
 put in E_blow - E_p(before) at a strike and take out E_p at a catch; what it gives the string is the
 contact's work int F_c v_impact dt (the string's W_impact, models.evaluation.energy), so that
 
@@ -96,10 +99,15 @@ class PistonContact(Coupling):
         return CLOSED if closure < 0 else CAUGHT if closure >= 0.5 * self.park_m else OPEN
 
 
-def default_contact_stiffness_n_per_m(piston: Body, struck: Body) -> float | None:
-    """The series stiffness of the two half-segments in contact, 1 / (L_p / (2 E_p A_p N_p) +
-    L_s / (2 E_s A_s N_s)) (a rigid face adds no compliance); None when both faces are rigid."""
+def contact_coupling_n_per_m(piston: Piston, struck: Body) -> float | None:
+    """The spring between the two lumped bodies either side of the contact: the faces' contact
+    stiffness k_c (``piston.contact_stiffness_n_per_m``; rigid faces when not given) in series with the
+    half-segments behind the faces (a rod's lumped masses sit at its segments' centres, its faces are
+    massless): 1/k = 1/k_c + L_p / (2 E_p A_p N_p) + L_s / (2 E_s A_s N_s) (a rigid body adds no
+    half-segment). None when nothing is compliant (a rigid piston on a rigid body, k_c not given)."""
     compliance = piston.half_segment_compliance_m_per_n() + struck.half_segment_compliance_m_per_n()
+    if piston.contact_stiffness_n_per_m is not None:
+        compliance += 1.0 / piston.contact_stiffness_n_per_m
     return 1.0 / compliance if compliance > 0 else None
 
 
@@ -134,7 +142,7 @@ class PistonSetup:
     impact_body: int  # the struck body (the impact body's first segment)
     segment_mass_kg: float
     segment_stiffness_n_per_m: float  # E A N / L between the segments (unused for a rigid piston)
-    contact_stiffness_n_per_m: float
+    contact_stiffness_n_per_m: float  # the coupling across the contact (contact_coupling_n_per_m)
     strike_velocity_m_per_s: float
     pulse_duration_s: float  # the contact time the step of a fixed-step solver must resolve (estimate)
 
@@ -226,10 +234,10 @@ def piston_setup(scene: Scene, chain: AxialChain) -> PistonSetup | None:
     if piston is None:
         return None
     struck = scene.drill_string.bodies[scene.drill_string.impact_body]
-    stiffness = piston.contact_stiffness_n_per_m or default_contact_stiffness_n_per_m(piston, struck)
+    stiffness = contact_coupling_n_per_m(piston, struck)
     if stiffness is None:
         raise ValueError("a rigid piston striking a rigid impact body: give impact.piston.contact_stiffness_n_per_m "
-                         "(the default comes from the rods' faces in contact)")
+                         "(without it the faces are rigid and only a rod's half-segments are compliant)")
     n = piston.segments
     if piston.is_rod:
         duration = 2.0 * piston.length_m / piston.wave_speed_m_per_s

@@ -133,8 +133,12 @@ class Simulation:
         data["effects"] = {**self.effects.as_dict(), "reasons": dict(self.effects.reasons)}
         data["outputs"] = self.outputs.model_dump(mode="json")
         data["solver"] = {key: value for key, value in vars(self.settings).items() if value is not None}
-        if self.piston is not None:  # the contact stiffness as run (given, or from the faces in contact)
-            data["impact"]["piston"]["contact_stiffness_n_per_m"] = self.piston.contact_stiffness_n_per_m
+        if self.piston is not None:  # the coupling across the contact as run
+            given = self.scene.impact.piston.contact_stiffness_n_per_m
+            faces = "rigid faces" if given is None else f"the faces' contact {given:.6g} N/m"
+            data["effects"]["reasons"]["piston_contact"] = (
+                f"coupling {self.piston.contact_stiffness_n_per_m:.6g} N/m: {faces} in series with the "
+                "half-segments behind the faces")
         return data
 
 
