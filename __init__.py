@@ -8,6 +8,7 @@ The public API (every name documented with an example in ``docs/api.md``)::
     result = rpdrill.simulate(scene)
     result.metrics["penetration_rate_m_per_s"]
     table = rpdrill.run_study(rpdrill.load_study("studies/paper/frequency_scan.yaml"), workers=2)
+    rpdrill.crosscheck(scene).passed   # Exudyn against the paper's Eq. 4 as an ODE, first 20 blows
 
 The package's folders: ``rocklaw`` (the rock contact laws), ``models`` (the drill models and their
 three formulations), ``studies`` (YAML inputs, scans, analyses, reports and the command line);
@@ -20,6 +21,7 @@ from .models.definition.scene import Scene
 from .models.definition.validation import InputError
 from .models.evaluation.run_result import Result
 from .models.evaluation.stability import SimulationFailed
+from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
 from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
 from .studies.runtime.budgets import BudgetError
 from .studies.scan.study import Study
@@ -43,6 +45,6 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'rpdrill' has no attribute {name!r}")
 
 
-__all__ = ["BudgetError", "ExudynModel", "InputError", "Result", "Scene", "SimulationFailed", "Study", "build_exudyn",
-           "draw", "load_scene", "load_study", "run_study", "save_result", "simulate", "table_frame", "view_solution",
+__all__ = ["BudgetError", "Crosscheck", "ExudynModel", "InputError", "Result", "Scene", "SimulationFailed", "Study", "build_exudyn",
+           "crosscheck", "draw", "load_scene", "load_study", "run_study", "save_result", "simulate", "table_frame", "view_solution",
            "write_animation"]

@@ -7,11 +7,10 @@ import argparse
 import sys
 
 from ...models.definition.formulations import ODE_METHODS
-from ...models.evaluation.compare import compare_runs, verdict
 from ...models.evaluation.stability import SimulationFailed
-from ..crosscheck.crosscheck_windows import DEFAULT_STEP_S, comparison_table, window_scenes
+from ..crosscheck.crosscheck_run import crosscheck
+from ..crosscheck.crosscheck_windows import DEFAULT_STEP_S
 from ..figures.crosscheck_figure import plot_overlay
-from ..inputs.reading import load_scene, prepare_scene
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import check_out, staged_directory, write_json
 from .options import add_budget_arguments, budget, positive_count, positive_number
@@ -32,31 +31,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.out:
         check_out(args.out, args.overwrite)
-    exudyn_scene, ode_scene = window_scenes(load_scene(args.scene), args.blows, args.step, args.method, args.rtol,
-                                            args.scene)
-    scene = exudyn_scene
-    simulations = [prepare_scene(window, args.scene) for window in (exudyn_scene, ode_scene)]
-    for simulation in simulations:
-        budget(args).check_run(simulation, args.scene, f"{simulation.settings.formulation} window: ")
     try:
-        exudyn, ode = (simulation.run() for simulation in simulations)
+        check = crosscheck(args.scene, args.blows, args.step, args.method, args.rtol, budget(args))
     except SimulationFailed as err:
         raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
         print(f"{args.scene}: {err}", file=sys.stderr)
         return 1
-    report = compare_runs(ode, exudyn, scene.solver.end_time_s)
-    checks = verdict(report)
-    passed = all(c["passed"] for c in checks.values())
-    print(f"{scene.name}: {args.blows} blows, exudyn {exudyn.simulation.settings.type} at {args.step:g} s, "
+    exudyn, ode = check.exudyn.raw, check.ode.raw
+    print(f"{check.exudyn.scene.name}: {args.blows} blows, exudyn {exudyn.simulation.settings.type} at {args.step:g} s, "
           f"ode {args.method} at rtol {args.rtol:g} ({ode.info['mode_switches']} rock mode switches)")
-    print(comparison_table(report, checks))
+    print(check.table())
     if args.out:
         with staged_directory(args.out) as stage:
-            write_json(stage / "crosscheck.json", {"scene": scene.name, "blows": args.blows,
+            write_json(stage / "crosscheck.json", {"scene": check.exudyn.scene.name, "blows": args.blows,
                                                     "exudyn": {"solver": exudyn.simulation.settings.type,
                                                                "step_s": args.step,
                                                                **exudyn.info},
-                                                    "ode": ode.info, "checks": checks, "passed": passed, **report})
-            plot_overlay(ode, exudyn, f"{scene.name}: first {args.blows} blows", stage / "crosscheck.png")
+                                                    "ode": ode.info, "checks": check.checks, "passed": check.passed,
+                                                    **check.report})
+            plot_overlay(ode, exudyn, f"{check.exudyn.scene.name}: first {args.blows} blows", stage / "crosscheck.png")
         print(f"wrote {args.out}")
-    return 0 if passed else 1
+    return 0 if check.passed else 1

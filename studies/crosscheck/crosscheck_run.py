@@ -1,0 +1,58 @@
+"""A cross-check as a library call: :func:`crosscheck` runs one scene in the Exudyn formulation and as
+the plain ODE of the paper's Eq. 4 over its first blows (studies.crosscheck.crosscheck_windows) and
+returns both runs with their comparison; ``rpdrill crosscheck`` is this function and a print."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ...models.definition.scene import Scene
+from ...models.evaluation.compare import compare_runs, verdict
+from ...models.evaluation.run_result import Result
+from ..inputs.reading import load_scene, prepare_scene
+from ..runtime.budgets import DEFAULT_BUDGET, Budget
+from .crosscheck_windows import DEFAULT_STEP_S, comparison_table, window_scenes
+
+
+@dataclass(frozen=True)
+class Crosscheck:
+    """The two runs of one window and their differences: ``report`` (models.evaluation.compare:
+    histories, the bottom at the window's end, every metric), ``checks`` (each checked figure with its
+    tolerance and verdict)."""
+
+    exudyn: Result
+    ode: Result
+    blows: int
+    step_s: float
+    report: dict[str, Any]
+    checks: dict[str, dict[str, Any]]
+
+    @property
+    def passed(self) -> bool:
+        """True when every checked figure is within its tolerance."""
+        return all(check["passed"] for check in self.checks.values())
+
+    def table(self) -> str:
+        """The comparison as the command prints it."""
+        return comparison_table(self.report, self.checks)
+
+
+def crosscheck(scene: Scene | str | Path, blows: int = 20, step_s: float = DEFAULT_STEP_S, method: str = "DOP853",
+               rtol: float = 1e-10, budget: Budget | None = DEFAULT_BUDGET) -> Crosscheck:
+    """The Exudyn model (the scene's solver type at ``step_s``) against the ODE (``method`` at relative
+    tolerance ``rtol``) over the first ``blows`` impact periods. InputError or BudgetError before
+    anything runs; SimulationFailed when a run diverges."""
+    source = f"scene {scene.name!r}" if isinstance(scene, Scene) else str(scene)
+    if not isinstance(scene, Scene):
+        scene = load_scene(scene)
+    windows = window_scenes(scene, blows, step_s, method, rtol, source)
+    simulations = [prepare_scene(window, source) for window in windows]
+    if budget is not None:
+        for simulation in simulations:
+            budget.check_run(simulation, source, f"{simulation.settings.formulation} window: ")
+    exudyn, ode = (Result(window, simulation.run(), {"source": source})
+                   for window, simulation in zip(windows, simulations, strict=True))
+    report = compare_runs(ode.raw, exudyn.raw, windows[0].solver.end_time_s)
+    return Crosscheck(exudyn, ode, blows, step_s, report, verdict(report))
