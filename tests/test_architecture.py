@@ -42,6 +42,20 @@ def test_installed_under_one_name_and_nothing_generic(tmp_path):
         assert done.returncode != 0, f"a generic top-level package '{folder}' is installed"
 
 
+def test_the_tests_run_in_a_checkout_of_any_folder_name(tmp_path):
+    """A checkout unpacked as ``rpdrill-main`` (not a Python name): pytest must not import the package's
+    ``__init__.py`` as a package of tests (conftest.py)."""
+    checkout = tmp_path / "rpdrill-main"
+    (checkout / "tests").mkdir(parents=True)
+    for name in ("pyproject.toml", "__init__.py", "conftest.py"):
+        (checkout / name).write_bytes((ROOT / name).read_bytes())
+    (checkout / "tests" / "test_front_door.py").write_text("import rpdrill\n\n\ndef test_it():\n"
+                                                          "    assert rpdrill.simulate\n")
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-n", "0", "-p", "no:cacheprovider"],
+                          cwd=checkout, capture_output=True, text=True, check=False, timeout=300)
+    assert done.returncode == 0, done.stdout[-2000:]
+
+
 def test_the_package_imports_itself_only_relatively():
     """Inside the package every import of its own modules is relative, so that the import graph read
     from the files of a checkout (an editor, an import-graph tool: no install) is the real one."""
