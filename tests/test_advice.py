@@ -131,7 +131,7 @@ def test_advise_command_writes_the_advice(tmp_path, capsys):
     assert "sandstone: best penetration rate" in printed and "along feed force" in printed
     assert {p.name for p in out.iterdir()} == {
         "advice.json", "advice.md", "sandstone_curves.png", "sandstone_curves.svg",
-        "sandstone_feed_frequency_map.png", "sandstone_feed_frequency_map.svg"}
+        "sandstone_feed_frequency_map.png", "sandstone_feed_frequency_map.svg", "evaluations.jsonl", "checkpoint.json"}
     record = json.loads((out / "advice.json").read_text())
     (result,) = record["results"]
     assert result["rock"] == "sandstone" and result["formulation"] == "exact"
@@ -140,6 +140,33 @@ def test_advise_command_writes_the_advice(tmp_path, capsys):
     assert text == (out / "advice.md").read_text()
     assert "--frequency-hz 45 70 --feed-kn 35 60" in record["command"] and record["command"] in text
     assert "| sandstone |" in text and "feed force [kN]" in text
+
+
+def test_an_interrupted_advice_continues_where_it_stopped(tmp_path, capsys):
+    """The points of a cut run (its checkpoint cut mid-line, as a kill leaves it) are replayed, the rest
+    run: the same advice as an uncut run; a finished advice run again replays every point; another
+    advice into the folder is refused before it runs."""
+    scene = write_scene(tmp_path)
+    command = ["advise", scene, "--frequency-hz", "45", "70", "--feed-kn", "35", "60", "--popsize", "3",
+               "--generations", "2", "--workers", "1", "--quiet"]
+    whole, cut = tmp_path / "whole", tmp_path / "cut"
+    assert main([*command, "--out", str(whole)]) == 0
+    capsys.readouterr()
+    lines = (whole / "evaluations.jsonl").read_text().splitlines(keepends=True)
+    assert len(lines) > 20
+    cut.mkdir()
+    (cut / "checkpoint.json").write_bytes((whole / "checkpoint.json").read_bytes())
+    (cut / "evaluations.jsonl").write_text("".join(lines[:10]) + lines[10][:15])
+    assert main([*command, "--out", str(cut)]) == 0
+    assert "10 replayed from an earlier session" in capsys.readouterr().out
+    best = [json.loads((folder / "advice.json").read_text())["results"][0] for folder in (whole, cut)]
+    assert best[0]["best"] == best[1]["best"] and best[0]["best_value"] == best[1]["best_value"]
+    assert len((cut / "evaluations.jsonl").read_text().splitlines()) == len(lines)
+    assert main([*command, "--out", str(whole)]) == 0
+    again = json.loads((whole / "advice.json").read_text())["results"][0]
+    assert again["replayed"] == again["runs"] == best[0]["runs"] and again["best"] == best[0]["best"]
+    assert main([*command[:-7], "--popsize", "4", "--generations", "2", "--workers", "1", "--quiet", "--out", str(whole)]) == 2
+    assert "differs from the run whose results are in" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("arguments, expected", [

@@ -199,3 +199,24 @@ def test_a_calibration_stops_within_2_s_and_resumes_to_the_same_evaluations(tmp_
 
     assert by_unit(out) == by_unit(whole)
     assert (out / "calibrated_scene.yaml").read_text() == (whole / "calibrated_scene.yaml").read_text()
+
+
+@pytest.mark.slow
+def test_an_advice_stops_within_2_s_and_resumes_to_the_same_advice(tmp_path):
+    """rpdrill advise keeps every point run before the signal (evaluations.jsonl) and, run again,
+    replays them and gives the advice of an uninterrupted run."""
+    scene = write(tmp_path / "drill.yaml", {**yaml.safe_load(PAPER_BASE.read_text()), "solver": {"end_time_s": 3.0}})
+    out, whole = tmp_path / "out", tmp_path / "whole"
+
+    def advise(folder: Path) -> list[str]:
+        return command("advise", str(scene), "--frequency-hz", "45", "75", "--feed-kn", "10", "30", "--popsize", "4",
+                       "--generations", "3", "--out", str(folder), "--workers", "2", "--quiet")
+
+    stopped = stop(advise(out), lambda: lines(out / "evaluations.jsonl"), signal.SIGINT, at_least=10)
+    assert_stopped_cleanly(stopped, 130, lines(out / "evaluations.jsonl"))
+    assert not (out / "advice.json").exists()
+    for folder in (out, whole):
+        subprocess.run(advise(folder), cwd=ROOT, check=True, capture_output=True)
+    first, second = (json.loads((f / "advice.json").read_text())["results"][0] for f in (out, whole))
+    assert first["replayed"] >= stopped.kept_at_signal and second["replayed"] == 0
+    assert (first["best"], first["best_value"]) == (second["best"], second["best_value"])

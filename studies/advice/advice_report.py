@@ -28,6 +28,7 @@ def best_point(advice: Advice) -> str:
     if advice.power_w is not None:
         at += f" ({blow_energy_text(advice)})"
     failed = f", {advice.failed_runs} failed" if advice.failed_runs else ""
+    failed += f", {advice.replayed} replayed from an earlier session" if advice.replayed else ""
     beyond = f", {advice.beyond_limit} points beyond the thrust limit not run" if advice.beyond_limit else ""
     return (f"{_rock(advice)}: best {y.name} {y.show_with_unit(advice.best_value)} at {at}, mean thrust "
             f"{advice.best_thrust_ratio:.0%} of F_th ({advice.formulation}, {advice.runs} runs{failed}{beyond}, "

@@ -33,12 +33,18 @@ scene: the penetration rate per unit hammer power; models.evaluation.metrics).
   impact frequency (others at the optimum). Percussive drilling has an optimum feed force in
   experiments (the rate rises, then falls, as the feed grows); :func:`feed_response` reads from the
   map, frequency by frequency, whether the model has one.
+* **Resumable**: with an :class:`~rpdrill.studies.runtime.evaluation_log.EvaluationLog`, every point
+  run is recorded as its run returns; a rerun of the same advice into the same folder replays the
+  recorded points (the seeded search retraces its path) and runs only the rest.
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
+import hashlib
 import itertools
+import json
 import math
 import time
 from collections.abc import Callable
@@ -56,6 +62,7 @@ from ...models.solvers.simulation import SceneError, Simulation, prepare
 from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter
 from ..inputs.specs import set_path
+from ..runtime.evaluation_log import EvaluationLog
 from ..runtime.pools import Runner
 from ..scan.curve_optima import band_hz
 from ..scan.frequency_scans import scan_target
@@ -149,6 +156,7 @@ class Advice:
     best_value: float = math.nan
     best_thrust_ratio: float = math.nan  # mean thrust / F_th at the best point
     runs: int = 0
+    replayed: int = 0  # of the runs, points recorded by an earlier session (module doc)
     failed_runs: int = 0
     beyond_limit: int = 0  # points not run: beyond the thrust limit
     first_error: str = ""
@@ -242,30 +250,62 @@ class Evaluation:
         return np.where(excess < 0, -np.nan_to_num(self.values, nan=0.0), excess)
 
 
+def advice_hash(scenes: list[dict[str, Any]], request: Request) -> str:
+    """SHA-256 of what determines an advice's points and their values: the scene of each rock and the
+    request (its checkpoint's hash, studies.runtime.evaluation_log)."""
+    content = json.dumps({"scenes": scenes, "request": dataclasses.asdict(request)}, sort_keys=True)
+    return hashlib.sha256(content.encode()).hexdigest()
+
+
+def _point_key(rock: str | None, point: Point) -> tuple[Any, ...]:
+    """The memo key of a point of one rock's search: its exact coordinates."""
+    return (rock or "", *sorted((path, float(value)) for path, value in point.items()))
+
+
 class AdviceEvaluator:
-    """The metric at batches of points, the runs of a batch on the runner at once; counts runs,
-    failures and points beyond the thrust limit."""
+    """The metric at batches of points, the runs of a batch on the runner at once (points that ``log``
+    recorded replayed, new ones recorded as they return); counts runs, replays, failures and points
+    beyond the thrust limit."""
 
     def __init__(self, scene: dict[str, Any], request: Request, runner: Runner,
-                 progress: Callable[[int], None] | None = None) -> None:
+                 progress: Callable[[int], None] | None = None, rock: str | None = None,
+                 log: EvaluationLog | None = None) -> None:
         self.scene, self.request, self.runner, self.progress = scene, request, runner, progress
-        self.runs = self.failed = self.beyond_limit = 0
+        self.rock, self.log = rock, log
+        self.recorded = {_point_key(r["rock"], r["point"]): r for r in (log.records if log else [])}
+        self.earlier = set(self.recorded)  # recorded by an earlier session (the rest: this one's repeats)
+        self.runs = self.replayed = self.failed = self.beyond_limit = 0
         self.first_error = ""
         self.best_point: Point = {}
         self.best_value = -math.inf
 
+    def _take(self, values: np.ndarray, index: int, record: dict[str, Any]) -> None:
+        values[index] = math.nan if record["value"] is None else record["value"]
+        self.failed += record["failed_runs"]
+        self.first_error = self.first_error or record["error"]
+
     def __call__(self, points: list[Point]) -> Evaluation:
         scenes = [at_point(self.scene, p, self.request.power_w) for p in points]
         ratios = np.array([thrust_ratio(scene) for scene in scenes])
-        tasks = [(i, scene, [self.request.metric], [scene["impact"]["frequency_hz"]])
-                 for i, scene in enumerate(scenes) if ratios[i] < self.request.max_thrust_ratio]
+        run = [i for i in range(len(points)) if ratios[i] < self.request.max_thrust_ratio]
         values = np.full(len(points), np.nan)
+        replays = {i: self.recorded[key] for i in run if (key := _point_key(self.rock, points[i])) in self.recorded}
+        for i, record in replays.items():
+            self._take(values, i, record)
+        tasks = [(i, scenes[i], [self.request.metric], [scenes[i]["impact"]["frequency_hz"]])
+                 for i in run if i not in replays]
         for scan in (scan for batch in self.runner(scan_target, tasks) for scan in batch) if tasks else ():
-            values[scan["key"]] = scan["values"][self.request.metric][0]
-            self.failed += scan["failed_runs"]
-            self.first_error = self.first_error or scan["error"]
-        self.runs += len(tasks)
-        self.beyond_limit += len(points) - len(tasks)
+            value = float(scan["values"][self.request.metric][0])
+            record = {"rock": self.rock or "", "point": {k: float(v) for k, v in points[scan["key"]].items()},
+                      "value": None if math.isnan(value) else value, "failed_runs": scan["failed_runs"],
+                      "error": scan["error"]}
+            self._take(values, scan["key"], record)
+            if self.log is not None:
+                self.log.append(record)
+                self.recorded[_point_key(self.rock, record["point"])] = record
+        self.runs += len(run)
+        self.replayed += sum(_point_key(self.rock, points[i]) in self.earlier for i in replays)
+        self.beyond_limit += len(points) - len(run)
         if self.progress:
             self.progress(len(points))
         below = np.where(ratios < self.request.max_thrust_ratio, np.nan_to_num(values, nan=-math.inf), -math.inf)
@@ -340,11 +380,12 @@ def feed_response(feed_map_: dict[str, Any]) -> dict[str, Any]:
 
 
 def advise(data: dict[str, Any], rock: str | None, request: Request, runner: Runner,
-           progress: Callable[[int], None] | None = None) -> Advice:
+           progress: Callable[[int], None] | None = None, log: EvaluationLog | None = None) -> Advice:
     """The best operating point (module doc) of the scene ``data`` (:func:`runnable_scene`, on ``rock``),
-    with the curves around it and the feed x frequency map; ``progress(points)`` after each batch."""
+    with the curves around it and the feed x frequency map; ``progress(points)`` after each batch;
+    ``log``: the points recorded and replayed (module doc)."""
     start = time.perf_counter()
-    evaluate = AdviceEvaluator(data, request, runner, progress)
+    evaluate = AdviceEvaluator(data, request, runner, progress, rock, log)
     scene = Scene.model_validate(data)
     advice = Advice(scene=data["name"], description=describe_scene(scene, request.bounds),
                     scene_description=describe_scene(scene, [*request.bounds, "rock.name"]), rock=rock, metric=request.metric, formulation=data["solver"]["formulation"],
@@ -360,6 +401,7 @@ def advise(data: dict[str, Any], rock: str | None, request: Request, runner: Run
         advice.slices = slices(evaluate, request.bounds, advice.best, advice.best_value)
     advice.feed_map["response"] = feed_response(advice.feed_map)
     advice.runs, advice.failed_runs, advice.beyond_limit = evaluate.runs, evaluate.failed, evaluate.beyond_limit
+    advice.replayed = evaluate.replayed
     advice.first_error = evaluate.first_error
     advice.wall_time_s = time.perf_counter() - start
     return advice

@@ -10,7 +10,7 @@ m_t = (f_t - f_t*) / f_t* the relative miss of target t (1 when its metric is no
 the second sum over neighbouring labels of each ``rising`` list, f* the paper's optima. SciPy's
 differential evolution (vectorized: a whole population's scans go to the runner together) or
 bounded Nelder-Mead minimise J over the unit cube. Every evaluation is recorded as it finishes
-(studies.calibration.evaluation_log) and replayed on a rerun. The best parameter set is then scanned once
+(studies.runtime.evaluation_log) and replayed on a rerun. The best parameter set is then scanned once
 more with points every ``refine_hz`` around its optima, for the report.
 """
 
@@ -31,7 +31,7 @@ from ..runtime.interrupts import raise_if_stopped
 from ..runtime.pools import Runner
 from ..scan.frequency_scans import ScanTask, rising_shortfalls, run_scans, scan_all, scan_cost, scan_optimum
 from .calibration_spec import Calibration
-from .evaluation_log import EvaluationLog, Record, unit_key
+from ..runtime.evaluation_log import EvaluationLog, Record, unit_key
 
 Progress = Callable[[Record, bool], None]  # (record, replayed)
 

@@ -197,6 +197,11 @@ class Calibration:
                          for name, parameter in self.spec.parameters.items()])
 
     @property
+    def identity(self) -> dict[str, str]:
+        """What names this calibration in its checkpoint (studies.runtime.evaluation_log)."""
+        return {"calibration": self.spec.name, "calibration_file": str(self.source), "hash": self.hash}
+
+    @property
     def hash(self) -> str:
         """SHA-256 of what determines the evaluations and the search path: everything but the
         name, description, report refinement and budget (a larger budget continues a search)."""

@@ -7,6 +7,7 @@ around it, one parameter at a time; exit status 1 when every run failed.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import shlex
 import sys
 from pathlib import Path
@@ -21,6 +22,7 @@ from ..advice.advice_search import (
     AdviceSearch,
     AdviseParameter,
     Request,
+    advice_hash,
     advise,
     planned_evaluations,
     runnable_scene,
@@ -28,17 +30,21 @@ from ..advice.advice_search import (
 from ..display.catalogue import metric, parameter
 from ..figures.advice_figures import plot_curves, plot_feed_map
 from ..inputs.reading import load_scene
+from ..runtime.evaluation_log import CHECKPOINT, EVALUATIONS, EvaluationLog
 from ..runtime.output_files import check_file_target, check_out, staged_directory, write_json
 from ..runtime.pools import pool
 from .options import add_runner_arguments, positive_count, positive_number
 
-FILES = """files written to DIR:
+FILES = f"""files written to DIR (an interrupted advice keeps its points there: the same command again
+replays them and runs the rest):
   advice.json                   the command, and per rock: the best point, the metric there, the search
                                 (runs, generations, wall time), the curves around the optimum, the
                                 feed x frequency map and where along the feed the metric is highest (SI units)
   advice.md                     the table of best points and the feed-force response (display units)
   ROCK_curves.png               the metric along each parameter through the optimum (and .svg)
-  ROCK_feed_frequency_map.png   the metric over feed force and impact frequency (and .svg)"""
+  ROCK_feed_frequency_map.png   the metric over feed force and impact frequency (and .svg)
+  {EVALUATIONS:<30}every point run, as it returned (the checkpoint)
+  {CHECKPOINT:<30}what determines the points (its hash) and the sessions"""
 
 
 def _given(args: argparse.Namespace, entry: AdviseParameter) -> tuple[float, float] | None:
@@ -94,7 +100,7 @@ def command_line(args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    check_out(args.out, args.overwrite, "advice.json")
+    out = check_out(args.out, args.overwrite, CHECKPOINT)
     if args.markdown:
         check_file_target("--markdown", args.markdown)
     scene = load_scene(args.scene).model_dump(by_alias=True, exclude_none=True)
@@ -105,12 +111,15 @@ def run(args: argparse.Namespace) -> int:
     rocks = args.rock or [None]
     scenes = [runnable_scene(scene, rock, request, args.scene) for rock in rocks]
     advices = []
-    with pool(args.dask, args.workers) as (label, runner), \
+    identity = {"advice": scene["name"], "scene_file": args.scene, "hash": advice_hash(scenes, request)}
+    with contextlib.closing(EvaluationLog(out, identity, Path(args.scene), args.overwrite)) as log, \
+            pool(args.dask, args.workers) as (label, runner), \
             tqdm(total=planned_evaluations(request) * len(rocks), desc="advise", unit="point", disable=args.quiet) as bar:
         print(f"advise: maximising {metric(args.metric).name} over {', '.join(parameter(p).name for p in bounds)} "
-              f"for {len(rocks)} rock(s) on {label}", file=sys.stderr)
+              f"for {len(rocks)} rock(s) on {label}" + (f"; {len(log.records)} points recorded earlier in {out}"
+                                                         if log.records else ""), file=sys.stderr)
         for rock, data in zip(rocks, scenes, strict=True):
-            advices.append(advise(data, rock, request, runner, bar.update))
+            advices.append(advise(data, rock, request, runner, bar.update, log))
             tqdm.write(advice_text(advices[-1]), file=sys.stdout)
     command = command_line(args)
     with staged_directory(args.out) as stage:

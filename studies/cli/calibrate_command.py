@@ -23,7 +23,7 @@ from tqdm import tqdm
 from ..calibration.calibration_report import write_report
 from ..calibration.calibration_search import calibrate
 from ..calibration.calibration_spec import load_calibration
-from ..calibration.evaluation_log import CHECKPOINT, EvaluationLog, Record
+from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog, Record
 from ..runtime.budgets import duration
 from ..runtime.output_files import check_out, staged_directory
 from ..runtime.pools import pool
@@ -41,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     calibration = load_calibration(args.calibration, budget(args))
     new = not out.exists() or all(p.name.startswith(".") for p in out.iterdir())  # (its lock: studies.runtime.out_lock)
     spec = calibration.spec
-    with contextlib.closing(EvaluationLog(out, calibration, args.overwrite)) as log, \
+    with contextlib.closing(EvaluationLog(out, calibration.identity, calibration.source, args.overwrite)) as log, \
             pool(args.dask, args.workers) as (label, runner), \
             tqdm(total=calibration.evaluations, desc=spec.name, unit="eval", disable=args.quiet) as bar:
         print(f"{spec.name}: {len(calibration.names)} parameters, {len(spec.targets)} targets x "

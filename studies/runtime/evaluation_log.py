@@ -1,11 +1,12 @@
-"""The checkpoint of a calibration: every evaluation as one JSON line, as soon as it finishes.
+"""The checkpoint of a search (``rpdrill calibrate``, ``rpdrill advise``): every evaluation as one
+JSON line, as soon as it finishes.
 
-``OUT/evaluations.jsonl`` holds the evaluations (unit point, parameters, per-target optima,
-objective, cost); ``OUT/checkpoint.json`` the calibration's hash and one entry per session. A
-rerun into the same OUT replays the recorded evaluations (by their exact unit point) instead of
-recomputing them, so a seeded search retraces its path and continues where it stopped; a
-different calibration is refused (InputError; with ``overwrite`` it starts afresh). A line cut by a
-kill is dropped.
+``OUT/evaluations.jsonl`` holds the evaluations (what the search's own records hold: a point, what
+was measured there); ``OUT/checkpoint.json`` the hash of everything that determines them (the
+search's inputs) and one entry per session. A rerun into the same OUT replays the recorded
+evaluations (by their exact point) instead of recomputing them, so a seeded search retraces its path
+and continues where it stopped; a different search is refused (InputError; with ``overwrite`` it
+starts afresh). A line cut by a kill is dropped.
 """
 
 from __future__ import annotations
@@ -15,10 +16,9 @@ import os
 from pathlib import Path
 from typing import Any, TextIO
 
-from ..inputs.reading import InputError
-from ..runtime.output_files import write_json
-from ..runtime.resumable import checked_record
-from .calibration_spec import Calibration
+from ...models.definition.validation import InputError
+from .output_files import write_json
+from .resumable import checked_record
 
 Record = dict[str, Any]
 EVALUATIONS = "evaluations.jsonl"
@@ -48,11 +48,12 @@ def _complete_records(path: Path) -> list[Record]:
 
 
 class EvaluationLog:
-    """The recorded evaluations of one calibration in one output directory (close it when done)."""
+    """The recorded evaluations of one search in one output directory (close it when done):
+    ``identity`` names the search and holds its ``hash``; ``source`` is the input file messages name."""
 
-    def __init__(self, out: Path, calibration: Calibration, overwrite: bool = False) -> None:
+    def __init__(self, out: Path, identity: dict[str, Any], source: Path, overwrite: bool = False) -> None:
         self.out = out
-        self.checkpoint, resumed = self._checkpoint(calibration, overwrite)
+        self.checkpoint, resumed = self._checkpoint(identity, source, overwrite)
         path = out / EVALUATIONS
         self.records = _complete_records(path) if resumed else []
         temporary = path.with_suffix(".jsonl.tmp")
@@ -60,13 +61,11 @@ class EvaluationLog:
         os.replace(temporary, path)
         self._handle: TextIO = path.open("a", encoding="utf-8")
 
-    def _checkpoint(self, calibration: Calibration, overwrite: bool) -> tuple[dict[str, Any], bool]:
-        """The checkpoint (this calibration's, or a fresh one) and whether it resumes an earlier run."""
+    def _checkpoint(self, identity: dict[str, Any], source: Path, overwrite: bool) -> tuple[dict[str, Any], bool]:
+        """The checkpoint (this search's, or a fresh one) and whether it resumes an earlier run."""
         self.out.mkdir(parents=True, exist_ok=True)
-        fresh = {"calibration": calibration.spec.name, "calibration_file": str(calibration.source),
-                 "hash": calibration.hash, "sessions": []}
-        checkpoint = checked_record(self.out / CHECKPOINT, fresh, calibration.source, [self.out / EVALUATIONS],
-                                    overwrite)
+        fresh = {**identity, "sessions": []}
+        checkpoint = checked_record(self.out / CHECKPOINT, fresh, source, [self.out / EVALUATIONS], overwrite)
         write_json(self.out / CHECKPOINT, checkpoint)
         return checkpoint, checkpoint is not fresh
 
