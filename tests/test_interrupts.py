@@ -220,3 +220,25 @@ def test_an_advice_stops_within_2_s_and_resumes_to_the_same_advice(tmp_path):
     first, second = (json.loads((f / "advice.json").read_text())["results"][0] for f in (out, whole))
     assert first["replayed"] >= stopped.kept_at_signal and second["replayed"] == 0
     assert (first["best"], first["best_value"]) == (second["best"], second["best_value"])
+
+
+def test_the_cancelled_futures_race_of_a_stop_prints_no_traceback():
+    """A stop that ends the workers can make concurrent.futures' management thread set an exception on
+    a future the stop cancelled (InvalidStateError; seen about once in seven Ctrl-Cs of a study):
+    nothing printed for it while a pool lives; another thread's exception still is."""
+    code = """
+import threading
+from concurrent.futures import InvalidStateError
+from rpdrill.studies.runtime.pools import process_pool
+
+def fail(error):
+    raise error
+
+with process_pool(1):
+    for error in (InvalidStateError("CANCELLED: <Future state=cancelled>"), ValueError("a real one")):
+        thread = threading.Thread(target=fail, args=(error,))
+        thread.start()
+        thread.join()
+"""
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=60)
+    assert "InvalidStateError" not in done.stderr and "ValueError: a real one" in done.stderr

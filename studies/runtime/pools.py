@@ -24,9 +24,10 @@ import contextlib
 import itertools
 import logging
 import os
+import threading
 import warnings
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import InvalidStateError, ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
 
@@ -144,14 +145,34 @@ def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
         return Completed(futures, as_completed, lambda pending: [f.cancel() for f in pending], registry, True)
 
     stopped = True
+    with _cancelled_futures_quiet():
+        try:
+            yield run
+            stopped = False
+        finally:
+            for executor in executors:
+                if stopped:  # an interrupt or an error: the points under way are not waited for
+                    _terminate_workers(executor)
+                executor.shutdown(wait=True, cancel_futures=True)
+
+
+@contextlib.contextmanager
+def _cancelled_futures_quiet() -> Iterator[None]:
+    """While a pool lives: when a stop ends its workers (a Ctrl-C reaches the whole process group), the
+    executor's management thread may set an exception on a future the stop already cancelled
+    (InvalidStateError, a race inside concurrent.futures); that is the stop itself, not a failure, and
+    no traceback is printed for it. Any other exception of a thread reaches the previous hook."""
+    previous = threading.excepthook
+
+    def hook(args: threading.ExceptHookArgs) -> None:
+        if not isinstance(args.exc_value, InvalidStateError):
+            previous(args)
+
+    threading.excepthook = hook
     try:
-        yield run
-        stopped = False
+        yield
     finally:
-        for executor in executors:
-            if stopped:  # an interrupt or an error: the points under way are not waited for
-                _terminate_workers(executor)
-            executor.shutdown(wait=True, cancel_futures=True)
+        threading.excepthook = previous
 
 
 def _terminate_workers(executor: ProcessPoolExecutor) -> None:
