@@ -34,8 +34,7 @@ import numpy as np
 
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.solvers.cost import CPU_S_PER_STEP, Cause, cost_key, run_cost
-from rpdrill.models.solvers.dispatch import unsupported
-from rpdrill.models.solvers.simulation import prepare
+from rpdrill.models.solvers.simulation import prepare, unsupported
 from rpdrill.studies.calibration.calibration_search import target_result
 from rpdrill.studies.calibration.calibration_spec import load_calibration
 from rpdrill.studies.inputs.reading import read_yaml

@@ -84,17 +84,13 @@ def package_files(root: Path = ROOT) -> dict[str, Path]:
 
 
 def module_imports(name: str, path: Path) -> list[tuple[str, bool]]:
-    """(imported module or module.attribute, absolute?) of one module, at any depth; imports only for
-    type checkers (``if TYPE_CHECKING:``) left out; relative imports resolved against its package."""
+    """(imported module or module.attribute, absolute?) of one module, at any depth, imports only for
+    type checkers (``if TYPE_CHECKING:``) too (a type named across a boundary is a dependency as well);
+    relative imports resolved against its package."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
-    typing_only = {id(node) for block in ast.walk(tree)
-                   if isinstance(block, ast.If) and "TYPE_CHECKING" in ast.unparse(block.test)
-                   for statement in block.body for node in ast.walk(statement)}
     package = [part for part in (name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]) if part]
     found: list[tuple[str, bool]] = []
     for node in ast.walk(tree):
-        if id(node) in typing_only:
-            continue
         if isinstance(node, ast.Import):
             found += [(alias.name, True) for alias in node.names]
         elif isinstance(node, ast.ImportFrom):

@@ -13,7 +13,7 @@ from .parts import link_series
 
 if TYPE_CHECKING:
     from ..drill.piston import PistonHistory
-    from ..solvers.simulation import Simulation
+    from .prepared_run import PreparedRun
 
 
 @dataclass
@@ -24,7 +24,7 @@ class SimulationResult:
     per body of the simulation's chain. ``bottom_m`` is the borehole bottom x_n.
     """
 
-    simulation: Simulation
+    simulation: PreparedRun
     formulation: str
     time_s: np.ndarray
     position_m: np.ndarray

@@ -8,7 +8,7 @@ a preset and without explicit accuracy options the ``standard`` preset applies.
   1/|lambda|_max (the stiffest or fastest mode: stability), a smaller multiple of 1/|lambda| of the
   fastest mode still ringing at the next blow (accuracy where errors add up blow by blow) and, for
   the presets that resolve it, a share of m_bit / c_n (the rock damper's force jump at contact:
-  models.evaluation.stability.StepScales); explicit ``type`` or ``step_s`` win (a step or tolerances without a
+  StepScales); explicit ``type`` or ``step_s`` win (a step or tolerances without a
   preset and without a type: RK44). The stated errors (penetration rate relative to the exact
   formulation, energy balance relative to the impact work) are the largest measured on the hard
   scenes of tests/stability, rounded up (docs/stability.md); the suite checks them.
@@ -26,7 +26,26 @@ from dataclasses import dataclass
 
 from ..definition.formulations import DEFAULT_PRESET
 from ..definition.scene import Solver
-from .stability import StepScales
+
+
+@dataclass(frozen=True)
+class StepScales:
+    """The rates, in 1/s, a fixed explicit step must resolve (from models.evaluation.stability.step_scales):
+
+    * ``spectral_radius_per_s``: |lambda|_max, for stability;
+    * ``ringing_radius_per_s``: the largest |lambda| of the modes that still ring when the next blow
+      comes, decaying by less than a factor e over a blow period T (-Re(lambda) T < 1; 0 if none).
+      The solver's phase and amplitude error on such a mode is carried into the next blow's contacts
+      and adds up blow by blow, so the mode must be resolved, not only kept stable; a mode that dies
+      within a blow starts afresh at each contact;
+    * ``damper_rate_per_s``: c_n / m_bit. The rock damper's force jumps by c_n v when the bit meets
+      the rock; a fixed step that straddles that instant puts the jump in the wrong part of the step,
+      an impulse error up to c_n v h, the share c_n h / m_bit of the bit's momentum.
+    """
+
+    spectral_radius_per_s: float
+    ringing_radius_per_s: float
+    damper_rate_per_s: float
 
 
 @dataclass(frozen=True)

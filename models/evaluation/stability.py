@@ -22,9 +22,10 @@ from ..definition.scene import Scene, Torsion
 from ..drill.chain import AxialChain, torsion_first_order_matrix
 from ..drill.pulse import impulse_per_blow_n_s
 from .energy import energy_account
+from .solver_settings import StepScales
 
 if TYPE_CHECKING:
-    from ..solvers.simulation import Simulation
+    from .prepared_run import PreparedRun
     from .results import SimulationResult
 
 # Positions beyond this are not drilling: the solver has blown up (states near 1e300 seen with
@@ -70,26 +71,6 @@ def spectral_radius_per_s(chain: AxialChain, law: RockLaw, torsion: Torsion | No
     """|lambda|_max of :func:`contact_eigenvalues_per_s`: what limits an explicit solver's step, the
     stiffest mode for light damping and the fastest decay for heavy damping."""
     return float(np.abs(contact_eigenvalues_per_s(chain, law, torsion)).max())
-
-
-@dataclass(frozen=True)
-class StepScales:
-    """The rates, in 1/s, a fixed explicit step must resolve (models.evaluation.solver_settings):
-
-    * ``spectral_radius_per_s``: |lambda|_max, for stability;
-    * ``ringing_radius_per_s``: the largest |lambda| of the modes that still ring when the next blow
-      comes, decaying by less than a factor e over a blow period T (-Re(lambda) T < 1; 0 if none).
-      The solver's phase and amplitude error on such a mode is carried into the next blow's contacts
-      and adds up blow by blow, so the mode must be resolved, not only kept stable; a mode that dies
-      within a blow starts afresh at each contact;
-    * ``damper_rate_per_s``: c_n / m_bit. The rock damper's force jumps by c_n v when the bit meets
-      the rock; a fixed step that straddles that instant puts the jump in the wrong part of the step,
-      an impulse error up to c_n v h, the share c_n h / m_bit of the bit's momentum.
-    """
-
-    spectral_radius_per_s: float
-    ringing_radius_per_s: float
-    damper_rate_per_s: float
 
 
 def step_scales(chain: AxialChain, law: RockLaw, torsion: Torsion | None, blow_period_s: float) -> StepScales:
@@ -171,7 +152,7 @@ def element_rates(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsio
     return candidates
 
 
-def largest_stable_step_s(simulation: Simulation, solver_type: str | None = None) -> float | None:
+def largest_stable_step_s(simulation: PreparedRun, solver_type: str | None = None) -> float | None:
     """h_max of a fixed-step explicit solver (default: the simulation's); None for implicit or
     adaptive ones."""
     solver_type = solver_type or simulation.settings.type
@@ -183,7 +164,7 @@ def largest_stable_step_s(simulation: Simulation, solver_type: str | None = None
     return 0.0 if factor is None else factor / radius
 
 
-def step_warning(simulation: Simulation) -> str | None:
+def step_warning(simulation: PreparedRun) -> str | None:
     """A warning when a fixed explicit step exceeds the measured stability limit."""
     settings = simulation.settings
     limit = largest_stable_step_s(simulation)
@@ -197,7 +178,7 @@ def step_warning(simulation: Simulation) -> str | None:
             f"{limit:.3g} s of {settings.type} for the stiffest mode of this drill")
 
 
-def _remedy(simulation: Simulation) -> str:
+def _remedy(simulation: PreparedRun) -> str:
     settings = simulation.settings
     if settings.type in STABLE_STEP_FACTOR:
         limit = largest_stable_step_s(simulation) or 0.0

@@ -36,7 +36,7 @@ from ..drill.piston import PistonSetup, piston_setup
 from ..drill.pulse import impulse_per_blow_n_s
 from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_settings
 from ..evaluation.stability import FastestElement, StepScales, fastest_element, step_scales
-from .dispatch import simulate
+from .dispatch import implementation
 
 if TYPE_CHECKING:
     from ..evaluation.results import SimulationResult
@@ -122,8 +122,9 @@ class Simulation:
         return needs(self.outputs.metrics, self.outputs.timeseries).data
 
     def run(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
-        """Simulate with the scene's formulation; ``progress(t)`` as simulated time advances."""
-        return simulate(self, progress)
+        """Simulate with the scene's formulation (models.solvers.dispatch); ``progress(t)`` as simulated
+        time advances."""
+        return implementation(self.settings.formulation).simulate(self, progress)
 
     def resolved_scene(self) -> dict[str, Any]:
         """The scene as run: rock values filled in, the effects built and why, the outputs, and the
@@ -140,6 +141,12 @@ class Simulation:
                 f"coupling {self.piston.contact_stiffness_n_per_m:.6g} N/m: {faces} in series with the "
                 "half-segments behind the faces")
         return data
+
+
+def unsupported(name: str, simulation: Simulation) -> str | None:
+    """Why formulation ``name`` cannot run ``simulation``, or None if it can."""
+    check = getattr(implementation(name, checks=True), "unsupported", None)
+    return check(simulation) if check else None
 
 
 def prepare(scene: Scene) -> Simulation:

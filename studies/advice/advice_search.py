@@ -57,8 +57,7 @@ from scipy import optimize
 
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, describe_validation_error
-from ...models.solvers.dispatch import unsupported
-from ...models.solvers.simulation import SceneError, Simulation, prepare
+from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
 from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter
 from ..inputs.specs import set_path

@@ -22,8 +22,7 @@ import yaml
 
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, parse, short
-from ...models.solvers.dispatch import unsupported
-from ...models.solvers.simulation import SceneError, Simulation, prepare
+from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
 
 __all__ = ["InputError", "load_scene", "parse", "parse_yaml", "prepare_scene", "read_text", "read_yaml"]
 
