@@ -9,6 +9,7 @@ The public API (every name documented with an example in ``docs/api.md``)::
     result.metrics["penetration_rate_m_per_s"]
     table = rpdrill.run_study(rpdrill.load_study("studies/paper/frequency_scan.yaml"), workers=2)
     rpdrill.crosscheck(scene).passed   # Exudyn against the paper's Eq. 4 as an ODE, first 20 blows
+    rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (10e3, 30e3)})[0].best
 
 The package's folders: ``rocklaw`` (the rock contact laws), ``models`` (the drill models and their
 three formulations), ``studies`` (YAML inputs, scans, analyses, reports and the command line);
@@ -21,6 +22,8 @@ from .models.definition.scene import Scene
 from .models.definition.validation import InputError
 from .models.evaluation.run_result import Result
 from .models.evaluation.stability import SimulationFailed
+from .studies.advice.advice_run import Advice, AdviceSearch
+from .studies.advice.advice_run import advise_scene as advise
 from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
 from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
 from .studies.runtime.budgets import BudgetError
@@ -45,6 +48,6 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'rpdrill' has no attribute {name!r}")
 
 
-__all__ = ["BudgetError", "Crosscheck", "ExudynModel", "InputError", "Result", "Scene", "SimulationFailed", "Study", "build_exudyn",
+__all__ = ["Advice", "AdviceSearch", "BudgetError", "Crosscheck", "ExudynModel", "InputError", "Result", "Scene", "SimulationFailed", "Study", "advise", "build_exudyn",
            "crosscheck", "draw", "load_scene", "load_study", "run_study", "save_result", "simulate", "table_frame", "view_solution",
            "write_animation"]

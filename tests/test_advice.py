@@ -179,3 +179,22 @@ def test_advise_bad_bounds_exit_2(tmp_path, capsys, arguments, expected):
     err = capsys.readouterr().err
     assert expected in err and "Traceback" not in err
     assert not (tmp_path / "out").exists()
+
+
+def test_the_library_call_gives_the_commands_advice(tmp_path):
+    """rpdrill.advise with the bounds in SI units: the advice the command writes for the same inputs;
+    a bound the search does not take is an InputError naming it and what is allowed."""
+    import rpdrill
+
+    scene = write_scene(tmp_path)
+    out = tmp_path / "out"
+    assert main(["advise", scene, "--frequency-hz", "45", "70", "--feed-kn", "35", "60", "--popsize", "3",
+                 "--generations", "2", "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    (advice,) = rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (35e3, 60e3)},
+                               search=rpdrill.AdviceSearch(popsize=3, max_generations=2), workers=1)
+    written = json.loads((out / "advice.json").read_text())["results"][0]
+    assert advice.best == written["best"] and advice.best_value == written["best_value"]
+    with pytest.raises(rpdrill.InputError, match="'rock.threshold_n': not a parameter advise searches; allowed: "
+                                                 "impact.frequency_hz, feed.force_n, impact.amplitude_n"):
+        rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (35e3, 60e3),
+                               "rock.threshold_n": (1e5, 2e5)})
