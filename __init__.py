@@ -24,8 +24,8 @@ from .models.evaluation.run_result import Result
 from .models.evaluation.stability import SimulationFailed
 from .studies.advice.advice_run import Advice, AdviceSearch
 from .studies.advice.advice_run import advise_scene as advise
-from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
 from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
+from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
 from .studies.runtime.budgets import BudgetError
 from .studies.scan.study import Study
 

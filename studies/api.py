@@ -19,7 +19,7 @@ from ..models.definition.scene import Scene
 from ..models.evaluation.run_result import Result
 from ..models.evaluation.run_status import run_status
 from ..models.solvers.cost import Cause
-from .inputs.reading import InputError, load_scene, prepare_scene
+from .inputs.reading import InputError, load_scene, prepare_scene, scene_and_source
 from .runtime.budgets import DEFAULT_BUDGET, Budget
 from .runtime.output_files import write_columns_csv, write_json, write_resolved
 from .scan.study import Study, load_study
@@ -58,13 +58,6 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     return written
 
 
-def _scene(scene: Scene | str | Path) -> tuple[Scene, str]:
-    """A validated scene and the name its messages use."""
-    if isinstance(scene, Scene):
-        return scene, f"scene {scene.name!r}"
-    return load_scene(scene), str(scene)
-
-
 def simulate(scene: Scene | str | Path, formulation: str | None = None,
              progress: Callable[[float], None] | None = None, budget: Budget | None = DEFAULT_BUDGET,
              solution_file: Path | None = None) -> Result:
@@ -76,7 +69,7 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     (for its SolutionViewer: studies.figures.drill_animation.view_solution)."""
     from .figures.drill_animation import run_with_solution
 
-    scene, source = _scene(scene)
+    scene, source = scene_and_source(scene)
     if formulation is not None:
         scene = scene.with_solver(formulation)
     simulation = prepare_scene(scene, source)

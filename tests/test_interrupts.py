@@ -224,7 +224,7 @@ def test_an_advice_stops_within_2_s_and_resumes_to_the_same_advice(tmp_path):
 
 def test_the_cancelled_futures_race_of_a_stop_prints_no_traceback():
     """A stop that ends the workers can make concurrent.futures' management thread set an exception on
-    a future the stop cancelled (InvalidStateError; seen about once in seven Ctrl-Cs of a study):
+    a future the stop cancelled (InvalidStateError; seen once in CI and once in seven Ctrl-Cs of a study):
     nothing printed for it while a pool lives; another thread's exception still is."""
     code = """
 import threading

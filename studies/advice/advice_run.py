@@ -8,9 +8,19 @@ from pathlib import Path
 
 from ...models.definition.scene import Scene
 from ...rocklaw.catalog import TABLE_1
-from ..inputs.reading import InputError, load_scene
+from ..inputs.reading import InputError, scene_and_source
 from ..runtime.pools import pool
-from .advice_search import FEED, FREQUENCY, METRICS, PARAMETERS, Advice, AdviceSearch, Request, advise, runnable_scene
+from .advice_search import (
+    FEED,
+    FREQUENCY,
+    METRICS,
+    PARAMETERS,
+    Advice,
+    AdviceSearch,
+    Request,
+    advise,
+    runnable_scene,
+)
 
 
 def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float]], metric: str = METRICS[0],
@@ -21,8 +31,8 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     60e3)}``, optionally ``"impact.amplitude_n"``; SI units) for the scene's rock, or for each Table 1
     rock of ``rocks``; ``power_kw``: a fixed hammer power (a piston scene, the blow energy P / f). One
     :class:`Advice` per rock (SI units). InputError before anything runs when an input cannot be used."""
-    source = f"scene {scene.name!r}" if isinstance(scene, Scene) else str(scene)
-    data = (scene if isinstance(scene, Scene) else load_scene(scene)).model_dump(by_alias=True, exclude_none=True)
+    validated, source = scene_and_source(scene)
+    data = validated.model_dump(by_alias=True, exclude_none=True)
     allowed = [entry.path for entry in PARAMETERS]
     for path, (low, high) in bounds.items():
         if path not in allowed:

@@ -20,10 +20,10 @@ import numpy as np
 import yaml
 
 from ...models.evaluation.workprecision import non_dominated
+from ..runtime.evaluation_log import Record
 from ..runtime.output_files import write_json, write_rows_csv
 from .calibration_search import CalibrationResult
 from .calibration_spec import Calibration
-from ..runtime.evaluation_log import Record
 
 TARGET_COLUMNS = ("label", "metric", "paper_optimum_hz", "paper_band_low_hz", "paper_band_high_hz",
                   "resonance_estimate_hz", "main_lobe_optimum_hz", "main_lobe_band_80_low_hz",

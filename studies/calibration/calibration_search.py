@@ -27,11 +27,11 @@ from typing import Any
 import numpy as np
 from scipy import optimize
 
+from ..runtime.evaluation_log import EvaluationLog, Record, unit_key
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.pools import Runner
 from ..scan.frequency_scans import ScanTask, rising_shortfalls, run_scans, scan_all, scan_cost, scan_optimum
 from .calibration_spec import Calibration
-from ..runtime.evaluation_log import EvaluationLog, Record, unit_key
 
 Progress = Callable[[Record, bool], None]  # (record, replayed)
 

@@ -23,8 +23,8 @@ from tqdm import tqdm
 from ..calibration.calibration_report import write_report
 from ..calibration.calibration_search import calibrate
 from ..calibration.calibration_spec import load_calibration
-from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog, Record
 from ..runtime.budgets import duration
+from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog, Record
 from ..runtime.output_files import check_out, staged_directory
 from ..runtime.pools import pool
 from .options import add_resumable_arguments, budget

@@ -11,7 +11,7 @@ from typing import Any
 from ...models.definition.scene import Scene
 from ...models.evaluation.compare import compare_runs, verdict
 from ...models.evaluation.run_result import Result
-from ..inputs.reading import load_scene, prepare_scene
+from ..inputs.reading import prepare_scene, scene_and_source
 from ..runtime.budgets import DEFAULT_BUDGET, Budget
 from .crosscheck_windows import DEFAULT_STEP_S, comparison_table, window_scenes
 
@@ -44,9 +44,7 @@ def crosscheck(scene: Scene | str | Path, blows: int = 20, step_s: float = DEFAU
     """The Exudyn model (the scene's solver type at ``step_s``) against the ODE (``method`` at relative
     tolerance ``rtol``) over the first ``blows`` impact periods. InputError or BudgetError before
     anything runs; SimulationFailed when a run diverges."""
-    source = f"scene {scene.name!r}" if isinstance(scene, Scene) else str(scene)
-    if not isinstance(scene, Scene):
-        scene = load_scene(scene)
+    scene, source = scene_and_source(scene)
     windows = window_scenes(scene, blows, step_s, method, rtol, source)
     simulations = [prepare_scene(window, source) for window in windows]
     if budget is not None:

@@ -24,7 +24,8 @@ from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, parse, short
 from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
 
-__all__ = ["InputError", "load_scene", "parse", "parse_yaml", "prepare_scene", "read_text", "read_yaml"]
+__all__ = ["InputError", "load_scene", "parse", "parse_yaml", "prepare_scene", "read_text", "read_yaml",
+           "scene_and_source"]
 
 MAX_FILE_BYTES = 16 * 2**20
 MAX_VALUES = 100_000  # values of a document, aliases expanded (a scene has about a hundred)
@@ -204,6 +205,13 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file."""
     return parse(Scene, read_yaml(path), str(path))
+
+
+def scene_and_source(scene: Scene | str | Path) -> tuple[Scene, str]:
+    """A validated scene (given, or read from a file) and the name its messages use."""
+    if isinstance(scene, Scene):
+        return scene, f"scene {scene.name!r}"
+    return load_scene(scene), str(scene)
 
 
 def prepare_scene(scene: Scene, source: str, where: str = "") -> Simulation:
