@@ -89,19 +89,20 @@ def three_scans(solver: str, workers: int, folder: Path) -> None:
     folders = [Path(tempfile.mkdtemp(prefix=f"{scan}_{solver}_", dir=folder)) for scan in SCANS]
     start = time.perf_counter()
     with pool(None, workers) as runner:
-        outcomes = run_studies(studies, folders, runner, plots_here=False, quiet=True)
-        plots_written = sum(len(written) for *_, written, _ in outcomes)
+        runs = run_studies(studies, folders, runner, plots_here=False, quiet=True)
+        plots_written = sum(len(run.plots) for run in runs)
         cpu = process_tree_cpu_s(os.getpid())
     wall = time.perf_counter() - start
-    run_once = {study.scene_keys[int(row["point"])]: float(row["cpu_time_s"]) if row["status"] == "ok" else 0.0
-                for study, _, rows, *_ in outcomes for row in rows}  # a point two scans share ran once
-    simulated_cpu = sum(run_once.values())
-    points = f"{sum(len(rows) for _, _, rows, *_ in outcomes)} ({len(run_once)})"
+    run_once = {run.study.scene_keys[point]: seconds if status == "ok" else 0.0
+                for run in runs for point, status, seconds in zip(run.table["point"], run.table["status"],
+                                                                   run.table["cpu_time_s"], strict=True)}
+    simulated_cpu = sum(run_once.values())  # a point two scans share ran once
+    points = f"{sum(len(run.table) for run in runs)} ({len(run_once)})"
     plots_cpu = []
     import rpdrill.studies.figures.scan_figures  # noqa: F401 - matplotlib loaded first, as in the pool's workers
-    for study, out, rows, optima, *_ in outcomes:  # each plot again, in this process, for its CPU time
-        (folder / "replotted" / out.name).mkdir(parents=True)
-        for task in plot_tasks(study, rows, optima, folder / "replotted" / out.name)[0]:
+    for run in runs:  # each plot again, in this process, for its CPU time
+        (folder / "replotted" / run.out.name).mkdir(parents=True)
+        for task in plot_tasks(run.study, run.table, run.optima, folder / "replotted" / run.out.name)[0]:
             start = time.process_time()
             draw_plot(task)
             plots_cpu.append(time.process_time() - start)

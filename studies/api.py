@@ -22,8 +22,9 @@ from ..models.solvers.cost import Cause
 from .inputs.reading import InputError, load_scene, prepare_scene, scene_and_source
 from .runtime.budgets import DEFAULT_BUDGET, Budget
 from .runtime.output_files import write_columns_csv, write_json, write_resolved
+from .runtime.tables import table_of
 from .scan.study import Study, load_study
-from .study_runs import Outcome, run_studies, run_study_files, study_folders
+from .study_runs import run_studies, run_study_files, study_folders
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -81,18 +82,11 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
 
 
 def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
-    """A results table (rows as read from ``results.csv``) as a DataFrame: numbers as numbers, text
-    (status, error, a rock's name) as text; one row a point, indexed by ``point``."""
-    import pandas as pd  # 0.3 s to import: only where a table is asked for
-
-    frame = pd.DataFrame(list(rows))
-    if frame.empty:
-        return frame
-    for column in frame.columns.difference(["status", "error"]):
-        numbers = pd.to_numeric(frame[column], errors="coerce")
-        if numbers.notna().sum() == frame[column].ne("").sum():  # every non-empty cell a number
-            frame[column] = numbers
-    return frame.set_index("point", drop=False)
+    """A results table (rows as read from ``results.csv``: text cells) as the typed DataFrame
+    :func:`run_study` returns: numbers as numbers, text (status, error, a rock's name) as text; one row
+    a point, in point order, indexed by the point (studies.runtime.tables)."""
+    rows = list(rows)
+    return table_of(list(rows[0]) if rows else [], [list(row.values()) for row in rows])
 
 
 def run_study(study: Study | str | Path, workers: int | None = None, out: str | Path | None = None,
@@ -110,5 +104,4 @@ def run_study(study: Study | str | Path, workers: int | None = None, out: str | 
         if out is None:  # a scratch folder keeps no plots
             study = dataclasses.replace(study, spec=study.spec.model_copy(update={"plots": []}))
         with pool(dask, workers) as runner:
-            outcome: Outcome = run_studies([study], [folder], runner, dask is not None, quiet)[0]
-    return table_frame(outcome[2])
+            return run_studies([study], [folder], runner, dask is not None, quiet)[0].table

@@ -9,8 +9,10 @@ import math
 import numpy as np
 import pytest
 import yaml
+from commands import main
 from scenes import crushing_scene, scene, scene_dict, simulate
 
+import rpdrill
 from rpdrill.models.drill.pulse import impulse_per_blow_n_s
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
@@ -21,22 +23,21 @@ from rpdrill.studies.advice.advice_search import (
     AdviceEvaluator,
     AdviseParameter,
     Request,
-    advise,
     at_point,
     feed_response,
     limit_feed_n,
     runnable_scene,
+    search_advice,
     thrust_ratio,
 )
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.runtime.pools import sequential
 
 RATE = "penetration_rate_m_per_s"
 SHORT = {"solver": {"end_time_s": 0.3}, "metrics": {"transient_blows": 4, "block_blows": 4}}
 
 
-def short_scene(**overrides) -> dict:
-    return scene(**SHORT, **overrides).model_dump(by_alias=True, exclude_none=True)
+def short_scene(**overrides) -> rpdrill.Scene:
+    return scene(**SHORT, **overrides)
 
 
 def test_advise_finds_the_best_of_a_fine_grid():
@@ -46,7 +47,7 @@ def test_advise_finds_the_best_of_a_fine_grid():
     grid = [{FREQUENCY: f, FEED: feed} for f in np.arange(45.0, 70.1, 1.0) for feed in np.arange(35e3, 60.1e3, 1e3)]
     data = runnable_scene(base, None, request, "test")
     brute = np.nanmax(AdviceEvaluator(data, request, sequential)(grid).values)
-    advice = advise(data, None, request, sequential)
+    advice = search_advice(data, None, request, sequential)
     assert brute > 0
     assert advice.best_value >= 0.99 * brute
     assert advice.formulation == "exact" and advice.runs < len(grid)
@@ -184,8 +185,6 @@ def test_advise_bad_bounds_exit_2(tmp_path, capsys, arguments, expected):
 def test_the_library_call_gives_the_commands_advice(tmp_path):
     """rpdrill.advise with the bounds in SI units: the advice the command writes for the same inputs;
     a bound the search does not take is an InputError naming it and what is allowed."""
-    import rpdrill
-
     scene = write_scene(tmp_path)
     out = tmp_path / "out"
     assert main(["advise", scene, "--frequency-hz", "45", "70", "--feed-kn", "35", "60", "--popsize", "3",

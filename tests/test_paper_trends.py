@@ -10,25 +10,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rpdrill.models.definition.scene import Scene
+import rpdrill
 from rpdrill.models.drill.modal import rock_mode_frequency_hz
 from rpdrill.models.evaluation.compare import compare_runs, verdict
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
-from rpdrill.studies.inputs.reading import read_yaml
-from rpdrill.studies.inputs.specs import set_path
 from rpdrill.studies.scan.curve_optima import curve_optimum
 
 PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"
 SOFT_ROCK = {"rock.stiffness_n_per_m": 8.93e7, "rock.damping_n_s_per_m": 683.0, "rock.threshold_n": 123e3}
 
 
-def pipe_drill(**overrides: object) -> Scene:
-    data = read_yaml(PIPE_DRILL)
-    for path, value in overrides.items():
-        set_path(data, path, value)
-    return Scene.model_validate(data)
+def pipe_drill(**overrides: object) -> rpdrill.Scene:
+    return rpdrill.load_scene(PIPE_DRILL).with_(overrides)
 
 
 def main_lobe_optimum_hz(frequencies_hz: np.ndarray, metric: str, **overrides: object) -> float:
@@ -39,7 +34,7 @@ def main_lobe_optimum_hz(frequencies_hz: np.ndarray, metric: str, **overrides: o
                                                          "outputs": {"metrics": [metric]}}))
         resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock)
         values.append(summary_metrics(simulation.run())[metric])
-    found = curve_optimum(frequencies_hz, values, resonance).main_hz
+    found = curve_optimum(frequencies_hz, values, resonance, metric=metric).optimum
     assert found is not None, f"no optimum of {metric} with {overrides}"
     return found
 
@@ -62,7 +57,7 @@ def test_the_optimum_rises_with_the_rock_stiffness():
     assert soft == pytest.approx(32.0, rel=0.15) and stiff == pytest.approx(69.0, rel=0.15)
 
 
-def crushing_window() -> Scene:
+def crushing_window() -> rpdrill.Scene:
     """Ten blows of the pipe drill crushing at 65 Hz (every output: energies too)."""
     return pipe_drill(**{"solver.end_time_s": 10 / 65.0, "metrics": {"transient_blows": 4, "block_blows": 3}})
 

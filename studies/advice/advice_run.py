@@ -18,8 +18,8 @@ from .advice_search import (
     Advice,
     AdviceSearch,
     Request,
-    advise,
     runnable_scene,
+    search_advice,
 )
 
 
@@ -31,8 +31,7 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     60e3)}``, optionally ``"impact.amplitude_n"``; SI units) for the scene's rock, or for each Table 1
     rock of ``rocks``; ``power_kw``: a fixed hammer power (a piston scene, the blow energy P / f). One
     :class:`Advice` per rock (SI units). InputError before anything runs when an input cannot be used."""
-    validated, source = scene_and_source(scene)
-    data = validated.model_dump(by_alias=True, exclude_none=True)
+    data, source = scene_and_source(scene)
     allowed = [entry.path for entry in PARAMETERS]
     for path, (low, high) in bounds.items():
         if path not in allowed:
@@ -53,7 +52,7 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
                       power_w=power_kw * 1e3 if power_kw else None)
     scenes = [(rock, runnable_scene(data, rock, request, source)) for rock in rocks or [None]]
     with pool(dask, workers) as (_, runner):
-        return [advise(prepared, rock, request, runner) for rock, prepared in scenes]
+        return [search_advice(prepared, rock, request, runner) for rock, prepared in scenes]
 
 
 __all__ = ["Advice", "AdviceSearch", "advise_scene"]

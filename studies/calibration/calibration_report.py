@@ -22,7 +22,7 @@ import yaml
 from ...models.evaluation.workprecision import non_dominated
 from ..runtime.evaluation_log import Record
 from ..runtime.output_files import write_json, write_rows_csv
-from .calibration_search import CalibrationResult
+from .calibration_search import SearchResult
 from .calibration_spec import Calibration
 
 TARGET_COLUMNS = ("label", "metric", "paper_optimum_hz", "paper_band_low_hz", "paper_band_high_hz",
@@ -44,17 +44,18 @@ def target_rows(calibration: Calibration, results: list[Record]) -> list[dict[st
     rows = []
     for index, (target, result) in enumerate(zip(calibration.spec.targets, results, strict=True)):
         band = target.band_hz or (None, None)
-        reached = result["band_80_hz"] or (None, None)
+        reached = result["band_80"] or (None, None)
         rows.append({
             "label": result["label"], "metric": calibration.metric(index),
             "paper_optimum_hz": _number(target.optimum_hz), "paper_band_low_hz": _number(band[0]),
             "paper_band_high_hz": _number(band[1]), "resonance_estimate_hz": _number(result["resonance_hz"]),
-            "main_lobe_optimum_hz": _number(result["main_hz"]), "main_lobe_band_80_low_hz": _number(reached[0]),
-            "main_lobe_band_80_high_hz": _number(reached[1]), "global_max_optimum_hz": _number(result["global_hz"]),
+            "main_lobe_optimum_hz": _number(result["optimum"]), "main_lobe_band_80_low_hz": _number(reached[0]),
+            "main_lobe_band_80_high_hz": _number(reached[1]),
+            "global_max_optimum_hz": _number(result["global_optimum"]),
             "relative_miss": _number(result["miss"], 3), "tolerance": _number(target.tolerance, 3),
             "within_tolerance": "yes" if abs(result["miss"]) <= target.tolerance else "no",
-            "main_lobe_peak_value": _number(result["main_value"]), "global_max_peak_value": _number(result["global_value"]),
-            "failed_runs": str(result["failed_runs"]),
+            "main_lobe_peak_value": _number(result["optimum_value"] or 0.0),
+            "global_max_peak_value": _number(result["best_value"] or 0.0), "failed_runs": str(result["failed"]),
         })
     return rows
 
@@ -88,11 +89,11 @@ def pareto_rows(calibration: Calibration, records: list[Record]) -> list[dict[st
             for i in front]
 
 
-def write_report(directory: Path, calibration: Calibration, result: CalibrationResult,
+def write_report(directory: Path, calibration: Calibration, result: SearchResult,
                  sessions: list[dict[str, Any]]) -> None:
     """Every output file of a calibration with a best evaluation (module docstring)."""
     best, final = result.best, result.final
-    scene = calibration.scene(best["parameters"])
+    scene = calibration.scene(best["parameters"]).model_dump(mode="json", by_alias=True, exclude_none=True)
     (directory / "calibrated_scene.yaml").write_text(yaml.safe_dump(scene, sort_keys=False), encoding="utf-8")
     rows = target_rows(calibration, final.results)
     write_rows_csv(directory / "targets.csv", rows, list(TARGET_COLUMNS))

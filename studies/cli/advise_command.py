@@ -23,9 +23,9 @@ from ..advice.advice_search import (
     AdviseParameter,
     Request,
     advice_hash,
-    advise,
     planned_evaluations,
     runnable_scene,
+    search_advice,
 )
 from ..display.catalogue import metric, parameter
 from ..figures.advice_figures import plot_curves, plot_feed_map
@@ -103,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     out = check_out(args.out, args.overwrite, CHECKPOINT)
     if args.markdown:
         check_file_target("--markdown", args.markdown)
-    scene = load_scene(args.scene).model_dump(by_alias=True, exclude_none=True)
+    scene = load_scene(args.scene)
     bounds = {e.path: e.si_bounds(_given(args, e)) for e in PARAMETERS if _given(args, e) is not None}
     request = Request(args.metric, bounds, args.max_thrust_ratio,
                       AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed),
@@ -111,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     rocks = args.rock or [None]
     scenes = [runnable_scene(scene, rock, request, args.scene) for rock in rocks]
     advices = []
-    identity = {"advice": scene["name"], "scene_file": args.scene, "hash": advice_hash(scenes, request)}
+    identity = {"advice": scene.name, "scene_file": args.scene, "hash": advice_hash(scenes, request)}
     with contextlib.closing(EvaluationLog(out, identity, Path(args.scene), args.overwrite)) as log, \
             pool(args.dask, args.workers) as (label, runner), \
             tqdm(total=planned_evaluations(request) * len(rocks), desc="advise", unit="point", disable=args.quiet) as bar:
@@ -119,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
               f"for {len(rocks)} rock(s) on {label}" + (f"; {len(log.records)} points recorded earlier in {out}"
                                                          if log.records else ""), file=sys.stderr)
         for rock, data in zip(rocks, scenes, strict=True):
-            advices.append(advise(data, rock, request, runner, bar.update, log))
+            advices.append(search_advice(data, rock, request, runner, bar.update, log))
             tqdm.write(advice_text(advices[-1]), file=sys.stdout)
     command = command_line(args)
     with staged_directory(args.out) as stage:

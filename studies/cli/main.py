@@ -127,7 +127,8 @@ def main(argv: list[str] | None = None) -> int:
         return 143 if terminated else 130
     except Exception as err:  # noqa: BLE001 - a bug, not bad input: one line naming the input, no traceback
         where = traceback.extract_tb(err.__traceback__)[-1]
-        source = next((getattr(args, key) for key in ("scene", "study", "calibration") if hasattr(args, key)), "")
+        source = next((getattr(args, key) for key in ("scene", "study", "calibration", "sensitivity", "reproduction", "runs")
+                       if hasattr(args, key)), "")
         print(f"{source}: rpdrill internal error: {type(err).__name__}: {err} (at {Path(where.filename).name}:"
               f"{where.lineno}); please report it with this input", file=sys.stderr)
         return 1

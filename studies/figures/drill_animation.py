@@ -28,7 +28,7 @@ from ...models.evaluation.results import SimulationResult
 from ...models.solvers.simulation import Simulation
 from ..inputs.reading import load_scene
 from .drill_drawing import BODY_HEIGHT, draw_string, drawn_layout, figure_title
-from .figure_style import plt
+from .figure_style import figure
 
 if TYPE_CHECKING:
     from ...models.solvers.exudyn_model import ExudynModel
@@ -71,7 +71,8 @@ def write_animation(result: SimulationResult, path: str | Path, blows: int = 3,
     # metres of displacement -> drawn x units: lengths are drawn to scale but for shortened bodies
     reach = max(float(np.max(np.abs(moved))), float(np.max(np.abs(rock))), 1e-12)
     factor = magnification or nice_factor(0.5 * drawing.gap / reach)
-    fig, ax = plt.subplots(figsize=(14, 3.6), layout="constrained")
+    fig = figure(figsize=(14, 3.6), layout="constrained")
+    ax = fig.subplots()
     title = figure_title(scene, drawing).splitlines()[0].split(";")[0]
 
     def frame(k: int) -> None:
@@ -88,7 +89,6 @@ def write_animation(result: SimulationResult, path: str | Path, blows: int = 3,
 
     animation = FuncAnimation(fig, frame, frames=len(times))
     animation.save(path, writer=writer)
-    plt.close(fig)
     return factor
 
 

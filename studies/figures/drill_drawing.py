@@ -26,7 +26,7 @@ from ...models.definition.drill_string import EVERY_BODY, GROUND
 from ...models.definition.links import Link
 from ...models.definition.scene import Scene
 from ...models.drill.shapes import DEFAULT_DIAMETER_M, Layout, axial_order, layout
-from .figure_style import OKABE_ITO, plt
+from .figure_style import OKABE_ITO, figure
 
 BREAK_SHARE = 0.35  # the most of the drawing's length one body takes; longer ones are drawn shortened
 MIN_SHORTENING = 1.5  # a body is shortened by this factor at least, or drawn to scale
@@ -311,7 +311,8 @@ def draw(scene: Scene, path: str | Path) -> Path:
     path = Path(path)
     drawing = drawn_layout(scene)
     width = drawing.rock_face + 2.5 * drawing.gap - drawing.start
-    fig, ax = plt.subplots(figsize=(14, 4.6), layout="constrained")
+    fig = figure(figsize=(14, 4.6), layout="constrained")
+    ax = fig.subplots()
     ax.set_ylim(*draw_string(ax, scene, drawing))
     ax.set_xlim(drawing.start - 1.6 * drawing.gap, drawing.rock_face + 2.7 * drawing.gap)
     ax.set_yticks([])
@@ -320,7 +321,6 @@ def draw(scene: Scene, path: str | Path) -> Path:
         ax.spines[side].set_visible(False)
     ax.set_title(figure_title(scene, drawing), fontsize=9)
     fig.savefig(path, dpi=130)
-    plt.close(fig)
     return path
 
 

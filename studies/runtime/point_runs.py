@@ -1,69 +1,85 @@
-"""One scene of a study, an accuracy study or a calibration: prepared once, run by a worker.
+"""One point of an analysis: a typed scene made from a base scene and axis values, prepared, run.
 
-Every point is validated and prepared where it is made (models.solvers.simulation.prepare: the chain, the
-rock law, the solver settings, the initial state); workers receive the prepared simulation and
-build the formulation's model themselves (Exudyn systems cannot be pickled). A point's problems
-are tied to the scan axis that caused them when there is one.
+A point's scene is ``base.with_(values)`` (models.definition.scene.Scene.with_: validated, so that any
+scene key path the scene accepts is an axis), its problems tied to the axis that caused them when
+there is one (:func:`point_scene`). It is prepared once where it is made (models.solvers.simulation.prepare:
+the chain, the rock law, the solver settings, the initial state; studies.inputs.reading.prepare_scene);
+a worker receives the prepared simulation and builds the formulation's model itself (Exudyn systems
+cannot be pickled). :func:`run_point` runs it into one row of a results table: the columns
+:func:`point_columns` names, what the run returns.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping, Sequence
 from typing import Any
 
-from pydantic import ValidationError
-
 from ...models.definition.scene import Scene
-from ...models.definition.validation import problem, short
+from ...models.definition.validation import short
 from ...models.evaluation.metrics import summary_metrics
 from ...models.evaluation.run_status import run_status
 from ...models.solvers.simulation import Simulation
 from ..inputs.reading import InputError, prepare_scene
 
+STATUS_COLUMNS = ("status", "error", "wall_time_s")
+# a finished point's status: ok; failed (its error says why); unstable or unsettled (metrics written,
+# but the stability check flags the run, or its blocks have not settled: models.evaluation.metrics)
+FINISHED = ("ok", "failed", "unstable", "unsettled")
 
-def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]) -> list[str]:
-    """Problems of one point, each tied to the scan axis that caused it when there is one."""
+
+def _point_errors(source: str, problems: Sequence[tuple[str, str]], values: Mapping[str, Any]) -> list[str]:
+    """Problems of one point, each tied to the axis that caused it when there is one."""
     lines = []
-    for item in error.errors():
-        loc = ".".join(str(p) for p in item["loc"] if p != "function-after")
-        related = [a for a in parameters if a == loc or a.startswith(loc + ".") or loc.startswith(a + ".")]
-        parent = loc.rpartition(".")[0]
+    for location, message in problems:
+        related = [a for a in values if a == location or a.startswith(location + ".") or location.startswith(a + ".")]
+        parent = location.rpartition(".")[0]
         if not related and parent:  # a check across keys (a pulse longer than the period): its sibling axes
-            related = [a for a in parameters if a.startswith(parent + ".")]
-        message = problem(item)
+            related = [a for a in values if a.startswith(parent + ".")]
         if len(related) == 1:
-            lines.append(f"{source}: scan.{related[0]}: {short(parameters[related[0]])}: {message}")
+            lines.append(f"{source}: scan.{related[0]}: {short(values[related[0]])}: {message}")
         else:
-            lines.append(f"{source}: {_point(parameters)}{loc or 'scene'}: {message}")
+            lines.append(f"{source}: {where(values)}{location or 'scene'}: {message}")
     return lines
 
 
-def _point(parameters: dict[str, Any]) -> str:
-    return f"scan point {parameters}: " if parameters else ""
+def where(values: Mapping[str, Any]) -> str:
+    """'scan point {...}: ' naming a point by its axis values in a message ('' without any)."""
+    return f"scan point {dict(values)}: " if values else ""
 
 
-def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]) -> Simulation:
-    """Validate and prepare one point's scene; InputError naming the scan axis that made it invalid
-    (or the point), and when its formulation cannot run it (studies.inputs.reading.prepare_scene)."""
+def point_scene(base: Scene, values: Mapping[str, Any], source: str, fixed: Mapping[str, Any] | None = None) -> Scene:
+    """The point's scene: ``base.with_`` the ``fixed`` changes every point shares (its outputs, a
+    calibration's parameters), then its axis ``values`` (key path -> value); InputError naming ``source``
+    and the axis that made it invalid (or the point)."""
     try:
-        validated = Scene.model_validate(scene)
-    except ValidationError as error:
-        raise InputError("\n".join(_point_error(source, error, parameters))) from None
-    return prepare_scene(validated, source, _point(parameters))
+        return base.with_({**(fixed or {}), **values}, source)
+    except InputError as error:
+        if not error.problems or not values:
+            raise
+        raise InputError("\n".join(_point_errors(source, error.problems, values))) from None
 
 
-def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
-    """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics and its
-    status (models.evaluation.run_status: ok, unstable or unsettled, the reason in ``error``); a failure is
-    returned, not raised."""
-    key, simulation = task
+def prepare_point(base: Scene, values: Mapping[str, Any], source: str,
+                  fixed: Mapping[str, Any] | None = None) -> Simulation:
+    """:func:`point_scene`, prepared; InputError also when its formulation cannot run it."""
+    return prepare_scene(point_scene(base, values, source, fixed), source, where(values))
+
+
+def point_columns(metrics: Sequence[str]) -> list[str]:
+    """The columns of a point's row (:func:`run_point`) when ``metrics`` are asked for."""
+    return [*STATUS_COLUMNS, *metrics]
+
+
+def run_point(simulation: Simulation) -> dict[str, Any]:
+    """Run one prepared point into its row (:func:`point_columns`): status (models.evaluation.run_status: ok,
+    unstable or unsettled, the reason in ``error``), wall time and every metric of its outputs; a
+    failure is returned (status ``failed``, the exception in ``error``, no metrics), not raised."""
     start = time.perf_counter()
     try:
         result = simulation.run()
         metrics = summary_metrics(result)
         status, why = run_status(result)
-    except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
-        return {"point": key, "status": "failed", "error": f"{type(err).__name__}: {err}",
-                "wall_time_s": time.perf_counter() - start, "metrics": {}}
-    return {"point": key, "status": status, "error": why, "wall_time_s": time.perf_counter() - start,
-            "metrics": metrics}
+    except Exception as err:  # noqa: BLE001 - one bad point is recorded and the analysis goes on
+        return {"status": "failed", "error": f"{type(err).__name__}: {err}", "wall_time_s": time.perf_counter() - start}
+    return {"status": status, "error": why, "wall_time_s": time.perf_counter() - start, **metrics}
