@@ -29,7 +29,7 @@ from .models.definition.validation import InputError
 from .models.evaluation.run_result import Result
 from .models.evaluation.stability import SimulationFailed
 from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
-from .studies.runtime.budgets import BudgetError
+from .studies.runtime.budgets import Budget, BudgetError
 from .studies.scan.study import Study
 
 # Names loaded when first used, not at ``import rpdrill``: the analyses (SciPy's optimizers, SALib), Exudyn
@@ -70,7 +70,7 @@ def __dir__() -> list[str]:
     return sorted({*globals(), *_LAZY})
 
 
-__all__ = ["AccuracyResult", "Advice", "AdviceSearch", "BudgetError", "CalibrationResult", "Crosscheck", "ExudynModel",
+__all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult", "Crosscheck", "ExudynModel",
            "InputError", "ReproductionResult", "Result", "RotationReport", "Scene", "SensitivityResult",
            "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck", "draw",
            "load_scene", "load_study", "reproduce", "rotation_report", "run_study", "save_result", "sensitivity",

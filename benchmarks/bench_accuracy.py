@@ -48,7 +48,7 @@ def preset_cost(base: Scene, preset: str, seconds: float, repeats: int) -> tuple
                                                  "timeseries": ["borehole_bottom_m"]}}))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        runs = [simulation.run().cpu_time_s for _ in range(repeats)]
+        runs = [simulation.solve().cpu_time_s for _ in range(repeats)]
     return statistics.median(runs) / seconds, simulation.settings.step_s
 
 

@@ -84,13 +84,13 @@ def cpu_table(repeats: int) -> None:
             continue
         measured.add((scene, key))
         try:
-            first = run.run()  # warm-up: the exact kernels compile, Exudyn loads
+            first = run.solve()  # warm-up: the exact kernels compile, Exudyn loads
         except Exception as err:  # noqa: BLE001 - a formulation that fails on a scene is reported, not measured
             print(f"{scene:<17}{key:<22}{run.chain.size:<8}failed: {type(err).__name__}: {err}")
             continue
         steps = measured_steps(first)
         del first  # each result is dropped before the next run, as in a study
-        cpu = statistics.median(run.run().cpu_time_s for _ in range(repeats))
+        cpu = statistics.median(run.solve().cpu_time_s for _ in range(repeats))
         cost, n = run_cost(run), run.chain.size
         fits.setdefault(key, []).append((n, cpu / steps))
         if formulation == "ode":
@@ -119,7 +119,7 @@ def child(scene: str, formulation: str, options: dict) -> None:
     run = simulation(scene, formulation, options)
     estimate = run_cost(run, Cause("solver.output_interval_s", run.settings.output_interval_s)).memory_bytes
     before = peak_resident_bytes()
-    result = run.run()
+    result = run.solve()
     table = np.column_stack(list(result.resampled(run.settings.output_interval_s).values()))  # as rpdrill simulate
     grown = peak_resident_bytes() - before
     del table

@@ -67,9 +67,8 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
     it starts; models.evaluation.stability.SimulationFailed when the run diverges. ``solution_file``:
     with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
-    (for its SolutionViewer: studies.figures.drill_animation.view_solution)."""
-    from .figures.drill_animation import run_with_solution
-
+    (for its SolutionViewer: studies.figures.drill_animation.view_solution). Loads no figure module:
+    the caller's matplotlib is left as it is."""
     scene, source = scene_and_source(scene)
     if formulation is not None:
         scene = scene.with_solver(formulation)
@@ -77,7 +76,12 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     if budget is not None:
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
-    raw = run_with_solution(simulation, progress, solution_file)
+    if solution_file is None:
+        raw = simulation.solve(progress)
+    else:  # Exudyn's model loaded only when its solution file is asked for
+        from ..models.solvers.exudyn_model import solve_with_solution
+
+        raw = solve_with_solution(simulation, progress, solution_file)
     return Result(scene, raw, {"source": source})
 
 

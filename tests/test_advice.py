@@ -65,7 +65,7 @@ def test_mean_thrust_is_the_mean_rock_force_of_a_steady_run():
                                         outputs={"metrics": ["rock_force_max_n", RATE]}))
     expected = simulation.scene.feed.force_n + impulse_per_blow_n_s(simulation.impact) * simulation.impact.frequency_hz
     assert simulation.mean_thrust_n == pytest.approx(expected)
-    result = simulation.run()
+    result = simulation.solve()
     window = result.time_s >= 10 / simulation.impact.frequency_hz
     t, force = result.time_s[window], result.rock_force_n[window]
     assert np.trapezoid(force, t) / (t[-1] - t[0]) == pytest.approx(simulation.mean_thrust_n, rel=1e-3)

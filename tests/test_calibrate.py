@@ -15,10 +15,10 @@ from commands import main
 from scenes import PAPER_BASE
 
 import rpdrill
+from rpdrill import Budget
 from rpdrill.models.evaluation.workprecision import non_dominated
 from rpdrill.studies.calibration.calibration_search import objective, refined_frequencies_hz
 from rpdrill.studies.calibration.calibration_spec import Parameter, load_calibration
-from rpdrill.studies.runtime.budgets import Budget
 from rpdrill.studies.scan import curves
 
 ROOT = Path(__file__).resolve().parents[1]

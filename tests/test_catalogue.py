@@ -13,8 +13,8 @@ from matplotlib.text import Text
 from scenes import PAPER_BASE, scene
 
 import rpdrill
+from rpdrill import Scene
 from rpdrill.models.definition.outputs import METRICS, SERIES
-from rpdrill.models.definition.scene import Scene
 from rpdrill.models.definition.validation import allowed_keys
 from rpdrill.studies.display import catalogue
 

@@ -12,16 +12,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from scenes import CRUSHING, crushing_scene, scene_dict, simulate
+from commands import main
+from scenes import CRUSHING, crushing_scene, read_yaml, scene_dict, simulate
 
-from rpdrill.models.definition.scene import Bit, Scene
+from rpdrill import InputError, Scene, load_study
+from rpdrill.models.definition.scene import Bit
 from rpdrill.models.drill.indexing import CRATER, FRESH, MIN_FRESH_FRACTION, RIDGES, Indexing
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
-from rpdrill.studies.inputs.reading import InputError, prepare_scene, read_yaml
-from rpdrill.studies.scan.study import load_study
+from rpdrill.studies.inputs.reading import prepare_scene
 
 BIT = {"diameter_m": 0.216, "gauge_button_diameter_m": 0.019, "gauge_buttons": 12}  # the DTH bit
 DIAMETER, BUTTON = BIT["diameter_m"], BIT["gauge_button_diameter_m"]

@@ -33,7 +33,7 @@ def main_lobe_optimum_hz(frequencies_hz: np.ndarray, metric: str, **overrides: o
         simulation = prepare(pipe_drill(**overrides, **{"impact.frequency_hz": float(frequency),
                                                          "outputs": {"metrics": [metric]}}))
         resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock)
-        values.append(summary_metrics(simulation.run())[metric])
+        values.append(summary_metrics(simulation.solve())[metric])
     found = curve_optimum(frequencies_hz, values, resonance, metric=metric).optimum
     assert found is not None, f"no optimum of {metric} with {overrides}"
     return found
@@ -66,7 +66,7 @@ def crushing_window() -> rpdrill.Scene:
 def runs():
     """The crushing window by the exact formulation (the reference, to round-off) and the Exudyn model."""
     scene = crushing_window()
-    return {"exact": prepare(scene).run(), "exudyn": prepare(scene.with_solver("exudyn", type="rk44", step_s=5e-6)).run()}
+    return {"exact": prepare(scene).solve(), "exudyn": prepare(scene.with_solver("exudyn", type="rk44", step_s=5e-6)).solve()}
 
 
 def test_the_arrangement_crushes_and_balances_its_energy(runs):
@@ -85,7 +85,7 @@ def test_the_ode_crushes_balances_its_energy_and_agrees_with_exact_and_exudyn(ru
     """The independent formulation on the arrangement (tight tolerance): it drills, closes its energy
     balance, ends with the exact solution's bottom to 1e-9 and agrees with the Exudyn model within the
     cross-check's tolerances."""
-    ode = prepare(crushing_window().with_solver("ode", relative_tolerance=1e-11, absolute_tolerance=1e-14)).run()
+    ode = prepare(crushing_window().with_solver("ode", relative_tolerance=1e-11, absolute_tolerance=1e-14)).solve()
     assert ode.bottom_m[-1] > 1e-4 and energy_account(ode).relative_residual() < 1e-3
     assert abs(runs["exact"].bottom_m[-1] - ode.bottom_m[-1]) <= 1e-9 * runs["exact"].bottom_m[-1]
     report = compare_runs(ode, runs["exudyn"], ode.scene.solver.end_time_s)

@@ -16,7 +16,7 @@ from pydantic import ValidationError
 from scenes import PAPER_BASE, scene_dict
 
 import rpdrill
-from rpdrill.models.definition.scene import Scene
+from rpdrill import Scene
 from rpdrill.models.drill.piston import rigid_piston_pulse_n
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.solvers.simulation import SceneError, prepare
@@ -61,7 +61,7 @@ def rod_piston(segments: int) -> dict:
 
 
 def run(data: dict):
-    return prepare(Scene.model_validate(data)).run()
+    return prepare(Scene.model_validate(data)).solve()
 
 
 def plateau_and_length(result) -> tuple[float, float]:

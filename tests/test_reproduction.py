@@ -13,9 +13,9 @@ import yaml
 from commands import main
 
 import rpdrill
+from rpdrill import Budget
 from rpdrill.studies.calibration.calibration_spec import is_free, load_calibration
 from rpdrill.studies.reproduction.paper_reproduction import load_reproduction
-from rpdrill.studies.runtime.budgets import Budget
 
 ROOT = Path(__file__).resolve().parents[1]
 PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"

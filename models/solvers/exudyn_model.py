@@ -133,10 +133,6 @@ class ExudynModel:
     _ran: bool = False
 
     @property
-    def system_container(self) -> Any:
-        return self.SC
-
-    @property
     def coordinate_count(self) -> int:
         return len(self.mbs.systemData.GetODE2Coordinates())
 
@@ -397,6 +393,18 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
              symbolic: bool = True) -> SimulationResult:
     """Build and run the Exudyn model (:func:`build_exudyn`, :meth:`ExudynModel.run`)."""
     return build_exudyn(run, symbolic).solve(progress)
+
+
+def solve_with_solution(simulation: Simulation, progress: Callable[[float], None] | None = None,
+                        solution: Path | None = None) -> SimulationResult:
+    """Run ``simulation`` with its formulation; with ``solution`` and the Exudyn formulation, Exudyn's
+    coordinates solution file written there during the run (every output interval; for Exudyn's
+    SolutionViewer). The other formulations write none."""
+    if solution is None or simulation.settings.formulation != "exudyn":
+        return simulation.solve(progress)
+    model = build_exudyn(simulation)
+    model.write_solution(solution)
+    return model.solve(progress)
 
 
 USER_ITEMS_NOTE = ("items added to model.mbs are seen only by the Exudyn formulation (the exact and ODE "

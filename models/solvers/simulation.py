@@ -121,9 +121,10 @@ class Simulation:
         """What must be recorded for the requested outputs: ``forces``, ``energy``."""
         return needs(self.outputs.metrics, self.outputs.timeseries).data
 
-    def run(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
+    def solve(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
         """Simulate with the scene's formulation (models.solvers.dispatch); ``progress(t)`` as simulated
-        time advances."""
+        time advances. The formulation's own result (``solve``, as ``ExudynModel.solve``); ``rpdrill.simulate``
+        and ``ExudynModel.run`` wrap it into ``rpdrill.Result``."""
         return implementation(self.settings.formulation).simulate(self, progress)
 
     def resolved_scene(self) -> dict[str, Any]:

@@ -232,7 +232,7 @@ def simulate_setting(scene: Scene, setting: Setting, grid_interval_s: float) -> 
     run is reported as SimulationFailed by the formulation)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return prepare(scene_for(scene, setting, grid_interval_s)).run()
+        return prepare(scene_for(scene, setting, grid_interval_s)).solve()
 
 
 class TimeLimitExceeded(RuntimeError):

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 import shutil
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -25,7 +24,6 @@ import numpy as np
 from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 
 from ...models.evaluation.results import SimulationResult
-from ...models.solvers.simulation import Simulation
 from ..inputs.reading import load_scene
 from .drill_drawing import BODY_HEIGHT, draw_string, drawn_layout, figure_title
 from .figure_style import figure
@@ -90,19 +88,6 @@ def write_animation(result: SimulationResult, path: str | Path, blows: int = 3,
     animation = FuncAnimation(fig, frame, frames=len(times))
     animation.save(path, writer=writer)
     return factor
-
-
-def run_with_solution(simulation: Simulation, progress: Callable[[float], None] | None = None,
-                      solution: Path | None = None) -> SimulationResult:
-    """Run ``simulation``; with ``solution`` and the Exudyn formulation, write Exudyn's coordinates solution
-    file there during the run (every output interval). The other formulations write none."""
-    if solution is None or simulation.settings.formulation != "exudyn":
-        return simulation.run(progress)
-    from ...models.solvers.exudyn_model import build_exudyn
-
-    model = build_exudyn(simulation)
-    model.write_solution(solution)
-    return model.solve(progress)
 
 
 def load_solution(run_dir: str | Path) -> tuple[ExudynModel, dict]:

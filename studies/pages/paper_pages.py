@@ -5,7 +5,6 @@ every figure on these pages comes from those inputs."""
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 from pathlib import Path
@@ -21,6 +20,7 @@ from ..reproduction.paper_reproduction import (
     trend_checks,
     within,
 )
+from ..runtime.tables import read_table
 from ..sensitivity.sensitivity_study import scene_values
 
 
@@ -146,8 +146,7 @@ def _calibration_run(run: Path | None) -> str:
     record = json.loads((run / "calibration.json").read_text(encoding="utf-8"))
     cost, best = record["cost"], record["best"]
     targets = (run / "targets.md").read_text(encoding="utf-8").split("\n", 2)[2]
-    with (run / "pareto.csv").open(newline="", encoding="utf-8") as handle:
-        alternatives = sum(1 for _ in csv.DictReader(handle))
+    alternatives = len(read_table(run / "pareto.csv"))
     return (f"`rpdrill calibrate studies/paper/calibration.yaml --out runs/calibration`: {cost['evaluations']} "
             f"evaluations ({cost['simulations']} simulations, {cost['simulation_cpu_time_s']:.0f} CPU s, "
             f"{cost['wall_time_s'] / 60:.1f} min wall time); best objective {best['objective']:.4g}, "
@@ -220,22 +219,20 @@ def sensitivity_page(run: Path, tornados: list[str], made_by: str) -> str:
         top = ", ".join(f"`{p}` {v:.1%}" for p, v in list(figures["parameters_by_peak_change"].items())[:5])
         lines.append(f"| {metric} | {figures['largest_optimum_shift']:.1%} | {figures['median_peak_change']:.1%} "
                      f"| {figures['largest_peak_change']:.1%} | {top} |")
-    with (run / "trends.csv").open(newline="", encoding="utf-8") as handle:
-        broken = [r for r in csv.DictReader(handle) if r["parameter"] != "nominal"
-                  and not (r["every_scan_has_an_optimum"] == "True" and r["rising_kept"] == "True")]
-    broken_rows = [f"| `{r['parameter']}` {float(r['change']):+.0%} | {r['shortfalls'] or 'a scan has no optimum'} |"
+    trends = read_table(run / "trends.csv", text=("parameter", "shortfalls"))
+    broken = [r for r in trends.to_dict("records") if r["parameter"] != "nominal"
+              and not (r["every_scan_has_an_optimum"] == "True" and r["rising_kept"] == "True")]
+    broken_rows = [f"| `{r['parameter']}` {r['change']:+.0%} | {r['shortfalls'] or 'a scan has no optimum'} |"
                    for r in broken]
     morris, not_computed = [], {}
-    if (run / "global.csv").exists():
-        with (run / "global.csv").open(newline="", encoding="utf-8") as handle:
-            for r in csv.DictReader(handle):
-                if r["quantity"] != "optimum_hz" or "mu_star" not in r:
-                    continue
-                if math.isfinite(float(r["mu_star"])):
-                    morris.append(f"| {r['scan']} | {r['metric']} | `{r['parameter']}` | {float(r['mu_star']):.3g} "
-                                  f"| {float(r['sigma']):.3g} |")
-                else:
-                    not_computed[f"{r['scan']} ({r['metric']})"] = r["missing"]
+    indices = read_table(run / "global.csv") if (run / "global.csv").exists() else None
+    for r in [] if indices is None or "mu_star" not in indices.columns else indices.to_dict("records"):
+        if r["quantity"] != "optimum_hz":
+            continue
+        if math.isfinite(r["mu_star"]):
+            morris.append(f"| {r['scan']} | {r['metric']} | `{r['parameter']}` | {r['mu_star']:.3g} | {r['sigma']:.3g} |")
+        else:
+            not_computed[f"{r['scan']} ({r['metric']})"] = r["missing"]
     kept = f"{summary['variations_keeping_every_trend']} of {summary['variations']}"
     broken_table = "\n".join(["| variation | trend broken |", "|---|---|", *broken_rows]) if broken_rows else ""
     morris_table = "\n".join(["| scan | metric | parameter | mu* [Hz] | sigma [Hz] |", "|---|---|---|---|---|", *morris]) \

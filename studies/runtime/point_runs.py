@@ -77,7 +77,7 @@ def run_point(simulation: Simulation) -> dict[str, Any]:
     failure is returned (status ``failed``, the exception in ``error``, no metrics), not raised."""
     start = time.perf_counter()
     try:
-        result = simulation.run()
+        result = simulation.solve()
         metrics = summary_metrics(result)
         status, why = run_status(result)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the analysis goes on
