@@ -15,13 +15,27 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..models.definition.formulations import FORMULATIONS
 from ..models.definition.scene import Scene
 from ..models.evaluation.run_result import Result
 from ..models.evaluation.run_status import run_status
 from ..models.solvers.cost import Cause
+from .inputs.arguments import (
+    boolean_problem,
+    callable_problem,
+    check,
+    choice_problem,
+    dask_problem,
+    either,
+    file_problem,
+    folder_problem,
+    instance_problem,
+    optional,
+    workers_problem,
+)
 from .inputs.reading import InputError, load_scene, prepare_scene, scene_and_source
 from .runtime.budgets import DEFAULT_BUDGET, Budget
-from .runtime.output_files import write_columns_csv, write_json, write_resolved
+from .runtime.output_files import check_out, write_columns_csv, write_json, write_resolved
 from .scan.study import Study, load_study
 from .study_runs import Outcome, run_studies, run_study_files, study_folders
 
@@ -40,7 +54,10 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     from .figures.drill_drawing import draw
     from .figures.timeseries_figure import plot_timeseries
 
-    folder = Path(folder)
+    check("rpdrill.save_result", "result", result, instance_problem(Result, "the Result of rpdrill.simulate"))
+    check("rpdrill.save_result", "folder", folder, folder_problem)
+    check("rpdrill.save_result", "animate", animate, boolean_problem)
+    folder = check_out(folder, overwrite=True, option="rpdrill.save_result: folder")
     folder.mkdir(parents=True, exist_ok=True)
     columns = {name: values.to_numpy() for name, values in result.timeseries.items()}
     write_columns_csv(folder / "timeseries.csv", columns)
@@ -69,7 +86,11 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     (for its SolutionViewer: studies.figures.drill_animation.view_solution)."""
     from .figures.drill_animation import run_with_solution
 
-    scene, source = scene_and_source(scene)
+    check("rpdrill.simulate", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
+    check("rpdrill.simulate", "progress", progress, callable_problem)
+    check("rpdrill.simulate", "budget", budget, instance_problem(Budget, "a rpdrill Budget or None", optional=True))
+    check("rpdrill.simulate", "solution_file", solution_file, optional(file_problem))
+    scene, source = scene_and_source(scene, "rpdrill.simulate")
     if formulation is not None:
         scene = scene.with_solver(formulation)
     simulation = prepare_scene(scene, source)
@@ -85,6 +106,8 @@ def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
     (status, error, a rock's name) as text; one row a point, indexed by ``point``."""
     import pandas as pd  # 0.3 s to import: only where a table is asked for
 
+    check("rpdrill.table_frame", "rows", rows, instance_problem((list, tuple), "a list of rows (mappings of "
+                                                                  "column -> text)"))
     frame = pd.DataFrame(list(rows))
     if frame.empty:
         return frame
@@ -103,12 +126,18 @@ def run_study(study: Study | str | Path, workers: int | None = None, out: str | 
     removed after (no plots). The results table as a DataFrame, one row a point."""
     from .runtime.pools import pool
 
+    check("rpdrill.run_study", "study", study, either(file_problem, instance_problem(Study, "a rpdrill Study or a "
+                                                                                    "study file's path")))
+    check("rpdrill.run_study", "workers", workers, optional(workers_problem))
+    check("rpdrill.run_study", "out", out, optional(folder_problem))
+    check("rpdrill.run_study", "dask", dask, dask_problem)
+    check("rpdrill.run_study", "quiet", quiet, boolean_problem)
     if not isinstance(study, Study):
         study = load_study(study)
     with tempfile.TemporaryDirectory(prefix="rpdrill-study-") as scratch:
         folder = study_folders([str(study.source)], str(out or scratch))[0]
         if out is None:  # a scratch folder keeps no plots
             study = dataclasses.replace(study, spec=study.spec.model_copy(update={"plots": []}))
-        with pool(dask, workers) as runner:
+        with pool(dask, workers, "rpdrill.run_study: dask") as runner:
             outcome: Outcome = run_studies([study], [folder], runner, dask is not None, quiet)[0]
     return table_frame(outcome[2])

@@ -42,7 +42,7 @@ from .formulations import (
     PRESETS,
 )
 from .outputs import BODY_METRICS, METRICS, SERIES, Need, body_metric, metric_need, needs
-from .validation import with_changes
+from .validation import InputError, parse, short, with_changes
 
 
 class Piston(Body):
@@ -328,9 +328,12 @@ class Scene(Strict):
         options (a new, validated scene)."""
         solver = self.solver.model_dump(exclude_none=True)
         if formulation is not None:
+            if not isinstance(formulation, str) or formulation not in FORMULATIONS:
+                raise InputError(f"Scene.with_solver: formulation: {short(formulation)}: not a formulation; "
+                                 f"allowed: {', '.join(FORMULATIONS)}")
             solver = switch_formulation(solver, formulation)
         data = self.model_dump(by_alias=True, exclude_none=True)
-        return Scene.model_validate({**data, "solver": {**solver, **options}})
+        return parse(Scene, {**data, "solver": {**solver, **options}}, "Scene.with_solver")
 
     @model_validator(mode="after")
     def _feed_body_exists(self) -> Scene:

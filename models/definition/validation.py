@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import copy
 import re
+from collections.abc import Mapping
 from typing import Any, TypeVar, get_args, get_origin
 
 from pydantic import BaseModel, ValidationError
@@ -176,6 +177,9 @@ def check_path(model: type[BaseModel], source: str, key: str, path: str, base: d
 def with_changes(model: ModelT, changes: dict[str, Any], source: str) -> ModelT:
     """A validated copy of ``model`` with ``changes`` (dotted key path -> value, the keys of its file
     format, ``None`` removes a key), or InputError naming ``source``, the key path and the value."""
+    if not isinstance(changes, Mapping):
+        raise InputError(f"{source}: changes: {short(changes)}: give a mapping of key paths to values, e.g. "
+                         "{'impact.frequency_hz': 70.0}")
     data = model.model_dump(by_alias=True, exclude_none=True)
     for path, value in changes.items():
         if not isinstance(path, str) or not path:

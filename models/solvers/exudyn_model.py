@@ -54,6 +54,7 @@ from ...rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 from ..definition.drill_string import STEEL_DENSITY_KG_PER_M3
 from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
 from ..definition.scene import Scene
+from ..definition.validation import InputError, short
 from ..drill.chain import AxialChain, Link
 from ..drill.indexing import BlowStarts
 from ..drill.pulse import impact_force
@@ -242,6 +243,9 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     ``symbolic=False`` uses Python callbacks for the impact and rock forces (same law, slower:
     kept for the benchmark that measures what the symbolic functions save).
     """
+    if not isinstance(run, (Scene, Simulation)):
+        raise InputError(f"rpdrill.build_exudyn: run: {short(run)}: give a rpdrill.Scene (rpdrill.load_scene) or a "
+                         "prepared simulation")
     simulation, named = _exudyn_simulation(run)
     chain, impact, piston = simulation.dynamic_chain, simulation.impact, simulation.piston
     initial_positions = simulation.initial_positions_m if piston is None else piston.parked(simulation.initial_positions_m)

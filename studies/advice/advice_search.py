@@ -60,6 +60,7 @@ from ...models.definition.validation import InputError, describe_validation_erro
 from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
 from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter
+from ..inputs.arguments import check, count_problem, positive_problem, seed_problem
 from ..inputs.specs import set_path
 from ..runtime.evaluation_log import EvaluationLog
 from ..runtime.pools import Runner
@@ -124,6 +125,11 @@ class AdviceSearch:
     max_generations: int = 30
     tolerance: float = 0.01
     seed: int = 1
+
+    def __post_init__(self) -> None:
+        for name, problem in (("popsize", count_problem), ("max_generations", count_problem),
+                              ("tolerance", positive_problem), ("seed", seed_problem)):
+            check("rpdrill.AdviceSearch", name, getattr(self, name), problem)
 
 
 @dataclass(frozen=True)

@@ -29,11 +29,12 @@ from ..advice.advice_search import (
 )
 from ..display.catalogue import metric, parameter
 from ..figures.advice_figures import plot_curves, plot_feed_map
+from ..inputs.arguments import choice_problem, cli_type
 from ..inputs.reading import load_scene
 from ..runtime.evaluation_log import CHECKPOINT, EVALUATIONS, EvaluationLog
 from ..runtime.output_files import check_file_target, check_out, staged_directory, write_json
 from ..runtime.pools import pool
-from .options import add_runner_arguments, positive_count, positive_number
+from .options import add_runner_arguments, positive_count, positive_number, seed
 
 FILES = f"""files written to DIR (an interrupted advice keeps its points there: the same command again
 replays them and runs the rest):
@@ -64,13 +65,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                             required=entry.required,
                             help=f"bounds of the {q.name} [{q.unit}]" + ("" if entry.required else
                                                                         " (default: fixed at the scene's value)"))
-    parser.add_argument("--metric", choices=METRICS, default=METRICS[0],
+    parser.add_argument("--metric", type=cli_type(choice_problem(METRICS, "metric")), default=METRICS[0],
+                        metavar="{" + ",".join(METRICS) + "}",
                         help=f"what to maximise (default {METRICS[0]}; {METRICS[1]}: penetration rate / impact power; "
                              f"{METRICS[2]}: penetration rate / hammer power, a piston scene)")
     parser.add_argument("--power-kw", type=positive_number, metavar="P",
                         help="a fixed hammer power [kW] (a piston scene): at every point the blow energy is P / f, "
                              "so the search trades frequency against blow energy")
-    parser.add_argument("--rock", nargs="+", choices=tuple(TABLE_1), metavar="NAME",
+    parser.add_argument("--rock", nargs="+", type=cli_type(choice_problem(TABLE_1, "Table 1 rock")), metavar="NAME",
                         help=f"search again for each Table 1 rock ({', '.join(TABLE_1)}; default: the scene's rock)")
     parser.add_argument("--max-thrust-ratio", type=positive_number, default=1.0,
                         help="run only points whose mean thrust (feed + frequency x impulse per blow) is below this "
@@ -80,7 +82,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"differential evolution: population per parameter (default {AdviceSearch.popsize})")
     parser.add_argument("--generations", type=positive_count, default=AdviceSearch.max_generations,
                         help=f"differential evolution: at most this many generations (default {AdviceSearch.max_generations})")
-    parser.add_argument("--seed", type=int, default=AdviceSearch.seed, help=f"random seed (default {AdviceSearch.seed})")
+    parser.add_argument("--seed", type=seed, default=AdviceSearch.seed, help=f"random seed (default {AdviceSearch.seed})")
     parser.add_argument("--markdown", type=Path, help="also write advice.md to this file (e.g. docs/advice.md)")
     add_runner_arguments(parser)
 

@@ -22,6 +22,7 @@ from ...models.evaluation.stability import SimulationFailed
 from ..api import save_result, simulate
 from ..display.catalogue import metric
 from ..figures.drill_animation import SOLUTION_FILE
+from ..inputs.arguments import choice_problem, cli_type
 from ..inputs.reading import load_scene
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import (
@@ -39,7 +40,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="scene YAML file")
     parser.add_argument("--out", required=True, help="output directory (new or empty)")
     parser.add_argument("--overwrite", action="store_true", help="write into --out although it holds other files")
-    parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
+    parser.add_argument("--formulation", type=cli_type(choice_problem(FORMULATIONS, "formulation")),
+                        metavar="{" + ",".join(FORMULATIONS) + "}",
                         help="run with this formulation (default: the scene's solver.formulation; the scene's "
                              "options of another formulation are dropped)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from ...models.definition.formulations import FORMULATIONS
 from ..api import run_study_files
+from ..inputs.arguments import choice_problem, cli_type
 from ..runtime.resumable import Row
 from ..scan.study import Study
 from ..scan.study_optima import Record, optima_table
@@ -37,7 +38,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.epilog = FILES
     add_resumable_arguments(parser, "study", "study YAML file(s)", many=True)
-    parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
+    parser.add_argument("--formulation", type=cli_type(choice_problem(FORMULATIONS, "formulation")),
+                        metavar="{" + ",".join(FORMULATIONS) + "}",
                         help="run every point with this formulation (default: the scene's solver.formulation)")
 
 

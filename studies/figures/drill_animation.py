@@ -26,6 +26,15 @@ from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 
 from ...models.evaluation.results import SimulationResult
 from ...models.solvers.simulation import Simulation
+from ..inputs.arguments import (
+    check,
+    count_problem,
+    file_problem,
+    folder_problem,
+    instance_problem,
+    optional,
+    positive_problem,
+)
 from ..inputs.reading import load_scene
 from .drill_drawing import BODY_HEIGHT, draw_string, drawn_layout, figure_title
 from .figure_style import plt
@@ -56,7 +65,13 @@ def movie_writer(path: Path) -> PillowWriter | FFMpegWriter:
 
 def write_animation(result: SimulationResult, path: str | Path, blows: int = 3,
                     magnification: float | None = None) -> float:
-    """Write the last ``blows`` blows of ``result`` to ``path`` (module doc); the magnification drawn."""
+    """Write the last ``blows`` blows of ``result`` (a run's raw result, or its rpdrill.Result) to ``path``
+    (module doc); the magnification drawn."""
+    result = getattr(result, "raw", result)
+    check("rpdrill.write_animation", "result", result, instance_problem(SimulationResult, "the Result of rpdrill.simulate"))
+    check("rpdrill.write_animation", "path", path, file_problem)
+    check("rpdrill.write_animation", "blows", blows, count_problem)
+    check("rpdrill.write_animation", "magnification", magnification, optional(positive_problem))
     path = Path(path)
     writer = movie_writer(path)
     scene, drawing = result.scene, drawn_layout(result.scene)
@@ -111,6 +126,7 @@ def load_solution(run_dir: str | Path) -> tuple[ExudynModel, dict]:
 
     from ...models.solvers.exudyn_model import build_exudyn
 
+    check("rpdrill.view_solution", "run_dir", run_dir, folder_problem)
     run_dir = Path(run_dir)
     model = build_exudyn(load_scene(run_dir / RESOLVED_SCENE))
     return model, LoadSolutionFile(str(run_dir / SOLUTION_FILE), verbose=False)

@@ -26,6 +26,7 @@ from ...models.definition.drill_string import EVERY_BODY, GROUND
 from ...models.definition.links import Link
 from ...models.definition.scene import Scene
 from ...models.drill.shapes import DEFAULT_DIAMETER_M, Layout, axial_order, layout
+from ..inputs.arguments import check, file_problem, instance_problem
 from .figure_style import OKABE_ITO, plt
 
 BREAK_SHARE = 0.35  # the most of the drawing's length one body takes; longer ones are drawn shortened
@@ -308,6 +309,8 @@ def figure_title(scene: Scene, drawing: DrawnLayout) -> str:
 
 def draw(scene: Scene, path: str | Path) -> Path:
     """Write the drawing of ``scene``'s drill string to ``path`` (PNG or SVG by its suffix; module doc)."""
+    check("rpdrill.draw", "scene", scene, instance_problem(Scene, "a rpdrill.Scene (rpdrill.load_scene)"))
+    check("rpdrill.draw", "path", path, file_problem)
     path = Path(path)
     drawing = drawn_layout(scene)
     width = drawing.rock_face + 2.5 * drawing.gap - drawing.start

@@ -18,6 +18,7 @@ from typing import Any
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, parse, short
 from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
+from .arguments import check, scene_file_problem
 from .strict_yaml import MAX_DEPTH, MAX_VALUES, parse_yaml
 
 __all__ = ["MAX_DEPTH", "MAX_FILE_BYTES", "MAX_VALUES", "InputError", "load_scene", "parse", "parse_yaml",
@@ -95,13 +96,16 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
 
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file."""
+    check("rpdrill.load_scene", "path", path, scene_file_problem)
     return parse(Scene, read_yaml(path), str(path))
 
 
-def scene_and_source(scene: Scene | str | Path) -> tuple[Scene, str]:
-    """A validated scene (given, or read from a file) and the name its messages use."""
+def scene_and_source(scene: Scene | str | Path, function: str = "rpdrill") -> tuple[Scene, str]:
+    """A validated scene (given, or read from a file) and the name its messages use; ``function``: the
+    library call whose argument it is, for the message when it is neither."""
     if isinstance(scene, Scene):
         return scene, f"scene {scene.name!r}"
+    check(function, "scene", scene, scene_file_problem)
     return load_scene(scene), str(scene)
 
 
