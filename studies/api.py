@@ -62,7 +62,7 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     columns = {name: values.to_numpy() for name, values in result.timeseries.items()}
     write_columns_csv(folder / "timeseries.csv", columns)
     write_json(folder / "summary.json", {"scene": result.scene.name, "formulation": result.formulation,
-                                         "status": run_status(result.raw)[0], "metrics": result.metrics,
+                                         "status": run_status(result.raw, result.metrics)[0], "metrics": result.metrics,
                                          "run": result.raw.info,
                                          "provenance": result.provenance})
     write_resolved(folder / "scene.resolved.yaml", result.raw.simulation.resolved_scene())

@@ -152,6 +152,25 @@ def element_rates(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsio
     return candidates
 
 
+def spring_spread(scene: Scene, chain: AxialChain, law: RockLaw) -> tuple[str, float, float, float]:
+    """The stiffest spring of the drill and the rock (its key, the key's value, its stiffness [N/m]) and
+    the softest spring's stiffness (a rod segment's from its Young's modulus: the key is the modulus)."""
+    owner = {i: name for name, (first, last) in chain.groups.items() for i in range(first, last + 1)}
+    rock_key = "rock.unloading_stiffness_n_per_m" if scene.rock.law == "bilinear" else "rock.stiffness_n_per_m"
+    rock = max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m)
+    springs = [(rock, rock_key, getattr(scene.rock, rock_key.split(".")[1]))]
+    for link in chain.links:
+        if link.stiffness_n_per_m > 0:
+            connector = scene.drill_string.connectors.get(link.name)
+            key = f"drill_string.connectors.{link.name}.stiffness_n_per_m" if connector is not None else \
+                f"drill_string.bodies.{owner[link.body_b]}.youngs_modulus_pa"
+            value = link.stiffness_n_per_m if connector is not None else \
+                scene.drill_string.bodies[owner[link.body_b]].youngs_modulus_pa
+            springs.append((link.stiffness_n_per_m, key, value))
+    stiffest = max(springs)
+    return stiffest[1], stiffest[2], stiffest[0], min(springs)[0]
+
+
 def largest_stable_step_s(simulation: PreparedRun, solver_type: str | None = None) -> float | None:
     """h_max of a fixed-step explicit solver (default: the simulation's); None for implicit or
     adaptive ones."""

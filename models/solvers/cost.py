@@ -85,6 +85,21 @@ def _fastest(simulation: Simulation) -> Cause:
     return Cause(simulation.fastest.key, simulation.fastest.value)
 
 
+def _pulse(simulation: Simulation) -> Cause:
+    """The key of the impact pulse's duration (a piston's contact: the piston)."""
+    if simulation.piston is None:
+        return Cause("impact.duration_s", simulation.scene.impact.duration_s)
+    return Cause("impact.piston", f"a contact of {simulation.pulse_duration_s:.3g} s")
+
+
+def _fastest_or_pulse(simulation: Simulation) -> Cause:
+    """The key of the fastest rate of the exact formulation's matrices: the drill's fastest element, or the
+    pulse generator's pi / duration (a half-sine's angular rate) when that is faster (a 1 ns pulse)."""
+    if math.pi / simulation.pulse_duration_s > simulation.fastest.rate_per_s:
+        return _pulse(simulation)
+    return _fastest(simulation)
+
+
 def _rock_damper(simulation: Simulation) -> Cause:
     """The key of the rock damper's rate c_n / m_bit that departs more from the drill's other values."""
     damper = next(e for e in element_rates(simulation.scene, simulation.chain, simulation.rock, simulation.torsion)
@@ -110,8 +125,7 @@ def _exudyn(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     if scene.solver.step_s is not None:
         cause = Cause("solver.step_s", step)
     elif math.isclose(step, limits["pulse"]):
-        cause = Cause("impact.duration_s", scene.impact.duration_s) if simulation.piston is None else \
-            Cause("impact.piston", f"a contact of {simulation.pulse_duration_s:.3g} s")
+        cause = _pulse(simulation)
     elif math.isclose(step, limits["damper"]):
         cause = _rock_damper(simulation)
     else:
@@ -132,7 +146,7 @@ def _exact(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     _, _, step = sub_step(simulation, one_period)
     switches = settings.max_switches_per_blow * math.ceil(settings.end_time_s * simulation.impact.frequency_hz)
     keys = len(simulation.rock.modes()) * len(set(one_period))
-    return step, sampled if step == settings.sample_interval_s else _fastest(simulation), [
+    return step, sampled if step == settings.sample_interval_s else _fastest_or_pulse(simulation), [
         (sampled, settings.end_time_s / settings.sample_interval_s * (m + 2), settings.sample_interval_s),
         (Cause("solver.max_switches_per_blow", settings.max_switches_per_blow), 2 * switches * (m + 3), None),
         (Cause("drill_string.bodies", f"{simulation.dynamic_chain.size} lumped bodies"), keys * OPERATOR_VALUES * m**2, None)]

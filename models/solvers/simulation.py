@@ -30,12 +30,18 @@ from ..definition.scene import (
     built_effects,
     requested_outputs,
 )
-from ..drill.chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
+from ..drill.chain import (
+    STATIC_CONDITION_LIMIT,
+    AxialChain,
+    axial_chain,
+    static_preload_m,
+    static_torsion_angle_rad,
+)
 from ..drill.indexing import BlowStarts, Indexing
 from ..drill.piston import PistonSetup, piston_setup
 from ..drill.pulse import impulse_per_blow_n_s
 from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_settings
-from ..evaluation.stability import FastestElement, StepScales, fastest_element, step_scales
+from ..evaluation.stability import FastestElement, StepScales, fastest_element, spring_spread, step_scales
 from .dispatch import implementation
 
 if TYPE_CHECKING:
@@ -179,6 +185,12 @@ def prepare(scene: Scene) -> Simulation:
         try:
             positions = static_preload_m(chain, rock)
         except ValueError as err:
+            key, value, stiffest, softest = spring_spread(scene, chain, rock)
+            if stiffest > STATIC_CONDITION_LIMIT * softest:  # the cause, rather than a body with no rest position
+                raise SceneError(tuple(key.split(".")), value, (
+                    f"a spring of {stiffest:.3g} N/m against the softest one's {softest:.3g} N/m: more than "
+                    f"{STATIC_CONDITION_LIMIT:.0e} apart, the static preload (start: preloaded) cannot be solved in "
+                    "double precision; give the values of a physical drill, or use start: rest")) from None
             raise SceneError(("start",), scene.start, str(err)) from None
         if effects.torsion:
             angle = static_torsion_angle_rad(scene.torsion)

@@ -32,7 +32,7 @@ from ..figures.advice_figures import plot_curves, plot_feed_map
 from ..inputs.arguments import choice_problem, cli_type
 from ..inputs.reading import load_scene
 from ..runtime.evaluation_log import CHECKPOINT, EVALUATIONS, EvaluationLog
-from ..runtime.output_files import check_file_target, check_out, staged_directory, write_json
+from ..runtime.output_files import check_file_target, check_out, staged_directory, write_atomic, write_json
 from ..runtime.pools import pool
 from .options import add_runner_arguments, positive_count, positive_number, seed
 
@@ -132,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
             plot_curves(advice, stage / f"{name}_curves.png")
             plot_feed_map(advice, stage / f"{name}_feed_frequency_map.png")
     if args.markdown:
-        args.markdown.write_text(advice_markdown(advices, command), encoding="utf-8")
+        write_atomic(args.markdown, advice_markdown(advices, command))
     print(best_table(advices))
     print(f"wrote {args.out}" + (f", {args.markdown}" if args.markdown else ""), file=sys.stderr)
     failed = [a for a in advices if a.failed_runs == a.runs]

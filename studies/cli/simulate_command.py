@@ -64,8 +64,8 @@ def run(args: argparse.Namespace) -> int:
         raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
         print(f"{args.scene}: {err}", file=sys.stderr)
         return 1
-    status, why = run_status(result.raw)
-    if status == "unsettled":  # (an unstable step was said as the run started: models.solvers.exudyn_model)
+    status, why = run_status(result.raw, result.metrics)
+    if status not in ("ok", "unstable"):  # (an unstable step was said as the run started: models.solvers.exudyn_model)
         warnings.warn(why, UnsettledWarning, stacklevel=1)
     with staged_directory(args.out) as stage:
         save_result(result, stage, animate=args.animate)
@@ -73,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
             (stage / SOLUTION_FILE).write_bytes(solution)
     shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}"
                       for name, value in result.metrics.items() if name in HEADLINE)
-    print(f"{result.scene.name} ({result.formulation}): {shown}; wrote {args.out}")
+    print(f"{result.scene.name} ({result.formulation}): {shown or 'no metrics asked for'}; wrote {args.out}")
     if solution is not None:
         print(f"Exudyn's viewer: python -c \"from rpdrill.studies.figures.drill_animation import view_solution; "
               f"view_solution('{args.out}')\"")

@@ -1,22 +1,32 @@
 """Writing run outputs: the output folder checked before any work, CSV with unit-carrying headers,
-JSON, the resolved scene; all or nothing."""
+JSON, the resolved scene; all or nothing.
+
+Every file is written whole or not at all: into a temporary file beside it, then renamed over it
+(:func:`write_atomic`), so that a full disk or a kill leaves the file as it was (or absent), never
+half written. JSON is valid JSON: a number that is not finite (NaN, infinite) is written as null.
+YAML is written so that YAML 1.1 and 1.2 read it alike (text that either would read as a number or
+a boolean is quoted), as the strict reader (studies.inputs.strict_yaml) reads it back."""
 
 from __future__ import annotations
 
 import contextlib
 import csv
 import json
+import math
 import os
+import re
 import shutil
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 import yaml
 
 from ..inputs.reading import InputError
+
+YAML_12_FLOAT = re.compile(r"^[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?$")
 
 
 def check_out(out: str | Path, overwrite: bool | None = False, record: str | None = None,
@@ -86,31 +96,74 @@ def staged_directory(out_dir: str | Path) -> Iterator[Path]:
         shutil.rmtree(stage, ignore_errors=True)
 
 
+@contextlib.contextmanager
+def atomic_file(path: str | Path, mode: str = "w") -> Iterator[IO[Any]]:
+    """A file open for writing in place of ``path``: a temporary file in its folder, renamed over
+    ``path`` when the block ends without an error, removed otherwise (module doc)."""
+    path = Path(path)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with open(handle, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": ""})) as file:
+            yield file
+        os.replace(temporary, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
+        raise
+
+
+def write_atomic(path: str | Path, content: str | bytes) -> None:
+    """Write ``content`` to ``path`` whole or not at all (:func:`atomic_file`)."""
+    with atomic_file(path, "wb" if isinstance(content, bytes) else "w") as file:
+        file.write(content)
+
+
 def write_columns_csv(path: Path, columns: dict[str, np.ndarray]) -> None:
     """Columns of equal length as CSV; the header is the column names (units in the names)."""
     table = np.column_stack(list(columns.values()))
-    np.savetxt(path, table, delimiter=",", header=",".join(columns), comments="", fmt="%.12g")
+    with atomic_file(path) as file:
+        np.savetxt(file, table, delimiter=",", header=",".join(columns), comments="", fmt="%.12g")
 
 
-def _plain(value: Any) -> Any:
-    """NumPy arrays and scalars (a formulation's run info) as JSON lists and numbers."""
+def json_ready(value: Any) -> Any:
+    """``value`` as JSON holds it: NumPy arrays and scalars as lists and numbers, tuples as lists, a
+    number that is not finite as None (null)."""
     if isinstance(value, (np.ndarray, np.generic)):
-        return value.tolist()
-    raise TypeError(f"{type(value).__name__} is not JSON serializable")
+        value = value.tolist()
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {key: json_ready(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(item) for item in value]
+    return value
+
+
+def json_text(data: Any, indent: int | None = None) -> str:
+    """``data`` as valid JSON text (:func:`json_ready`; NaN is never written)."""
+    return json.dumps(json_ready(data), indent=indent, sort_keys=False, allow_nan=False)
 
 
 def write_json(path: Path, data: Any) -> None:
-    path.write_text(json.dumps(data, indent=2, sort_keys=False, default=_plain) + "\n", encoding="utf-8")
+    write_atomic(path, json_text(data, indent=2) + "\n")
+
+
+class _SameInBothVersions(yaml.SafeDumper):
+    """PyYAML's safe dumper (YAML 1.1: it quotes text 1.1 reads otherwise) that also quotes text YAML 1.2
+    reads as a number ('1e5')."""
+
+
+_SameInBothVersions.add_implicit_resolver("tag:yaml.org,2002:float", YAML_12_FLOAT, list("-+.0123456789"))
 
 
 def write_resolved(path: Path, data: dict[str, Any]) -> None:
     """A resolved scene (every value filled in) as YAML."""
-    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    write_atomic(path, yaml.dump(data, Dumper=_SameInBothVersions, sort_keys=False))
 
 
 def write_rows_csv(path: Path, rows: list[dict[str, Any]], columns: Sequence[str] = ()) -> None:
     """Rows as CSV under ``columns`` (default: the keys of the first row; none without rows)."""
-    with path.open("w", newline="", encoding="utf-8") as handle:
+    with atomic_file(path) as handle:
         writer = csv.DictWriter(handle, list(columns) or (list(rows[0]) if rows else []))
         writer.writeheader()
         writer.writerows(rows)

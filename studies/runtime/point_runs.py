@@ -54,14 +54,15 @@ def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]
 
 def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
     """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics and its
-    status (models.evaluation.run_status: ok, unstable or unsettled, the reason in ``error``); a failure is
+    status (models.evaluation.run_status: ok, unstable, unsettled, not_finite or unbalanced, the reason in
+    ``error``); a failure is
     returned, not raised."""
     key, simulation = task
     start = time.perf_counter()
     try:
         result = simulation.run()
         metrics = summary_metrics(result)
-        status, why = run_status(result)
+        status, why = run_status(result, metrics)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
         return {"point": key, "status": "failed", "error": f"{type(err).__name__}: {err}",
                 "wall_time_s": time.perf_counter() - start, "metrics": {}}

@@ -21,7 +21,7 @@ import csv
 import importlib.metadata
 import io
 import json
-import os
+import math
 import sys
 import time
 import warnings
@@ -33,16 +33,17 @@ from typing import Any, Protocol
 
 from tqdm import tqdm
 
+from ...models.evaluation.run_status import STATUSES
 from ..inputs.reading import InputError, short
 from .budgets import duration
 from .interrupts import raise_if_stopped
-from .output_files import write_json
+from .output_files import atomic_file, write_json
 from .pools import Runner
 
 STATUS_COLUMNS = ("status", "error", "wall_time_s")
-# a finished point's status: ok; failed (its error says why); unstable or unsettled (metrics written,
-# but the stability check flags the run, or its blocks have not settled: models.evaluation.metrics)
-FINISHED = ("ok", "failed", "unstable", "unsettled")
+# a finished point's status: ok; failed (its error says why); unstable, unsettled, not_finite or
+# unbalanced (metrics written, but the run's figures do not stand as they are: models.evaluation.run_status)
+FINISHED = ("failed", *STATUSES)
 RECORD = "study.json"
 Row = dict[str, str]
 
@@ -108,18 +109,18 @@ def provenance(study: ResumableStudy, out: Path, table: str) -> dict[str, Any]:
     return checked_record(out / RECORD, fresh, study.source, [out / table])
 
 
-def _is_number(text: str) -> bool:
+def _is_finite(text: str) -> bool:
     try:
-        float(text)
+        return math.isfinite(float(text))
     except ValueError:
         return False
-    return True
 
 
 def damage(row: Row, columns: list[str], points: Sequence[TablePoint]) -> str | None:
     """Why a finished row of a table is not one rpdrill wrote for its point (None: it is): its columns,
     status and point index; its parameters those of the point; its wall time and every column after it
-    (the metrics) a number, or empty."""
+    (the metrics) a finite number, or empty (rpdrill writes a metric that is not a finite number as empty:
+    an edited 'inf' is damage)."""
     if list(row) != columns or None in row.values():
         return "not the table's columns"
     if not row["point"].isdigit() or int(row["point"]) >= len(points):
@@ -131,8 +132,8 @@ def damage(row: Row, columns: list[str], points: Sequence[TablePoint]) -> str | 
         if name in point.parameters and row[name] != str(point.parameters[name]):
             return f"{name} {short(row[name])}: the point's is {short(point.parameters[name])}"
     numeric = columns[columns.index("wall_time_s"):] if "wall_time_s" in columns else []
-    bad = next((name for name in numeric if row[name] != "" and not _is_number(row[name])), None)
-    return None if bad is None else f"{bad} {short(row[bad])}: not a number"
+    bad = next((name for name in numeric if row[name] != "" and not _is_finite(row[name])), None)
+    return None if bad is None else f"{bad} {short(row[bad])}: not a finite number"
 
 
 def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint]) -> dict[int, Row]:
@@ -156,12 +157,10 @@ def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint]) 
         more = f" and {len(damaged) - 3} more" if len(damaged) > 3 else ""
         warnings.warn(f"{path}: {len(damaged)} row(s) damaged or edited, dropped and their points run again "
                       f"({'; '.join(damaged[:3])}{more})", stacklevel=2)
-    temporary = path.with_suffix(".csv.tmp")
-    with temporary.open("w", newline="", encoding="utf-8") as handle:
+    with atomic_file(path) as handle:
         writer = csv.DictWriter(handle, columns)
         writer.writeheader()
         writer.writerows(rows[i] for i in sorted(rows))
-    os.replace(temporary, path)
     return rows
 
 
@@ -171,9 +170,18 @@ def read_rows(path: Path) -> list[Row]:
 
 
 def result_row(point: TablePoint, outcome: dict[str, Any]) -> dict[str, Any]:
-    """A table row: the point, its parameters, status, error, wall time and the outcome's metrics."""
+    """A table row: the point, its parameters, status, error, wall time and the outcome's metrics (empty
+    where not a finite number: its status says so, models.evaluation.run_status)."""
     return {"point": point.index, **point.parameters, "status": outcome["status"], "error": outcome["error"],
-            "wall_time_s": f"{outcome['wall_time_s']:.4g}", **outcome["metrics"]}
+            "wall_time_s": f"{outcome['wall_time_s']:.4g}", **{k: cell(v) for k, v in outcome["metrics"].items()}}
+
+
+def cell(value: Any) -> Any:
+    """A table's cell of a value: empty where it is not a finite number (NaN, infinite; also as text)."""
+    try:
+        return value if math.isfinite(float(value)) else ""
+    except (TypeError, ValueError):
+        return value
 
 
 @dataclass

@@ -36,6 +36,7 @@ from ...models.definition.scene import Scene
 from ..inputs.reading import InputError, parse, read_yaml
 from ..inputs.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, base_estimate_s
+from ..runtime.resumable import cell
 from ..scan.frequency_scans import (
     FREQUENCY,
     Scan,
@@ -271,7 +272,7 @@ def row_of(study: SensitivityStudy, outcome: dict[str, Any]) -> dict[str, Any]:
     point = study.points[outcome["point"]]
     return {"point": point.index, "kind": "", "parameter": "", "change": "", "sample": "", **point.parameters,
             "status": outcome["status"], "error": outcome["error"], "wall_time_s": f"{outcome['wall_time_s']:.4g}",
-            **{k: f"{v:.10g}" if isinstance(v, float) else v for k, v in outcome["metrics"].items()}}
+            **{k: cell(f"{v:.10g}" if isinstance(v, float) else v) for k, v in outcome["metrics"].items()}}
 
 
 def _number(text: str) -> float:
