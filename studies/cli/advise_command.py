@@ -10,7 +10,10 @@ import argparse
 import contextlib
 import shlex
 import sys
+import time
+from datetime import datetime, timezone
 from pathlib import Path
+from typing import Any
 
 from tqdm import tqdm
 
@@ -101,6 +104,14 @@ def command_line(args: argparse.Namespace) -> str:
     return shlex.join(words)
 
 
+def session(runner: str, points_run: int, advices: list[Any], start: float, interrupted: bool) -> dict[str, Any]:
+    """One session of an advice, for its checkpoint (as a calibration records its sessions)."""
+    return {"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"), "runner": runner,
+            "interrupted": interrupted, "points_run": points_run,
+            "points_replayed": sum(advice.replayed for advice in advices), "rocks_done": len(advices),
+            "wall_time_s": round(time.perf_counter() - start, 3)}
+
+
 def run(args: argparse.Namespace) -> int:
     out = check_out(args.out, args.overwrite, CHECKPOINT)
     if args.markdown:
@@ -120,9 +131,15 @@ def run(args: argparse.Namespace) -> int:
         print(f"advise: maximising {metric(args.metric).name} over {', '.join(parameter(p).name for p in bounds)} "
               f"for {len(rocks)} rock(s) on {label}" + (f"; {len(log.records)} points recorded earlier in {out}"
                                                          if log.records else ""), file=sys.stderr)
-        for rock, data in zip(rocks, scenes, strict=True):
-            advices.append(advise(data, rock, request, runner, bar.update, log))
-            tqdm.write(advice_text(advices[-1]), file=sys.stdout)
+        earlier, start = len(log.records), time.perf_counter()
+        try:
+            for rock, data in zip(rocks, scenes, strict=True):
+                advices.append(advise(data, rock, request, runner, bar.update, log))
+                tqdm.write(advice_text(advices[-1]), file=sys.stdout)
+        except KeyboardInterrupt:  # the points run are kept (evaluations.jsonl); the session says where it stopped
+            log.add_session(session(label, len(log.records) - earlier, advices, start, interrupted=True))
+            raise
+        log.add_session(session(label, len(log.records) - earlier, advices, start, interrupted=False))
     command = command_line(args)
     with staged_directory(args.out) as stage:
         write_json(stage / "advice.json", advice_record(advices, command))

@@ -26,7 +26,21 @@ import yaml
 
 from ..inputs.reading import InputError
 
+_UMASK = os.umask(0o022)  # the process's umask, read once (setting it is the only way to read it)
+os.umask(_UMASK)
+NEW_FILE_MODE = 0o666 & ~_UMASK
 YAML_12_FLOAT = re.compile(r"^[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?$")
+
+
+def check_name(option: str, path: str | Path) -> None:
+    """InputError unless ``path`` is UTF-8 text (a name of other bytes, 0xff, cannot go into the files a
+    command writes: its command line, its messages)."""
+    try:
+        os.fsencode(path).decode("utf-8")
+    except UnicodeDecodeError as error:
+        shown = os.fsencode(path).decode("utf-8", "backslashreplace")
+        raise InputError(f"{option}: {shown}: the name holds the byte 0x{error.object[error.start]:02x}, not UTF-8 "
+                         "text; give a name of UTF-8 text") from None
 
 
 def check_out(out: str | Path, overwrite: bool | None = False, record: str | None = None,
@@ -35,7 +49,8 @@ def check_out(out: str | Path, overwrite: bool | None = False, record: str | Non
     is a file, lies below a file, cannot be written, or is a folder that holds another run's files
     (anything but names starting with '.') unless ``overwrite`` (None: the command has no
     ``--overwrite``), or unless it holds ``record`` (a resumable command's own record, which the
-    command checks itself)."""
+    command checks itself); a name that is not UTF-8 text is refused (:func:`check_name`)."""
+    check_name(option, out)
     out = Path(out)
     try:
         dangling = next((p for p in (out, *out.parents) if p.is_symlink() and not p.exists()), None)
@@ -63,7 +78,8 @@ def check_out(out: str | Path, overwrite: bool | None = False, record: str | Non
 
 def check_file_target(option: str, path: str | Path) -> Path:
     """A file a command will write (``option`` names it), checked before any work: InputError unless its
-    folder exists and can be written, and it is not a folder itself."""
+    folder exists and can be written, and it is not a folder itself (its name UTF-8 text: :func:`check_name`)."""
+    check_name(option, path)
     path = Path(path)
     try:
         if path.is_dir():
@@ -103,6 +119,7 @@ def atomic_file(path: str | Path, mode: str = "w") -> Iterator[IO[Any]]:
     path = Path(path)
     handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        os.chmod(handle, NEW_FILE_MODE)  # (mkstemp makes it 0600) as open() would make the file
         with open(handle, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": ""})) as file:
             yield file
         os.replace(temporary, path)

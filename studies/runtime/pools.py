@@ -24,6 +24,8 @@ import contextlib
 import itertools
 import logging
 import os
+import signal
+import sys
 import threading
 import warnings
 from collections.abc import Callable, Iterator, Sequence
@@ -44,6 +46,7 @@ Caught = list[tuple[str, type[Warning], str, int]]
 
 # Child processes a Dask LocalCluster starts: one BLAS thread each (set before they load NumPy).
 ONE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+DASK_CLOSE_S = 1  # a LocalCluster and its client close within this (after a stop: its workers ended first)
 DASK_ANSWER_S = 10  # a scheduler that accepts the connection answers within this (Dask's default: 30 s)
 BATCHES_PER_WORKER = 4  # enough to even out unequal points; few enough that a batch costs ~nothing to send
 
@@ -211,10 +214,15 @@ def dask_pool(address: str | None = None, workers: int | None = None, option: st
             if why is not None:
                 raise InputError(f"{option}: {why}")
         else:
-            cluster = stack.enter_context(LocalCluster(
-                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                dashboard_address=":0", silence_logs=logging.ERROR, env=ONE_THREAD))
-            client = stack.enter_context(Client(cluster))
+            import dask
+
+            _forkserver_without_interrupts()
+            with dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"}):
+                cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                                       dashboard_address=":0", silence_logs=logging.ERROR, env=ONE_THREAD)
+            stack.callback(_close_cluster, cluster)
+            client = Client(cluster)
+            stack.callback(client.close, DASK_CLOSE_S)
         slots = sum(client.nthreads().values()) or 1
         registry: dict[Any, Any] = {}
 
@@ -223,6 +231,33 @@ def dask_pool(address: str | None = None, workers: int | None = None, option: st
             return Completed(futures, dask_completed, client.cancel, registry, False)
 
         yield run
+
+
+def _forkserver_without_interrupts() -> None:
+    """Start multiprocessing's fork server (if not running) ignoring Ctrl-C, so that the processes it forks
+    (a LocalCluster's workers) ignore it from their first instruction: a Ctrl-C of the whole process group
+    then reaches the command's process only, which ends them (no worker prints a traceback). The
+    disposition is inherited only as 'ignored' (a handler is reset by exec), so this process ignores
+    Ctrl-C while the server starts (milliseconds) and takes it again after."""
+    import multiprocessing.forkserver
+
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        multiprocessing.forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _close_cluster(cluster: Any) -> None:
+    """Close a LocalCluster: at once after a stop (its worker processes ended first: what they run is
+    not waited for), within DASK_CLOSE_S otherwise."""
+    if sys.exc_info()[0] is not None:  # a stop or an error is on its way out
+        for nanny in list(getattr(cluster, "workers", {}).values()):
+            process = getattr(getattr(nanny, "process", None), "process", None)
+            with contextlib.suppress(Exception):
+                process.terminate()
+    with contextlib.suppress(Exception):
+        cluster.close(timeout=DASK_CLOSE_S)
 
 
 @contextlib.contextmanager
