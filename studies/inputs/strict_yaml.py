@@ -24,6 +24,7 @@ from __future__ import annotations
 import re
 import unicodedata
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 from ruamel.yaml import YAML
@@ -156,9 +157,10 @@ def _keys(node: MappingNode, path: str, merging: frozenset[int] = frozenset()) -
     return keys
 
 
-def check_nodes(root: Node, explicit: set[int]) -> None:
+def check_nodes(root: Node, explicit: set[int], resolve: Callable[[str], str]) -> None:
     """Refused for the first problem of the module doc below ``root`` (tags of the ids in
-    ``explicit`` were written in the file); plain dates and '=' become text."""
+    ``explicit`` were written in the file: such a value is what its tag says, and must read as it,
+    ``resolve`` giving the tag its text reads as); plain dates and '=' become text."""
     sizes: dict[int, int] = {}  # id -> values below the node, aliases expanded
     stack: list[tuple[Node, str, int, bool]] = [(root, "", 1, False)]
     open_nodes: set[int] = set()
@@ -182,7 +184,7 @@ def check_nodes(root: Node, explicit: set[int]) -> None:
             raise Refused(path, _line(node), f"nested more than {MAX_DEPTH} levels deep")
         _check_tag(node, path, explicit)
         if isinstance(node, ScalarNode):
-            why = read_otherwise(node)
+            why = read_otherwise(node) if id(node) not in explicit else _not_as_tagged(node, resolve)
             if why:
                 raise Refused(path, _line(node), f"{node.value}: {why}")
             if node.tag in AS_TEXT and id(node) not in explicit:
@@ -195,7 +197,7 @@ def check_nodes(root: Node, explicit: set[int]) -> None:
                 if key.tag == MERGE:
                     stack.append((value, path, depth + 1, False))
                     continue
-                _check_key(key, path)
+                _check_key(key, path, key_tag_written=id(key) in explicit)
                 stack.append((value, _join(path, key.value), depth + 1, False))
         else:
             stack += [(child, _join(path, i), depth + 1, False) for i, child in enumerate(children)]
@@ -209,13 +211,23 @@ def _check_tag(node: Node, path: str, explicit: set[int]) -> None:
                   "(text, numbers, true/false, null, mappings and lists)")
 
 
-def _check_key(key: Node, path: str) -> None:
-    """Refused unless ``key`` is text that YAML 1.1 reads the same way."""
+def _not_as_tagged(node: ScalarNode, resolve: Callable[[str], str]) -> str | None:
+    """Why a value of a written core tag (``!!int 1.5``) does not read as its tag (None: it does; text
+    and null always do)."""
+    read = resolve(node.value)
+    if node.tag in (TEXT, CORE + "null") or node.tag not in CORE_TAGS or read == node.tag or \
+            (node.tag == CORE + "float" and read == CORE + "int"):  # (!!float 3 is 3.0)
+        return None
+    return f"not a value of its tag {node.tag.replace(CORE, '!!')}"
+
+
+def _check_key(key: Node, path: str, key_tag_written: bool = False) -> None:
+    """Refused unless ``key`` is text that YAML 1.1 reads the same way (or text by its written tag)."""
     if not isinstance(key, ScalarNode):
         shown = "a mapping" if isinstance(key, MappingNode) else "a list"
         raise Refused(_join(path, "?"), _line(key), f"key {shown} is not text; a key is a name")
     where = _join(path, key.value)
-    why = read_otherwise(key, as_key=True)
+    why = None if key_tag_written else read_otherwise(key, as_key=True)
     if why:
         raise Refused(where, _line(key), f"the key {key.value}: {why}")
     if key.tag != TEXT:
@@ -258,7 +270,7 @@ def _document(text: str) -> Any:
     if declared != (1, 2):
         raise Refused("", 1, f"the directive %YAML {'.'.join(map(str, declared))}: rpdrill reads YAML 1.2; remove "
                       "the %YAML line")
-    check_nodes(node, reader.composer.explicit)
+    check_nodes(node, reader.composer.explicit, lambda text: reader.resolver.resolve(ScalarNode, text, (True, False)))
     return reader.constructor.construct_document(node)
 
 
