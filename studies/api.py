@@ -31,6 +31,7 @@ from .inputs.arguments import (
     folder_problem,
     instance_problem,
     optional,
+    rows_problem,
     workers_problem,
 )
 from .inputs.reading import InputError, load_scene, prepare_scene, scene_and_source
@@ -106,8 +107,7 @@ def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
     (status, error, a rock's name) as text; one row a point, indexed by ``point``."""
     import pandas as pd  # 0.3 s to import: only where a table is asked for
 
-    check("rpdrill.table_frame", "rows", rows, instance_problem((list, tuple), "a list of rows (mappings of "
-                                                                  "column -> text)"))
+    check("rpdrill.table_frame", "rows", rows, rows_problem)
     frame = pd.DataFrame(list(rows))
     if frame.empty:
         return frame

@@ -13,6 +13,7 @@ import pytest
 import yaml
 from scenes import PAPER_BASE
 
+from rpdrill import InputError
 from rpdrill.studies.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -217,3 +218,18 @@ def test_a_figure_of_one_requested_series_draws_it(tmp_path):
     written = plot_timeseries({"time_s": t, "piston_contact_force_n": np.sin(40 * t) ** 8 * 4e5}, scene,
                               tmp_path / "timeseries.png")
     assert written and all(path.stat().st_size > 0 for path in written)
+
+
+def test_a_checkpoint_line_edited_to_nan_is_refused_not_replayed(tmp_path):
+    """rpdrill writes null for a number that is not finite; a NaN or Infinity in evaluations.jsonl was
+    put there by hand: refused naming the line (it would be replayed as a result)."""
+    from rpdrill.studies.runtime.evaluation_log import EVALUATIONS, EvaluationLog
+
+    identity, source = {"hash": "0" * 64}, tmp_path / "search.yaml"
+    log = EvaluationLog(tmp_path, identity, source)
+    log.append({"point": {"impact.frequency_hz": 50.0}, "value": float("nan")})
+    log.close()
+    assert json.loads((tmp_path / EVALUATIONS).read_text())["value"] is None  # written as null
+    (tmp_path / EVALUATIONS).write_text('{"point": {"impact.frequency_hz": 50.0}, "value": Infinity}\n')
+    with pytest.raises(InputError, match="line 1 is not an evaluation rpdrill wrote"):
+        EvaluationLog(tmp_path, identity, source)

@@ -157,6 +157,13 @@ def bounds_problem(value: Any) -> str | None:
     return None
 
 
+def rows_problem(value: Any) -> str | None:
+    """A results table's rows: a list of mappings of column -> text, each with its 'point'."""
+    if isinstance(value, (list, tuple)) and all(isinstance(row, Mapping) and "point" in row for row in value):
+        return None
+    return f"{short(value)}: give a list of rows (mappings of column -> text, as csv.DictReader reads results.csv)"
+
+
 def dask_problem(value: Any) -> str | None:
     """A Dask scheduler's address (``tcp://host:port``, ``host:port``), or '' for a LocalCluster."""
     if value is None or value == "":

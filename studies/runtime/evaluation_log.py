@@ -29,6 +29,10 @@ def unit_key(unit: Any) -> tuple[float, ...]:
     return tuple(float(u) for u in unit)
 
 
+def _not_json(constant: str) -> None:
+    raise json.JSONDecodeError(f"{constant} is not JSON", constant, 0)
+
+
 def _complete_records(path: Path) -> list[Record]:
     """The records of whole lines (a last line cut by a kill is left out); InputError naming the file
     and line when a whole line is not a record."""
@@ -38,8 +42,8 @@ def _complete_records(path: Path) -> list[Record]:
     except UnicodeDecodeError:
         raise InputError(f"--out: {path}: not evaluations rpdrill wrote (not UTF-8 text)") from None
     for number, line in enumerate(lines, 1):
-        try:
-            records.append(json.loads(line))
+        try:  # (rpdrill writes null for a number that is not finite: a NaN or Infinity was edited in)
+            records.append(json.loads(line, parse_constant=_not_json))
         except json.JSONDecodeError:
             if line.endswith("\n"):
                 raise InputError(f"--out: {path}: line {number} is not an evaluation rpdrill wrote") from None
