@@ -84,6 +84,8 @@ def check_file_target(option: str, path: str | Path) -> Path:
     try:
         if path.is_dir():
             raise InputError(f"{option}: {path}: is a folder; give a file name")
+        if path.exists() and not path.is_file():  # (a file is replaced by a renamed one: never a device)
+            raise InputError(f"{option}: {path}: not a regular file (a device, pipe or socket); give a file name")
         folder = path.parent
         if not folder.is_dir():
             raise InputError(f"{option}: {path}: no folder {folder}; create it or give a file in an existing folder")

@@ -238,13 +238,18 @@ def _forkserver_without_interrupts() -> None:
     (a LocalCluster's workers) ignore it from their first instruction: a Ctrl-C of the whole process group
     then reaches the command's process only, which ends them (no worker prints a traceback). The
     disposition is inherited only as 'ignored' (a handler is reset by exec), so this process ignores
-    Ctrl-C while the server starts (milliseconds) and takes it again after."""
+    Ctrl-C while the server starts (milliseconds) and takes it again after. The resource tracker it starts
+    (a process that cleans up the workers' semaphores) says nothing of those a stop leaves it to clean
+    up: its warning filter, given to it as -W, ignores that one warning."""
     import multiprocessing.forkserver
 
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    quiet_tracker = "ignore:resource_tracker:UserWarning"
+    sys.warnoptions.append(quiet_tracker)
     try:
         multiprocessing.forkserver.ensure_running()
     finally:
+        sys.warnoptions.remove(quiet_tracker)
         signal.signal(signal.SIGINT, previous)
 
 

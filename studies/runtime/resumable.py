@@ -150,8 +150,9 @@ def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint]) 
                 rows.setdefault(int(row["point"]), row)
             else:
                 damaged.append(f"line {line}: {why}")
-    except (UnicodeDecodeError, csv.Error) as error:
-        raise InputError(f"--out: {path}: not a results table rpdrill wrote ({error}); use a new --out directory") \
+    except (UnicodeDecodeError, csv.Error, OSError) as error:
+        why = error.strerror if isinstance(error, OSError) and error.strerror else error
+        raise InputError(f"--out: {path}: not a results table rpdrill wrote ({why}); use a new --out directory") \
             from None
     if damaged:
         more = f" and {len(damaged) - 3} more" if len(damaged) > 3 else ""
