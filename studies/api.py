@@ -77,7 +77,7 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
     raw = run_with_solution(simulation, progress, solution_file)
-    return Result(scene, raw, {"source": source})
+    return Result(scene, raw, {"source": source, **simulation.code_records()})
 
 
 def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
