@@ -103,6 +103,14 @@ def pre_step(actions: Sequence[Callable[[Any, float], bool]]) -> Callable[[Any, 
     return run_all
 
 
+def replaced_pre_step(mbs: Any, installed: Any) -> dict[str, Any] | None:
+    """Exudyn's record of the pre-step function on ``mbs`` when it is not ``installed`` (one a user set with
+    ``mbs.SetPreStepUserFunction``), else None."""
+    current = mbs.GetPreStepUserFunction()
+    function = current.get("function") if isinstance(current, dict) else None
+    return None if function is None or function is installed else current
+
+
 def simulation_settings(simulation: Simulation) -> Any:
     """Exudyn's simulation settings of a prepared run (its solver, step, tolerances, sensor storage)."""
     solver = simulation.settings

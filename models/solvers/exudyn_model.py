@@ -72,11 +72,12 @@ from .exudyn_messages import (
     no_cyclic_gc,
     pre_step,
     progress_reporter,
+    replaced_pre_step,
     set_step,
     simulation_settings,
 )
 from .exudyn_piston import ExudynPiston
-from .exudyn_user_items import KINDS, EnergyTerm, UserAccount, assembled_scales, item_counts, user_outcome
+from .exudyn_user_items import EnergyTerm, UserAccount, assembled_scales, item_counts, user_outcome
 from .simulation import Simulation, as_simulation, prepare, solver_settings
 
 SOLVER_TYPES = {
@@ -158,8 +159,14 @@ class ExudynModel:
         self._install()
 
     @property
-    def system_container(self) -> Any:
-        return self.SC
+    def has_run(self) -> bool:
+        """Whether the system has been solved (by :meth:`run` or Exudyn's ``SolveDynamic``)."""
+        return self._ran or self.mbs.systemData.GetTime() > 0
+
+    @property
+    def built_items(self) -> dict[str, int]:
+        """How many items of each kind the build made (a user's items are numbered from there)."""
+        return dict(self._built_items)
 
     @property
     def coordinate_count(self) -> int:
@@ -190,9 +197,7 @@ class ExudynModel:
         run's stored steps (read from sensors of one's own after the run); ``items`` the Exudyn items it
         accounts for (taken out of the automatic account; an item no term covers and the account cannot
         take makes the balance not a number)."""
-        if kind not in KINDS:
-            raise ValueError(f"add_energy_term {name!r}: kind {kind!r} is not one of {', '.join(KINDS)}")
-        self._account.terms.append(EnergyTerm(name, kind, joules, tuple(items)))
+        self._account.declare(EnergyTerm(name, kind, joules, tuple(items)))
 
     def write_solution(self, path: str | Path, period_s: float | None = None) -> None:
         """Have the run write Exudyn's coordinates solution file to ``path`` every ``period_s`` (default: the
@@ -207,9 +212,7 @@ class ExudynModel:
     def user_items(self) -> dict[str, int]:
         """The Exudyn items added to ``mbs`` since the model was built (by the scene's extensions too), by
         kind (none: empty); the sensors the energy account adds are not counted."""
-        counts = item_counts(self.mbs)
-        counts["sensors"] -= len(self._account.own_sensors)
-        return {kind: counts[kind] - self._built_items[kind] for kind in counts if counts[kind] != self._built_items[kind]}
+        return self._account.added(self.mbs, self._built_items)
 
     def prepare(self) -> None:
         """Take in the items added since the last call: assemble the system, size the step for it (the
@@ -244,9 +247,7 @@ class ExudynModel:
 
     def _replaced(self) -> dict[str, Any] | None:
         """The pre-step function on ``mbs`` when it is not the model's (a user's mbs.SetPreStepUserFunction)."""
-        current = self.mbs.GetPreStepUserFunction()
-        function = current.get("function") if isinstance(current, dict) else None
-        return None if function is None or function is self._installed else current
+        return replaced_pre_step(self.mbs, self._installed)
 
     def run(self, progress: Callable[[float], None] | None = None) -> Result:
         """Run the system (with any items added) by the scene's solver settings; ``progress(t)`` about
@@ -256,7 +257,7 @@ class ExudynModel:
 
     def solve(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
         """Run the system and return the formulation's raw result (:meth:`run` wraps it)."""
-        if self._ran or self.mbs.systemData.GetTime() > 0:
+        if self.has_run:
             raise RuntimeError("an ExudynModel runs once (its rock state has moved on): build_exudyn(scene) again")
         self._ran = True
         replaced = self._replaced()
@@ -309,10 +310,6 @@ def _add_body(mbs: Any, name: str, make_object: Callable[[Any], Any], initial: f
     body = make_object(node)
     return ExudynBody(name, node, body, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0)),
                       mbs.AddMarker(MarkerBodyPosition(bodyNumber=body, localPosition=[0.0, 0.0, 0.0])))
-
-
-def _store(mbs: Any, sensor: Any) -> Any:
-    return mbs.AddSensor(sensor)
 
 
 def _link_force_function(link: Link, backend: Any) -> Callable[..., Any]:
@@ -405,12 +402,12 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
 
     sensors: dict[str, Any] = {}
     for i, body in enumerate(bodies):
-        sensors[f"x{i}"] = _store(mbs, SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=COORDINATE))
-        sensors[f"v{i}"] = _store(mbs, SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=RATE))
+        sensors[f"x{i}"] = mbs.AddSensor(SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=COORDINATE))
+        sensors[f"v{i}"] = mbs.AddSensor(SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=RATE))
     if "forces" in simulation.needed_data:
-        sensors["rock"] = _store(mbs, SensorObject(objectNumber=rock.object, storeInternal=True,
+        sensors["rock"] = mbs.AddSensor(SensorObject(objectNumber=rock.object, storeInternal=True,
                                                    outputVariableType=exu.OutputVariableType.Force))
-        sensors["impact"] = _store(mbs, SensorLoad(loadNumber=impact_load, storeInternal=True))
+        sensors["impact"] = mbs.AddSensor(SensorLoad(loadNumber=impact_load, storeInternal=True))
 
     if torsion is not None:
         mbs.AddObject(
@@ -423,9 +420,9 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
         )
         mbs.AddLoad(LoadCoordinate(markerNumber=torsion.marker_coordinate,
                                    load=tor.drive_torque_n_m - tor.resisting_torque_n_m))
-        sensors["phi"] = _store(mbs, SensorNode(nodeNumber=torsion.node, storeInternal=True,
+        sensors["phi"] = mbs.AddSensor(SensorNode(nodeNumber=torsion.node, storeInternal=True,
                                                 outputVariableType=COORDINATE))
-        sensors["omega"] = _store(mbs, SensorNode(nodeNumber=torsion.node, storeInternal=True, outputVariableType=RATE))
+        sensors["omega"] = mbs.AddSensor(SensorNode(nodeNumber=torsion.node, storeInternal=True, outputVariableType=RATE))
 
     drawn = DrillGraphics(simulation.chain, shapes, [body.node for body in bodies[:simulation.chain.size]], COORDINATE)
     mbs.AddObject(ObjectGround(visualization=VObjectGround(graphicsData=drawn.static(),
@@ -449,10 +446,6 @@ class ExtensionFailed(RuntimeError):
     """An extension of the scene (models.definition.extensions) raised while it was applied to the model."""
 
 
-def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
-    return mbs.GetSensorStoredData(sensor)
-
-
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None,
              symbolic: bool = True) -> SimulationResult:
     """Build and run the Exudyn model (:func:`build_exudyn`, :meth:`ExudynModel.run`)."""
@@ -463,7 +456,7 @@ def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
     """The solved system's sensors read into a result (module doc), checked (models.evaluation.stability)."""
     simulation, mbs = model.simulation, model.mbs
     reached_s = mbs.systemData.GetTime()
-    data = {name: _sensor(mbs, sensor) for name, sensor in model.sensors.items()}
+    data = {name: mbs.GetSensorStoredData(sensor) for name, sensor in model.sensors.items()}
     time_s = data["x0"][:, 0]
     n = model.chain.size
     position = np.column_stack([data[f"x{i}"][:, 1] for i in range(n)])

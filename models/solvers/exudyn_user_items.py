@@ -168,6 +168,19 @@ class UserAccount:
     own_sensors: set[int] = field(default_factory=set)  # the sensors this account added
     unaccounted: list[str] = field(default_factory=list)
 
+    def declare(self, term: EnergyTerm) -> None:
+        """Take an energy term an extension declares (``model.add_energy_term``)."""
+        if term.kind not in KINDS:
+            raise ValueError(f"add_energy_term {term.name!r}: kind {term.kind!r} is not one of {', '.join(KINDS)}")
+        self.terms.append(term)
+
+    def added(self, mbs: Any, built: dict[str, int]) -> dict[str, int]:
+        """The items of each kind added to ``mbs`` since it was built with ``built`` (the account's sensors not
+        counted), the kinds with none left out."""
+        counts = item_counts(mbs)
+        counts["sensors"] -= len(self.own_sensors)
+        return {kind: counts[kind] - built[kind] for kind in counts if counts[kind] != built[kind]}
+
     def _sensor(self, mbs: Any, sensor: Any) -> Any:
         index = mbs.AddSensor(sensor)
         self.own_sensors.add(int(index))
