@@ -1,8 +1,12 @@
-"""Extensions a user of rpdrill writes for their rig (the tests name them by import path, ``user_rig:NAME``):
-a clamp on a body (a mass on its own Node1D and a coordinate spring-damper to the body), sensors of one's
-own, an item the energy account cannot take with the energy term that accounts for it."""
+"""What a user of rpdrill writes for their rig (the tests name it by import path, ``user_rig:NAME``):
+extensions (a clamp on a body: a mass on its own Node1D and a coordinate spring-damper to the body;
+sensors of one's own; an item the energy account cannot take, with the energy term that accounts for it)
+and rock laws of one's own (the paper's law under another name; one without a mode table)."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
 
 import exudyn
 import numpy as np
@@ -14,6 +18,8 @@ from exudyn.itemInterface import (
     SensorNode,
     SensorObject,
 )
+
+from rpdrill.rocklaw import JenkinsRock
 
 
 def add_clamp(model, mass_kg: float, stiffness_n_per_m: float, damping_n_s_per_m: float = 0.0,
@@ -78,3 +84,20 @@ def add_friction_clamp(model, mass_kg: float, stiffness_n_per_m: float, damping_
 
     model.add_energy_term("friction joint, stored", "stored", stored, items=[joint])
     model.add_energy_term("friction joint, dissipated", "dissipated", dissipated, items=[joint])
+
+
+@dataclass(frozen=True)
+class RenamedJenkins(JenkinsRock):
+    """The paper's law under another name, named by import path (``user_rig:RenamedJenkins``)."""
+
+    name: ClassVar[str] = "renamed_jenkins"
+
+
+@dataclass(frozen=True)
+class ForceOnlyRock(JenkinsRock):
+    """The paper's law without its mode table: enough for the Exudyn formulation, not for the exact one."""
+
+    name: ClassVar[str] = "force_only"
+
+    def modes(self):
+        raise NotImplementedError("no mode table")

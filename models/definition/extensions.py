@@ -88,10 +88,14 @@ def signature_model(target: Callable[..., Any], skip: int = 0) -> type[BaseModel
     parameters left out): each parameter's annotation (Any without one), required unless it has a default;
     unknown keys are errors unless ``target`` takes ``**kwargs``."""
     parameters = list(inspect.signature(target).parameters.values())[skip:]
-    try:
-        hints = typing.get_type_hints(target.__init__ if inspect.isclass(target) else target)
-    except (NameError, TypeError):  # an annotation that does not resolve: checked as Any
-        hints = {}
+    hints: dict[str, Any] = {}
+    # a class's annotations resolve in the module of the class that declares each (a dataclass's fields),
+    # its __init__'s in its own; one that does not resolve is checked as Any
+    for source in ((target, target.__init__) if inspect.isclass(target) else (target,)):
+        try:
+            hints = {**typing.get_type_hints(source), **hints}
+        except (NameError, TypeError):
+            continue
     fields: dict[str, Any] = {}
     extra = "forbid"
     for parameter in parameters:

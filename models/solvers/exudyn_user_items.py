@@ -275,10 +275,11 @@ class UserAccount:
     def energies(self, model: Any, time_s: np.ndarray) -> UserEnergy:
         """The user's energies at every stored step (after the run)."""
         totals = {kind: np.zeros(len(time_s)) for kind in KINDS}
-        for _, kind, joules in self._parts:
-            totals[kind] = totals[kind] + joules(model, time_s)
-        for term in self.terms:
-            totals[term.kind] = totals[term.kind] + np.asarray(term.joules(model, time_s), dtype=float)
+        with np.errstate(all="ignore"):  # a run that diverged: its energies are not numbers, and it is refused
+            for _, kind, joules in self._parts:
+                totals[kind] = totals[kind] + joules(model, time_s)
+            for term in self.terms:
+                totals[term.kind] = totals[term.kind] + np.asarray(term.joules(model, time_s), dtype=float)
         return UserEnergy(totals["stored"], totals["dissipated"], totals["work_in"], tuple(self.unaccounted),
                           tuple(sorted({name for name, _, _ in self._parts})), tuple(term.name for term in self.terms))
 

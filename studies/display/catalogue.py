@@ -230,10 +230,36 @@ def series(column: str) -> Quantity:
     return found
 
 
+# the SI unit of a key of one's own (an extension's or a rock law's parameter) by its name's ending, longest first
+UNIT_SUFFIXES = (("_n_s_per_m", "N s/m"), ("_n_m_per_rad", "N m/rad"), ("_n_per_m", "N/m"), ("_kg_m2", "kg m²"),
+                 ("_kg", "kg"), ("_m_per_s", "m/s"), ("_hz", "Hz"), ("_rpm", "rpm"), ("_pa", "Pa"), ("_j", "J"),
+                 ("_n", "N"), ("_m", "m"), ("_s", "s"))
+
+
+def _own_parameter(path: str) -> Quantity | None:
+    """A parameter of one's own (``extensions.NAME.parameters.KEY``, ``rock.parameters.KEY``): its key as its
+    name (and the extension's), SI units read off the key's ending (none: a number without a unit)."""
+    parts = path.split(".")
+    if len(parts) == 4 and parts[0] == "extensions" and parts[2] == "parameters":
+        owner = f" ({parts[1]})"
+    elif len(parts) == 3 and parts[:2] == ["rock", "parameters"]:
+        owner = " (rock)"
+    else:
+        return None
+    key = parts[-1]
+    unit = next((unit for suffix, unit in UNIT_SUFFIXES if key.endswith(suffix)), "-")
+    name = key.removesuffix(next((suffix for suffix, _ in UNIT_SUFFIXES if key.endswith(suffix)), ""))
+    return _q(name.replace("_", " ") + owner, "", unit, si_unit=unit)
+
+
 def parameter(path: str) -> Quantity:
-    """The entry of a dotted scene path ('drill_string.bodies.collar.mass_kg': 'collar mass')."""
+    """The entry of a dotted scene path ('drill_string.bodies.collar.mass_kg': 'collar mass'; a parameter of
+    one's own by its key, :func:`_own_parameter`)."""
     if path in PARAMETERS:
         return PARAMETERS[path]
+    own = _own_parameter(path)
+    if own is not None:
+        return own
     parts = path.split(".")
     for i, name in enumerate(parts):
         pattern = ".".join([*parts[:i], "*", *parts[i + 1:]])
