@@ -33,7 +33,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from rpdrill.rocklaw.backends import NUMERIC, Backend
-from rpdrill.rocklaw.base import POSITION, VELOCITY, State, trapezoidal_plastic_work_j
+from rpdrill.rocklaw.base import POSITION, State, trapezoidal_plastic_work_j
 from rpdrill.rocklaw.modes import ONE, Mode, ModeTable, Switch
 
 BOTTOM = "bottom_m"

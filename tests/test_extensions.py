@@ -166,11 +166,11 @@ def test_an_extension_that_changes_the_motion_is_refused_by_the_exact_and_ode_fo
 
 @pytest.mark.parametrize(("changes", "message"), [
     ({"extensions.clamp.parameters.mass_kg": "heavy"}, "extensions.clamp.parameters.mass_kg: 'heavy': a number is required"),
-    ({"extensions.clamp.parameters.mass": 1.0}, "extensions.clamp.parameters.mass: 1.0: not a parameter of "
-     "user_rig:add_clamp; its parameters: mass_kg, stiffness_n_per_m, damping_n_s_per_m, body"),
+    ({"extensions.clamp.parameters.mass": 1.0}, ("extensions.clamp.parameters.mass: 1.0: not a parameter of "
+     "user_rig:add_clamp; its parameters: mass_kg, stiffness_n_per_m, damping_n_s_per_m, body")),
     ({"extensions.clamp.parameters.stiffness_n_per_m": None}, "extensions.clamp.parameters.stiffness_n_per_m: missing"),
-    ({"extensions.clamp.function": "user_rig:no_such"}, "extensions.clamp.function: 'user_rig:no_such': module "
-     "'user_rig' has no 'no_such'"),
+    ({"extensions.clamp.function": "user_rig:no_such"}, ("extensions.clamp.function: 'user_rig:no_such': module "
+     "'user_rig' has no 'no_such'")),
     ({"extensions.clamp.function": "no_such_module:f"}, "cannot import module 'no_such_module'"),
     ({"extensions.other.parameters.mass_kg": 1.0}, "'other' is not in the scene's extensions"),
 ])
@@ -226,8 +226,8 @@ def test_the_crushing_work_is_the_work_of_the_law_that_ran():
 
 
 @pytest.mark.parametrize(("parameters", "message"), [
-    ({"stiffness_n_per_m": "5e8", "damping_n_s_per_m": 0.0, "threshold_n": 1e5}, "rock.parameters.stiffness_n_per_m: "
-     "'5e8': a number is required"),
+    ({"stiffness_n_per_m": "5e8", "damping_n_s_per_m": 0.0, "threshold_n": 1e5}, ("rock.parameters.stiffness_n_per_m: "
+     "'5e8': a number is required")),
     ({"stiffness_n_per_m": 5e8, "threshold_n": 1e5}, "rock.parameters.damping_n_s_per_m: missing"),
     ({"stiffness_n_per_m": 5e8, "damping_n_s_per_m": 0.0, "threshold_n": 1e5, "friction": 1.0},
      "rock.parameters.friction: 1.0: not a parameter of user_rig:RenamedJenkins"),
@@ -258,7 +258,7 @@ def test_draw_and_animate_an_extended_model_from_its_exudyn_graphics(tmp_path):
     model = clamped(PAPER.with_(SHORT), stiffness_n_per_m=1e9)
     assert rpdrill.draw(model, tmp_path / "model.png").stat().st_size > 10_000
     assert rpdrill.draw(model, tmp_path / "model.svg").stat().st_size > 10_000
-    points, tags = SystemPicture(Figure().add_subplot(), model.mbs, model.built_items["objects"]).show()
+    _points, tags = SystemPicture(Figure().add_subplot(), model.mbs, model.built_items["objects"]).show()
     clamp = next((point, user) for point, text, user, _ in tags if text.startswith("clamp\n300 kg"))
     collar = model.mbs.GetObjectOutputBody(model.bodies["collar"].object, exudyn.OutputVariableType.Position, [0, 0, 0])
     assert clamp[1] and clamp[0] == pytest.approx(collar)  # the user's body, where it is, in its own colour

@@ -284,13 +284,15 @@ def _shown(scene: Scene, path: str, varied: Collection[str], text: str = "{}") -
 
 
 def describe_scene(scene: Scene, varied: Collection[str] = ()) -> str:
-    """The scene, its rock, impact and feed in one line for a title, leaving out the ``varied`` paths:
-    'paper_base: rock sandstone (k_n 510 MN/m, F_th 210 kN), impact 220 kN half-sine of 1.6 ms at 65 Hz,
+    """The scene, its rock, impact, feed and extensions in one line for a title, leaving out the ``varied``
+    paths: 'paper_base: rock sandstone (k_n 510 MN/m, F_th 210 kN), impact 220 kN half-sine of 1.6 ms at 65 Hz,
     feed 75 kN'."""
     rock = scene.rock.completed()
     filled = scene.model_copy(update={"rock": rock})
     if "rock.name" in varied:
         rock_text = "rock varied"
+    elif rock.own_law:
+        rock_text = f"rock law {rock.law}"
     else:
         symbols = {"stiffness_n_per_m": "k_n", "threshold_n": "F_th", "loading_stiffness_n_per_m": "k_l",
                    "unloading_stiffness_n_per_m": "k_u"}
@@ -308,4 +310,6 @@ def describe_scene(scene: Scene, varied: Collection[str] = ()) -> str:
         impact = " ".join(["impact", *_shown(scene, "impact.amplitude_n", varied), scene.impact.shape.replace("_", "-"),
                            *_shown(scene, "impact.duration_s", varied, "of {}"),
                            *_shown(scene, "impact.frequency_hz", varied, "at {}")])
-    return f"{scene.name}: " + ", ".join([rock_text, impact, *_shown(scene, "feed.force_n", varied, "feed {}")])
+    extensions = [f"extension {name} ({extension.function})" for name, extension in (scene.extensions or {}).items()]
+    return f"{scene.name}: " + ", ".join([rock_text, impact, *_shown(scene, "feed.force_n", varied, "feed {}"),
+                                          *extensions])

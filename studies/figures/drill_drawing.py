@@ -296,6 +296,8 @@ def _impact_text(scene: Scene) -> str:
 
 def _rock_text(scene: Scene) -> str:
     rock = scene.rock.completed()
+    if rock.own_law:
+        return f"law {rock.law.partition(':')[2]}"
     if rock.law == "bilinear":
         return (f"k_l {_number(rock.loading_stiffness_n_per_m / 1e6)} MN/m\n"
                 f"k_u {_number(rock.unloading_stiffness_n_per_m / 1e6)} MN/m")
