@@ -160,6 +160,10 @@ PARAMETERS: dict[str, Quantity] = {
     "impact.piston.energy_j": _q("blow energy", r"E_{blow}", "J"),
     "impact.piston.contact_stiffness_n_per_m": _q("piston contact stiffness", "k_c", "MN/m", 1e-6, "N/m"),
     "rock.law": _category("rock law"),
+    "rock.parameters": _category("rock law parameters"),  # each by its key: _own_parameter
+    "extensions.*.function": _category("{name} extension"),
+    "extensions.*.parameters": _category("{name} parameters"),  # each by its key: _own_parameter
+    "extensions.*.recorded": _category("{name} as recorded"),
     "rock.name": _category("rock"),
     "rock.stiffness_n_per_m": _q("rock stiffness", "k_n", "MN/m", 1e-6, "N/m"),
     "rock.damping_n_s_per_m": _q("rock damping", "c_n", "kN s/m", 1e-3, "N s/m"),
