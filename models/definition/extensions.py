@@ -109,9 +109,10 @@ def signature_model(target: Callable[..., Any], skip: int = 0) -> type[BaseModel
 
 
 def check_parameters(target: Callable[..., Any], parameters: Mapping[str, Any], where: tuple[str, ...],
-                     title: str, skip: int = 0) -> dict[str, Any]:
+                     title: str, skip: int = 0, path: str | None = None) -> dict[str, Any]:
     """``parameters`` validated against the signature of ``target`` (:func:`signature_model`); a
-    ValidationError at ``where`` + the key otherwise (``title``: the model the error names)."""
+    ValidationError at ``where`` + the key otherwise (``title``: the model the error names; ``path``: the
+    import path the messages name it by, default its module and name)."""
     model = signature_model(target, skip)
     try:
         validated = model.model_validate(dict(parameters))
@@ -120,7 +121,8 @@ def check_parameters(target: Callable[..., Any], parameters: Mapping[str, Any], 
         for item in error.errors():
             if item["type"] == "extra_forbidden":  # what the callable takes, not pydantic's words
                 details.append(_problem((*where, *item["loc"]), item["input"], "not a parameter of {name}; its "
-                                        "parameters: {names}", name=_name(target), names=", ".join(model.model_fields)))
+                                        "parameters: {names}", name=path or _name(target),
+                                        names=", ".join(model.model_fields)))
                 continue
             item = {**item, "loc": (*where, *item["loc"])}
             item.pop("url", None)
@@ -154,7 +156,7 @@ class Extension(Strict):
         if not callable(target):
             raise _key_error("Extension", ("function",), self.function, "not a callable: {kind}",
                              kind=type(target).__name__)
-        check_parameters(target, self.parameters, ("parameters",), "Extension", skip=1)
+        check_parameters(target, self.parameters, ("parameters",), "Extension", skip=1, path=self.function)
         return self
 
     @property

@@ -124,7 +124,7 @@ class Rock(Strict):
             raise _key_error("Rock", (given[0],), getattr(self, given[0]), "a key of the built-in laws; the keys of a "
                              "law of one's own go under rock.parameters")
         target = law_class(self.law)
-        parameters = check_parameters(target, self.parameters or {}, ("parameters",), "Rock")
+        parameters = check_parameters(target, self.parameters or {}, ("parameters",), "Rock", path=self.law)
         try:
             law = target(**parameters)
         except (TypeError, ValueError) as error:
