@@ -96,7 +96,8 @@ def test_an_extension_parameter_is_a_sensitivity_parameter(tmp_path):
 
 
 def test_an_extension_parameter_is_an_advice_axis():
-    scene = rpdrill.load_scene(PAPER_BASE).with_({**SHORT, "extensions": CLAMP})
+    scene = rpdrill.load_scene(PAPER_BASE).with_({**SHORT, "extensions": CLAMP, "solver.end_time_s": 0.07,
+                                                  "metrics.transient_blows": 1, "metrics.block_blows": 2})
     (advice,) = rpdrill.advise(scene, {"impact.frequency_hz": (45.0, 60.0), "feed.force_n": (20e3, 30e3),
                                        MASS: (100.0, 900.0)},
                                search=rpdrill.AdviceSearch(popsize=2, max_generations=1), workers=2)

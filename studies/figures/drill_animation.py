@@ -27,7 +27,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
+from matplotlib.animation import AbstractMovieWriter, FFMpegWriter, PillowWriter
+from matplotlib.figure import Figure
 
 from ...models.evaluation.results import SimulationResult
 from ...models.evaluation.run_result import Result
@@ -59,6 +60,15 @@ def movie_writer(path: Path) -> PillowWriter | FFMpegWriter:
     if shutil.which("ffmpeg") is None:
         raise ValueError(f"{path}: writing {path.suffix} needs ffmpeg, which is not installed; write a .gif")
     return FFMpegWriter(fps=FRAMES_PER_SECOND)
+
+
+def save_frames(fig: Figure, frame: Callable[[int], None], count: int, path: Path, writer: AbstractMovieWriter) -> None:
+    """Write ``count`` frames of ``fig`` to ``path``, ``frame(k)`` drawing the k-th: each drawn once (a
+    FuncAnimation draws each frame twice when it saves)."""
+    with writer.saving(fig, str(path), fig.dpi):
+        for k in range(count):
+            frame(k)
+            writer.grab_frame()
 
 
 def write_animation(result: SimulationResult | Result | ExudynModel, path: str | Path, blows: int = 3,
@@ -98,8 +108,7 @@ def write_animation(result: SimulationResult | Result | ExudynModel, path: str |
                      f"{1e3 * (positions[k, result.chain.bit_body] - positions[0, result.chain.bit_body]):+.3f} mm, "
                      f"borehole bottom {1e3 * (bottom[k] - bottom[0]):+.3f} mm since the window's start", fontsize=9)
 
-    animation = FuncAnimation(fig, frame, frames=len(times))
-    animation.save(path, writer=writer)
+    save_frames(fig, frame, len(times), path, writer)
     plt.close(fig)
     return factor
 
@@ -203,6 +212,6 @@ def model_animation(model: ExudynModel, path: str | Path, blows: int = 3, magnif
     frame(0)
     fig.canvas.draw()
     fig.set_layout_engine("none")  # laid out once: every frame is drawn as the first (a layout per frame costs)
-    FuncAnimation(fig, frame, frames=len(rows)).save(path, writer=writer)
+    save_frames(fig, frame, len(rows), path, writer)
     plt.close(fig)
     return factor

@@ -77,7 +77,7 @@ def _marker_point(mbs: Any, marker: int, bodies: dict[int, int]) -> np.ndarray |
     if not item["markerType"].endswith("Coordinate"):
         return np.asarray(mbs.GetMarkerOutput(marker, exu.OutputVariableType.Position,
                                               exu.ConfigurationType.Visualization), dtype=float)
-    index = bodies.get(item.get("nodeNumber"))  # a coordinate has no position: the body on its node
+    index = bodies.get(int(item["nodeNumber"]))  # a coordinate has no position: the body on its node
     pose = None if index is None else _pose(mbs, index, mbs.GetObject(index))
     return None if pose is None else pose[0]
 
@@ -291,9 +291,12 @@ def draw_model(model: Any, path: str | Path, coordinates: Sequence[float] | None
         f"\nitems of one's own (labelled in this colour): {told}"
     near = axes[-1, 0]
     if whole_too:
-        draw_system(axes[0, 0], model.mbs, coordinates, own, names)
-        axes[0, 0].autoscale_view()
-        axes[0, 0].set_title(f"{heading}; the whole system", fontsize=9)
+        whole = axes[0, 0]
+        draw_system(whole, model.mbs, coordinates, own, names)
+        (x_low, y_low), (x_high, y_high) = points[:, :2].min(axis=0), points[:, :2].max(axis=0)
+        whole.set_xlim(x_low - 0.02 * (x_high - x_low), x_high + 0.02 * (x_high - x_low))
+        whole.set_ylim(y_low - 0.1 * (y_high - y_low), y_high + 0.1 * (y_high - y_low))
+        whole.set_title(f"{heading}; the whole system", fontsize=9)
     _, tags = draw_system(near, model.mbs, coordinates, own, names)
     near.set_xlim(low, high)
     near.set_ylim(-2 * half, 2 * half)  # room for the labels above and below
