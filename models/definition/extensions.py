@@ -160,18 +160,19 @@ class Extension(Strict):
         return self
 
     @property
-    def callable(self) -> Callable[..., Any]:
+    def target(self) -> Callable[..., Any]:
+        """The function the import path names."""
         return import_object(self.function)
 
     @property
     def changes_motion(self) -> bool:
         """False when the callable says it adds nothing the exact and ODE formulations miss
         (``changes_motion = False``: sensors, energy terms, graphics)."""
-        return bool(getattr(self.callable, "changes_motion", True))
+        return bool(getattr(self.target, "changes_motion", True))
 
     def apply(self, model: Any) -> None:
         """Call the extension on a built model."""
-        self.callable(model, **self.parameters)
+        self.target(model, **self.parameters)
 
 
 def refusal(extensions: Mapping[str, Extension] | None, formulation: str) -> tuple[str, str] | None:
