@@ -13,7 +13,7 @@ import dataclasses
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ..models.definition.formulations import FORMULATIONS
 from ..models.definition.scene import Scene
@@ -50,7 +50,9 @@ __all__ = ["InputError", "Result", "load_scene", "load_study", "run_study", "run
 def save_result(result: Result, folder: str | Path, animate: bool = False) -> list[Path]:
     """What ``rpdrill simulate`` writes into ``folder`` (made if missing): ``timeseries.csv``,
     ``summary.json``, ``scene.resolved.yaml``, the ``timeseries.png``/``.svg`` figure, the drawing of the
-    drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified. The files written."""
+    drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified. A scene with extensions is drawn
+    (and, from a run with a solution file, animated) as its built Exudyn model, every item of the extensions
+    included (studies.figures.system_drawing). The files written."""
     from .figures.drill_animation import write_animation  # matplotlib only when saving
     from .figures.drill_drawing import draw
     from .figures.timeseries_figure import plot_timeseries
@@ -64,16 +66,31 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     write_columns_csv(folder / "timeseries.csv", columns)
     write_json(folder / "summary.json", {"scene": result.scene.name, "formulation": result.formulation,
                                          "status": run_status(result.raw, result.metrics)[0], "metrics": result.metrics,
-                                         "run": result.raw.info,
+                                         "run": {key: value for key, value in result.raw.info.items()
+                                                 if key != "solution_file"},  # a scratch file of the run
                                          "provenance": result.provenance})
     write_resolved(folder / "scene.resolved.yaml", result.raw.simulation.resolved_scene())
     written = [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml",
                *plot_timeseries(columns, result.scene, folder / "timeseries.png"),
                draw(result.scene, folder / "drill.png")]
     if animate:
-        write_animation(result.raw, folder / "drill.gif")
+        write_animation(_animated(result), folder / "drill.gif")
         written.append(folder / "drill.gif")
     return written
+
+
+def _animated(result: Result) -> Any:
+    """What the animation of a run draws: an Exudyn run of a scene with extensions, from its solution file
+    (``simulate(..., solution_file=...)``), as its model rebuilt (every item of the extensions drawn); any
+    other run as the drill string of its scene."""
+    solution = result.raw.info.get("solution_file")
+    if not result.scene.extensions or result.formulation != "exudyn" or not solution or not Path(solution).exists():
+        return result.raw
+    from ..models.solvers.exudyn_model import build_exudyn
+
+    model = build_exudyn(result.scene)
+    model.solution_path = Path(solution)
+    return model
 
 
 def simulate(scene: Scene | str | Path, formulation: str | None = None,
@@ -99,7 +116,7 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
     raw = run_with_solution(simulation, progress, solution_file)
-    return Result(scene, raw, {"source": source})
+    return Result(scene, raw, {"source": source, **simulation.code_records()})
 
 
 def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:

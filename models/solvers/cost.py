@@ -6,7 +6,8 @@ of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2
 + 2 (torsion) + 3 (the constant and the pulse generator) values:
 
 * exudyn: T / ``step_s`` steps (for dopri5 and ode23 ``step_s`` is the largest step: a lower
-  bound); it stores every step when an energy output is asked for, else every
+  bound; a scene with extensions: the step of its built model, sized for the assembled system); it
+  stores every step when an energy output is asked for, else every
   ``output_interval_s``, two values (time, value) per sensor of 2 n + 4;
 * exact: T / h sub-grid points, h the exact solver's own sub-step (models.solvers.exact_system.sub_step:
   the sample interval over ceil(sample interval x ||A_bal||_1)); it stores m + 2 values per
@@ -117,13 +118,28 @@ def _interval(simulation: Simulation) -> Cause:
 Part = tuple[Cause, float, float | None]
 
 
+def _extended(simulation: Simulation) -> tuple[Simulation, Cause | None]:
+    """The simulation as the Exudyn model of a scene with extensions sizes it (the step of the assembled
+    system, models.solvers.exudyn_model), and the extensions as the cause when they made it faster."""
+    if not simulation.scene.extensions:
+        return simulation, None
+    from .exudyn_model import build_exudyn  # Exudyn only for a scene with extensions
+
+    sized = build_exudyn(simulation).simulation
+    faster = sized.spectral_radius_per_s > simulation.spectral_radius_per_s * (1 + 1e-9)
+    return sized, Cause("extensions", ", ".join(simulation.scene.extensions)) if faster else None
+
+
 def _exudyn(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
+    simulation, extended = _extended(simulation)
     settings, scene, n = simulation.settings, simulation.scene, simulation.dynamic_chain.size
     step = settings.step_s
     limits = EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].step_limits(simulation.pulse_duration_s,
                                                                           simulation.step_scales)
     if scene.solver.step_s is not None:
         cause = Cause("solver.step_s", step)
+    elif extended is not None and min(limits["stability"], limits["ringing"]) <= step * (1 + 1e-9):
+        cause = extended
     elif math.isclose(step, limits["pulse"]):
         cause = _pulse(simulation)
     elif math.isclose(step, limits["damper"]):

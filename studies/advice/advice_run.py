@@ -39,7 +39,8 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
                  search: AdviceSearch | None = None, workers: int | None = None,
                  dask: str | None = None) -> list[Advice]:
     """Maximise ``metric`` over ``bounds`` (``{"impact.frequency_hz": (45, 70), "feed.force_n": (35e3,
-    60e3)}``, optionally ``"impact.amplitude_n"``; SI units) for the scene's rock, or for each Table 1
+    60e3)}``, optionally ``"impact.amplitude_n"`` and an extension's ``"extensions.NAME.parameters.KEY"``; SI
+    units) for the scene's rock, or for each Table 1
     rock of ``rocks``; ``power_kw``: a fixed hammer power (a piston scene, the blow energy P / f). One
     :class:`Advice` per rock (SI units). InputError before anything runs when an input cannot be used."""
     where = "rpdrill.advise"
@@ -54,19 +55,28 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     validated, source = scene_and_source(scene, where)
     data = validated.model_dump(by_alias=True, exclude_none=True)
     allowed = [entry.path for entry in PARAMETERS]
+    own = [f"extensions.{name}.parameters.KEY" for name in validated.extensions or {}]  # an extension's parameter
     for path in bounds:
-        if path not in allowed:
+        if path not in allowed and not _extension_parameter(path, validated):
             raise InputError(f"{source}: bounds: {path!r}: not a parameter advise searches; allowed: "
-                             f"{', '.join(allowed)}")
+                             f"{', '.join(allowed + own)}")
     missing = [path for path in (FREQUENCY, FEED) if path not in bounds]
     if missing:
         raise InputError(f"{source}: bounds: give {' and '.join(missing)} (low, high)")
-    ordered = {entry.path: tuple(map(float, bounds[entry.path])) for entry in PARAMETERS if entry.path in bounds}
+    ordered = {path: tuple(map(float, bounds[path])) for path in [*allowed, *sorted(set(bounds) - set(allowed))]
+               if path in bounds}
     request = Request(metric, ordered, max_thrust_ratio, search or AdviceSearch(),
                       power_w=power_kw * 1e3 if power_kw else None)
     scenes = [(rock, runnable_scene(data, rock, request, source)) for rock in rocks or [None]]
     with pool(dask, workers, f"{where}: dask") as (_, runner):
         return [advise(prepared, rock, request, runner) for rock, prepared in scenes]
+
+
+def _extension_parameter(path: str, scene: Scene) -> bool:
+    """Whether ``path`` is ``extensions.NAME.parameters.KEY`` of an extension of ``scene``."""
+    parts = path.split(".")
+    return len(parts) == 4 and parts[0] == "extensions" and parts[2] == "parameters" and \
+        parts[1] in (scene.extensions or {})
 
 
 __all__ = ["Advice", "AdviceSearch", "advise_scene"]

@@ -201,7 +201,7 @@ def runnable_scene(scene: dict[str, Any], rock: str | None, request: Request, so
     data = checked.with_solver(formulation).model_dump(by_alias=True, exclude_none=True)
     blows = checked.metrics.transient_blows + checked.metrics.block_blows
     data["solver"]["end_time_s"] = max(checked.solver.end_time_s, blows / request.bounds[FREQUENCY][0])
-    options = {p.path: p.option for p in PARAMETERS}
+    options = {path: path for path in request.bounds} | {p.path: p.option for p in PARAMETERS}
     for corner in itertools.product(*request.bounds.values()):
         point = dict(zip(request.bounds, corner, strict=True))
         try:

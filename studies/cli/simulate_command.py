@@ -54,23 +54,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite)
     scene = load_scene(args.scene)
-    try:
-        with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress, \
-                tempfile.TemporaryDirectory() as scratch:
-            solution = Path(scratch) / SOLUTION_FILE if args.animate else None
-            result = simulate(args.scene, args.formulation, progress, budget(args), solution_file=solution)
-            solution = solution.read_bytes() if solution is not None and solution.exists() else None
-    except SimulationFailed as err:
-        raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
-        print(f"{args.scene}: {err}", file=sys.stderr)
-        return 1
-    status, why = run_status(result.raw, result.metrics)
-    if status not in ("ok", "unstable"):  # (an unstable step was said as the run started: models.solvers.exudyn_model)
-        warnings.warn(why, UnsettledWarning, stacklevel=1)
-    with staged_directory(args.out) as stage:
-        save_result(result, stage, animate=args.animate)
-        if solution is not None:
-            (stage / SOLUTION_FILE).write_bytes(solution)
+    with tempfile.TemporaryDirectory() as scratch:  # the solution file, kept until the animation is drawn
+        try:
+            with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
+                solution = Path(scratch) / SOLUTION_FILE if args.animate else None
+                result = simulate(args.scene, args.formulation, progress, budget(args), solution_file=solution)
+                solution = solution if solution is not None and solution.exists() else None
+        except SimulationFailed as err:
+            raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
+            print(f"{args.scene}: {err}", file=sys.stderr)
+            return 1
+        status, why = run_status(result.raw, result.metrics)
+        if status not in ("ok", "unstable"):  # (an unstable step was said as the run started: models.solvers.exudyn_model)
+            warnings.warn(why, UnsettledWarning, stacklevel=1)
+        with staged_directory(args.out) as stage:
+            save_result(result, stage, animate=args.animate)
+            if solution is not None:
+                (stage / SOLUTION_FILE).write_bytes(solution.read_bytes())
     shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}"
                       for name, value in result.metrics.items() if name in HEADLINE)
     print(f"{result.scene.name} ({result.formulation}): {shown or 'no metrics asked for'}; wrote {args.out}")

@@ -239,6 +239,14 @@ def instance_problem(kind: type, what: str, optional: bool = False) -> Problem:
     return problem
 
 
+def built_model_problem(value: Any) -> str | None:
+    """A built Exudyn model (rpdrill.build_exudyn): an object with the system ``mbs`` and its ``simulation``
+    (checked by what it has: Exudyn is not imported to check it)."""
+    if hasattr(value, "mbs") and hasattr(value, "simulation"):
+        return None
+    return f"{short(value)}: give a built model (rpdrill.build_exudyn), not {_kind(value)}"
+
+
 def either(*problems: Problem) -> Problem:
     """A value that passes one of ``problems`` (the last one's words when it passes none)."""
     def problem(value: Any) -> str | None:

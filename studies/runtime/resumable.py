@@ -105,8 +105,25 @@ def provenance(study: ResumableStudy, out: Path, table: str) -> dict[str, Any]:
     fresh = {"study": study.spec.name, "study_file": str(study.source), "hash": study.hash,
              "rpdrill_version": importlib.metadata.version("rpdrill"),
              "exudyn_version": importlib.metadata.version("exudyn"),
-             "points": len(study.points), "resolved_study": study.resolved(), "sessions": [], "point_wall_time_s": {}}
+             "points": len(study.points), "resolved_study": study.resolved(), "sessions": [], "point_wall_time_s": {},
+             **code_records(study.points)}
     return checked_record(out / RECORD, fresh, study.source, [out / table])
+
+
+def code_records(points: Sequence[Any]) -> dict[str, Any]:
+    """The code of one's own the points import (models.solvers.simulation.Simulation.code_records): every
+    extension by name (import path, package and version where it has one, file) and a rock law of one's own,
+    over all points (their parameters left out: the results table holds the scanned ones)."""
+    records: dict[str, Any] = {}
+    for point in points:
+        simulation = getattr(point, "simulation", None)
+        for kind, found in ({} if simulation is None else simulation.code_records()).items():
+            if kind == "extensions":
+                records.setdefault(kind, {}).update({name: {key: value for key, value in record.items()
+                                                            if key != "parameters"} for name, record in found.items()})
+            else:
+                records.setdefault(kind, found)
+    return records
 
 
 def _is_finite(text: str) -> bool:

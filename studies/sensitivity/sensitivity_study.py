@@ -5,7 +5,8 @@ labelled ``scans`` (studies.scan.frequency_scans.Scan), the ``rising`` trends, t
 each scan's metric) and
 
 * one at a time: every numeric value of the scene's drill string, feed, impact (not the scanned
-  frequency) and rock (``parameters: all``), or a listed set of dotted paths, each multiplied by
+  frequency), rock and extensions' parameters (``parameters: all``), or a listed set of dotted paths, each
+  multiplied by
   1 +- ``relative_step`` (0.10) in every scan, after the scan's own overrides (a scan that sets the
   rock still has its rock stiffness changed);
 * optionally ``global``: SALib's Morris screening (``method: morris``, ``samples`` trajectories) or
@@ -47,7 +48,7 @@ from ..scan.frequency_scans import (
     set_frequency,
 )
 
-SECTIONS = ("drill_string", "feed", "impact", "rock")
+SECTIONS = ("drill_string", "feed", "impact", "rock", "extensions")
 NOT_VARIED = (FREQUENCY, "segments")  # the scanned axis and counts
 NOMINAL = "nominal"
 ONE_AT_A_TIME_COLUMNS = ("parameter", "change", "scan", "metric", "optimum_hz", "optimum_change", "peak", "peak_change")
@@ -147,8 +148,9 @@ def varied_scene(base: dict[str, Any], overrides: dict[str, Any], factors: dict[
 
 
 def scene_values(scene_data: dict[str, Any]) -> dict[str, float]:
-    """Every numeric value a scene sets in its drill string, feed, impact and rock (the rock's Table 1
-    values filled in), by dotted path; values at their defaults are left out (nothing to vary)."""
+    """Every numeric value a scene sets in its drill string, feed, impact, rock (the rock's Table 1
+    values filled in) and its extensions' parameters, by dotted path; values at their defaults are left out
+    (nothing to vary)."""
     scene = Scene.model_validate(scene_data)
     data = scene.model_dump(mode="json", by_alias=True, exclude_defaults=True)
     data["rock"] = scene.rock.completed().model_dump(mode="json", exclude_defaults=True)
