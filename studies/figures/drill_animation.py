@@ -89,7 +89,8 @@ def write_animation(result: SimulationResult | Result | ExudynModel, path: str |
     one's own included (:func:`model_animation`)."""
     where = "rpdrill.write_animation"
     result = result.raw if isinstance(result, Result) else result
-    check(where, "result", result, either(instance_problem(SimulationResult, "a built model"), built_model_problem))
+    check(where, "result", result, either(built_model_problem, instance_problem(
+        SimulationResult, "the Result of rpdrill.simulate or a built model (rpdrill.build_exudyn)")))
     check(where, "path", path, file_problem)
     check(where, "blows", blows, count_problem)
     check(where, "magnification", magnification, optional(positive_problem))

@@ -320,8 +320,8 @@ def draw(scene: Scene | ExudynModel, path: str | Path) -> Path:
     """Write the drawing of ``scene``'s drill string to ``path`` (PNG or SVG by its suffix; module doc). A built
     Exudyn model (``rpdrill.build_exudyn``), or a scene with extensions (drawn as its built model), is drawn
     from the system's own graphics with every item of one's own (studies.figures.system_drawing)."""
-    check("rpdrill.draw", "scene", scene, either(instance_problem(Scene, "a rpdrill.Scene (rpdrill.load_scene)"),
-                                                 built_model_problem))
+    check("rpdrill.draw", "scene", scene, either(built_model_problem, instance_problem(
+        Scene, "a rpdrill.Scene (rpdrill.load_scene) or a built model (rpdrill.build_exudyn)")))
     check("rpdrill.draw", "path", path, file_problem)
     path = Path(path)
     if not isinstance(scene, Scene) or scene.extensions:
