@@ -22,29 +22,34 @@ inputs, scans, analyses, reports and the command line); dependencies run one way
 rocklaw (``docs/architecture.md``).
 """
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from .models.definition.scene import Scene
-from .models.definition.validation import InputError
-from .models.evaluation.run_result import Result
-from .models.evaluation.stability import SimulationFailed
-from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
-from .studies.runtime.budgets import Budget, BudgetError
-from .studies.scan.study import Study
-
-# Names loaded when first used, not at ``import rpdrill``: the analyses (SciPy's optimizers, SALib), Exudyn
-# (a user's ``import exudyn`` gets the build it would get without rpdrill) and matplotlib. ``import
-# rpdrill`` and every command load only what they use.
-_LAZY = {"build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
+# Every public name is imported when first used, not at ``import rpdrill``: the ``rpdrill`` program starts
+# (and takes its Ctrl-C handler, studies.cli.main.console) before NumPy, pydantic or Exudyn load; the program
+# chooses Exudyn's build in its entry point, and a user's ``import exudyn`` gets the regular one.
+_LAZY = {"Scene": ("models.definition.scene", "Scene"),
+         "InputError": ("models.definition.validation", "InputError"),
+         "Result": ("models.evaluation.run_result", "Result"),
+         "SimulationFailed": ("models.evaluation.stability", "SimulationFailed"),
+         "Advice": ("studies.advice.advice_run", "Advice"),
+         "AdviceSearch": ("studies.advice.advice_run", "AdviceSearch"),
+         "advise": ("studies.advice.advice_run", "advise_scene"),
+         "load_scene": ("studies.api", "load_scene"),
+         "load_study": ("studies.api", "load_study"),
+         "run_study": ("studies.api", "run_study"),
+         "save_result": ("studies.api", "save_result"),
+         "simulate": ("studies.api", "simulate"),
+         "table_frame": ("studies.api", "table_frame"),
+         "Crosscheck": ("studies.crosscheck.crosscheck_run", "Crosscheck"),
+         "crosscheck": ("studies.crosscheck.crosscheck_run", "crosscheck"),
+         "Budget": ("studies.runtime.budgets", "Budget"),
+         "BudgetError": ("studies.runtime.budgets", "BudgetError"),
+         "Study": ("studies.scan.study", "Study"),
+         "build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
          "ExudynModel": ("models.solvers.exudyn_model", "ExudynModel"),
          "draw": ("studies.figures.drill_drawing", "draw"),
          "write_animation": ("studies.figures.drill_animation", "write_animation"),
          "view_solution": ("studies.figures.drill_animation", "view_solution"),
-         "advise": ("studies.advice.advice_run", "advise_scene"),
-         "Advice": ("studies.advice.advice_run", "Advice"),
-         "AdviceSearch": ("studies.advice.advice_run", "AdviceSearch"),
-         "crosscheck": ("studies.crosscheck.crosscheck_run", "crosscheck"),
-         "Crosscheck": ("studies.crosscheck.crosscheck_run", "Crosscheck"),
          "calibrate": ("studies.calibration.calibration_run", "calibrate"),
          "CalibrationResult": ("studies.calibration.calibration_run", "CalibrationResult"),
          "sensitivity": ("studies.sensitivity.sensitivity_run", "sensitivity"),
@@ -56,13 +61,35 @@ _LAZY = {"build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
          "rotation_report": ("studies.pages.rotation_note", "rotation_report"),
          "RotationReport": ("studies.pages.rotation_note", "RotationReport")}
 
+if TYPE_CHECKING:  # the names as type checkers and editors see them
+    from .models.definition.scene import Scene
+    from .models.definition.validation import InputError
+    from .models.evaluation.run_result import Result
+    from .models.evaluation.stability import SimulationFailed
+    from .models.solvers.exudyn_model import ExudynModel, build_exudyn
+    from .studies.accuracy.accuracy_run import AccuracyResult, accuracy
+    from .studies.advice.advice_run import Advice, AdviceSearch
+    from .studies.advice.advice_run import advise_scene as advise
+    from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
+    from .studies.calibration.calibration_run import CalibrationResult, calibrate
+    from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
+    from .studies.figures.drill_animation import view_solution, write_animation
+    from .studies.figures.drill_drawing import draw
+    from .studies.pages.reproduction_run import ReproductionResult, reproduce
+    from .studies.pages.rotation_note import RotationReport, rotation_report
+    from .studies.runtime.budgets import Budget, BudgetError
+    from .studies.scan.study import Study
+    from .studies.sensitivity.sensitivity_run import SensitivityResult, sensitivity
+
 
 def __getattr__(name: str) -> Any:
     if name in _LAZY:
         import importlib
 
         module, attribute = _LAZY[name]
-        return getattr(importlib.import_module(f".{module}", __name__), attribute)
+        value = getattr(importlib.import_module(f".{module}", __name__), attribute)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'rpdrill' has no attribute {name!r}")
 
 
@@ -70,8 +97,8 @@ def __dir__() -> list[str]:
     return sorted({*globals(), *_LAZY})
 
 
-__all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult", "Crosscheck", "ExudynModel",
-           "InputError", "ReproductionResult", "Result", "RotationReport", "Scene", "SensitivityResult",
+__all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult", "Crosscheck",
+           "ExudynModel", "InputError", "ReproductionResult", "Result", "RotationReport", "Scene", "SensitivityResult",
            "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck", "draw",
            "load_scene", "load_study", "reproduce", "rotation_report", "run_study", "save_result", "sensitivity",
            "simulate", "table_frame", "view_solution", "write_animation"]

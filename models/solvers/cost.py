@@ -6,7 +6,8 @@ of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2
 + 2 (torsion) + 3 (the constant and the pulse generator) values:
 
 * exudyn: T / ``step_s`` steps (for dopri5 and ode23 ``step_s`` is the largest step: a lower
-  bound); it stores every step when an energy output is asked for, else every
+  bound; a scene with extensions: the step of its built model, sized for the assembled system); it
+  stores every step when an energy output is asked for, else every
   ``output_interval_s``, two values (time, value) per sensor of 2 n + 4;
 * exact: T / h sub-grid points, h the exact solver's own sub-step (models.solvers.exact_system.sub_step:
   the sample interval over ceil(sample interval x ||A_bal||_1)); it stores m + 2 values per
@@ -85,6 +86,21 @@ def _fastest(simulation: Simulation) -> Cause:
     return Cause(simulation.fastest.key, simulation.fastest.value)
 
 
+def _pulse(simulation: Simulation) -> Cause:
+    """The key of the impact pulse's duration (a piston's contact: the piston)."""
+    if simulation.piston is None:
+        return Cause("impact.duration_s", simulation.scene.impact.duration_s)
+    return Cause("impact.piston", f"a contact of {simulation.pulse_duration_s:.3g} s")
+
+
+def _fastest_or_pulse(simulation: Simulation) -> Cause:
+    """The key of the fastest rate of the exact formulation's matrices: the drill's fastest element, or the
+    pulse generator's pi / duration (a half-sine's angular rate) when that is faster (a 1 ns pulse)."""
+    if math.pi / simulation.pulse_duration_s > simulation.fastest.rate_per_s:
+        return _pulse(simulation)
+    return _fastest(simulation)
+
+
 def _rock_damper(simulation: Simulation) -> Cause:
     """The key of the rock damper's rate c_n / m_bit that departs more from the drill's other values."""
     damper = next(e for e in element_rates(simulation.scene, simulation.chain, simulation.rock, simulation.torsion)
@@ -102,16 +118,30 @@ def _interval(simulation: Simulation) -> Cause:
 Part = tuple[Cause, float, float | None]
 
 
+def _extended(simulation: Simulation) -> tuple[Simulation, Cause | None]:
+    """The simulation as the Exudyn model of a scene with extensions sizes it (the step of the assembled
+    system, models.solvers.exudyn_model), and the extensions as the cause when they made it faster."""
+    if not simulation.scene.extensions:
+        return simulation, None
+    from .exudyn_model import build_exudyn  # Exudyn only for a scene with extensions
+
+    sized = build_exudyn(simulation).simulation
+    faster = sized.spectral_radius_per_s > simulation.spectral_radius_per_s * (1 + 1e-9)
+    return sized, Cause("extensions", ", ".join(simulation.scene.extensions)) if faster else None
+
+
 def _exudyn(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
+    simulation, extended = _extended(simulation)
     settings, scene, n = simulation.settings, simulation.scene, simulation.dynamic_chain.size
     step = settings.step_s
     limits = EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].step_limits(simulation.pulse_duration_s,
                                                                           simulation.step_scales)
     if scene.solver.step_s is not None:
         cause = Cause("solver.step_s", step)
+    elif extended is not None and min(limits["stability"], limits["ringing"]) <= step * (1 + 1e-9):
+        cause = extended
     elif math.isclose(step, limits["pulse"]):
-        cause = Cause("impact.duration_s", scene.impact.duration_s) if simulation.piston is None else \
-            Cause("impact.piston", f"a contact of {simulation.pulse_duration_s:.3g} s")
+        cause = _pulse(simulation)
     elif math.isclose(step, limits["damper"]):
         cause = _rock_damper(simulation)
     else:
@@ -132,7 +162,7 @@ def _exact(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     _, _, step = sub_step(simulation, one_period)
     switches = settings.max_switches_per_blow * math.ceil(settings.end_time_s * simulation.impact.frequency_hz)
     keys = len(simulation.rock.modes()) * len(set(one_period))
-    return step, sampled if step == settings.sample_interval_s else _fastest(simulation), [
+    return step, sampled if step == settings.sample_interval_s else _fastest_or_pulse(simulation), [
         (sampled, settings.end_time_s / settings.sample_interval_s * (m + 2), settings.sample_interval_s),
         (Cause("solver.max_switches_per_blow", settings.max_switches_per_blow), 2 * switches * (m + 3), None),
         (Cause("drill_string.bodies", f"{simulation.dynamic_chain.size} lumped bodies"), keys * OPERATOR_VALUES * m**2, None)]

@@ -20,6 +20,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...rocklaw import RockLaw, State
+from ..definition.extensions import record, refusal
+from ..definition.extensions import records as extension_records
 from ..definition.outputs import needs
 from ..definition.scene import (
     BuiltEffects,
@@ -30,12 +32,18 @@ from ..definition.scene import (
     built_effects,
     requested_outputs,
 )
-from ..drill.chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
+from ..drill.chain import (
+    STATIC_CONDITION_LIMIT,
+    AxialChain,
+    axial_chain,
+    static_preload_m,
+    static_torsion_angle_rad,
+)
 from ..drill.indexing import BlowStarts, Indexing
 from ..drill.piston import PistonSetup, piston_setup
 from ..drill.pulse import impulse_per_blow_n_s
 from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_settings
-from ..evaluation.stability import FastestElement, StepScales, fastest_element, step_scales
+from ..evaluation.stability import FastestElement, StepScales, fastest_element, spring_spread, step_scales
 from .dispatch import implementation
 
 if TYPE_CHECKING:
@@ -124,8 +132,23 @@ class Simulation:
     def solve(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
         """Simulate with the scene's formulation (models.solvers.dispatch); ``progress(t)`` as simulated
         time advances. The formulation's own result (``solve``, as ``ExudynModel.solve``); ``rpdrill.simulate``
-        and ``ExudynModel.run`` wrap it into ``rpdrill.Result``."""
+        and ``ExudynModel.run`` wrap it into ``rpdrill.Result``. SceneError naming the extension when the
+        formulation builds no Exudyn model and the scene has an extension that changes the motion
+        (models.definition.extensions)."""
+        refused = refusal(self.scene.extensions, self.settings.formulation)
+        if refused:
+            raise SceneError(("extensions", refused[0]), self.scene.extensions[refused[0]].function, refused[1])
         return implementation(self.settings.formulation).simulate(self, progress)
+
+    def code_records(self) -> dict[str, Any]:
+        """The code of one's own the run imports, as provenance keeps it: every extension (import path,
+        package and version where it has one, the file, its parameters) and a rock law of one's own."""
+        records: dict[str, Any] = {}
+        if self.scene.extensions:
+            records["extensions"] = extension_records(self.scene.extensions)
+        if self.scene.rock.own_law:
+            records["rock_law"] = record(self.scene.rock.law)
+        return records
 
     def resolved_scene(self) -> dict[str, Any]:
         """The scene as run: rock values filled in, the effects built and why, the outputs, and the
@@ -135,6 +158,8 @@ class Simulation:
         data["effects"] = {**self.effects.as_dict(), "reasons": dict(self.effects.reasons)}
         data["outputs"] = self.outputs.model_dump(mode="json")
         data["solver"] = {key: value for key, value in vars(self.settings).items() if value is not None}
+        for name, recorded in self.code_records().get("extensions", {}).items():  # informational (Extension)
+            data["extensions"][name]["recorded"] = {key: value for key, value in recorded.items() if key != "parameters"}
         if self.piston is not None:  # the coupling across the contact as run
             given = self.scene.impact.piston.contact_stiffness_n_per_m
             faces = "rigid faces" if given is None else f"the faces' contact {given:.6g} N/m"
@@ -145,9 +170,25 @@ class Simulation:
 
 
 def unsupported(name: str, simulation: Simulation) -> str | None:
-    """Why formulation ``name`` cannot run ``simulation``, or None if it can."""
+    """Why formulation ``name`` cannot run ``simulation``, or None if it can: an extension that changes the
+    motion of the Exudyn model, or what the formulation's own check says."""
+    refused = refusal(simulation.scene.extensions, name)
+    if refused:
+        return refused[1]
     check = getattr(implementation(name, checks=True), "unsupported", None)
     return check(simulation) if check else None
+
+
+def solver_settings(scene: Scene, piston: PistonSetup | None, scales: StepScales | None) -> Settings:
+    """The settings of the scene's formulation for a drill of these step scales (an Exudyn preset's step
+    follows them; models.evaluation.solver_settings)."""
+    settings = resolve_settings(scene.solver, scene.impact.duration_s if piston is None else piston.pulse_duration_s,
+                                scales)
+    if piston is not None and isinstance(settings, ExudynSettings) and scene.solver.step_s is None:
+        # the strikes fall on step starts: a whole number of steps per period (a strike one step late
+        # shifts the blow against the string's ringing; 2 % in the rate of the top-hammer scene)
+        settings = replace(settings, step_s=scene.impact.period_s / math.ceil(scene.impact.period_s / settings.step_s))
+    return settings
 
 
 def prepare(scene: Scene) -> Simulation:
@@ -169,17 +210,18 @@ def prepare(scene: Scene) -> Simulation:
         raise SceneError(tuple(fastest.key.split(".")), fastest.value,
                          f"with {fastest.other_key} {fastest.other_value:g} the model's fastest rate overflows "
                          f"(k/m or c/m beyond {sys.float_info.max:.3g}); give values of a physical drill")
-    settings = resolve_settings(scene.solver, scene.impact.duration_s if piston is None else piston.pulse_duration_s,
-                                scales)
-    if piston is not None and isinstance(settings, ExudynSettings) and scene.solver.step_s is None:
-        # the strikes fall on step starts: a whole number of steps per period (a strike one step late
-        # shifts the blow against the string's ringing; 2 % in the rate of the top-hammer scene)
-        settings = replace(settings, step_s=scene.impact.period_s / math.ceil(scene.impact.period_s / settings.step_s))
+    settings = solver_settings(scene, piston, scales)
     positions, angle = np.zeros(chain.size), 0.0
     if scene.start == "preloaded":
         try:
             positions = static_preload_m(chain, rock)
         except ValueError as err:
+            key, value, stiffest, softest = spring_spread(scene, chain, rock)
+            if stiffest > STATIC_CONDITION_LIMIT * softest:  # the cause, rather than a body with no rest position
+                raise SceneError(tuple(key.split(".")), value, (
+                    f"a spring of {stiffest:.3g} N/m against the softest one's {softest:.3g} N/m: more than "
+                    f"{STATIC_CONDITION_LIMIT:.0e} apart, the static preload (start: preloaded) cannot be solved in "
+                    "double precision; give the values of a physical drill, or use start: rest")) from None
             raise SceneError(("start",), scene.start, str(err)) from None
         if effects.torsion:
             angle = static_torsion_angle_rad(scene.torsion)

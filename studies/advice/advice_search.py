@@ -59,6 +59,7 @@ from ...models.definition.validation import InputError
 from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
 from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter
+from ..inputs.arguments import check, count_problem, positive_problem, seed_problem
 from ..runtime.evaluation_log import EvaluationLog
 from ..runtime.pools import Runner
 from ..scan.curve_optima import band
@@ -122,6 +123,11 @@ class AdviceSearch:
     max_generations: int = 30
     tolerance: float = 0.01
     seed: int = 1
+
+    def __post_init__(self) -> None:
+        for name, problem in (("popsize", count_problem), ("max_generations", count_problem),
+                              ("tolerance", positive_problem), ("seed", seed_problem)):
+            check("rpdrill.AdviceSearch", name, getattr(self, name), problem)
 
 
 @dataclass(frozen=True)
@@ -191,7 +197,7 @@ def runnable_scene(scene: Scene, rock: str | None, request: Request, source: str
     blows = checked.metrics.transient_blows + checked.metrics.block_blows
     data = checked.with_solver(formulation).with_(
         {"solver.end_time_s": max(checked.solver.end_time_s, blows / request.bounds[FREQUENCY][0])}, source)
-    options = {p.path: p.option for p in PARAMETERS}
+    options = {path: path for path in request.bounds} | {p.path: p.option for p in PARAMETERS}
     for corner in itertools.product(*request.bounds.values()):
         point = dict(zip(request.bounds, corner, strict=True))
         try:

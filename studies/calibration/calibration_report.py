@@ -17,11 +17,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import yaml
 
 from ...models.evaluation.workprecision import non_dominated
 from ..runtime.evaluation_log import Record
-from ..runtime.output_files import write_json, write_rows_csv
+from ..runtime.output_files import write_json, write_resolved, write_rows_csv
 from ..runtime.tables import write_table
 from .calibration_search import SearchResult
 from .calibration_spec import Calibration
@@ -103,7 +102,7 @@ def write_report(directory: Path, calibration: Calibration, result: SearchResult
     """Every output file of a calibration with a best evaluation (module docstring)."""
     best, final = result.best, result.final
     scene = calibration.scene(best["parameters"]).model_dump(mode="json", by_alias=True, exclude_none=True)
-    (directory / "calibrated_scene.yaml").write_text(yaml.safe_dump(scene, sort_keys=False), encoding="utf-8")
+    write_resolved(directory / "calibrated_scene.yaml", scene)
     table = target_table(calibration, final.results)
     write_table(directory / "targets.csv", table, TARGET_FORMATS)
     step = calibration.spec.refine_hz

@@ -318,8 +318,11 @@ def _check_parameters(spec: CalibrationSpec, base: Scene, source: str) -> None:
                                  f"(e.g. {{impact.amplitude_n: {name}}}) or drop it")
             continue
         check_scene_path(source, "parameters", name, base)
-        if not _takes_numbers(field_at(Scene, tuple(name.split("."))).annotation):
-            raise InputError(f"{source}: parameters.{name}: {scene_value(base, name)!r} in the base scene: a scene key "
+        field = field_at(Scene, tuple(name.split(".")))  # None: a parameter of one's own (an extension's)
+        value = scene_value(base, name)
+        numeric = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not (numeric if field is None else _takes_numbers(field.annotation)):
+            raise InputError(f"{source}: parameters.{name}: {value!r} in the base scene: a scene key "
                              "that does not take a real number; a fitted parameter is a key that does")
         if name == FREQUENCY or all(name in target.overrides for target in spec.targets):
             raise InputError(f"{source}: parameters.{name}: every target sets it (the scanned frequency or "

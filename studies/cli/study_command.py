@@ -7,7 +7,8 @@ the budgets before any runs (studies.runtime.budgets). Several studies run on on
 run, each into DIR/<its file name without .yaml>: the workers go from one study's points to the
 next, a point whose scene equals another's runs once (the paper's impulse scan repeats the
 frequency scan at 220 kN), and a study's plots are drawn by the workers once its points are done.
-The exit status is 1 when some point failed. What DIR holds: FILES below.
+The exit status is 1 when some point failed, or no point of a study is usable (its status ok or
+unsettled: models.evaluation.run_status). What DIR holds: FILES below.
 """
 
 from __future__ import annotations
@@ -16,7 +17,9 @@ import argparse
 import sys
 
 from ...models.definition.formulations import FORMULATIONS
+from ...models.evaluation.run_status import STATUSES, USABLE
 from ..api import run_study_files
+from ..inputs.arguments import choice_problem, cli_type
 from ..scan.study_optima import optima_table
 from ..study_runs import StudyRun
 from .options import add_resumable_arguments, budget
@@ -35,7 +38,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.epilog = FILES
     add_resumable_arguments(parser, "study", "study YAML file(s)", many=True)
-    parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
+    parser.add_argument("--formulation", type=cli_type(choice_problem(FORMULATIONS, "formulation")),
+                        metavar="{" + ",".join(FORMULATIONS) + "}",
                         help="run every point with this formulation (default: the scene's solver.formulation)")
 
 
@@ -43,7 +47,7 @@ def report(run: StudyRun) -> None:
     """What a study wrote and its failed points (stderr), its optima table (stdout)."""
     status, out = run.table["status"], run.out
     counts = status.value_counts()
-    kinds = ", ".join(f"{counts[kind]} {kind}" for kind in ("unstable", "unsettled") if kind in counts)
+    kinds = ", ".join(f"{counts[kind]} {kind}" for kind in STATUSES[1:] if kind in counts)
     print(f"{run.study.spec.name}: {counts.get('ok', 0)} points ok, {kinds + ', ' if kinds else ''}"
           f"{counts.get('failed', 0)} failed; wrote "
           f"{out / 'results.csv'}, {out / 'study.json'}, {out / 'optima.csv'}" + "".join(f", {p}" for p in run.plots),
@@ -64,4 +68,8 @@ def run(args: argparse.Namespace) -> int:
                            workers=args.workers, dask=args.dask, quiet=args.quiet)
     for study_run in runs:
         report(study_run)
-    return 1 if any((study_run.table["status"] == "failed").any() for study_run in runs) else 0
+    useless = [study_run.study.source for study_run in runs if not study_run.table["status"].isin(USABLE).any()]
+    for source in useless:
+        print(f"{source}: no point gave figures that stand (status {' or '.join(USABLE)}); nothing to compare: "
+              "see the errors in results.csv", file=sys.stderr)
+    return 1 if useless or any((study_run.table["status"] == "failed").any() for study_run in runs) else 0

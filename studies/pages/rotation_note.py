@@ -28,7 +28,7 @@ from ...models.drill.indexing import Indexing
 from ..display.catalogue import metric
 from ..figures.rotation_map import draw_rotation_map
 from ..inputs.reading import InputError
-from ..runtime.output_files import check_out, staged_directory
+from ..runtime.output_files import check_out, staged_directory, write_atomic
 from ..runtime.tables import read_table
 
 if TYPE_CHECKING:
@@ -51,9 +51,10 @@ def manual_speed_rpm(bit: Bit, frequency_hz: float) -> float:
 
 
 def _rows(results: Path) -> pd.DataFrame:
-    """A study's results table without its failed points (unsettled ones kept: models.evaluation.run_status)."""
+    """A study's results table without its failed points and those without a rate (unsettled ones kept: their
+    values stand; a metric that is not a finite number is empty: models.evaluation.run_status)."""
     table = read_table(results)
-    return table[table["status"] != "failed"]
+    return table[(table["status"] != "failed") & table[RATE].notna()]
 
 
 def _study(run: Path) -> dict:
@@ -210,7 +211,7 @@ def write_report(runs: Path, out: Path, rock: str, made_by: str) -> list[Path]:
     draw_rotation_map(table[table[ROCK] == rock], figure, f"{rock}: {metric(RATE).label()}",
                       lambda f: Indexing(bit, None, f).best_speed_rpm(), lambda f: manual_speed_rpm(bit, f), DRILLED)
     note = out / "rotation.md"
-    note.write_text(render(runs, figure, rock, made_by), encoding="utf-8")
+    write_atomic(note, render(runs, figure, rock, made_by))
     return [note, figure, figure.with_suffix(".svg")]
 
 

@@ -18,14 +18,14 @@ from typing import Any
 from ...models.definition.scene import Scene
 from ...models.definition.validation import short
 from ...models.evaluation.metrics import summary_metrics
-from ...models.evaluation.run_status import run_status
+from ...models.evaluation.run_status import STATUSES, run_status
 from ...models.solvers.simulation import Simulation
 from ..inputs.reading import InputError, prepare_scene
 
 STATUS_COLUMNS = ("status", "error", "wall_time_s")
-# a finished point's status: ok; failed (its error says why); unstable or unsettled (metrics written,
-# but the stability check flags the run, or its blocks have not settled: models.evaluation.metrics)
-FINISHED = ("ok", "failed", "unstable", "unsettled")
+# a finished point's status: ok; failed (its error says why); unstable, unsettled, not_finite or
+# unbalanced (metrics written, but the run's figures do not stand as they are: models.evaluation.run_status)
+FINISHED = ("failed", *STATUSES)
 
 
 def _point_errors(source: str, problems: Sequence[tuple[str, str]], values: Mapping[str, Any]) -> list[str]:
@@ -73,13 +73,14 @@ def point_columns(metrics: Sequence[str]) -> list[str]:
 
 def run_point(simulation: Simulation) -> dict[str, Any]:
     """Run one prepared point into its row (:func:`point_columns`): status (models.evaluation.run_status: ok,
-    unstable or unsettled, the reason in ``error``), wall time and every metric of its outputs; a
-    failure is returned (status ``failed``, the exception in ``error``, no metrics), not raised."""
+    unstable, unsettled, not_finite or unbalanced, the reason in ``error``), wall time and every metric of
+    its outputs; a failure is returned (status ``failed``, the exception in ``error``, no metrics), not
+    raised."""
     start = time.perf_counter()
     try:
         result = simulation.solve()
         metrics = summary_metrics(result)
-        status, why = run_status(result)
+        status, why = run_status(result, metrics)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the analysis goes on
         return {"status": "failed", "error": f"{type(err).__name__}: {err}", "wall_time_s": time.perf_counter() - start}
     return {"status": status, "error": why, "wall_time_s": time.perf_counter() - start, **metrics}

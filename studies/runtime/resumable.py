@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import importlib.metadata
 import json
-import os
 import sys
 import time
 import warnings
@@ -37,10 +36,10 @@ from tqdm import tqdm
 from ..inputs.reading import InputError, short
 from .budgets import duration
 from .interrupts import raise_if_stopped
-from .output_files import write_json
+from .output_files import atomic_file, write_json
 from .point_runs import FINISHED
 from .pools import Runner
-from .tables import append_rows, cell_text, is_number, read_table, read_text, write_header
+from .tables import append_rows, cell_text, is_finite, read_table, read_text, write_rows
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -106,15 +105,33 @@ def provenance(study: ResumableStudy, out: Path, table: str) -> dict[str, Any]:
     fresh = {"study": study.spec.name, "study_file": str(study.source), "hash": study.hash,
              "rpdrill_version": importlib.metadata.version("rpdrill"),
              "exudyn_version": importlib.metadata.version("exudyn"),
-             "points": len(study.points), "resolved_study": study.resolved(), "sessions": [], "point_wall_time_s": {}}
+             "points": len(study.points), "resolved_study": study.resolved(), "sessions": [], "point_wall_time_s": {},
+             **code_records(study.points)}
     return checked_record(out / RECORD, fresh, study.source, [out / table])
+
+
+def code_records(points: Sequence[Any]) -> dict[str, Any]:
+    """The code of one's own the points import (models.solvers.simulation.Simulation.code_records): every
+    extension by name (import path, package and version where it has one, file) and a rock law of one's own,
+    over all points (their parameters left out: the results table holds the scanned ones)."""
+    records: dict[str, Any] = {}
+    for point in points:
+        simulation = getattr(point, "simulation", None)
+        for kind, found in ({} if simulation is None else simulation.code_records()).items():
+            if kind == "extensions":
+                records.setdefault(kind, {}).update({name: {key: value for key, value in record.items()
+                                                            if key != "parameters"} for name, record in found.items()})
+            else:
+                records.setdefault(kind, found)
+    return records
 
 
 def damage(cells: list[str], header: list[str], columns: list[str], points: Sequence[TablePoint],
            text: Sequence[str] = (), formats: Mapping[str, str] | None = None) -> str | None:
     """Why a finished row of a table is not one rpdrill wrote for its point (None: it is): its columns,
     status and point index; its starting values those of the point (in the column's ``formats``); its
-    wall time and every column after it (the metrics) but the ``text`` ones a number, or empty."""
+    wall time and every column after it (the metrics) but the ``text`` ones a finite number, or empty
+    (rpdrill writes a value that is not a finite number as empty: an edited 'inf' is damage)."""
     if header != columns or len(cells) != len(columns):
         return "not the table's columns"
     row = dict(zip(columns, cells, strict=True))
@@ -128,8 +145,8 @@ def damage(cells: list[str], header: list[str], columns: list[str], points: Sequ
             return f"{name} {short(row[name])}: the point's is {short(point.values[name])}"
     numeric = [name for name in columns[columns.index("wall_time_s"):] if name not in text] \
         if "wall_time_s" in columns else []
-    bad = next((name for name in numeric if row[name] != "" and not is_number(row[name])), None)
-    return None if bad is None else f"{bad} {short(row[bad])}: not a number"
+    bad = next((name for name in numeric if row[name] != "" and not is_finite(row[name])), None)
+    return None if bad is None else f"{bad} {short(row[bad])}: not a finite number"
 
 
 def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint], text: Sequence[str] = (),
@@ -150,10 +167,8 @@ def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint], 
         more = f" and {len(damaged) - 3} more" if len(damaged) > 3 else ""
         warnings.warn(f"{path}: {len(damaged)} row(s) damaged or edited, dropped and their points run again "
                       f"({'; '.join(damaged[:3])}{more})", stacklevel=2)
-    temporary = path.with_suffix(".csv.tmp")
-    write_header(temporary, columns)
-    append_rows(temporary, columns, [dict(zip(columns, rows[i], strict=True)) for i in sorted(rows)], {})
-    os.replace(temporary, path)
+    with atomic_file(path) as handle:
+        write_rows(handle, columns, [dict(zip(columns, rows[i], strict=True)) for i in sorted(rows)], {}, header=True)
     return set(rows)
 
 

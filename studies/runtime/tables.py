@@ -2,8 +2,8 @@
 
 A table's file is CSV: a header of column names (units in the names), then one row per point, each
 cell the text of its value (a number as Python writes it, or in its column's format, e.g. a wall time
-to 4 significant digits; an empty cell for a value the point does not have: a failed point's
-metrics). :func:`read_table` reads a file back into the typed table and :func:`typed` gives text cells
+to 4 significant digits; an empty cell for a value the point does not have, a failed point's metrics,
+and for a number that is not finite, its status says why: models.evaluation.run_status). :func:`read_table` reads a file back into the typed table and :func:`typed` gives text cells
 their types: numbers as numbers, text (status, error, a rock's name) as text. Nothing else in rpdrill
 reads a number from text.
 """
@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any
 
 from ..inputs.reading import InputError
+from .output_files import atomic_file
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -25,43 +27,50 @@ TEXT_COLUMNS = ("status", "error")  # text even where every cell reads as a numb
 NOT_A_NUMBER = ("nan", "+nan", "-nan")
 
 
-def cell_text(value: Any, number_format: str | None = None) -> str:
-    """A cell's text: nothing for None, a float in ``number_format`` when given, anything else as
-    ``str`` gives it (a float's shortest text that reads back to it, 'nan' for NaN)."""
-    if value is None:
+def cell_text(value: Any, number_format: str | None = None, finite: bool = True) -> str:
+    """A cell's text: nothing for None (and, ``finite``, for a float that is not finite), a float in
+    ``number_format`` when given, anything else as ``str`` gives it (a float's shortest text that reads
+    back to it; 'nan' for NaN when not ``finite``)."""
+    if value is None or (finite and isinstance(value, float) and not math.isfinite(value)):
         return ""
     if number_format is not None and isinstance(value, float):
         return format(value, number_format)
     return str(value)
 
 
-def text_row(row: Mapping[str, Any], columns: Sequence[str], formats: Mapping[str, str]) -> list[str]:
+def text_row(row: Mapping[str, Any], columns: Sequence[str], formats: Mapping[str, str],
+             finite: bool = True) -> list[str]:
     """A row's cells under ``columns`` (a column the row does not have: empty); ValueError for a value
     of a column the table does not have (it would be lost)."""
     extra = [name for name in row if name not in columns]
     if extra:
         raise ValueError(f"columns {', '.join(extra)} are not columns of the table ({', '.join(columns)})")
-    return [cell_text(row.get(name), formats.get(name)) for name in columns]
+    return [cell_text(row.get(name), formats.get(name), finite) for name in columns]
 
 
-def write_header(path: Path, columns: Sequence[str]) -> None:
-    with path.open("w", newline="", encoding="utf-8") as handle:
-        csv.writer(handle).writerow(columns)
+def write_rows(handle: IO[str], columns: Sequence[str], rows: Sequence[Mapping[str, Any]], formats: Mapping[str, str],
+               header: bool = False, finite: bool = True) -> None:
+    """Rows (column name -> value) as CSV into an open file, the header first when asked."""
+    writer = csv.writer(handle)
+    if header:
+        writer.writerow(columns)
+    writer.writerows(text_row(row, columns, formats, finite) for row in rows)
 
 
 def append_rows(path: Path, columns: Sequence[str], rows: Sequence[Mapping[str, Any]],
                 formats: Mapping[str, str]) -> None:
-    """Append rows (column name -> value) to a table's file, flushed at once."""
+    """Append rows to a results table's file (its header already there), flushed at once."""
     with path.open("a", newline="", encoding="utf-8") as handle:
-        csv.writer(handle).writerows(text_row(row, columns, formats) for row in rows)
+        write_rows(handle, columns, rows, formats)
 
 
 def write_table(path: Path, table: pd.DataFrame, formats: Mapping[str, str] | None = None) -> None:
-    """A table (e.g. an analysis of a results table) as its file: its columns, a row per row, numbers in
-    their column's ``formats`` (else the shortest text that reads back to them, 'nan' for NaN)."""
-    columns = [str(name) for name in table.columns]
-    write_header(path, columns)
-    append_rows(path, columns, table.to_dict("records"), formats or {})
+    """A table (an analysis of a results table) as its file, whole or not at all: its columns, a row per
+    row, numbers in their column's ``formats`` (else the shortest text that reads back to them, 'nan' for
+    NaN: a figure of the analysis, not a point's missing value)."""
+    with atomic_file(path) as handle:
+        write_rows(handle, [str(name) for name in table.columns], table.to_dict("records"), formats or {},
+                   header=True, finite=False)
 
 
 def read_text(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
@@ -70,21 +79,21 @@ def read_text(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     try:
         text = path.read_text(encoding="utf-8") if path.exists() else ""
         lines = list(csv.reader(io.StringIO(text[: text.rfind("\n") + 1], newline="")))
-    except (UnicodeDecodeError, csv.Error) as error:
-        raise InputError(f"--out: {path}: not a results table rpdrill wrote ({error}); use a new --out directory") \
+    except (UnicodeDecodeError, csv.Error, OSError) as error:
+        why = error.strerror if isinstance(error, OSError) and error.strerror else error
+        raise InputError(f"--out: {path}: not a results table rpdrill wrote ({why}); use a new --out directory") \
             from None
     if not lines:
         return [], []
     return lines[0], list(enumerate(lines[1:], 2))
 
 
-def is_number(text: str) -> bool:
-    """Whether a cell's text is a number (NaN and infinities included)."""
+def is_finite(text: str) -> bool:
+    """Whether a cell's text is a finite number."""
     try:
-        float(text)
+        return math.isfinite(float(text))
     except ValueError:
         return False
-    return True
 
 
 def typed(frame: pd.DataFrame, text: Sequence[str] = ()) -> pd.DataFrame:

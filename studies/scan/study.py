@@ -41,9 +41,11 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
+from ...models.definition.formulations import FORMULATIONS
 from ...models.definition.scene import Scene
 from ...models.definition.validation import short
 from ...models.solvers.simulation import Simulation
+from ..inputs.arguments import check, choice_problem, file_problem, instance_problem, optional
 from ..inputs.reading import InputError, parse, read_yaml
 from ..inputs.specs import METRIC_NAMES, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, BudgetError, base_estimate_s, check_size
@@ -190,6 +192,9 @@ def load_study(path: str | Path, formulation: str | None = None, budget: Budget 
     """Read, validate and expand a study file, every point with ``formulation`` when given (the base
     scene's solver options of another formulation dropped) and checked against the ``budget`` before it
     runs; InputError naming the file and key path, BudgetError naming the cost, otherwise."""
+    check("rpdrill.load_study", "path", path, file_problem)
+    check("rpdrill.load_study", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
+    check("rpdrill.load_study", "budget", budget, instance_problem(Budget, "a rpdrill Budget"))
     path = Path(path)
     source = str(path)
     spec = parse(StudySpec, read_yaml(path), source)

@@ -5,7 +5,8 @@ labelled ``scans`` (studies.scan.curves.Scan), the ``rising`` trends, the ``metr
 each scan's metric) and
 
 * one at a time: every numeric value of the scene's drill string, feed, impact (not the scanned
-  frequency) and rock (``parameters: all``), or a listed set of dotted paths, each multiplied by
+  frequency), rock and extensions' parameters (``parameters: all``), or a listed set of dotted paths, each
+  multiplied by
   1 +- ``relative_step`` (0.10) in every scan, after the scan's own overrides (a scan that sets the
   rock still has its rock stiffness changed);
 * optionally ``global``: SALib's Morris screening (``method: morris``, ``samples`` trajectories) or
@@ -43,7 +44,7 @@ from ..scan.curves import Curve, Scan, rising_shortfalls, run_curve
 if TYPE_CHECKING:
     import pandas as pd
 
-SECTIONS = ("drill_string", "feed", "impact", "rock")
+SECTIONS = ("drill_string", "feed", "impact", "rock", "extensions")
 NOT_VARIED = (FREQUENCY, "segments")  # the scanned axis and counts
 NOMINAL = "nominal"
 CHANGE_FORMAT = "+.3g"  # a variation's relative change as the tables write it
@@ -148,8 +149,9 @@ def varied_scene(base: Scene, overrides: dict[str, Any], factors: dict[str, floa
 
 
 def scene_values(scene: Scene) -> dict[str, float]:
-    """Every numeric value a scene sets in its drill string, feed, impact and rock (the rock's Table 1
-    values filled in), by dotted path; values at their defaults are left out (nothing to vary)."""
+    """Every numeric value a scene sets in its drill string, feed, impact, rock (the rock's Table 1
+    values filled in) and its extensions' parameters, by dotted path; values at their defaults are left out
+    (nothing to vary)."""
     data = scene.model_dump(mode="json", by_alias=True, exclude_defaults=True)
     data["rock"] = scene.rock.completed().model_dump(mode="json", exclude_defaults=True)
     values: dict[str, float] = {}
