@@ -183,16 +183,28 @@ def test_advise_bad_bounds_exit_2(tmp_path, capsys, arguments, expected):
 
 
 def test_the_library_call_gives_the_commands_advice(tmp_path):
-    """rpdrill.advise with the bounds in SI units: the advice the command writes for the same inputs;
-    a bound the search does not take is an InputError naming it and what is allowed."""
+    """rpdrill.advise with the bounds in SI units: the advice and the files the command writes for the same
+    inputs (``out``; a rerun there replays every point); a bound the search does not take is an InputError naming it and what is allowed."""
     scene = write_scene(tmp_path)
     out = tmp_path / "out"
     assert main(["advise", scene, "--frequency-hz", "45", "70", "--feed-kn", "35", "60", "--popsize", "3",
                  "--generations", "2", "--out", str(out), "--workers", "1", "--quiet"]) == 0
     (advice,) = rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (35e3, 60e3)},
-                               search=rpdrill.AdviceSearch(popsize=3, max_generations=2), workers=1)
-    written = json.loads((out / "advice.json").read_text())["results"][0]
-    assert advice.best == written["best"] and advice.best_value == written["best_value"]
+                               search=rpdrill.AdviceSearch(popsize=3, max_generations=2), workers=1,
+                               out=tmp_path / "library", markdown=tmp_path / "advice.md")
+    written = json.loads((out / "advice.json").read_text())
+    assert advice.best == written["results"][0]["best"] and advice.best_value == written["results"][0]["best_value"]
+    library = json.loads((tmp_path / "library" / "advice.json").read_text())
+    assert library["command"].startswith(f"rpdrill.advise({scene!r}, ")
+    same = {"wall_time_s": None}  # (the runs' wall time differs)
+    assert [r | same for r in library["results"]] == [r | same for r in written["results"]]
+    assert sorted(p.name for p in (tmp_path / "library").iterdir()) == sorted(p.name for p in out.iterdir())
+    markdown = (tmp_path / "advice.md").read_text()
+    assert markdown == (tmp_path / "library" / "advice.md").read_text() and "rpdrill.advise(" in markdown
+    (again,) = rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (35e3, 60e3)},
+                              search=rpdrill.AdviceSearch(popsize=3, max_generations=2), workers=1,
+                              out=tmp_path / "library")
+    assert again.replayed == again.runs == advice.runs and again.best == advice.best
     with pytest.raises(rpdrill.InputError, match="'rock.threshold_n': not a parameter advise searches; allowed: "
                                                  "impact.frequency_hz, feed.force_n, impact.amplitude_n"):
         rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (35e3, 60e3),
