@@ -18,6 +18,17 @@ from typing import TYPE_CHECKING, Any
 
 from ...models.evaluation.workprecision import Signature
 from ..figures.workprecision_figure import plot_workprecision
+from ..inputs.arguments import (
+    boolean_problem,
+    check,
+    dask_problem,
+    either,
+    file_problem,
+    folder_problem,
+    instance_problem,
+    optional,
+    workers_problem,
+)
 from ..runtime.budgets import DEFAULT_BUDGET, Budget
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import check_out, write_json
@@ -42,6 +53,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
 TABLE = "workprecision.csv"
+WHERE = "rpdrill.accuracy"
 
 
 class ReferenceFailed(RuntimeError):
@@ -88,12 +100,19 @@ def accuracy(study: AccuracyStudy | str | Path, workers: int | None = None, out:
     or a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (resumable: module doc) or a
     scratch folder. InputError or BudgetError before anything runs, ReferenceFailed when a reference
     run fails; ``quiet``: no progress bar."""
+    check(WHERE, "study", study,
+          either(file_problem, instance_problem(AccuracyStudy, "a work-precision study file's path or its loaded study")))
+    check(WHERE, "workers", workers, optional(workers_problem))
+    check(WHERE, "out", out, optional(folder_problem))
+    check(WHERE, "dask", dask, dask_problem)
+    check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
+    check(WHERE, "quiet", quiet, boolean_problem)
     folder = None if out is None else check_out(out, None, RECORD)
     if not isinstance(study, AccuracyStudy):
         study = load_accuracy_study(study, budget)
     wall: dict[str, float] = {}
     reference = _reference(study, study.reference, "reference", wall)
-    check = _reference(study, study.reference_check, "reference check", wall)
+    second = _reference(study, study.reference_check, "reference check", wall)
     spec = study.spec
     with tempfile.TemporaryDirectory(prefix="rpdrill-accuracy-") as scratch, pool(dask, workers) as runner:
         table = run_points(Table(study, folder or Path(scratch), TABLE, COLUMNS,
@@ -101,7 +120,7 @@ def accuracy(study: AccuracyStudy | str | Path, workers: int | None = None, out:
                                  run_setting, lambda point, outcome: outcome_row(study, reference, point, outcome),
                                  formats=FORMATS, text=TEXT), runner, quiet)
     front = pareto_rows(table)
-    report = reference_report(study, reference, check, table)
+    report = reference_report(study, reference, second, table)
     figures = []
     if folder is not None:
         write_table(folder / "pareto.csv", front, {**FORMATS, "error": ".6g"})

@@ -20,6 +20,17 @@ from typing import Any
 from tqdm import tqdm
 
 from ...models.definition.scene import Scene
+from ..inputs.arguments import (
+    boolean_problem,
+    check,
+    dask_problem,
+    either,
+    file_problem,
+    folder_problem,
+    instance_problem,
+    optional,
+    workers_problem,
+)
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, duration
 from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog, Record
 from ..runtime.output_files import check_out, staged_directory
@@ -27,6 +38,8 @@ from ..runtime.pools import pool
 from .calibration_report import write_report
 from .calibration_search import FinalScan, search_calibration
 from .calibration_spec import Calibration, load_calibration
+
+WHERE = "rpdrill.calibrate"
 
 
 @dataclass(frozen=True)
@@ -67,6 +80,14 @@ def calibrate(calibration: Calibration | str | Path, workers: int | None = None,
     folder holding anything else, or another calibration, is refused unless ``overwrite``, which starts
     afresh there) or a scratch folder. InputError or BudgetError before anything runs; ``quiet``: no
     progress bar. An ``out`` that was new is removed again when no evaluation has a best (nothing to keep)."""
+    check(WHERE, "calibration", calibration,
+          either(file_problem, instance_problem(Calibration, "a calibration file's path or its loaded Calibration")))
+    check(WHERE, "workers", workers, optional(workers_problem))
+    check(WHERE, "out", out, optional(folder_problem))
+    check(WHERE, "dask", dask, dask_problem)
+    check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
+    check(WHERE, "overwrite", overwrite, boolean_problem)
+    check(WHERE, "quiet", quiet, boolean_problem)
     folder = None if out is None else check_out(out, overwrite, CHECKPOINT)
     if not isinstance(calibration, Calibration):
         calibration = load_calibration(calibration, budget)

@@ -24,6 +24,15 @@ from typing import Any
 
 from ..calibration.calibration_spec import load_calibration
 from ..figures.paper_figures import draw_figure
+from ..inputs.arguments import (
+    boolean_problem,
+    check,
+    dask_problem,
+    file_problem,
+    folder_problem,
+    optional,
+    workers_problem,
+)
 from ..inputs.reading import InputError
 from ..reproduction.paper_reproduction import (
     CaseResult,
@@ -117,6 +126,13 @@ def reproduce(reproduction: str | Path = DEFAULT, out: str | Path | None = None,
     ``--out`` folders of ``rpdrill calibrate`` and ``rpdrill sensitivity`` for parameters.md and
     sensitivity.md. ``out`` must be new, empty or an earlier reproduction's (``overwrite``: any folder).
     InputError before anything runs."""
+    where = "rpdrill.reproduce"
+    check(where, "reproduction", reproduction, file_problem)
+    for name, value in (("out", out), ("calibration", calibration), ("sensitivity", sensitivity), ("docs", docs)):
+        check(where, name, value, optional(folder_problem))
+    check(where, "workers", workers, optional(workers_problem))
+    check(where, "dask", dask, dask_problem)
+    check(where, "overwrite", overwrite, boolean_problem)
     file = Path(reproduction)
     folder = None if out is None else check_out(out, overwrite, "reproduction.json")
     docs_folder = None if docs is None else check_out(docs, True, option="--docs")

@@ -27,6 +27,7 @@ from ...models.definition.scene import Bit
 from ...models.drill.indexing import Indexing
 from ..display.catalogue import metric
 from ..figures.rotation_map import draw_rotation_map
+from ..inputs.arguments import boolean_problem, check, folder_problem, instance_problem, optional
 from ..inputs.reading import InputError
 from ..runtime.output_files import check_out, staged_directory, write_atomic
 from ..runtime.tables import read_table
@@ -235,6 +236,12 @@ def rotation_report(runs: str | Path, out: str | Path | None = None, rock: str =
     before anything is written when a study's results or the rock are missing."""
     import pandas as pd
 
+    where = "rpdrill.rotation_report"
+    check(where, "runs", runs, folder_problem)
+    check(where, "out", out, optional(folder_problem))
+    check(where, "rock", rock, instance_problem(str, "a rock's name (text)"))
+    check(where, "docs", docs, optional(folder_problem))
+    check(where, "overwrite", overwrite, boolean_problem)
     runs = Path(runs)
     folder = None if out is None else check_out(out, overwrite, "rotation.md")
     docs_folder = None if docs is None else check_out(docs, True, option="--docs")

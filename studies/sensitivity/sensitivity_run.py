@@ -15,6 +15,17 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..figures.tornado_figures import draw_tornados
+from ..inputs.arguments import (
+    boolean_problem,
+    check,
+    dask_problem,
+    either,
+    file_problem,
+    folder_problem,
+    instance_problem,
+    optional,
+    workers_problem,
+)
 from ..runtime.budgets import DEFAULT_BUDGET, Budget
 from ..runtime.output_files import check_out, write_json
 from ..runtime.pools import pool
@@ -37,6 +48,9 @@ from .sensitivity_study import (
 
 if TYPE_CHECKING:
     import pandas as pd
+
+
+WHERE = "rpdrill.sensitivity"
 
 
 @dataclass(frozen=True)
@@ -66,6 +80,13 @@ def sensitivity(study: SensitivityStudy | str | Path, workers: int | None = None
     """Run a sensitivity study (or file) on ``workers`` processes (default all cores; 1: in this process) or
     a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (resumable: module doc) or a
     scratch folder. InputError or BudgetError before anything runs; ``quiet``: no progress bar."""
+    check(WHERE, "study", study,
+          either(file_problem, instance_problem(SensitivityStudy, "a sensitivity file's path or its loaded study")))
+    check(WHERE, "workers", workers, optional(workers_problem))
+    check(WHERE, "out", out, optional(folder_problem))
+    check(WHERE, "dask", dask, dask_problem)
+    check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
+    check(WHERE, "quiet", quiet, boolean_problem)
     folder = None if out is None else check_out(out, None, RECORD)
     if not isinstance(study, SensitivityStudy):
         study = load_sensitivity(study, budget)
