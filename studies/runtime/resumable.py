@@ -39,7 +39,7 @@ from .interrupts import raise_if_stopped
 from .output_files import write_json
 from .pools import Runner
 
-STATUS_COLUMNS = ("status", "error", "wall_time_s")
+STATUS_COLUMNS = ("status", "error", "steady_state", "regime", "wall_time_s", "period_blows", "floquet_max_abs")
 # a finished point's status: ok; failed (its error says why); unstable or unsettled (metrics written,
 # but the stability check flags the run, or its blocks have not settled: models.evaluation.metrics)
 FINISHED = ("ok", "failed", "unstable", "unsettled")
@@ -173,7 +173,9 @@ def read_rows(path: Path) -> list[Row]:
 def result_row(point: TablePoint, outcome: dict[str, Any]) -> dict[str, Any]:
     """A table row: the point, its parameters, status, error, wall time and the outcome's metrics."""
     return {"point": point.index, **point.parameters, "status": outcome["status"], "error": outcome["error"],
-            "wall_time_s": f"{outcome['wall_time_s']:.4g}", **outcome["metrics"]}
+            "steady_state": outcome.get("steady_state", ""), "regime": outcome.get("regime", ""),
+            "wall_time_s": f"{outcome['wall_time_s']:.4g}", "period_blows": outcome.get("period_blows"),
+            "floquet_max_abs": outcome.get("floquet_max_abs"), **outcome["metrics"]}
 
 
 @dataclass

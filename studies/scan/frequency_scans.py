@@ -22,9 +22,10 @@ from typing import Any
 from pydantic import Field
 
 from ...models.drill.modal import rock_mode_frequency_hz
+from ...models.steady.continuation import Continuation, branch_point
 from ..inputs.reading import InputError
 from ..inputs.specs import MetricName, StrictSpec, set_path
-from ..runtime.point_runs import prepare_point, run_point
+from ..runtime.point_runs import prepare_point, run_prepared
 from ..runtime.pools import Runner
 from .curve_optima import curve_optimum
 
@@ -62,6 +63,7 @@ def scan_target(task: ScanTask) -> dict[str, Any]:
     start = time.process_time()
     values: dict[str, list[float]] = {metric: [] for metric in metrics}
     errors, resonance = [], None
+    branch = Continuation()  # solver.steady_state periodic: each orbit from its neighbours' (models.steady)
     for frequency in frequencies:
         try:
             simulation = prepare_point("frequency scan", scan_scene(scene, frequency, metrics), {})
@@ -69,7 +71,9 @@ def scan_target(task: ScanTask) -> dict[str, Any]:
             outcome = {"status": "failed", "error": str(error), "metrics": {}}
         else:
             resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock) or None
-            outcome = run_point((key, simulation))
+            outcome, result = run_prepared(key, simulation, branch.guess(frequency), branch.cold_newton)
+            if result is not None:
+                branch.add(branch_point(frequency, result.info, math.nan))
         for metric in metrics:
             values[metric].append(outcome["metrics"].get(metric, math.nan))
         if outcome["status"] == "failed":  # (an unsettled or unstable run has its values: models.evaluation.run_status)
