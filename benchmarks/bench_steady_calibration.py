@@ -8,7 +8,7 @@ Usage:
 absolute, ``search.max_generations`` set to N - 1 when given: N generations counting the initial
 population; VARIANT ``periodic`` adds ``solver.steady_state: periodic`` to ``base_overrides``) and runs
 ``rpdrill calibrate`` on it into ``DIR/VARIANT``; a larger N continues an earlier run (the calibration's
-budget keys do not change what it has recorded). ``report`` prints, per variant, the evaluations, the
+budget keys do not change what it has recorded). ``report`` (``--generations N``: of the first N generations) prints, per variant, the evaluations, the
 simulation CPU seconds the evaluations recorded (the workers' own process time, summed), the best objective
 after each generation, and the ratios between the variants. Run each variant once, in the background
 (``nohup ... &``); the machine is shared, so the CPU seconds are the workers' own, not wall time.
@@ -52,11 +52,13 @@ def records(folder: Path) -> list[dict]:
     return [row for row in rows if "objective" in row]
 
 
-def report(out: Path) -> None:
+def report(out: Path, generations: int | None) -> None:
     population = None
     summary = {}
     for variant in VARIANTS:
         rows = records(out / variant)
+        if rows and generations is not None:  # the same number of evaluations of each variant
+            rows = rows[:generations * 8 * len(rows[0]["unit"])]
         if not rows:
             print(f"{variant}: no evaluations in {out / variant}")
             continue
@@ -86,7 +88,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
     if args.action == "report":
-        report(args.out)
+        report(args.out, args.generations)
         return
     if args.variant is None:
         parser.error("run needs a VARIANT")

@@ -11,6 +11,7 @@ bifurcations read from a branch.
 
 from __future__ import annotations
 
+import csv
 from pathlib import Path
 
 import numpy as np
@@ -204,3 +205,40 @@ metrics: [penetration_rate_m_per_s]
     table = rpdrill.run_study(study, workers=1)
     assert list(table["regime"]) == ["period-1", "period-1"] and list(table["steady_state"]) == ["periodic"] * 2
     assert list(table["period_blows"]) == [1, 1] and ((table["floquet_max_abs"] > 0) & (table["floquet_max_abs"] < 1)).all()
+
+
+def test_a_continuation_study_follows_its_axis_both_ways_and_writes_what_changed(tmp_path):
+    study = tmp_path / "study.yaml"
+    drill = Path(__file__).resolve().parent / "test_drill.yaml"
+    study.write_text(f"""name: doubling
+base_scene: {drill}
+base_overrides: {{solver: {{formulation: exact, end_time_s: 1.5}}, impact.amplitude_n: 400.0e+3,
+                 drill_string.connectors.shock_absorber.damping_n_s_per_m: 2.0e+3}}
+scan:
+  impact.frequency_hz: [27.5, 28.0, 28.5, 29.5]
+steady_state: continuation
+metrics: [penetration_rate_m_per_s]
+""", encoding="utf-8")
+    out = tmp_path / "out"
+    table = rpdrill.run_study(study, workers=1, out=out)
+    assert list(table["regime"])[1:] == ["period-2", "period-2", "period-1"]  # up the axis
+    assert set(table["steady_state"]) == {"periodic"}
+    passes = rpdrill.table_frame(list(csv.DictReader((out / "continuation.csv").open())))
+    assert list(passes["regime_down"])[1:3] == ["period-2", "period-2"] and len(passes) == 4
+    changed = list(csv.DictReader((out / "bifurcations.csv").open()))
+    assert any(row["kind"] == "period doubling" and row["impact.frequency_hz_from"] == "28.5" for row in changed)
+    with pytest.raises(rpdrill.InputError, match="continuation_axis: 'rock.threshold_n': not a scan axis"):
+        study.write_text(study.read_text() + "continuation_axis: rock.threshold_n\n")
+        rpdrill.load_study(study)
+
+
+def test_the_bifurcation_diagram_draws_time_runs_and_orbits(tmp_path):
+    from rpdrill.studies.figures.bifurcation_figure import plot_bifurcation
+    from rpdrill.studies.scan.bifurcation_diagram import bifurcation_data
+
+    data = bifurcation_data(scene().with_solver("exact").with_({**PERIOD_DOUBLING}), "impact.frequency_hz",
+                            [28.0, 28.5], settle_blows=60, last_blows=10)
+    assert [f.regime for f in data.up] == ["period-2", "period-2"] and len(data.brute_force[0].advance_m) == 10
+    assert len(data.up[0].advance_m) == 2 and data.up[0].advance_m[0] * data.up[0].advance_m[1] == 0
+    written = plot_bifurcation(data, tmp_path / "diagram.png", "test")
+    assert all(path.stat().st_size > 0 for path in written)
