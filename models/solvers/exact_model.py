@@ -255,15 +255,16 @@ class ExactSolver:
                                    len(self.model.pieces[0].table) * len(set(self.phases)),
                                    "energy" in simulation.needed_data)
 
-    def with_frequency(self, simulation: Simulation) -> ExactSolver:
+    def with_frequency(self, simulation: Simulation, end_time_s: float | None = None) -> ExactSolver:
         """This solver for ``simulation``, whose scene differs from its own in the impact frequency only:
         the matrices, the sub-step and the operators built do not depend on it (the pulse's shape,
-        amplitude and duration do), so a frequency scan builds them once (models.steady)."""
+        amplitude and duration do), so a frequency scan builds them once (models.steady); it runs to
+        ``end_time_s`` (default the simulation's end time)."""
         twin = copy.copy(self)
         twin.simulation, twin.impact = simulation, simulation.impact
         twin.blows = simulation.blow_starts()
         twin.piston = None if simulation.piston is None else PistonJumps(simulation.piston)
-        twin.retime(simulation.settings.end_time_s)
+        twin.retime(simulation.settings.end_time_s if end_time_s is None else end_time_s)
         return twin
 
     def retime(self, end_time_s: float) -> None:

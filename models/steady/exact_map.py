@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..definition.scene import Metrics, Scene
 from ..drill.piston import PistonJumps
 from ..drill.pulse import PHASES
 from ..evaluation.results import SimulationResult
@@ -58,7 +57,8 @@ class ExactPeriodMap:
         self.period_s = simulation.impact.period_s
         self.section: Section = section_of(simulation)
         if shared is not None:  # one solver, its operators and the matrices for maps of any length
-            self.solver = shared.solver if shared.simulation is simulation else shared.solver.with_frequency(simulation)
+            self.solver = shared.solver if shared.simulation is simulation else \
+                shared.solver.with_frequency(simulation, periods * self.period_s)
             self._matrices, self._modes, self._series, self._switches, self._blocks = (
                 shared._matrices, shared._modes, shared._series, shared._switches, shared._blocks)
         else:
@@ -76,13 +76,15 @@ class ExactPeriodMap:
         return ExactPeriodMap(self.simulation, periods, shared=self)
 
     def result(self, y0: np.ndarray, blows: int, cpu_start: float,
-               jacobian: bool = True) -> tuple[SimulationResult, np.ndarray | None]:
+               jacobian: bool = True) -> tuple[SimulationResult, MapRun]:
         """The scene's result of a run of ``blows`` periods from y0 (models.steady.map_runs.started_at: the
-        metrics' window those blows), by this map's solver, and with ``jacobian`` dY/dy0 of that run (None
-        where not asked for or not exact)."""
+        metrics' window those blows), by this map's solver, and that run as a map run (its end state, and with
+        ``jacobian`` dY/dy0 where exact)."""
         ran = self._run(y0, blows)
         monodromy = self._monodromy(*ran[:2]) if jacobian and self.has_exact_jacobian else None
-        return solver_result(self.solver, started_at(self.simulation, y0, blows), cpu_start, ran=ran), monodromy
+        end = physical_state(self.simulation, ran[1][-1, :self.solver.layout.size])
+        result = solver_result(self.solver, started_at(self.simulation, y0, blows), cpu_start, ran=ran)
+        return result, MapRun(end, monodromy, ())
 
     def _run_setup(self, blows: int) -> None:
         """The solver set for a run of ``blows`` periods (fresh blow-start trackers: it starts at a blow)."""
@@ -215,23 +217,26 @@ class ExactPeriodMap:
         return physical_state(simulation, product)
 
 
-_LAST: list[tuple[Scene, ExactPeriodMap]] = []  # the last scene's map, by its scene without the frequency
+_LAST: list[tuple[tuple, ExactPeriodMap]] = []  # the last map made in this process, by what its operators depend on
 
 
-def _frequency_free(scene: Scene) -> Scene:
-    """The scene with its frequency, end time and averaging window set aside (what the operators do not
-    depend on)."""
-    return scene.model_copy(update={"impact": scene.impact.model_copy(update={"frequency_hz": 1.0}),
-                                    "solver": scene.solver.model_copy(update={"end_time_s": 1.0}),
-                                    "metrics": Metrics()})
+def _operators_key(simulation: Simulation) -> tuple:
+    """What the exact solver's matrices, sub-step and operators depend on: all but the impact frequency, the
+    end time and the start (the chain with a piston's bodies, the rock law as built, the torsion line, the
+    pulse's amplitude, shape and duration, the settings, the data recorded, the piston, the indexing)."""
+    impact, settings = simulation.impact, simulation.settings
+    return (simulation.dynamic_chain, simulation.rock, simulation.torsion,
+            (impact.amplitude_n, impact.shape, impact.duration_s, impact.piston),
+            tuple(value for name, value in vars(settings).items() if name != "end_time_s"), simulation.outputs,
+            simulation.piston, simulation.indexing)
 
 
 def exact_period_map(simulation: Simulation, periods: int = 1) -> ExactPeriodMap:
     """The exact n-blow map of ``simulation``; on the solver of the last map made in this process when the
-    two scenes differ in the impact frequency only (ExactSolver.with_frequency: the next point of a
-    frequency scan reuses the operators)."""
-    key = _frequency_free(simulation.scene)
-    if _LAST and _LAST[0][0] == key and _LAST[0][1].simulation.outputs == simulation.outputs:
+    two differ in the impact frequency only (ExactSolver.with_frequency: the next point of a frequency scan
+    reuses the operators)."""
+    key = _operators_key(simulation)
+    if _LAST and _LAST[0][0] == key:
         made = ExactPeriodMap(simulation, periods, shared=_LAST[0][1])
     else:
         made = ExactPeriodMap(simulation, periods)

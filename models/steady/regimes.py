@@ -226,20 +226,21 @@ class RegimeFinder:
         return SteadyState(regime, orbit, tuple(self.unstable), note, self.runs, time.process_time() - start,
                            None if guide is None else guide.orbit)
 
-    def result(self, orbit: Orbit, cpu_start: float) -> tuple[SimulationResult, Orbit]:
+    def result(self, orbit: Orbit, cpu_start: float) -> tuple[SimulationResult, Orbit, np.ndarray]:
         """The scene's run over the orbit (models.steady.map_runs.started_at), by the map's own solver where
-        it is the exact formulation's, and the orbit, with the multipliers of that run's exact Jacobian where
-        its own are near the unit circle."""
+        it is the exact formulation's; the orbit, with the multipliers of that run's exact Jacobian where its
+        own are near the unit circle; the run's end state y."""
         periodic = self.map(orbit.periods)
         if isinstance(periodic, ExactPeriodMap):
             # an updated Jacobian's multipliers (measured within 1e-6 of the exact |mu|max on the paper scans)
             # decide unless they lie within STABILITY_MARGIN of the unit circle
             near = orbit.jacobian != "exact" and abs(orbit.floquet_max_abs - 1.0) < STABILITY_MARGIN
-            result, monodromy = periodic.result(orbit.state, orbit.periods, cpu_start, jacobian=near)
-            if monodromy is not None:
-                orbit = orbit.with_jacobian(self.section.jacobian(monodromy), "exact")
-            return result, orbit
-        return started_at(self.simulation, orbit.state, orbit.periods).run(), orbit
+            result, ran = periodic.result(orbit.state, orbit.periods, cpu_start, jacobian=near)
+            if ran.monodromy is not None:
+                orbit = orbit.with_jacobian(self.section.jacobian(ran.monodromy), "exact")
+            return result, orbit, ran.end_state
+        result = started_at(self.simulation, orbit.state, orbit.periods).run()
+        return result, orbit, end_state(result)
 
     def _why_none(self) -> str:
         distance = getattr(self, "distance", None)

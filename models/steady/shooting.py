@@ -108,19 +108,23 @@ class Orbit:
 
 
 def scales(simulation: Simulation, section: Section, z: np.ndarray) -> np.ndarray:
-    """s_i = max(|z_i|, floor): lengths the rock's crushing penetration (F_th / k_n; else 1e-4 m), velocities
-    that length x 2 pi f, other rock states (forces) the threshold, the torsion angle 1e-3 rad and its rate
-    1e-3 rad x 2 pi f."""
+    """s_i = max(|z_i|, floor_i) (:func:`floors`)."""
+    return np.maximum(np.abs(z), floors(simulation, section))
+
+
+def floors(simulation: Simulation, section: Section) -> np.ndarray:
+    """The floor of each section coordinate's scale: lengths the rock's crushing penetration (F_th / k_n;
+    else 1e-4 m), velocities that length x 2 pi f, other rock states (forces) the threshold, the torsion
+    angle 1e-3 rad and its rate 1e-3 rad x 2 pi f."""
     rock = simulation.rock
     length = rock.crushing_penetration_m if 0.0 < rock.crushing_penetration_m < math.inf else 1e-4
     omega = 2.0 * math.pi * simulation.impact.frequency_hz
     threshold = rock.threshold_n if math.isfinite(rock.threshold_n) else 1e5
     n = section.bodies
-    floors = [length] * n + [length * omega] * n
-    floors += [length if shift else threshold for shift in section.shift[2 * n:2 * n + section.rock_states]]
-    floors += [1e-3, 1e-3 * omega] if section.torsion else []
-    floor = np.delete(np.array(floors), section.bottom)
-    return np.maximum(np.abs(z), floor)
+    values = [length] * n + [length * omega] * n
+    values += [length if shift else threshold for shift in section.shift[2 * n:2 * n + section.rock_states]]
+    values += [1e-3, 1e-3 * omega] if section.torsion else []
+    return np.array(values)[section.kept]
 
 
 def _eigenvalues(jacobian: np.ndarray) -> np.ndarray:
@@ -136,6 +140,7 @@ class Shooter:
                  jacobian_of: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
         self.map, self.simulation, self.jacobian_of = period_map, simulation, jacobian_of
         self.section = period_map.section
+        self.floor = floors(simulation, self.section)
         self.runs = 0
 
     @property
@@ -184,7 +189,7 @@ class Shooter:
             raise NoConvergence(f"the guess does not run: {err}") from None
         jacobian, before, bottom_row, source, stalled = None, None, None, self.jacobian_source, 0
         for iteration in range(1, max_iterations + 1):
-            scale = scales(self.simulation, section, z)
+            scale = np.maximum(np.abs(z), self.floor)
             residual = image - z
             if run.monodromy is not None or jacobian is None or before is None:
                 jacobian = self.jacobian(z, image, run, scale)
@@ -217,7 +222,7 @@ class Shooter:
                     step = step / 2
                     halved += 1
                     continue
-                if np.max(np.abs(trial_image - trial) / scales(self.simulation, section, trial)) <= residual_size:
+                if np.max(np.abs(trial_image - trial) / np.maximum(np.abs(trial), self.floor)) <= residual_size:
                     break
                 step = step / 2
                 halved += 1

@@ -28,7 +28,6 @@ import numpy as np
 
 from ..evaluation.results import SimulationResult
 from ..solvers.simulation import Simulation
-from .map_runs import end_state
 from .section import section_of
 from .shooting import Orbit, scales
 from .steady_state import NONE_FOUND, SteadyState
@@ -89,7 +88,7 @@ def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
     except SteadyStateUnavailable as why:
         state = SteadyState(NONE_FOUND, None, note=str(why))
     if state.orbit is not None and finder is not None:
-        result, orbit = finder.result(state.orbit, start)
+        result, orbit, end = finder.result(state.orbit, start)
         if orbit.stable:
             state = replace(state, orbit=orbit)
         else:  # the exact multipliers of the run over it put it outside: not the drill's rate
@@ -102,13 +101,13 @@ def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
     result.cpu_time_s = time.process_time() - start
     result.info.update(steady_state="periodic", **orbit_info(state))
     if state.orbit is not None:
-        result.info["orbit_residual"] = orbit_residual(simulation, state.orbit, result)
+        result.info["orbit_residual"] = orbit_residual(simulation, state.orbit, end)
     return result
 
 
-def orbit_residual(simulation: Simulation, orbit: Orbit, result: SimulationResult) -> float:
-    """max_i |z_i(end) - z_i(start)| / s_i of the run over the orbit (models.steady.shooting.scales): how
-    closely the run from the orbit's state returns to it."""
+def orbit_residual(simulation: Simulation, orbit: Orbit, end: np.ndarray) -> float:
+    """max_i |z_i(end) - z_i(start)| / s_i of the run over the orbit ending in ``end`` (models.steady.shooting
+    .scales): how closely the run from the orbit's state returns to it."""
     section = section_of(simulation)
-    start, end = section.reduce(orbit.state)[0], section.reduce(end_state(result))[0]
-    return float(np.max(np.abs(end - start) / scales(simulation, section, start)))
+    start = section.reduce(orbit.state)[0]
+    return float(np.max(np.abs(section.reduce(end)[0] - start) / scales(simulation, section, start)))

@@ -11,7 +11,6 @@ optima must follow (the paper's 3.1 b: the optimum rises with the impulse).
 
 from __future__ import annotations
 
-import copy
 import itertools
 import json
 import math
@@ -24,7 +23,7 @@ from pydantic import Field
 from ...models.drill.modal import rock_mode_frequency_hz
 from ...models.steady.continuation import Continuation, branch_point
 from ..inputs.reading import InputError
-from ..inputs.specs import MetricName, StrictSpec, set_path
+from ..inputs.specs import MetricName, StrictSpec
 from ..runtime.point_runs import prepare_point, run_prepared
 from ..runtime.pools import Runner
 from .curve_optima import curve_optimum
@@ -45,9 +44,10 @@ class Scan(StrictSpec):
 
 
 def set_frequency(scene: dict[str, Any], frequency_hz: float) -> dict[str, Any]:
-    point = copy.deepcopy(scene)
-    set_path(point, FREQUENCY, frequency_hz)
-    return point
+    """``scene`` at ``frequency_hz``: a new mapping and ``impact`` section, the other sections shared with
+    ``scene`` (nothing changes them: a point is validated into a new Scene), so that a scan of many points
+    does not copy the whole scene for each."""
+    return {**scene, "impact": {**scene.get("impact", {}), FREQUENCY.split(".")[1]: frequency_hz}}
 
 
 def scan_scene(scene: dict[str, Any], frequency_hz: float, metrics: Sequence[str]) -> dict[str, Any]:
