@@ -5,10 +5,11 @@
    neighbour; models.steady.shooting). A stable orbit is the regime (``period-1``, ``period-n``).
 2. Otherwise (no convergence, or an unstable orbit, which a drill never shows: its rate is not reported)
    the scene's own time run (what ``steady_state: time`` runs) says, from the section states of its last
-   blows, which period n <= ``MAX_PERIOD_BLOWS`` repeats best (:func:`repeating_period`); where none
-   repeats within ``REPEAT_TOLERANCE`` the drill is run on ``SETTLE_BLOWS`` blows from its end (by the exact
-   map: milliseconds) and read again. Newton on the n-blow map starts from the last blow start. A stable
-   orbit is ``period-n``.
+   blows, which period n <= ``MAX_PERIOD_BLOWS`` repeats best (:func:`repeating_period`), Newton on the
+   one-blow map, then on the n-blow map, from its last blow start where that repeats within ``NEWTON_TRY``; where none repeats within
+   ``REPEAT_TOLERANCE`` the drill is run on as many blows again from its end (by the exact map) and read
+   again, Newton from its last blow start. A stable orbit is ``period-n``. A periodic run costs at most
+   about two time runs more than a time run.
 3. Otherwise ``no periodic orbit found``: the result is that time run (models.steady.steady_run), and the
    unstable orbits found are kept for the report.
 
@@ -44,7 +45,7 @@ from .steady_state import NONE_FOUND, SteadyState, SteadyStateUnavailable, regim
 
 MAX_PERIOD_BLOWS = 6  # the longest orbit looked for, in blows
 REPEAT_TOLERANCE = 0.05  # scaled distance of section states n blows apart under which Newton is tried
-SETTLE_BLOWS = 100  # blows run on from the time run's end when its last blows repeat no period
+NEWTON_TRY = 1.0  # ... and tried before running on, from the time run's own last blow
 EXUDYN_TOLERANCE = 1e-8
 REPEATS_WITHIN = 1e-6  # scaled distance under which an n-blow orbit's state repeats after fewer blows
 STABILITY_MARGIN = 0.01  # multipliers this near the unit circle are taken from the exact Jacobian at the orbit
@@ -131,15 +132,17 @@ class RegimeFinder:
                 make_map(self.simulation, periods)
         return self.maps[periods]
 
-    def shoot(self, periods: int, guess: np.ndarray) -> Orbit | None:
-        """The orbit of ``periods`` blows from ``guess`` (unstable ones kept aside), None if Newton fails."""
+    def shoot(self, periods: int, guess: np.ndarray, patient: bool = False) -> Orbit | None:
+        """The orbit of ``periods`` blows from ``guess`` (unstable ones kept aside), None if Newton fails;
+        ``patient``: from a settled state, more steps and more halvings (models.steady.shooting)."""
         jacobian_of = None
         if self.guide is not None:
             guide_map = self.guide.map(periods)
             jacobian_of = lambda y: guide_map(y).monodromy  # the exact model's Jacobian at y
         shooter = Shooter(self.map(periods), self.simulation, jacobian_of)
         try:
-            orbit = shooter.solve(guess, newton_tolerance(self.simulation))
+            orbit = shooter.solve(guess, newton_tolerance(self.simulation),
+                                  **({"max_iterations": 20, "halvings": 6, "stalled": 4} if patient else {}))
         except NoConvergence:
             return None
         finally:
@@ -202,19 +205,28 @@ class RegimeFinder:
             return found
         states = [end_state(time_run, k * period_s) for k in range(blows - 2 * longest, blows + 1)]
         n, self.distance = repeating_period(self.simulation, states, longest)
+        if REPEAT_TOLERANCE < self.distance <= NEWTON_TRY:  # near enough for Newton's basin, perhaps: one blow
+            for periods in dict.fromkeys((1, n)):  # first (a transient's ringing can look like another period)
+                try:
+                    orbit = self.shoot(periods, states[-1], patient=True)
+                except SimulationFailed:
+                    orbit = None
+                if orbit is not None:
+                    return self._state(orbit, start, None)
         if self.distance > REPEAT_TOLERANCE:  # run on from its end (the exact guide's map for another formulation)
             settle = (self.guide or self).map(1)
             self.runs += 1
+            more = max(blows, 2 * MAX_PERIOD_BLOWS + 1)
             try:
-                states = settle.blow_states(states[-1], SETTLE_BLOWS)
+                states = settle.blow_states(states[-1], more)
             except SimulationFailed:
                 return found
             n, self.distance = repeating_period(self.simulation, states, MAX_PERIOD_BLOWS)
-            self.settled_blows = SETTLE_BLOWS
+            self.settled_blows = more
         orbit = None
         if self.distance <= REPEAT_TOLERANCE:
             try:
-                orbit = self.shoot(n, states[-1])
+                orbit = self.shoot(n, states[-1], patient=True)
             except SimulationFailed:
                 pass
         state = self._state(orbit, start, None)

@@ -7,9 +7,12 @@ On the section (models.steady.section) the orbit is z = P_n(z). Newton solves F(
 
 J = dP_n/dz from the map's exact Jacobian (models.steady.exact_map), from a Jacobian given by the caller
 (``jacobian_of``: the exact model's at the same state, for a formulation that has none), or by forward
-differences (one map run per coordinate). A step that raises the scaled residual max_i |F_i| / s_i is
-halved (at most ``HALVINGS`` times): the map is only piecewise smooth, and a full step from a poor guess
-can cross into another sequence of contacts. The last step is the first whose scaled size max_i |dz_i| / s_i
+differences (one map run per coordinate); after the first, a Jacobian is updated by Broyden's rule,
+J += (dP - J dz) dz^T / dz^T dz, where the last step was below ``BROYDEN_BELOW`` of the scales (with the
+exact map's own Jacobian formed again where it was larger). A step that raises the scaled residual
+max_i |F_i| / s_i is halved (at most ``HALVINGS`` times): the map is only piecewise smooth, and a full step
+from a poor guess can cross into another sequence of contacts; ``STALLED_ITERATIONS`` shortened steps in a
+row, or ``MAX_ITERATIONS`` steps, end the search (NoConvergence). The last step is the first whose scaled size max_i |dz_i| / s_i
 is below sqrt(tolerance) / 10 with the exact Jacobian (Newton's convergence is quadratic: the error after it
 is of the order of its square), below ``tolerance`` with another (a chord method converges linearly); it is
 taken and not checked by another map run (the caller's run of the orbit checks it). A residual that no step
