@@ -33,6 +33,7 @@ from matplotlib.figure import Figure
 from ...models.evaluation.results import SimulationResult
 from ...models.evaluation.run_result import Result
 from ...models.solvers.simulation import Simulation
+from ...models.steady.steady_run import run_scene
 from ..inputs.arguments import (
     built_model_problem,
     check,
@@ -132,10 +133,12 @@ def write_animation(result: SimulationResult | Result | ExudynModel, path: str |
 
 def run_with_solution(simulation: Simulation, progress: Callable[[float], None] | None = None,
                       solution: Path | None = None) -> SimulationResult:
-    """Run ``simulation``; with ``solution`` and the Exudyn formulation, write Exudyn's coordinates solution
+    """Run ``simulation`` as its scene asks (models.steady.steady_run.run_scene: a time run, or its steady
+    state); with ``solution``, a time run and the Exudyn formulation, write Exudyn's coordinates solution
     file there during the run (every output interval). The other formulations write none."""
-    if solution is None or simulation.settings.formulation != "exudyn":
-        return simulation.run(progress)
+    if solution is None or simulation.settings.formulation != "exudyn" \
+            or simulation.scene.solver.steady_state != "time":
+        return run_scene(simulation, progress=progress)
     from ...models.solvers.exudyn_model import build_exudyn
 
     model = build_exudyn(simulation)

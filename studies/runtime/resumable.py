@@ -40,7 +40,7 @@ from .interrupts import raise_if_stopped
 from .output_files import atomic_file, write_json
 from .pools import Runner
 
-STATUS_COLUMNS = ("status", "error", "wall_time_s")
+STATUS_COLUMNS = ("status", "error", "steady_state", "regime", "wall_time_s", "period_blows", "floquet_max_abs")
 # a finished point's status: ok; failed (its error says why); unstable, unsettled, not_finite or
 # unbalanced (metrics written, but the run's figures do not stand as they are: models.evaluation.run_status)
 FINISHED = ("failed", *STATUSES)
@@ -191,7 +191,9 @@ def result_row(point: TablePoint, outcome: dict[str, Any]) -> dict[str, Any]:
     """A table row: the point, its parameters, status, error, wall time and the outcome's metrics (empty
     where not a finite number: its status says so, models.evaluation.run_status)."""
     return {"point": point.index, **point.parameters, "status": outcome["status"], "error": outcome["error"],
-            "wall_time_s": f"{outcome['wall_time_s']:.4g}", **{k: cell(v) for k, v in outcome["metrics"].items()}}
+            "steady_state": outcome.get("steady_state", ""), "regime": outcome.get("regime", ""),
+            "wall_time_s": f"{outcome['wall_time_s']:.4g}", "period_blows": cell(outcome.get("period_blows")),
+            "floquet_max_abs": cell(outcome.get("floquet_max_abs")), **{k: cell(v) for k, v in outcome["metrics"].items()}}
 
 
 def cell(value: Any) -> Any:
