@@ -47,9 +47,9 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "Study": ("studies.scan.study", "Study"),
          "build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
          "ExudynModel": ("models.solvers.exudyn_model", "ExudynModel"),
-         "draw": ("studies.figures.drill_drawing", "draw"),
-         "write_animation": ("studies.figures.drill_animation", "write_animation"),
-         "view_solution": ("studies.figures.drill_animation", "view_solution"),
+         "draw": ("studies.drawings.drill_drawing", "draw"),
+         "write_animation": ("studies.drawings.drill_animation", "write_animation"),
+         "view_solution": ("studies.drawings.drill_animation", "view_solution"),
          "calibrate": ("studies.calibration.calibration_run", "calibrate"),
          "CalibrationResult": ("studies.calibration.calibration_run", "CalibrationResult"),
          "sensitivity": ("studies.sensitivity.sensitivity_run", "sensitivity"),
@@ -73,8 +73,8 @@ if TYPE_CHECKING:  # the names as type checkers and editors see them
     from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
     from .studies.calibration.calibration_run import CalibrationResult, calibrate
     from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
-    from .studies.figures.drill_animation import view_solution, write_animation
-    from .studies.figures.drill_drawing import draw
+    from .studies.drawings.drill_animation import view_solution, write_animation
+    from .studies.drawings.drill_drawing import draw
     from .studies.pages.reproduction_run import ReproductionResult, reproduce
     from .studies.pages.rotation_note import RotationReport, rotation_report
     from .studies.runtime.budgets import Budget, BudgetError

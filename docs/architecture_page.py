@@ -39,6 +39,11 @@ ROLES = {
     "models.evaluation": "What a run gives: the result and its time series, the energy account, metrics, "
                          "stability checks and step bounds, the solver presets, comparisons between runs, "
                          "work-precision fronts, stress-wave checks.",
+    "models.steady": "The drill's steady state found, not waited for: the periodic orbit relative to the borehole "
+                     "bottom by shooting (the exact map's Jacobian from matrix exponentials and saltation "
+                     "matrices, finite differences for the other formulations), its Floquet multipliers, the "
+                     "regime of a scene (period-1, period-n, none), continuation along a scan and its "
+                     "bifurcations, and the run a scene's solver.steady_state asks for.",
     "models.solvers": "Preparing a scene for a run and the three formulations of one model: the Exudyn "
                       "multibody system, the exact piecewise-linear propagation (its linear system and "
                       "compiled kernels), the paper's Eq. 4 as a SciPy ODE; a run's cost estimate.",
@@ -72,6 +77,8 @@ ROLES = {
                             "paper's, the trends checked.",
     "studies.figures": "Every figure (matplotlib): scans, maps, time series, work-precision, tornado, the "
                        "paper's figures redrawn, and the plot tasks a pool's workers draw.",
+    "studies.drawings": "Pictures of the drill itself: the string drawn to scale, its animation over the last "
+                        "blows, a built Exudyn system drawn from its own graphics, Exudyn's solution file.",
     "studies.pages": "The generated documentation pages (reproduction, parameters, sensitivity, figures, "
                      "rotation).",
     "studies.cli": "The `rpdrill` command line: `main.py` (argparse, exit statuses, one-line warnings) and a "

@@ -53,9 +53,9 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     ``summary.json``, ``scene.resolved.yaml``, the ``timeseries.png``/``.svg`` figure, the drawing of the
     drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified. A scene with extensions is drawn
     (and, from a run with a solution file, animated) as its built Exudyn model, every item of the extensions
-    included (studies.figures.system_drawing). The files written."""
-    from .figures.drill_animation import write_animation  # matplotlib only when saving
-    from .figures.drill_drawing import draw
+    included (studies.drawings.system_drawing). The files written."""
+    from .drawings.drill_animation import write_animation  # matplotlib only when saving
+    from .drawings.drill_drawing import draw
     from .figures.timeseries_figure import plot_timeseries
 
     check("rpdrill.save_result", "result", result, instance_problem(Result, "the Result of rpdrill.simulate"))
@@ -102,8 +102,11 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
     it starts; models.evaluation.stability.SimulationFailed when the run diverges. ``solution_file``:
     with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
-    (for its SolutionViewer: studies.figures.drill_animation.view_solution). Loads no figure module:
-    the caller's matplotlib is left as it is."""
+    (for its SolutionViewer: studies.drawings.drill_animation.view_solution). Loads no figure module:
+    the caller's matplotlib is left as it is. A scene with ``solver.steady_state: periodic`` gives its
+    steady state (models.steady.steady_run.run_scene)."""
+    from ..models.steady.steady_run import run_scene
+
     check("rpdrill.simulate", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
     check("rpdrill.simulate", "progress", progress, callable_problem)
     check("rpdrill.simulate", "budget", budget, instance_problem(Budget, "a rpdrill Budget or None", optional=True))
@@ -115,12 +118,7 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     if budget is not None:
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
-    if solution_file is None:
-        raw = simulation.solve(progress)
-    else:  # Exudyn's model loaded only when its solution file is asked for
-        from ..models.solvers.solution_file import solve_with_solution
-
-        raw = solve_with_solution(simulation, progress, solution_file)
+    raw = run_scene(simulation, progress=progress, solution=None if solution_file is None else Path(solution_file))
     return Result(scene, raw, {"source": source, **simulation.code_records()})
 
 

@@ -1,4 +1,4 @@
-"""The drill string drawn, animated and handed to Exudyn's viewer (studies.figures.drill_drawing, studies.figures.drill_animation)."""
+"""The drill string drawn, animated and handed to Exudyn's viewer (studies.drawings.drill_drawing, studies.drawings.drill_animation)."""
 
 import json
 from pathlib import Path
@@ -13,8 +13,8 @@ from scenes import crushing_scene, scene_dict, simulate
 
 import rpdrill
 from rpdrill.models.drill.shapes import layout
-from rpdrill.studies.figures.drill_animation import load_solution, nice_factor
-from rpdrill.studies.figures.drill_drawing import draw_string, drawn_layout
+from rpdrill.studies.drawings.drill_animation import load_solution, nice_factor
+from rpdrill.studies.drawings.drill_drawing import draw_string, drawn_layout
 
 load_scene, draw, write_animation = rpdrill.load_scene, rpdrill.draw, rpdrill.write_animation
 

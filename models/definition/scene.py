@@ -33,10 +33,12 @@ from .drill_string import (
 from .extensions import Extension
 from .formulations import (
     COMMON_SOLVER_KEYS,
+    DEFAULT_STEADY_STATE,
     EXUDYN_SOLVERS,
     FORMULATIONS,
     ODE_METHODS,
     PRESETS,
+    STEADY_STATES,
 )
 from .outputs import BODY_METRICS, METRICS, SERIES, Need, body_metric, metric_need, needs
 from .rock import JENKINS_VALUES, ROCK_LAW_KEYS, Rock, refuse_foreign_keys
@@ -132,7 +134,10 @@ class Solver(Strict):
     of the state), ``sample_interval_s`` (dense-output sampling); exact ``sample_interval_s``,
     ``min_switch_interval_s``, ``max_switches_per_blow``. A preset fills the options not given;
     without a preset and without explicit accuracy options the ``standard`` preset applies
-    (models.evaluation.solver_settings resolves them once per run).
+    (models.evaluation.solver_settings resolves them once per run). ``steady_state`` (every formulation):
+    ``time`` (default) runs from the start to the end time and averages the blocks after the transient;
+    ``periodic`` solves for the drill's periodic orbit by shooting (models.steady: period-1, period-n, or,
+    where none is found, the time run as with ``time``).
     """
 
     formulation: Literal[tuple(FORMULATIONS)] = "exudyn"  # type: ignore[valid-type]
@@ -148,6 +153,7 @@ class Solver(Strict):
     sample_interval_s: Positive | None = None
     min_switch_interval_s: Positive | None = None
     max_switches_per_blow: Annotated[int, Field(ge=1, le=MAX_COUNT)] | None = None
+    steady_state: Literal[STEADY_STATES] = DEFAULT_STEADY_STATE  # type: ignore[valid-type]
 
     @model_validator(mode="after")
     def _options_of_the_formulation(self) -> Solver:

@@ -236,9 +236,8 @@ class ExudynModel:
 
     def _install(self) -> None:
         """Set the one pre-step function of the model's own functions, the user's and the run's watchers."""
-        actions = [*self._own_actions(), *self.pre_steps, *self._watch]
-        if self._foreign is not None:
-            actions.append(self._foreign)
+        foreign = [] if self._foreign is None else [self._foreign]  # the user's, set on mbs: last
+        actions = [*self._own_actions(), *self.pre_steps, *self._watch, *foreign]
         self._installed = pre_step(actions)
         self.mbs.SetPreStepUserFunction(self._installed or 0)
 
@@ -306,8 +305,9 @@ class ExudynModel:
                       {"source": "exu.SolveDynamic", **self.simulation.code_records()})
 
 
-def _add_body(mbs: Any, name: str, make_object: Callable[[Any], Any], initial: float = 0.0) -> ExudynBody:
-    node = mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[initial], initialVelocities=[0.0]))
+def _add_body(mbs: Any, name: str, make_object: Callable[[Any], Any], initial: float = 0.0,
+              velocity: float = 0.0) -> ExudynBody:
+    node = mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[initial], initialVelocities=[velocity]))
     body = make_object(node)
     return ExudynBody(name, node, body, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0)),
                       mbs.AddMarker(MarkerBodyPosition(bodyNumber=body, localPosition=[0.0, 0.0, 0.0])))
@@ -351,10 +351,12 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
 
     bodies: list[ExudynBody] = []
     rods = {name for name, body in simulation.scene.drill_string.bodies.items() if body.is_rod}
-    for body, cylinder, initial in zip(chain.bodies, chain_cylinders(shapes, chain), initial_positions, strict=True):
+    velocities = np.pad(simulation.initial_velocities, (0, chain.size - simulation.chain.size))  # a piston's: 0
+    for body, cylinder, initial, speed in zip(chain.bodies, chain_cylinders(shapes, chain), initial_positions, velocities,
+                                              strict=True):
         shown = VObjectMass1D(graphicsData=body_graphics(cylinder, cylinder.group in rods))
         bodies.append(_add_body(mbs, body.name, lambda n, m=body.mass_kg, x=cylinder.centre_m, v=shown: mbs.AddObject(
-            ObjectMass1D(nodeNumber=n, mass=m, referencePosition=[x, 0.0, 0.0], visualization=v)), initial))
+            ObjectMass1D(nodeNumber=n, mass=m, referencePosition=[x, 0.0, 0.0], visualization=v)), initial, speed))
         if body.constant_force_n:
             mbs.AddLoad(LoadCoordinate(markerNumber=bodies[-1].marker_coordinate, load=body.constant_force_n))
     markers = [body.marker_coordinate for body in bodies]
@@ -389,7 +391,8 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
         shown = VObjectRotationalMass1D(graphicsData=torsion_graphics(bit.diameter_m))
         torsion = _add_body(mbs, "torsion", lambda n: mbs.AddObject(ObjectRotationalMass1D(
             nodeNumber=n, inertia=tor.inertia_kg_m2, referencePosition=[bit.centre_m, 0.0, 0.0],
-            referenceRotation=AXIS_X_FROM_Z, visualization=shown)), simulation.initial_torsion_angle_rad)
+            referenceRotation=AXIS_X_FROM_Z, visualization=shown)), simulation.initial_torsion_angle_rad,
+            simulation.initial_torsion_rate_rad_per_s)
     blows = simulation.blow_starts()
     start_blow = None
     if blows is not None:

@@ -75,6 +75,15 @@ class Simulation:
     fastest: FastestElement  # the element of the highest rate and the keys that set it
     indexing: Indexing | None = None
     piston: PistonSetup | None = None  # a piston striking the impact body (models.drill.piston), or the pulse
+    # a start in motion (models.steady: a periodic orbit's state at a blow start); None and 0: at rest
+    initial_velocities_m_per_s: np.ndarray | None = None
+    initial_torsion_rate_rad_per_s: float = 0.0
+
+    @property
+    def initial_velocities(self) -> np.ndarray:
+        """The chain's initial velocities (zero at rest)."""
+        given = self.initial_velocities_m_per_s
+        return np.zeros(self.chain.size) if given is None else given
 
     @property
     def dynamic_chain(self) -> AxialChain:
@@ -160,6 +169,7 @@ class Simulation:
         data["solver"] = {key: value for key, value in vars(self.settings).items() if value is not None}
         for name, recorded in self.code_records().get("extensions", {}).items():  # informational (Extension)
             data["extensions"][name]["recorded"] = {key: value for key, value in recorded.items() if key != "parameters"}
+        data["solver"]["steady_state"] = self.scene.solver.steady_state
         if self.piston is not None:  # the coupling across the contact as run
             given = self.scene.impact.piston.contact_stiffness_n_per_m
             faces = "rigid faces" if given is None else f"the faces' contact {given:.6g} N/m"

@@ -1,5 +1,5 @@
 """A run that writes Exudyn's coordinates solution file as it goes (for Exudyn's SolutionViewer,
-studies.figures.drill_animation.view_solution), beside the plain run of every formulation."""
+studies.drawings.drill_animation.view_solution), beside the plain run of every formulation."""
 
 from __future__ import annotations
 

@@ -3,7 +3,7 @@ printing (studies.advice.advice_search: the search, the curves around the optimu
 map), with the bounds in SI units by key path. With ``out`` every point run is recorded there as it
 returns (evaluations.jsonl, studies.runtime.evaluation_log: a rerun into the same folder replays them and
 runs the rest) and the report is written at the end (advice.json, advice.md, the figures of each rock:
-studies.advice.advice_report, studies.figures.advice_figures)."""
+studies.advice.advice_report, studies.advice.advice_figures)."""
 
 from __future__ import annotations
 
@@ -20,7 +20,6 @@ from ...models.definition.scene import Scene
 from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import metric as metric_entry
 from ..display.catalogue import parameter
-from ..figures.advice_figures import plot_curves, plot_feed_map
 from ..inputs.arguments import (
     boolean_problem,
     bounds_problem,
@@ -39,6 +38,7 @@ from ..inputs.reading import InputError, scene_and_source
 from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog
 from ..runtime.output_files import check_file_target, check_out, staged_directory, write_atomic, write_json
 from ..runtime.pools import pool
+from .advice_figures import plot_curves, plot_feed_map
 from .advice_report import advice_markdown, advice_record
 from .advice_search import (
     FEED,

@@ -178,6 +178,7 @@ PARAMETERS: dict[str, Quantity] = {
     "rotation.speed_rpm": _q("rotation speed", "n", "rpm"),
     "solver.formulation": _category("formulation"),
     "solver.preset": _category("accuracy preset"),
+    "solver.steady_state": _category("steady state"),
     "solver.end_time_s": _q("end time", r"t_{end}", "s"),
     "solver.output_interval_s": _q("output interval", r"\Delta t_{out}", "ms", 1e3, "s"),
     "solver.type": _category("solver"),

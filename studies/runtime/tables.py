@@ -23,7 +23,7 @@ from .output_files import atomic_file
 if TYPE_CHECKING:
     import pandas as pd
 
-TEXT_COLUMNS = ("status", "error")  # text even where every cell reads as a number
+TEXT_COLUMNS = ("status", "error", "steady_state", "regime")  # text even where every cell reads as a number or is empty
 NOT_A_NUMBER = ("nan", "+nan", "-nan")
 
 

@@ -5,7 +5,8 @@ A :class:`Curve` is the points of a base scene with some changes along one scene
 the impact frequency), made as every analysis makes its points (studies.runtime.point_runs.point_scene:
 ``base.with_({**changes, axis: value})``, each point validated on its own: a change may be valid at
 some values of the axis only) and asking for ``metrics`` only. :func:`run_curve` runs them in order in
-one worker, each into the row a study's results table holds (studies.runtime.point_runs.run_point), and
+one worker, each into the row a study's results table holds (studies.runtime.point_runs.run_followed: a
+periodic run starts from the orbits of the points before it), and
 returns a :class:`CurveRun`: that table, the scene's rock-mode frequency (models.drill.modal: along the
 frequency, the main lobe is the one nearest to it) and the CPU seconds; its optimum of a metric is the
 studies.scan.curve_optima.Optimum a study's curve has. Many curves (every scan of many parameter sets)
@@ -28,9 +29,10 @@ from pydantic import Field
 
 from ...models.definition.scene import Scene
 from ...models.drill.modal import rock_mode_frequency_hz
+from ...models.steady.continuation import Continuation
 from ..inputs.reading import InputError
 from ..inputs.specs import MetricName, StrictSpec
-from ..runtime.point_runs import point_columns, prepare_point, run_point
+from ..runtime.point_runs import point_columns, prepare_point, run_followed
 from ..runtime.pools import Runner
 from .curve_optima import FREQUENCY, Optimum, curve_optimum
 
@@ -108,6 +110,7 @@ def run_curve(curve: Curve) -> CurveRun:
 
     start = time.process_time()
     rows, resonance = [], None
+    branch = Continuation()  # solver.steady_state periodic: each orbit from its neighbours' (models.steady)
     for value in curve.values:
         try:
             simulation = prepare_point(curve.base, {curve.axis: value}, f"{curve.axis} scan",
@@ -117,7 +120,7 @@ def run_curve(curve: Curve) -> CurveRun:
             continue
         if curve.axis == FREQUENCY:
             resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock) or None
-        rows.append({curve.axis: value, **run_point(simulation)})
+        rows.append({curve.axis: value, **run_followed(branch, value, simulation)})
     table = pd.DataFrame(rows, columns=[curve.axis, *point_columns(curve.metrics)])
     return CurveRun(curve.key, curve.axis, table, resonance, time.process_time() - start)
 

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..advice.advice_search import FEED, FREQUENCY, Advice
 from ..display.catalogue import metric, parameter
-from .cell_maps import cell_map, no_result_patch
-from .figure_style import OKABE_ITO, figure, save
+from ..figures.cell_maps import cell_map, no_result_patch
+from ..figures.figure_style import OKABE_ITO, figure, save
+from .advice_search import FEED, FREQUENCY, Advice
 
 
 def _title(advice: Advice, what: str) -> str:

@@ -12,7 +12,7 @@ system is drawn in one panel and the part from the impact body to the rock in a 
 y to their own scales (a drill is thin beside its length).
 
 :func:`draw_model` writes the drawing of a model (``rpdrill.draw`` of a model); :func:`draw_system` draws
-one configuration on axes (the animation of a model, studies.figures.drill_animation, draws each frame).
+one configuration on axes (the animation of a model, studies.drawings.drill_animation, draws each frame).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from matplotlib.axes import Axes
 from matplotlib.collections import PolyCollection
 from matplotlib.patches import Circle
 
-from .figure_style import OKABE_ITO, figure
+from ..figures.figure_style import OKABE_ITO, figure
 
 USER_COLOUR = OKABE_ITO[6]  # items of one's own
 CONNECTOR_KINDS = ("Connector", "Contact")  # objectType prefixes of items joining two markers
