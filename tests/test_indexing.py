@@ -15,6 +15,7 @@ import yaml
 from commands import main
 from scenes import CRUSHING, crushing_scene, read_yaml, scene_dict, simulate
 
+import rpdrill
 from rpdrill import InputError, Scene, load_study
 from rpdrill.models.definition.scene import Bit
 from rpdrill.models.drill.indexing import CRATER, FRESH, MIN_FRESH_FRACTION, RIDGES, Indexing
@@ -241,3 +242,11 @@ def test_rotation_report_from_two_small_studies(tmp_path):
     manual = 1600 * 0.019 / (math.pi * 0.216)
     assert f"**{manual:.1f} rpm**" in text and f"**{60 * 36 * 0.019 / (math.pi * 0.216):.1f} rpm**" in text
     assert "| conglomerate | 60 |" in text and (out / "rotation_map_conglomerate.png").stat().st_size > 0
+    # the library call behind the command: the same note (but for the command line it records), no files kept
+    note = rpdrill.rotation_report(tmp_path / "runs", rock="conglomerate")
+    assert note.files == [] and note.out is None
+    assert [line for line in note.text.splitlines() if "rpdrill rotation-report" not in line] == \
+        [line for line in text.splitlines() if "rpdrill rotation-report" not in line]
+    assert set(note.ridge["rock"]) == {"conglomerate"} and note.ridge["best_speed_rpm"].notna().all()
+    with pytest.raises(rpdrill.InputError, match="rock.*granite.*not on the map.*conglomerate"):
+        rpdrill.rotation_report(tmp_path / "runs", rock="granite")
