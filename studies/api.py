@@ -24,15 +24,14 @@ from .inputs.arguments import (
     boolean_problem,
     callable_problem,
     check,
+    check_run_options,
     choice_problem,
-    dask_problem,
     either,
     file_problem,
     folder_problem,
     instance_problem,
     optional,
     rows_problem,
-    workers_problem,
 )
 from .inputs.reading import InputError, load_scene, prepare_scene, scene_and_source
 from .runtime.budgets import DEFAULT_BUDGET, Budget
@@ -141,10 +140,7 @@ def run_study(study: Study | str | Path, workers: int | None = None, out: str | 
 
     check("rpdrill.run_study", "study", study, either(file_problem, instance_problem(Study, "a rpdrill Study or a "
                                                                                     "study file's path")))
-    check("rpdrill.run_study", "workers", workers, optional(workers_problem))
-    check("rpdrill.run_study", "out", out, optional(folder_problem))
-    check("rpdrill.run_study", "dask", dask, dask_problem)
-    check("rpdrill.run_study", "quiet", quiet, boolean_problem)
+    check_run_options("rpdrill.run_study", workers, out, dask, quiet)
     if not isinstance(study, Study):
         study = load_study(study)
     with tempfile.TemporaryDirectory(prefix="rpdrill-study-") as scratch:

@@ -19,15 +19,11 @@ from typing import TYPE_CHECKING, Any
 from ...models.evaluation.workprecision import Signature
 from ..figures.workprecision_figure import plot_workprecision
 from ..inputs.arguments import (
-    boolean_problem,
     check,
-    dask_problem,
+    check_run_options,
     either,
     file_problem,
-    folder_problem,
     instance_problem,
-    optional,
-    workers_problem,
 )
 from ..runtime.budgets import DEFAULT_BUDGET, Budget
 from ..runtime.interrupts import raise_if_stopped
@@ -102,11 +98,8 @@ def accuracy(study: AccuracyStudy | str | Path, workers: int | None = None, out:
     run fails; ``quiet``: no progress bar."""
     check(WHERE, "study", study,
           either(file_problem, instance_problem(AccuracyStudy, "a work-precision study file's path or its loaded study")))
-    check(WHERE, "workers", workers, optional(workers_problem))
-    check(WHERE, "out", out, optional(folder_problem))
-    check(WHERE, "dask", dask, dask_problem)
+    check_run_options(WHERE, workers, out, dask, quiet)
     check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
-    check(WHERE, "quiet", quiet, boolean_problem)
     folder = None if out is None else check_out(out, None, RECORD)
     if not isinstance(study, AccuracyStudy):
         study = load_accuracy_study(study, budget)

@@ -23,13 +23,10 @@ from ...models.definition.scene import Scene
 from ..inputs.arguments import (
     boolean_problem,
     check,
-    dask_problem,
+    check_run_options,
     either,
     file_problem,
-    folder_problem,
     instance_problem,
-    optional,
-    workers_problem,
 )
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, duration
 from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog, Record
@@ -82,12 +79,9 @@ def calibrate(calibration: Calibration | str | Path, workers: int | None = None,
     progress bar. An ``out`` that was new is removed again when no evaluation has a best (nothing to keep)."""
     check(WHERE, "calibration", calibration,
           either(file_problem, instance_problem(Calibration, "a calibration file's path or its loaded Calibration")))
-    check(WHERE, "workers", workers, optional(workers_problem))
-    check(WHERE, "out", out, optional(folder_problem))
-    check(WHERE, "dask", dask, dask_problem)
+    check_run_options(WHERE, workers, out, dask, quiet)
     check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
     check(WHERE, "overwrite", overwrite, boolean_problem)
-    check(WHERE, "quiet", quiet, boolean_problem)
     folder = None if out is None else check_out(out, overwrite, CHECKPOINT)
     if not isinstance(calibration, Calibration):
         calibration = load_calibration(calibration, budget)

@@ -16,15 +16,11 @@ from typing import TYPE_CHECKING, Any
 
 from ..figures.tornado_figures import draw_tornados
 from ..inputs.arguments import (
-    boolean_problem,
     check,
-    dask_problem,
+    check_run_options,
     either,
     file_problem,
-    folder_problem,
     instance_problem,
-    optional,
-    workers_problem,
 )
 from ..runtime.budgets import DEFAULT_BUDGET, Budget
 from ..runtime.output_files import check_out, write_json
@@ -82,11 +78,8 @@ def sensitivity(study: SensitivityStudy | str | Path, workers: int | None = None
     scratch folder. InputError or BudgetError before anything runs; ``quiet``: no progress bar."""
     check(WHERE, "study", study,
           either(file_problem, instance_problem(SensitivityStudy, "a sensitivity file's path or its loaded study")))
-    check(WHERE, "workers", workers, optional(workers_problem))
-    check(WHERE, "out", out, optional(folder_problem))
-    check(WHERE, "dask", dask, dask_problem)
+    check_run_options(WHERE, workers, out, dask, quiet)
     check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
-    check(WHERE, "quiet", quiet, boolean_problem)
     folder = None if out is None else check_out(out, None, RECORD)
     if not isinstance(study, SensitivityStudy):
         study = load_sensitivity(study, budget)
