@@ -212,7 +212,8 @@ class Solver(Strict):
     the largest step for dopri5/ode23), ``spectral_radius``, ``relative_tolerance``,
     ``absolute_tolerance``; ode ``method``, ``relative_tolerance``, ``absolute_tolerance`` (SI units
     of the state), ``sample_interval_s`` (dense-output sampling); exact ``sample_interval_s``,
-    ``min_switch_interval_s``, ``max_switches_per_blow``. A preset fills the options not given;
+    ``min_switch_interval_s``, ``max_switches_per_blow``, ``wave_step_s`` (the step of the
+    characteristics of wave rods, models.waves; Exudyn's wave step is its ``step_s``). A preset fills the options not given;
     without a preset and without explicit accuracy options the ``standard`` preset applies
     (models.evaluation.solver_settings resolves them once per run).
     """
@@ -230,6 +231,7 @@ class Solver(Strict):
     sample_interval_s: Positive | None = None
     min_switch_interval_s: Positive | None = None
     max_switches_per_blow: Annotated[int, Field(ge=1, le=MAX_COUNT)] | None = None
+    wave_step_s: Positive | None = None
 
     @model_validator(mode="after")
     def _options_of_the_formulation(self) -> Solver:

@@ -5,17 +5,22 @@ Every formulation assembles from this one description (built from a scene's ``dr
 solver cannot disagree on the topology. The chain owns the first-order form of its linear part,
 :meth:`AxialChain.first_order_matrix`, which the ODE, the exact solver and the stability limits use. A rod of ``segments`` N becomes N lumped masses
 ``name[0]`` .. ``name[N-1]`` joined by springs E A N / L; connectors attach to a rod's first
-segment (``to``) and last segment (``from``).
+segment (``to``) and last segment (``from``). A rod with ``model: waves`` becomes its two end faces,
+massless nodes ``name[top]`` and ``name[bottom]``, and a wave element between them
+(``AxialChain.waves``, models.waves.rods); a connector without a stiffness that joins only rigid faces
+(a wave rod's, a rigid body's) is rigid (stiffness infinite: :attr:`Link.rigid`).
 """
 
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ...rocklaw import RockLaw
+from ..waves.rods import WaveRod, wave_rod
 from ...rocklaw.modes import ONE
 from ..definition.drill_string import EVERY_BODY, GROUND, Body, Connector
 from ..definition.links import CLOSED as CLOSED_MODE
@@ -39,10 +44,16 @@ class AxialChain:
     impact_body: int
     bit_body: int
     groups: dict[str, tuple[int, int]]  # drill-string body name -> (first, last) chain index
+    waves: tuple[WaveRod, ...] = ()  # the rods carried as waves, between their face nodes (massless)
 
     @property
     def size(self) -> int:
         return len(self.bodies)
+
+    @property
+    def massless(self) -> tuple[int, ...]:
+        """The nodes without mass: the faces of the wave rods."""
+        return tuple(i for i, body in enumerate(self.bodies) if body.mass_kg == 0.0)
 
     @property
     def is_linear(self) -> bool:
@@ -132,6 +143,8 @@ class AxialChain:
         stretch, rate = incidence @ positions.T, incidence @ velocities.T
         elastic, damping = np.zeros(len(positions)), np.zeros(len(positions))
         for link, delta, delta_rate in zip(self.links, stretch, rate, strict=True):
+            if link.rigid:  # a constraint stores and dissipates nothing
+                continue
             spring = link.spring_force_n(delta)
             elastic += spring**2 * (0.5 / link.stiffness_n_per_m)
             damping += (link.force_n(delta, delta_rate) - spring) * delta_rate
@@ -153,9 +166,15 @@ def axial_chain(scene: Scene, joint_damping: bool = True) -> AxialChain:
     bodies: list[ChainBody] = []
     links: list[Link] = []
     groups: dict[str, tuple[int, int]] = {}
+    waves: list[WaveRod] = []
     for name, body in string.bodies.items():
         n, first = body.segments, len(bodies)
         force = feed.force_n if feed.acts_on in (EVERY_BODY, name) else 0.0
+        if body.is_wave:  # two massless faces; the feed on the top face (module doc of models.waves)
+            bodies += [ChainBody(f"{name}[top]", 0.0, force), ChainBody(f"{name}[bottom]", 0.0, 0.0)]
+            groups[name] = (first, first + 1)
+            waves.append(wave_rod(name, body, first, first + 1))
+            continue
         bodies += [ChainBody(name if n == 1 else f"{name}[{i}]", body.total_mass_kg / n, force / n) for i in range(n)]
         groups[name] = (first, first + n - 1)
         links += [Link(f"{name}[{i}-{i + 1}]", first + i, first + i + 1,
@@ -163,14 +182,16 @@ def axial_chain(scene: Scene, joint_damping: bool = True) -> AxialChain:
     for name, connector in string.connectors.items():
         links.append(_connector_link(scene, name, connector, groups, joint_damping))
     return AxialChain(tuple(bodies), tuple(links), impact_body=groups[string.impact_body][0],
-                      bit_body=groups[string.rock_body][1], groups=groups)
+                      bit_body=groups[string.rock_body][1], groups=groups, waves=tuple(waves))
 
 
 def _connector_link(scene: Scene, name: str, connector: Connector, groups: dict[str, tuple[int, int]],
                     damped: bool) -> Link:
     bodies = scene.drill_string.bodies
     ends = [bodies[b] for b in (connector.from_body, connector.to_body) if b != GROUND]
-    stiffness = connector.stiffness_n_per_m or _derived_stiffness_n_per_m(ends)
+    compliance = sum(body.half_segment_compliance_m_per_n() for body in ends)
+    rigid = math.inf if compliance == 0 else None  # rigid faces joined without a stiffness (module doc)
+    stiffness = connector.stiffness_n_per_m or rigid or _derived_stiffness_n_per_m(ends)
     body_a = None if connector.from_body == GROUND else groups[connector.from_body][1]
     extra = {key: getattr(connector, key) for key in LINK_TYPES[connector.type].parameters()
              if getattr(connector, key) is not None}

@@ -13,6 +13,7 @@ from .parts import link_series
 
 if TYPE_CHECKING:
     from ..drill.piston import PistonHistory
+    from ..waves.record import WaveRecord
     from .prepared_run import PreparedRun
 
 
@@ -48,6 +49,8 @@ class SimulationResult:
     works_j: dict[str, np.ndarray] | None = None
     # a piston scene: the piston's states, contact force (also impact_force_n), jumps and rebounds (models.drill.piston)
     piston: PistonHistory | None = None
+    # a scene with wave rods: the rods' ends at the samples, per-blow section figures, rigid joints' forces
+    waves: WaveRecord | None = None
 
     @property
     def scene(self) -> Scene:
@@ -104,7 +107,8 @@ class SimulationResult:
         for i, body in enumerate(self.chain.bodies):
             out[f"{body.name}_position_m"] = self.position_m[:, i]
             out[f"{body.name}_velocity_m_per_s"] = self.velocity_m_per_s[:, i]
-        out.update(link_series(self.chain, self.position_m, self.velocity_m_per_s))
+        out.update(link_series(self.chain, self.position_m, self.velocity_m_per_s,
+                               None if self.waves is None else self.waves.joint_force_n))
         optional = {
             "borehole_bottom_m": self.bottom_m,
             "rock_force_n": self.rock_force_n,

@@ -36,6 +36,8 @@ from ..drill.piston import PistonSetup, piston_setup
 from ..drill.pulse import impulse_per_blow_n_s
 from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_settings
 from ..evaluation.stability import FastestElement, StepScales, fastest_element, step_scales
+from ..waves.statics import wave_preload_m
+from ..waves.steps import wave_settings
 from .dispatch import implementation
 
 if TYPE_CHECKING:
@@ -163,21 +165,26 @@ def prepare(scene: Scene) -> Simulation:
         raise SceneError(("impact", "piston", "contact_stiffness_n_per_m"), None, str(err)) from None
     dynamic = chain if piston is None else piston.dynamic_chain(chain)
     fastest = fastest_element(scene, chain, rock, torsion)
-    scales = step_scales(dynamic, rock, torsion, scene.impact.period_s) if scene.solver.formulation == "exudyn" else None
+    waves = dynamic.waves
+    scales = step_scales(dynamic, rock, torsion, scene.impact.period_s) \
+        if scene.solver.formulation == "exudyn" and not waves else None
     if not math.isfinite(fastest.rate_per_s) or not math.isfinite(scales.spectral_radius_per_s if scales else 0.0):
         raise SceneError(tuple(fastest.key.split(".")), fastest.value,
                          f"with {fastest.other_key} {fastest.other_value:g} the model's fastest rate overflows "
                          f"(k/m or c/m beyond {sys.float_info.max:.3g}); give values of a physical drill")
     settings = resolve_settings(scene.solver, scene.impact.duration_s if piston is None else piston.pulse_duration_s,
                                 scales)
-    if piston is not None and isinstance(settings, ExudynSettings) and scene.solver.step_s is None:
+    if waves:  # the characteristics' step (models.waves.steps): blows start on its grid
+        settings = wave_settings(settings, scene.solver, waves, scene.impact,
+                                 scene.impact.duration_s if piston is None else piston.pulse_duration_s)
+    elif piston is not None and isinstance(settings, ExudynSettings) and scene.solver.step_s is None:
         # the strikes fall on step starts: a whole number of steps per period (a strike one step late
         # shifts the blow against the string's ringing; 2 % in the rate of the top-hammer scene)
         settings = replace(settings, step_s=scene.impact.period_s / math.ceil(scene.impact.period_s / settings.step_s))
     positions, angle = np.zeros(chain.size), 0.0
     if scene.start == "preloaded":
         try:
-            positions = static_preload_m(chain, rock)
+            positions = static_preload_m(chain, rock) if not chain.waves else wave_preload_m(chain, rock)
         except ValueError as err:
             raise SceneError(("start",), scene.start, str(err)) from None
         if effects.torsion:

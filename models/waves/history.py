@@ -1,0 +1,112 @@
+"""The waves in flight: every rod end's outgoing wave, step by step, carried to the other end.
+
+On the grid t_k = k h of the characteristics a rod of transit time T is N = round(T / h) steps long
+(the transit times as run, N h, are stated: :func:`delays`). Over each step the outgoing wave at a port
+is the straight line through its values at the step's ends, (left, right): ``right`` the wave at the
+step's end, ``left`` chosen so that the line keeps the step's mean, which the exact integration of the
+node gives (left = 2 mean - right; the node's displacement over the step less the arriving wave's).
+A front that falls on a grid time is a jump between two steps and is carried exactly; one within a
+step (a fast contact's rise) keeps its area. A wave arrives N steps after it left:
+
+    incoming(port, k) = outgoing(other end of the rod, k - N).
+
+Before the start each rod carries the waves of its initial state: at rest under a compression P,
+d = P / (2 Z), u = -P / (2 Z).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from .rods import WaveRod
+
+
+def delays(rods: Sequence[WaveRod], step_s: float) -> tuple[int, ...]:
+    """N = round(T / h) steps per rod (at least one)."""
+    return tuple(max(1, round(rod.transit_time_s / step_s)) for rod in rods)
+
+
+def transit_errors(rods: Sequence[WaveRod], step_s: float) -> dict[str, float]:
+    """(N h - T) / T of every rod: the transit time as run against the rod's own."""
+    return {rod.name: (n * step_s - rod.transit_time_s) / rod.transit_time_s
+            for rod, n in zip(rods, delays(rods, step_s), strict=True)}
+
+
+def wave_step_s(durations_s: Sequence[float], target_s: float, period_s: float, tolerance: float = 1e-4,
+                tries: int = 2000) -> float:
+    """The step of the characteristics: h = period / M (blows start on the grid) for the smallest
+    M >= period / target that makes every duration (the rods' transit times, a prescribed pulse's length)
+    a whole number of steps within ``tolerance`` (relative); the best of ``tries`` candidates when none is."""
+    first = max(1, math.ceil(period_s / target_s - 1e-9))
+    if not durations_s:
+        return period_s / first
+    transit = np.array(durations_s, dtype=float)
+    counts = np.arange(first, first + tries)
+    steps = period_s / counts
+    ratio = transit[None, :] / steps[:, None]
+    error = np.max(np.abs(np.maximum(np.round(ratio), 1) - ratio) / ratio, axis=1)
+    good = np.flatnonzero(error <= tolerance)
+    return float(steps[good[0]] if len(good) else steps[np.argmin(error)])
+
+
+class WaveLines:
+    """The outgoing waves of every port (2 per rod: top, bottom) over the last steps (module doc), with the
+    integrals over each step of the wave and of its square kept as running sums over the waves in flight
+    (a rod's energy and momentum at any step without summing its window)."""
+
+    def __init__(self, rods: Sequence[WaveRod], step_s: float, initial_outgoing: np.ndarray) -> None:
+        self.rods, self.step_s = tuple(rods), step_s
+        self.delays = np.array(delays(rods, step_s), dtype=int)
+        self.ring = int(self.delays.max(initial=1)) + 1
+        ports = len(initial_outgoing)
+        self.left = np.zeros((ports, self.ring))
+        self.right = np.zeros((ports, self.ring))
+        self.square = np.zeros((ports, self.ring))  # int over the step of the wave^2, / h
+        self.mean = np.zeros((ports, self.ring))  # int over the step of the wave, / h
+        self.square_sum = np.zeros(ports)  # over the N steps before the next one stored
+        self.mean_sum = np.zeros(ports)
+        for rod in range(len(self.rods)):
+            for port in (2 * rod, 2 * rod + 1):
+                self._fill_port(port, rod, 0, float(initial_outgoing[port]))
+
+    def incoming(self, port: int, step: int) -> tuple[float, float]:
+        """(left, right) of the wave arriving at ``port`` over step ``step``."""
+        k = (step - self.delays[port // 2]) % self.ring
+        source = port ^ 1  # the other end of the same rod
+        return float(self.left[source, k]), float(self.right[source, k])
+
+    def store(self, port: int, step: int, left: float, right: float) -> None:
+        """The outgoing wave of ``port`` over ``step`` (steps are stored in order)."""
+        k, old = step % self.ring, (step - self.delays[port // 2]) % self.ring
+        square, mean = (left * left + left * right + right * right) / 3.0, 0.5 * (left + right)
+        self.square_sum[port] += square - self.square[port, old]
+        self.mean_sum[port] += mean - self.mean[port, old]
+        self.left[port, k], self.right[port, k] = left, right
+        self.square[port, k], self.mean[port, k] = square, mean
+
+    def _fill_port(self, port: int, rod: int, step: int, value: float) -> None:
+        n = self.delays[rod]
+        for k in range(step - n, step + 1):
+            j = k % self.ring
+            self.left[port, j] = self.right[port, j] = self.mean[port, j] = value
+            self.square[port, j] = value * value
+        self.square_sum[port], self.mean_sum[port] = n * value * value, n * value
+
+    def fill(self, rod: int, step: int, value: float) -> None:
+        """Both ends of ``rod`` emitted ``value`` over the last N steps before ``step`` (a rod at a uniform
+        velocity 2 value, unstressed: a piston at its strike, 0 when it is caught)."""
+        for port in (2 * rod, 2 * rod + 1):
+            self._fill_port(port, rod, step, value)
+
+    def energy_j(self, rod: int) -> float:
+        """Z int (d^2 + u^2) over the waves in flight: the rod's kinetic and strain energy."""
+        return float(self.rods[rod].impedance_n_s_per_m * self.step_s * (self.square_sum[2 * rod]
+                                                                         + self.square_sum[2 * rod + 1]))
+
+    def momentum_n_s(self, rod: int) -> float:
+        """Z int (d + u) over the waves in flight: the rod's momentum mu int v dx."""
+        return float(self.rods[rod].impedance_n_s_per_m * self.step_s * (self.mean_sum[2 * rod]
+                                                                         + self.mean_sum[2 * rod + 1]))

@@ -1,0 +1,449 @@
+"""The method of characteristics at a stated step h, with the rest of the drill integrated exactly.
+
+Step k covers [t_k, t_k + h]: the waves arriving at every rod end are set from the waves that left
+the other end N steps before (models.waves.history), and the system of models.waves.system is
+propagated exactly, w(t + s) = expm(A s) w(t), piece by piece: a piece ends at a pulse phase change or
+at the first switch of a piecewise element, located to round-off (Brent's method on the exit function
+of the exact solution, a crossing and its return within a piece found from the slopes). At the step's
+end every port's outgoing wave is stored (its end value and the value that keeps the step's mean).
+
+What is exact and what is not: between two grid times every node, face, body and element follows
+the exact solution of the arriving waves as straight lines; the waves are carried without dispersion
+or delay error beyond the rounding of each transit time to whole steps (stated: history.transit_errors).
+The only approximation is the outgoing wave as a straight line over each step (second order in h where
+it is smooth; a front keeps its area).
+
+Blow starts fall on the grid (h divides the blow period): the indexing model's rock state and the
+piston's strike are applied there, as in the exact formulation. A rigid or lumped piston is caught by
+its contact's mode table; a wave piston when its contact is open and its momentum (in its waves) is
+negative at a step's end: at most a step late, its energy kept (models.drill.piston).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg import expm
+from scipy.optimize import brentq
+
+from ..definition.links import CLOSED, OPEN
+from ..drill.piston import CAUGHT, CONTACT, PARK_M, PistonJumps
+from ..drill.pulse import generator_states, phase_pieces, phase_row
+from ..evaluation.stability import POSITION_LIMIT_M, SimulationFailed
+from .history import WaveLines
+from .rods import SIGMA, TOP
+from .system import Key, Modes, WaveSystem
+
+MAX_SWITCHES_PER_STEP = 64
+
+
+@dataclass
+class BlowStatistics:
+    """Per blow and per port (2 per rod: top, bottom): the largest compression and tension (N, tension as a
+    positive number), and the energy through the section int P v dt along +x (into the rock); per blow the
+    work the rock took, int F_r v_bit dt."""
+
+    compression_n: list[np.ndarray] = field(default_factory=list)
+    tension_n: list[np.ndarray] = field(default_factory=list)
+    energy_j: list[np.ndarray] = field(default_factory=list)
+    rock_work_j: list[float] = field(default_factory=list)
+
+    def open_blow(self, ports: int) -> None:
+        self.compression_n.append(np.zeros(ports))
+        self.tension_n.append(np.zeros(ports))
+        self.energy_j.append(np.zeros(ports))
+        self.rock_work_j.append(0.0)
+
+    def arrays(self, ports: int) -> dict[str, np.ndarray]:
+        shape = (len(self.energy_j), ports)
+        return {"compression_n": np.array(self.compression_n).reshape(shape),
+                "tension_n": np.array(self.tension_n).reshape(shape),
+                "energy_j": np.array(self.energy_j).reshape(shape), "rock_work_j": np.array(self.rock_work_j)}
+
+
+@dataclass
+class Samples:
+    time_s: list[float] = field(default_factory=list)
+    states: list[np.ndarray] = field(default_factory=list)
+    velocity: list[np.ndarray] = field(default_factory=list)
+    forces: list[np.ndarray] = field(default_factory=list)  # rock, impact, then each rigid joint's
+    works: list[np.ndarray] = field(default_factory=list)  # cumulative impact, internal (string) work
+    waves_j: list[float] = field(default_factory=list)  # energy of the string's rods' waves in flight
+    piston_j: list[float] = field(default_factory=list)  # a wave piston's energy
+    compression: list[np.ndarray] = field(default_factory=list)  # every port's compression
+    after: list[bool] = field(default_factory=list)  # recorded after a jump at its own time (a catch)
+
+
+class Stepper:
+    """One run on the grid of the characteristics (module doc). ``kinematic`` nodes move at their
+    velocity over each step (the Exudyn formulation's bodies, set before each step)."""
+
+    def __init__(self, simulation, step_s: float, sample_interval_s: float, kinematic: tuple[int, ...] = ()) -> None:
+        self.simulation, self.step_s = simulation, step_s
+        chain = self.chain = simulation.dynamic_chain
+        self.string_size = simulation.chain.size
+        self.setup = simulation.piston
+        self.piston_rod = next((r for r, rod in enumerate(chain.waves) if self.setup is not None
+                                and rod.top >= self.string_size), None)
+        self.system = WaveSystem(chain, simulation.rock, simulation.torsion, simulation.impact, kinematic,
+                                 catch_by_row=self.piston_rod is None)
+        layout = self.layout = self.system.layout
+        self.lines = WaveLines(chain.waves, step_s, initial_outgoing(simulation, chain))
+        end = simulation.settings.end_time_s
+        self.steps = max(1, round(end / step_s))
+        self.period_steps = round(simulation.impact.period_s / step_s)
+        times, phases = phase_pieces(simulation.impact, end)
+        self.phase_changes, self.phases = times[:, 0], phases
+        self.blows = simulation.blow_starts()
+        self.jumps = PistonJumps(self.setup) if self.setup is not None else None
+        self.contact = next((i for i, piece in enumerate(self.system.pieces) if piece.name == CONTACT), None)
+        self.ports = self.system.ports
+        self.string_ports = [p for p, port in enumerate(self.ports) if port.node < self.string_size]
+        self.rigid_names = [link.name for link in self.system.rigid_links]
+        self.sample_every = max(1, round(sample_interval_s / step_s))
+        self.w = self._initial_state()
+        self.modes = self.system.initial_modes(self.w)
+        self.phase_index = 0
+        self.samples, self.statistics = Samples(), BlowStatistics()
+        self.works = np.zeros(2)
+        self.switch_times: list[float] = []
+        self.switch_modes: list[Modes] = []
+        self.step_index = 0
+        self.on_step: Callable[[int], None] | None = None
+
+    # -- state ----------------------------------------------------------------------------------------
+
+    def _initial_state(self) -> np.ndarray:
+        layout, simulation = self.layout, self.simulation
+        w = np.zeros(layout.size)
+        positions = simulation.initial_positions_m
+        w[:layout.n] = positions if self.setup is None else self.setup.parked(positions)
+        w[layout.rock:layout.rock + layout.rock_states] = simulation.initial_rock_state
+        if layout.torsion:
+            w[layout.angle] = simulation.initial_torsion_angle_rad
+        w[layout.one] = 1.0
+        w[layout.one + 1:layout.one + 3] = generator_states(simulation.impact, np.zeros(1))[0]
+        return w
+
+    def key(self) -> Key:
+        return self.system.key(self.modes, self.phases[self.phase_index])
+
+    def _propagator(self, key: Key, span_s: float) -> np.ndarray:
+        if abs(span_s - self.step_s) <= 1e-12 * self.step_s:
+            if "step" not in key.cache:
+                key.cache["step"] = expm(key.matrix * self.step_s)
+            return key.cache["step"]
+        return expm(key.matrix * span_s)
+
+    # -- one step -------------------------------------------------------------------------------------
+
+    def advance(self) -> None:
+        """Step ``step_index`` (module doc)."""
+        k, h, layout = self.step_index, self.step_s, self.layout
+        t0 = k * h
+        w = self.w
+        if k % self.period_steps == 0:
+            self._start_blow(k, t0)
+            if self.setup is not None:  # the strike: a jump, recorded on both sides
+                self._set_inputs(k)
+                self._record(t0, w, self.key(), after=True)
+        self._set_inputs(k)
+        x0, a0 = w[:layout.n].copy(), w[layout.inputs::2].copy()
+        t, t1, switches = t0, t0 + h, 0
+        key = self.key()
+        while t < t1 - 1e-12 * h:
+            later = np.flatnonzero(self.phase_changes > t + 1e-12 * h)
+            boundary = min(t1, self.phase_changes[later[0]]) if len(later) else t1
+            key = self.key()
+            span = boundary - t
+            w1 = self._propagator(key, span) @ w
+            hit = self._first_switch(key, w, w1, span)
+            if hit is None:
+                self._integrate(key, w, span)
+                w, t = w1, boundary
+                if len(later) and boundary >= self.phase_changes[later[0]] - 1e-12 * h:
+                    self.phase_index = int(later[0])
+                continue
+            s, exit_ = hit
+            w_s = expm(key.matrix * s) @ w
+            self._integrate(key, w, s)
+            t += s
+            self._record(t, w_s, key)
+            w = self._switch(t, w_s, key, exit_)
+            self._record(t, w, self.key(), after=True)
+            switches += 1
+            if switches > MAX_SWITCHES_PER_STEP:
+                raise SimulationFailed(f"scene '{self.simulation.name}': more than {MAX_SWITCHES_PER_STEP} switches "
+                                       f"within one wave step at t = {t:.6g} s (a chattering contact)")
+        self.w = w
+        if not np.all(np.isfinite(w)) or np.max(np.abs(w[:layout.n])) > POSITION_LIMIT_M:
+            raise SimulationFailed(f"scene '{self.simulation.name}': the wave solution diverged at t = {t1:.6g} s")
+        caught = self._close_step(k, x0, a0, key)
+        self.step_index += 1
+        if caught or self.step_index % self.sample_every == 0 or self.step_index == self.steps:
+            self._record(self.step_index * h, self.w, self.key(), after=caught)
+
+    def _set_inputs(self, k: int) -> None:
+        """The arriving waves of step k as (a, b) of every port."""
+        w, inputs, h = self.w, self.layout.inputs, self.step_s
+        for p in range(len(self.ports)):
+            left, right = self.lines.incoming(p, k)
+            w[inputs + 2 * p], w[inputs + 2 * p + 1] = left, (right - left) / h
+
+    def run(self) -> None:
+        self._record(0.0, self.w, self.key())
+        while self.step_index < self.steps:
+            self.advance()
+
+    def _close_step(self, k: int, x0: np.ndarray, a0: np.ndarray, key: Key) -> bool:
+        """The outgoing waves of step k (at its end before any change there: ``key`` that of its last
+        piece), the blow's section statistics, a wave piston's catch (True then)."""
+        h, layout, w = self.step_s, self.layout, self.w
+        velocity = key.velocity @ w
+        stats = self.statistics
+        for p, port in enumerate(self.ports):
+            a1 = w[layout.inputs + 2 * p]
+            right = velocity[port.node] - a1
+            mean = (w[port.node] - x0[port.node]) / h - 0.5 * (a0[p] + a1)
+            left = 2.0 * mean - right
+            self.lines.store(p, k, left, right)
+            z, sigma = port.impedance_n_s_per_m, SIGMA[port.end]
+            compression = sigma * z * (np.array([left, right]) - np.array([a0[p], a1]))
+            stats.compression_n[-1][p] = max(stats.compression_n[-1][p], compression.max())
+            stats.tension_n[-1][p] = max(stats.tension_n[-1][p], -compression.min())
+            flux = z * h * ((left**2 + left * right + right**2) - (a0[p]**2 + a0[p] * a1 + a1**2)) / 3.0
+            stats.energy_j[-1][p] += flux if port.end == TOP else -flux
+        if self.piston_rod is not None and self._wave_piston_done(key):
+            self._catch_wave_piston(k + 1)
+            return True
+        return False
+
+    def _wave_piston_done(self, key: Key) -> bool:
+        """A wave piston is caught when its contact is open and its momentum not forward, or when it rests
+        against the struck face without pushing (its momentum and the contact force both nil to 1e-9)."""
+        mode, setup = self.modes[self.contact], self.setup
+        momentum = self.lines.momentum_n_s(self.piston_rod)
+        if mode == OPEN:
+            return momentum <= 0.0
+        if mode != CLOSED:
+            return False
+        rod = self.chain.waves[self.piston_rod]
+        scale = setup.strike_velocity_m_per_s
+        return abs(momentum) <= 1e-9 * setup.momentum_n_s and \
+            abs(self.impact_force(key, self.w)) <= 1e-9 * rod.impedance_n_s_per_m * scale
+
+    def _integrate(self, key: Key, w0: np.ndarray, span_s: float) -> None:
+        """The works over a piece from its start w0, exactly: int_0^s w^T Q w = w0^T G(s) w0 (:meth:`_grams`)."""
+        works = np.einsum("i,kij,j->k", w0, self._grams(key, span_s), w0)
+        self.works += works[:2]
+        self.statistics.rock_work_j[-1] += works[2]
+
+    def _grams(self, key: Key, span_s: float) -> np.ndarray:
+        """G_q(s) = int_0^s expm(A^T u) Q_q expm(A u) du of the three power forms (:meth:`_forms`): Van
+        Loan's block exponential over s / 2^j with ||A|| s / 2^j <= 1/2 (the block's expm(-A^T u) would
+        overflow on a stiff mode), doubled j times, G(2 s) = G(s) + expm(A s)^T G(s) expm(A s); cached
+        for a whole step."""
+        whole = abs(span_s - self.step_s) <= 1e-12 * self.step_s
+        if whole and "grams" in key.cache:
+            return key.cache["grams"]
+        forms = key.cache.get("forms")
+        if forms is None:
+            forms = key.cache["forms"] = self._forms(key)
+        matrix = key.matrix
+        m = matrix.shape[0]
+        doublings = max(0, math.ceil(math.log2(max(np.linalg.norm(matrix, 1) * span_s / 0.5, 1.0))))
+        small = span_s / 2**doublings
+        block = np.zeros((4 * m, 4 * m))
+        block[:m, :m] = -matrix.T
+        for q in range(3):
+            block[:m, m * (q + 1):m * (q + 2)] = forms[q]
+            block[m * (q + 1):m * (q + 2), m * (q + 1):m * (q + 2)] = matrix
+        exponential = expm(block * small)
+        step = exponential[m:2 * m, m:2 * m]  # expm(A s / 2^j)
+        grams = np.array([step.T @ exponential[:m, m * (q + 1):m * (q + 2)] for q in range(3)])
+        for _ in range(doublings):
+            grams = grams + np.einsum("ji,qjk,kl->qil", step, grams, step)
+            step = step @ step
+        if whole:
+            key.cache["grams"] = grams
+        return grams
+
+    def _forms(self, key: Key) -> np.ndarray:
+        """(Q_impact, Q_internal, Q_rock) with power = w^T Q w: F_d v_impact; what the string's links, rock,
+        torsion line and rods absorb (F u over each: a link's force and stretch rate, the rock's force and
+        the bit's velocity, Z (v - 2 a) v into a rod); F_r v_bit."""
+        system, layout, velocity = self.system, self.layout, key.velocity
+        m = layout.size
+
+        def pair(force: np.ndarray, rate: np.ndarray) -> np.ndarray:
+            return 0.5 * (np.outer(force, rate) + np.outer(rate, force))
+        rock = pair(key.rock_force, velocity[self.chain.bit_body])
+        internal = rock.copy()
+        for link in system.springs:
+            if link.body_b < self.string_size:
+                rate = velocity[link.body_b] - (0.0 if link.body_a is None else velocity[link.body_a])
+                internal += pair(key.link_forces[link.name] + link.damping_n_s_per_m * rate, rate)
+        for index, piece in enumerate(system.pieces[1:], start=1):
+            row = key.element_forces[index]
+            if row is not None and piece.name != CONTACT:
+                link = piece.law
+                internal += pair(row, velocity[link.body_b] - (0.0 if link.body_a is None else velocity[link.body_a]))
+        if layout.torsion:
+            torsion, force, rate = self.simulation.torsion, np.zeros(m), np.zeros(m)
+            force[layout.angle], force[layout.angle + 1] = torsion.stiffness_n_m_per_rad, torsion.damping_n_m_s_per_rad
+            rate[layout.angle + 1] = 1.0
+            internal += pair(force, rate)
+        for p in self.string_ports:
+            port = self.ports[p]
+            arriving = np.zeros(m)
+            arriving[layout.inputs + 2 * p] = 2.0
+            internal += port.impedance_n_s_per_m * pair(velocity[port.node] - arriving, velocity[port.node])
+        impact = pair(self._impact_row(key), velocity[self.chain.impact_body])
+        return np.array([impact, internal, rock])
+
+    def impact_force(self, key: Key, w: np.ndarray) -> float:
+        """F_d on the impact body along +x: the pulse, or the piston's contact (-F of the link)."""
+        return float(self._impact_row(key) @ w)
+
+    def _impact_row(self, key: Key) -> np.ndarray:
+        if self.contact is None:
+            row = np.zeros(self.layout.size)
+            row[self.layout.one:self.layout.one + 3] = phase_row(self.simulation.impact, key.phase)
+            return row
+        row = key.element_forces[self.contact]
+        return -(key.constraints[CONTACT] if row is None else row)
+
+    # -- switches -------------------------------------------------------------------------------------
+
+    def _first_switch(self, key: Key, w0: np.ndarray, w1: np.ndarray, span_s: float) -> tuple[float, int] | None:
+        """(time into the piece, exit) of the first switch in the piece, None without one."""
+        best = None
+        tiny = self.simulation.settings.min_switch_interval_s
+        if "exit_rows" not in key.cache:
+            rows = np.array([direction * row for row, direction, *_ in key.exits]).reshape(len(key.exits), len(w0))
+            key.cache["exit_rows"], key.cache["exit_slopes"] = rows, rows @ key.matrix
+        rows, slopes = key.cache["exit_rows"], key.cache["exit_slopes"]
+        start, end = rows @ w0, rows @ w1
+        returning = (start < 0.0) & (end <= 0.0) & (slopes @ w0 > 0.0) & (slopes @ w1 < 0.0)
+        xtol = 1e-15 * span_s + 1e-300
+        for e in np.flatnonzero((end > 0.0) | returning):
+            row = rows[e]
+
+            def g(s: float, row=row) -> float:
+                return float(row @ (expm(key.matrix * s) @ w0))
+            found = None
+            if end[e] > 0.0:
+                if start[e] < 0.0:
+                    found = brentq(g, 0.0, span_s, xtol=xtol)
+                elif g(min(tiny, span_s)) > 0.0:
+                    found = min(tiny, span_s)
+                else:
+                    found = brentq(g, min(tiny, span_s), span_s, xtol=xtol)
+            else:  # a crossing and its return within the piece: test the top between them
+                slope = slopes[e]
+                top = brentq(lambda s, slope=slope: float(slope @ (expm(key.matrix * s) @ w0)), 0.0, span_s, xtol=xtol)
+                if g(top) > 0.0:
+                    found = brentq(g, 0.0, top, xtol=xtol)
+            if found is not None and (best is None or found < best[0]):
+                best = (found, int(e))
+        return best
+
+    def _switch(self, t: float, w: np.ndarray, key: Key, exit_: int) -> np.ndarray:
+        """Enter the exit's modes: its entry resets (the borehole bottom never decreases)."""
+        _, _, following, resets, element = key.exits[exit_]
+        if self.contact is not None and element == self.contact and following[self.contact] == CAUGHT \
+                and self.jumps is not None:  # the piston's energy before the reset
+            self.jumps.noted_catch(t, *self._piston_state(key, w))
+        w = w.copy()
+        monotone = self.system.pieces[0].monotone
+        values = {target: float(row @ w) for target, row in resets}
+        for target, value in values.items():
+            w[target] = max(w[target], value) if target == monotone else value
+        self.modes = following
+        self.switch_times.append(t)
+        self.switch_modes.append(following)
+        return w
+
+    def _piston_state(self, key: Key, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return w[:self.layout.n], key.velocity @ w
+
+    # -- blows ----------------------------------------------------------------------------------------
+
+    def _start_blow(self, k: int, t: float) -> None:
+        """The rock state the blow meets (indexing) and the piston's strike."""
+        self.statistics.open_blow(len(self.ports))
+        layout, w = self.layout, self.w
+        if self.blows:
+            states = slice(layout.rock, layout.rock + layout.rock_states)
+            angle = w[layout.angle] if layout.torsion else 0.0
+            _, w[states] = self.blows(w[self.chain.bit_body], tuple(w[states]), angle)
+            self.modes = (self.system.pieces[0].initial_mode(self._z(w)), *self.modes[1:])
+        if self.setup is None:
+            return
+        setup, velocity_index = self.setup, layout.velocity
+        if self.piston_rod is None:
+            velocities = self.key().velocity @ w
+            self.jumps.strike(t, w[:layout.n], velocities)
+            for node in range(setup.first, setup.front + 1):
+                w[node] = w[setup.impact_body]
+                if node in velocity_index:
+                    w[velocity_index[node]] = setup.strike_velocity_m_per_s
+        else:
+            rod = self.chain.waves[self.piston_rod]
+            self.jumps.note(t, "strike", self.lines.energy_j(self.piston_rod),
+                            self.lines.momentum_n_s(self.piston_rod) / rod.mass_kg)
+            w[rod.top] = w[rod.bottom] = w[setup.impact_body]
+            self.lines.fill(self.piston_rod, k, 0.5 * setup.strike_velocity_m_per_s)
+        self.modes = self.modes[:self.contact] + (CLOSED,) + self.modes[self.contact + 1:]
+
+    def _catch_wave_piston(self, k: int) -> None:
+        rod = self.chain.waves[self.piston_rod]
+        t = k * self.step_s
+        self.jumps.note(t, "catch", self.lines.energy_j(self.piston_rod),
+                        self.lines.momentum_n_s(self.piston_rod) / rod.mass_kg)
+        self.lines.fill(self.piston_rod, k, 0.0)
+        self.w[rod.top] = self.w[rod.bottom] = self.w[self.setup.impact_body] - PARK_M
+        self.modes = self.modes[:self.contact] + (CAUGHT,) + self.modes[self.contact + 1:]
+        self.switch_times.append(t)
+        self.switch_modes.append(self.modes)
+
+    def _z(self, w: np.ndarray) -> np.ndarray:
+        return np.concatenate([w, self.key().velocity @ w])
+
+    # -- records --------------------------------------------------------------------------------------
+
+    def _record(self, t: float, w: np.ndarray, key: Key, after: bool = False) -> None:
+        samples, layout = self.samples, self.layout
+        samples.time_s.append(t)
+        samples.after.append(after)
+        samples.states.append(w.copy())
+        velocity = key.velocity @ w
+        samples.velocity.append(velocity)
+        forces = [float(key.rock_force @ w), self.impact_force(key, w)]
+        forces += [float(key.constraints[name] @ w) for name in self.rigid_names]
+        samples.forces.append(np.array(forces))
+        samples.works.append(self.works.copy())
+        samples.waves_j.append(sum(self.lines.energy_j(r) for r in range(len(self.chain.waves)) if r != self.piston_rod))
+        samples.piston_j.append(0.0 if self.piston_rod is None else self.lines.energy_j(self.piston_rod))
+        compression = []
+        for p, port in enumerate(self.ports):
+            incoming = w[layout.inputs + 2 * p]
+            compression.append(SIGMA[port.end] * port.impedance_n_s_per_m * (velocity[port.node] - 2.0 * incoming))
+        samples.compression.append(np.array(compression))
+
+
+def initial_outgoing(simulation, chain) -> np.ndarray:
+    """Every port's outgoing wave before the start: at rest, P / (2 Z) at the top and -P / (2 Z) at the
+    bottom of a rod compressed by P (a preload: P = (E A / L) (x_top - x_bottom))."""
+    positions = simulation.initial_positions_m
+    out = np.zeros(2 * len(chain.waves))
+    for r, rod in enumerate(chain.waves):
+        if rod.top < len(positions):
+            compression = rod.stiffness_n_per_m * (positions[rod.top] - positions[rod.bottom])
+            out[2 * r], out[2 * r + 1] = compression / (2 * rod.impedance_n_s_per_m), \
+                -compression / (2 * rod.impedance_n_s_per_m)
+    return out
+
