@@ -136,7 +136,7 @@ def element_rates(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsio
                       else f"{path}.youngs_modulus_pa", moved, True),
                      (link.damping_n_s_per_m, f"{path}.damping_n_s_per_m", moved, False)]
     typical = {spring: median([e[0] for e in elements if e[3] == spring and e[0] > 0] or [1.0]) for spring in (True, False)}
-    typical_mass = median(masses)
+    typical_mass = median([m for m in masses if m > 0] or [1.0])
     candidates = []
     for value, key, moved, spring in elements:
         if any(masses[i] == 0.0 for i in moved) or math.isinf(value):

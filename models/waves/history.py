@@ -35,12 +35,14 @@ def transit_errors(rods: Sequence[WaveRod], step_s: float) -> dict[str, float]:
             for rod, n in zip(rods, delays(rods, step_s), strict=True)}
 
 
-def wave_step_s(durations_s: Sequence[float], target_s: float, period_s: float, tolerance: float = 1e-4,
-                tries: int = 2000) -> float:
+def wave_step_s(durations_s: Sequence[float], target_s: float, period_s: float, tolerance: float = 1e-3,
+                tries: int | None = None) -> float:
     """The step of the characteristics: h = period / M (blows start on the grid) for the smallest
     M >= period / target that makes every duration (the rods' transit times, a prescribed pulse's length)
-    a whole number of steps within ``tolerance`` (relative); the best of ``tries`` candidates when none is."""
+    a whole number of steps within ``tolerance`` (relative), among M up to 1.5 times the first (``tries``
+    candidates); the best of them when none is."""
     first = max(1, math.ceil(period_s / target_s - 1e-9))
+    tries = tries or max(1, first // 2)
     if not durations_s:
         return period_s / first
     transit = np.array(durations_s, dtype=float)
@@ -68,24 +70,26 @@ class WaveLines:
         self.mean = np.zeros((ports, self.ring))  # int over the step of the wave, / h
         self.square_sum = np.zeros(ports)  # over the N steps before the next one stored
         self.mean_sum = np.zeros(ports)
+        self.port_delays = np.repeat(self.delays, 2)
+        self.sources = np.arange(ports) ^ 1  # the other end of the same rod
         for rod in range(len(self.rods)):
             for port in (2 * rod, 2 * rod + 1):
                 self._fill_port(port, rod, 0, float(initial_outgoing[port]))
 
-    def incoming(self, port: int, step: int) -> tuple[float, float]:
-        """(left, right) of the wave arriving at ``port`` over step ``step``."""
-        k = (step - self.delays[port // 2]) % self.ring
-        source = port ^ 1  # the other end of the same rod
-        return float(self.left[source, k]), float(self.right[source, k])
+    def incoming(self, step: int) -> tuple[np.ndarray, np.ndarray]:
+        """(left, right) of the waves arriving at every port over step ``step``."""
+        k = (step - self.port_delays) % self.ring
+        return self.left[self.sources, k], self.right[self.sources, k]
 
-    def store(self, port: int, step: int, left: float, right: float) -> None:
-        """The outgoing wave of ``port`` over ``step`` (steps are stored in order)."""
-        k, old = step % self.ring, (step - self.delays[port // 2]) % self.ring
+    def store(self, step: int, left: np.ndarray, right: np.ndarray) -> None:
+        """Every port's outgoing wave over ``step`` (steps are stored in order)."""
+        k, old = step % self.ring, (step - self.port_delays) % self.ring
+        ports = np.arange(len(left))
         square, mean = (left * left + left * right + right * right) / 3.0, 0.5 * (left + right)
-        self.square_sum[port] += square - self.square[port, old]
-        self.mean_sum[port] += mean - self.mean[port, old]
-        self.left[port, k], self.right[port, k] = left, right
-        self.square[port, k], self.mean[port, k] = square, mean
+        self.square_sum += square - self.square[ports, old]
+        self.mean_sum += mean - self.mean[ports, old]
+        self.left[:, k], self.right[:, k] = left, right
+        self.square[:, k], self.mean[:, k] = square, mean
 
     def _fill_port(self, port: int, rod: int, step: int, value: float) -> None:
         n = self.delays[rod]

@@ -101,6 +101,10 @@ class Stepper:
         self.jumps = PistonJumps(self.setup) if self.setup is not None else None
         self.contact = next((i for i, piece in enumerate(self.system.pieces) if piece.name == CONTACT), None)
         self.ports = self.system.ports
+        self.port_nodes = np.array([port.node for port in self.ports], dtype=int)
+        self.port_impedances = np.array([port.impedance_n_s_per_m for port in self.ports])
+        self.port_signs = np.array([SIGMA[port.end] for port in self.ports]) * self.port_impedances
+        self.port_down = np.array([1.0 if port.end == TOP else -1.0 for port in self.ports])  # flux along +x
         self.string_ports = [p for p, port in enumerate(self.ports) if port.node < self.string_size]
         self.rigid_names = [link.name for link in self.system.rigid_links]
         self.sample_every = max(1, round(sample_interval_s / step_s))
@@ -188,10 +192,11 @@ class Stepper:
 
     def _set_inputs(self, k: int) -> None:
         """The arriving waves of step k as (a, b) of every port."""
-        w, inputs, h = self.w, self.layout.inputs, self.step_s
-        for p in range(len(self.ports)):
-            left, right = self.lines.incoming(p, k)
-            w[inputs + 2 * p], w[inputs + 2 * p + 1] = left, (right - left) / h
+        if not self.ports:
+            return
+        left, right = self.lines.incoming(k)
+        inputs = self.layout.inputs
+        self.w[inputs::2], self.w[inputs + 1::2] = left, (right - left) / self.step_s
 
     def run(self) -> None:
         self._record(0.0, self.w, self.key())
@@ -201,21 +206,18 @@ class Stepper:
     def _close_step(self, k: int, x0: np.ndarray, a0: np.ndarray, key: Key) -> bool:
         """The outgoing waves of step k (at its end before any change there: ``key`` that of its last
         piece), the blow's section statistics, a wave piston's catch (True then)."""
-        h, layout, w = self.step_s, self.layout, self.w
-        velocity = key.velocity @ w
-        stats = self.statistics
-        for p, port in enumerate(self.ports):
-            a1 = w[layout.inputs + 2 * p]
-            right = velocity[port.node] - a1
-            mean = (w[port.node] - x0[port.node]) / h - 0.5 * (a0[p] + a1)
-            left = 2.0 * mean - right
-            self.lines.store(p, k, left, right)
-            z, sigma = port.impedance_n_s_per_m, SIGMA[port.end]
-            compression = sigma * z * (np.array([left, right]) - np.array([a0[p], a1]))
-            stats.compression_n[-1][p] = max(stats.compression_n[-1][p], compression.max())
-            stats.tension_n[-1][p] = max(stats.tension_n[-1][p], -compression.min())
-            flux = z * h * ((left**2 + left * right + right**2) - (a0[p]**2 + a0[p] * a1 + a1**2)) / 3.0
-            stats.energy_j[-1][p] += flux if port.end == TOP else -flux
+        if self.ports:
+            h, w, nodes = self.step_s, self.w, self.port_nodes
+            a1 = w[self.layout.inputs::2]
+            right = key.velocity[nodes] @ w - a1
+            left = 2.0 * ((w[nodes] - x0[nodes]) / h - 0.5 * (a0 + a1)) - right
+            self.lines.store(k, left, right)
+            stats = self.statistics
+            start, end = self.port_signs * (left - a0), self.port_signs * (right - a1)  # compression / Z, sigma Z
+            stats.compression_n[-1] = np.maximum(stats.compression_n[-1], np.maximum(start, end))
+            stats.tension_n[-1] = np.maximum(stats.tension_n[-1], -np.minimum(start, end))
+            flux = self.port_impedances * h * ((left**2 + left * right + right**2) - (a0**2 + a0 * a1 + a1**2)) / 3.0
+            stats.energy_j[-1] += self.port_down * flux
         if self.piston_rod is not None and self._wave_piston_done(key):
             self._catch_wave_piston(k + 1)
             return True
@@ -237,7 +239,8 @@ class Stepper:
 
     def _integrate(self, key: Key, w0: np.ndarray, span_s: float) -> None:
         """The works over a piece from its start w0, exactly: int_0^s w^T Q w = w0^T G(s) w0 (:meth:`_grams`)."""
-        works = np.einsum("i,kij,j->k", w0, self._grams(key, span_s), w0)
+        grams = self._grams(key, span_s)
+        works = (grams.reshape(-1, len(w0)) @ w0).reshape(3, -1) @ w0
         self.works += works[:2]
         self.statistics.rock_work_j[-1] += works[2]
 
@@ -265,7 +268,7 @@ class Stepper:
         step = exponential[m:2 * m, m:2 * m]  # expm(A s / 2^j)
         grams = np.array([step.T @ exponential[:m, m * (q + 1):m * (q + 2)] for q in range(3)])
         for _ in range(doublings):
-            grams = grams + np.einsum("ji,qjk,kl->qil", step, grams, step)
+            grams = grams + step.T @ grams @ step
             step = step @ step
         if whole:
             key.cache["grams"] = grams
@@ -428,11 +431,7 @@ class Stepper:
         samples.works.append(self.works.copy())
         samples.waves_j.append(sum(self.lines.energy_j(r) for r in range(len(self.chain.waves)) if r != self.piston_rod))
         samples.piston_j.append(0.0 if self.piston_rod is None else self.lines.energy_j(self.piston_rod))
-        compression = []
-        for p, port in enumerate(self.ports):
-            incoming = w[layout.inputs + 2 * p]
-            compression.append(SIGMA[port.end] * port.impedance_n_s_per_m * (velocity[port.node] - 2.0 * incoming))
-        samples.compression.append(np.array(compression))
+        samples.compression.append(self.port_signs * (velocity[self.port_nodes] - 2.0 * w[layout.inputs::2]))
 
 
 def initial_outgoing(simulation, chain) -> np.ndarray:

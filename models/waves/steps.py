@@ -2,7 +2,7 @@
 
 The step h is the grid of the waves (models.waves.history) and, in the Exudyn formulation, Exudyn's
 own fixed step. It divides the blow period (blows start on the grid) and is chosen so that every rod's
-transit time, and a prescribed pulse's length, are whole numbers of steps to 1e-4 where such a step
+transit time, and a prescribed pulse's length, are whole numbers of steps to 1e-3 where such a step
 exists near the target (:func:`models.waves.history.wave_step_s`; the rounding is stated in the run's
 info, ``transit_time_errors``). The target is the scene's (exact: ``wave_step_s``; Exudyn: ``step_s``) or
 the preset's: the shortest transit time over STEPS_PER_TRANSIT and the pulse over STEPS_PER_PULSE,
