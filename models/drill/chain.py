@@ -20,12 +20,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...rocklaw import RockLaw
-from ..waves.rods import WaveRod, wave_rod
 from ...rocklaw.modes import ONE
 from ..definition.drill_string import EVERY_BODY, GROUND, Body, Connector
 from ..definition.links import CLOSED as CLOSED_MODE
 from ..definition.links import LINK_TYPES, RATE, STRETCH, Link
 from ..definition.scene import Scene, Torsion
+from ..waves.rods import WaveRod, wave_rod
 
 
 @dataclass(frozen=True)

@@ -61,10 +61,11 @@ from ..drill.shapes import DEFAULT_DIAMETER_M, Cylinder, Layout, layout
 from ..evaluation.results import SimulationResult
 from ..evaluation.run_result import Result
 from ..evaluation.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
+from ..waves.exudyn_waves import WaveExudyn
 from .exudyn_graphics import DrillGraphics, body_graphics, torsion_graphics
 from .exudyn_messages import exudyn_messages_as_warnings, no_cyclic_gc
 from .exudyn_piston import ExudynPiston
-from .simulation import Simulation, as_simulation, prepare
+from .simulation import SceneError, Simulation, as_simulation, prepare
 
 SOLVER_TYPES = {
     "rk67": exu.DynamicSolverType.RK67,
@@ -126,6 +127,7 @@ class ExudynModel:
     symbolic_functions: list[Any] = field(default_factory=list)  # kept alive with the system
     blows: BlowStarts | None = None  # the blow starts of this run (models.drill.indexing)
     piston: ExudynPiston | None = None  # the piston's strikes and catches (models.drill.piston)
+    waves: WaveExudyn | None = None  # wave rods: the element updated before every step (models.waves.exudyn_waves)
     scene_formulation: str = "exudyn"  # the formulation the scene named (the model is always Exudyn's)
     symbolic: bool = True
     pre_steps: list[Callable[[Any, float], bool]] = field(default_factory=list)
@@ -243,6 +245,8 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     kept for the benchmark that measures what the symbolic functions save).
     """
     simulation, named = _exudyn_simulation(run)
+    if simulation.dynamic_chain.waves:
+        return _wave_model(simulation, named, symbolic)
     chain, impact, piston = simulation.dynamic_chain, simulation.impact, simulation.piston
     initial_positions = simulation.initial_positions_m if piston is None else piston.parked(simulation.initial_positions_m)
     shapes = layout(simulation.scene)
@@ -340,6 +344,21 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
                        blows, hook, named, symbolic, _built_items=_item_counts(mbs))
 
 
+def _wave_model(simulation: Simulation, named: str, symbolic: bool) -> ExudynModel:
+    """The Exudyn model of a scene with wave rods: the string's bodies with mass in ``mbs``, the wave rods an
+    element of their own (models.waves.exudyn_waves); ``bodies`` and ``connectors`` hold the Exudyn items."""
+    if simulation.settings.type in AUTOMATIC_STEP_SOLVERS:
+        raise SceneError(("solver", "type"), simulation.settings.type, "wave rods step at the characteristics' "
+                         "fixed step (every step advances the waves once): use a fixed-step type such as rk44")
+    element = WaveExudyn(simulation, symbolic)
+    chain = simulation.dynamic_chain
+    bodies = {chain.bodies[i].name: ExudynBody(chain.bodies[i].name, *items) for i, items in element.bodies.items()}
+    connectors = {name: ExudynConnector(name, connector, link) for name, (connector, link) in element.connectors.items()}
+    return ExudynModel(simulation, chain, element.SC, element.mbs, bodies, connectors, element.rock, None, None, {},
+                       _simulation_settings(simulation), element.functions, waves=element, scene_formulation=named,
+                       symbolic=symbolic, _built_items=_item_counts(element.mbs))
+
+
 def _cylinders(shapes: Layout, chain: AxialChain) -> list[Cylinder]:
     """The drawn cylinder of every body of the dynamic chain: the string's from its layout, a piston's
     bodies (after the string's) as steel cylinders of the default diameter behind the string."""
@@ -407,6 +426,13 @@ def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: di
     """Solve the built system and read its sensors into a result (module doc)."""
     simulation = model.simulation
     settings = simulation.settings
+    if model.waves is not None:
+        actions = ([] if progress is None else [_progress_reporter(settings.end_time_s, progress)]) + model.pre_steps
+        result = model.waves.solve(model.settings, SOLVER_TYPES[settings.type], actions)
+        if added or model.scene_formulation != "exudyn":
+            result.info["exudyn_model"] = {"scene_formulation": model.scene_formulation, "user_items": added,
+                                           "note": USER_ITEMS_NOTE}
+        return result
     warning = step_warning(simulation)
     if warning:
         warnings.warn(warning, StepLimitWarning, stacklevel=3)

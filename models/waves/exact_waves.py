@@ -22,7 +22,6 @@ from .history import transit_errors
 from .record import WaveRecord
 from .stepping import Stepper
 
-
 BLAS = ThreadpoolController()
 
 

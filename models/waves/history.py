@@ -81,15 +81,19 @@ class WaveLines:
         k = (step - self.port_delays) % self.ring
         return self.left[self.sources, k], self.right[self.sources, k]
 
-    def store(self, step: int, left: np.ndarray, right: np.ndarray) -> None:
-        """Every port's outgoing wave over ``step`` (steps are stored in order)."""
-        k, old = step % self.ring, (step - self.port_delays) % self.ring
-        ports = np.arange(len(left))
+    def store(self, step: int, left: np.ndarray, right: np.ndarray, ports: np.ndarray | None = None,
+              again: bool = False) -> None:
+        """The outgoing waves of ``ports`` (default: every port; arrays over every port) over ``step``, steps
+        stored in order; ``again``: a step stored before, its values replaced."""
+        ports = np.arange(len(left)) if ports is None else ports
+        k = step % self.ring
+        old = k if again else (step - self.port_delays[ports]) % self.ring
+        left, right = left[ports], right[ports]
         square, mean = (left * left + left * right + right * right) / 3.0, 0.5 * (left + right)
-        self.square_sum += square - self.square[ports, old]
-        self.mean_sum += mean - self.mean[ports, old]
-        self.left[:, k], self.right[:, k] = left, right
-        self.square[:, k], self.mean[:, k] = square, mean
+        self.square_sum[ports] += square - self.square[ports, old]
+        self.mean_sum[ports] += mean - self.mean[ports, old]
+        self.left[ports, k], self.right[ports, k] = left, right
+        self.square[ports, k], self.mean[ports, k] = square, mean
 
     def _fill_port(self, port: int, rod: int, step: int, value: float) -> None:
         n = self.delays[rod]

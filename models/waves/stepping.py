@@ -22,7 +22,6 @@ negative at a step's end: at most a step late, its energy kept (models.drill.pis
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -81,7 +80,8 @@ class Stepper:
     """One run on the grid of the characteristics (module doc). ``kinematic`` nodes move at their
     velocity over each step (the Exudyn formulation's bodies, set before each step)."""
 
-    def __init__(self, simulation, step_s: float, sample_interval_s: float, kinematic: tuple[int, ...] = ()) -> None:
+    def __init__(self, simulation, step_s: float, sample_interval_s: float, kinematic: tuple[int, ...] = (),
+                 record_steps: bool = True) -> None:
         self.simulation, self.step_s = simulation, step_s
         chain = self.chain = simulation.dynamic_chain
         self.string_size = simulation.chain.size
@@ -105,6 +105,7 @@ class Stepper:
         self.port_impedances = np.array([port.impedance_n_s_per_m for port in self.ports])
         self.port_signs = np.array([SIGMA[port.end] for port in self.ports]) * self.port_impedances
         self.port_down = np.array([1.0 if port.end == TOP else -1.0 for port in self.ports])  # flux along +x
+        self.own_ports = np.arange(len(self.ports))  # the Exudyn model closes the others (its bodies' ports)
         self.string_ports = [p for p, port in enumerate(self.ports) if port.node < self.string_size]
         self.rigid_names = [link.name for link in self.system.rigid_links]
         self.sample_every = max(1, round(sample_interval_s / step_s))
@@ -116,7 +117,11 @@ class Stepper:
         self.switch_times: list[float] = []
         self.switch_modes: list[Modes] = []
         self.step_index = 0
-        self.on_step: Callable[[int], None] | None = None
+        self.kinematic = tuple(sorted(kinematic))
+        self.record_steps = record_steps  # False: the Exudyn model records at its step starts
+        self.record_inputs = False  # True: a sample after the arriving waves are set at every step start
+        self.caught_at_end = False  # the last step ended with a wave piston's catch
+        self.body_loads = np.zeros((2, len(self.kinematic)))  # (start, end) of the force on each over the step
 
     # -- state ----------------------------------------------------------------------------------------
 
@@ -135,12 +140,29 @@ class Stepper:
     def key(self) -> Key:
         return self.system.key(self.modes, self.phases[self.phase_index])
 
-    def _propagator(self, key: Key, span_s: float) -> np.ndarray:
-        if abs(span_s - self.step_s) <= 1e-12 * self.step_s:
-            if "step" not in key.cache:
-                key.cache["step"] = expm(key.matrix * self.step_s)
+    def _propagator(self, key: Key, span_s: float) -> tuple[np.ndarray, np.ndarray | None]:
+        """(expm(A s), int_0^s expm(A u) du with kinematic nodes, whose loads need the impulse over the step):
+        one exponential of [[A, I], [0, 0]] s; cached for a whole step."""
+        whole = abs(span_s - self.step_s) <= 1e-12 * self.step_s
+        if whole and "step" in key.cache:
             return key.cache["step"]
-        return expm(key.matrix * span_s)
+        m = key.matrix.shape[0]
+        if self.kinematic:
+            block = np.zeros((2 * m, 2 * m))
+            block[:m, :m], block[:m, m:] = key.matrix, np.eye(m)
+            exponential = expm(block * span_s)
+            out = (exponential[:m, :m], exponential[:m, m:])
+        else:
+            out = (expm(key.matrix * span_s), None)
+        if whole:
+            key.cache["step"] = out
+        return out
+
+    def _impulse(self, key: Key, w0: np.ndarray, span_s: float, integral: np.ndarray | None) -> None:
+        if self.kinematic:
+            if integral is None:
+                integral = self._propagator(key, span_s)[1]
+            self._step_impulse += key.body_forces @ (integral @ w0)
 
     # -- one step -------------------------------------------------------------------------------------
 
@@ -155,18 +177,23 @@ class Stepper:
                 self._set_inputs(k)
                 self._record(t0, w, self.key(), after=True)
         self._set_inputs(k)
+        if self.record_inputs:  # the arriving waves jump at t0: a sample on this side too (an energy account)
+            self._record(t0, w, self.key(), after=True)
         x0, a0 = w[:layout.n].copy(), w[layout.inputs::2].copy()
         t, t1, switches = t0, t0 + h, 0
         key = self.key()
+        self._step_impulse = np.zeros(len(self.kinematic))
         while t < t1 - 1e-12 * h:
             later = np.flatnonzero(self.phase_changes > t + 1e-12 * h)
             boundary = min(t1, self.phase_changes[later[0]]) if len(later) else t1
             key = self.key()
             span = boundary - t
-            w1 = self._propagator(key, span) @ w
+            propagator, integral = self._propagator(key, span)
+            w1 = propagator @ w
             hit = self._first_switch(key, w, w1, span)
             if hit is None:
                 self._integrate(key, w, span)
+                self._impulse(key, w, span, integral)
                 w, t = w1, boundary
                 if len(later) and boundary >= self.phase_changes[later[0]] - 1e-12 * h:
                     self.phase_index = int(later[0])
@@ -174,6 +201,7 @@ class Stepper:
             s, exit_ = hit
             w_s = expm(key.matrix * s) @ w
             self._integrate(key, w, s)
+            self._impulse(key, w, s, None)
             t += s
             self._record(t, w_s, key)
             w = self._switch(t, w_s, key, exit_)
@@ -186,8 +214,12 @@ class Stepper:
         if not np.all(np.isfinite(w)) or np.max(np.abs(w[:layout.n])) > POSITION_LIMIT_M:
             raise SimulationFailed(f"scene '{self.simulation.name}': the wave solution diverged at t = {t1:.6g} s")
         caught = self._close_step(k, x0, a0, key)
+        self.caught_at_end = caught
+        if self.kinematic:  # the loads on the Exudyn bodies over the step: its end value and its mean
+            end = key.body_forces @ w
+            self.body_loads = np.array([2.0 * self._step_impulse / h - end, end])
         self.step_index += 1
-        if caught or self.step_index % self.sample_every == 0 or self.step_index == self.steps:
+        if self.record_steps and (caught or self.step_index % self.sample_every == 0 or self.step_index == self.steps):
             self._record(self.step_index * h, self.w, self.key(), after=caught)
 
     def _set_inputs(self, k: int) -> None:
@@ -207,21 +239,32 @@ class Stepper:
         """The outgoing waves of step k (at its end before any change there: ``key`` that of its last
         piece), the blow's section statistics, a wave piston's catch (True then)."""
         if self.ports:
-            h, w, nodes = self.step_s, self.w, self.port_nodes
-            a1 = w[self.layout.inputs::2]
-            right = key.velocity[nodes] @ w - a1
-            left = 2.0 * ((w[nodes] - x0[nodes]) / h - 0.5 * (a0 + a1)) - right
-            self.lines.store(k, left, right)
-            stats = self.statistics
-            start, end = self.port_signs * (left - a0), self.port_signs * (right - a1)  # compression / Z, sigma Z
-            stats.compression_n[-1] = np.maximum(stats.compression_n[-1], np.maximum(start, end))
-            stats.tension_n[-1] = np.maximum(stats.tension_n[-1], -np.minimum(start, end))
-            flux = self.port_impedances * h * ((left**2 + left * right + right**2) - (a0**2 + a0 * a1 + a1**2)) / 3.0
-            stats.energy_j[-1] += self.port_down * flux
+            w, nodes = self.w, self.port_nodes
+            a1 = w[self.layout.inputs::2].copy()
+            self.last_inputs = (a0, a1)
+            self.close_ports(k, self.own_ports, w[nodes] - x0[nodes], key.velocity[nodes] @ w, a0, a1,
+                             provisional=True)
         if self.piston_rod is not None and self._wave_piston_done(key):
             self._catch_wave_piston(k + 1)
             return True
         return False
+
+    def close_ports(self, k: int, ports: np.ndarray, moved_m: np.ndarray, velocity: np.ndarray, a0: np.ndarray,
+                    a1: np.ndarray, again: bool = False, provisional: bool = False) -> None:
+        """Store the outgoing waves over step k from the ports' nodes' displacement over the step and velocity
+        at its end (arrays over every port) and add the step to the blow's section figures of ``ports``;
+        ``provisional``: store every port (the others are stored ``again`` later, from the Exudyn bodies)."""
+        h = self.step_s
+        right = velocity - a1
+        left = 2.0 * (moved_m / h - 0.5 * (a0 + a1)) - right
+        self.lines.store(k, left, right, None if provisional else ports, again)
+        left, right, a0, a1 = left[ports], right[ports], a0[ports], a1[ports]
+        stats, signs = self.statistics, self.port_signs[ports]
+        start, end = signs * (left - a0), signs * (right - a1)  # compression: sigma Z (outgoing - incoming)
+        stats.compression_n[-1][ports] = np.maximum(stats.compression_n[-1][ports], np.maximum(start, end))
+        stats.tension_n[-1][ports] = np.maximum(stats.tension_n[-1][ports], -np.minimum(start, end))
+        flux = self.port_impedances[ports] * h * ((left**2 + left * right + right**2) - (a0**2 + a0 * a1 + a1**2)) / 3
+        stats.energy_j[-1][ports] += self.port_down[ports] * flux
 
     def _wave_piston_done(self, key: Key) -> bool:
         """A wave piston is caught when its contact is open and its momentum not forward, or when it rests
@@ -324,7 +367,7 @@ class Stepper:
     def _first_switch(self, key: Key, w0: np.ndarray, w1: np.ndarray, span_s: float) -> tuple[float, int] | None:
         """(time into the piece, exit) of the first switch in the piece, None without one."""
         best = None
-        tiny = self.simulation.settings.min_switch_interval_s
+        tiny = getattr(self.simulation.settings, "min_switch_interval_s", 1e-12)
         if "exit_rows" not in key.cache:
             rows = np.array([direction * row for row, direction, *_ in key.exits]).reshape(len(key.exits), len(w0))
             key.cache["exit_rows"], key.cache["exit_slopes"] = rows, rows @ key.matrix

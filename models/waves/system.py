@@ -24,7 +24,10 @@ here, never written by hand:
   (:meth:`WaveSystem.key`: ``constraints``); a rigid contact opens when that force would pull.
 
 A node may also be *kinematic* (the Exudyn formulation's bodies seen from the waves: moving at its
-velocity at the step's start, models.waves.exudyn_waves): v' = 0.
+velocity at the step's start, models.waves.exudyn_waves): v' = 0. What acts only between kinematic
+nodes (and ground) is then Exudyn's, not this system's: those links, the rock law on a kinematic bit,
+the pulse on a kinematic impact body and the feed on kinematic nodes; the system gives each kinematic
+node the force of everything else on it (``Key.body_forces``), which the Exudyn model applies as a load.
 """
 
 from __future__ import annotations
@@ -106,6 +109,7 @@ class Key:
     element_forces: list[np.ndarray | None]  # each element's force row in its mode (None: no force)
     constraints: dict[str, np.ndarray]  # rigid link or closed rigid contact -> its force row (F > 0 pulls)
     link_forces: dict[str, np.ndarray] = field(default_factory=dict)  # finite linear links, spring part
+    body_forces: np.ndarray | None = None  # (kinematic nodes, m): the system's force on each
     phase: str = ""  # the pulse phase of the key
     cache: dict = field(default_factory=dict)  # propagators of this key (models.waves.stepping)
 
@@ -137,6 +141,8 @@ class WaveSystem:
         n = chain.size
         self.masses = np.array([body.mass_kg for body in chain.bodies])
         self.kinematic = frozenset(kinematic)
+        external = self._external
+        self.rock_owned = chain.bit_body not in self.kinematic
         velocity_nodes = tuple(i for i in range(n) if self.masses[i] > 0 or i in self.kinematic)
         self.layout = layout = Layout(n, velocity_nodes, len(rock.state_names), torsion is not None,
                                       2 * len(chain.waves))
@@ -144,11 +150,15 @@ class WaveSystem:
                            for r, rod in enumerate(chain.waves) for e, end in enumerate((TOP, BOTTOM)))
         self.z = layout.size + n
         self.rigid_links = tuple(link for link in chain.links if link.linear and link.rigid)
-        self.springs = tuple(link for link in chain.links if link.linear and not link.rigid)
+        self.springs = tuple(link for link in chain.links if link.linear and not link.rigid and not external(link))
         self.pieces = (self._rock_element(), *(self._link_element(link, catch_by_row)
-                                               for link in chain.nonlinear_links()))
+                                               for link in chain.nonlinear_links() if not external(link)))
         self.rigid = tuple(i for i, piece in enumerate(self.pieces) if i > 0 and piece.law.rigid)
         self.keys: dict[tuple[Modes, str], Key] = {}
+
+    def _external(self, link: Link) -> bool:
+        """Whether ``link`` acts between kinematic nodes (and ground) only: the Exudyn model's."""
+        return link.body_b in self.kinematic and (link.body_a is None or link.body_a in self.kinematic)
 
     # -- placement ------------------------------------------------------------------------------------
 
@@ -221,7 +231,7 @@ class WaveSystem:
                 forces[link.body_a] += row
         element_forces: list[np.ndarray | None] = []
         for index, (piece, mode) in enumerate(zip(self.pieces, modes, strict=True)):
-            if index in self.rigid and mode == CLOSED:
+            if (index in self.rigid and mode == CLOSED) or (index == 0 and not self.rock_owned):
                 element_forces.append(None)
                 continue
             row, constant = piece.row(piece.table[mode].force)
@@ -232,8 +242,10 @@ class WaveSystem:
         for port in self.ports:
             forces[port.node, port.input] += 2.0 * port.impedance_n_s_per_m
             forces[port.node, m + port.node] -= port.impedance_n_s_per_m
-        forces[:, layout.one] += self.chain.constant_forces()
-        forces[self.chain.impact_body, layout.one:layout.one + 3] += phase_row(self.impact, phase)
+        owned = np.array([i not in self.kinematic for i in range(n)])
+        forces[owned, layout.one] += self.chain.constant_forces()[owned]
+        if self.chain.impact_body not in self.kinematic:
+            forces[self.chain.impact_body, layout.one:layout.one + 3] += phase_row(self.impact, phase)
         return forces, element_forces
 
     def _stretch(self, link: Link, offset: int = 0) -> np.ndarray:
@@ -281,7 +293,10 @@ class WaveSystem:
             if node not in self.kinematic:
                 matrix[index] = forces[owner[node]].sum(axis=0) / self.masses[node]
         key = Key(matrix, velocity, [], np.zeros(m), [], {}, phase=phase)
-        for piece, mode in zip(self.pieces, modes, strict=True):
+        key.body_forces = np.array([forces[owner[node]].sum(axis=0) for node in sorted(self.kinematic)]).reshape(-1, m)
+        for index, (piece, mode) in enumerate(zip(self.pieces, modes, strict=True)):
+            if index == 0 and not self.rock_owned:
+                continue
             for state, affine in piece.table[mode].rates.items():
                 row, constant = piece.row(affine)
                 matrix[piece.states[state]] += key.over_w(row)
@@ -294,7 +309,7 @@ class WaveSystem:
         for port in range(layout.ports):
             matrix[layout.inputs + 2 * port, layout.inputs + 2 * port + 1] = 1.0
         key.element_forces = [None if row is None else key.over_w(row) for row in element_forces]
-        key.rock_force = key.element_forces[0]
+        key.rock_force = key.element_forces[0] if self.rock_owned else np.zeros(m)
         key.constraints = self._constraints(modes, groups, forces, velocity_index)
         key.link_forces = {link.name: link.stiffness_n_per_m * key.over_w(self._stretch(link))
                            for link in self.springs}
@@ -338,6 +353,8 @@ class WaveSystem:
         out = []
         velocity_index = self.layout.velocity
         for index, (piece, mode) in enumerate(zip(self.pieces, modes, strict=True)):
+            if index == 0 and not self.rock_owned:
+                continue
             switches: list[tuple[np.ndarray, int, str]] = []
             if index in self.rigid and mode == CLOSED:
                 switches.append((key.constraints[piece.name], 1, OPEN))
