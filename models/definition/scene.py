@@ -362,6 +362,11 @@ class Scene(Strict):
             raise ValueError(f"outputs {', '.join(pistonless)} need a piston (impact.piston)")
         bodies = {f"{name}[{i}]" if body.segments > 1 else name for name, body in self.drill_string.bodies.items()
                   for i in range(body.segments)} | set(self.drill_string.bodies)
+        rods = {name for name, body in self.drill_string.bodies.items() if body.is_rod}
+        rodless = [o for o in outputs.metrics if "rods" in _need(o).data and _need(o).bodies and not _need(o).bodies <= rods
+                   and _need(o).bodies <= bodies] + ([o for o in outputs.metrics if o == "rod_stress_max_pa"] if not rods else [])
+        if rodless:
+            raise ValueError(f"outputs {', '.join(rodless)} need a rod (a body with length_m and diameter_m)")
         missing = [o for o in outputs.metrics + outputs.timeseries if not _need(o).bodies <= bodies]
         if missing:
             absent = set().union(*(_need(o).bodies for o in missing)) - bodies
@@ -455,7 +460,9 @@ def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
         return scene.outputs
     built = {effect for effect, on in effects.as_dict().items() if on}
     bodies = set(scene.drill_string.bodies)
+    rods = any(body.is_rod for body in scene.drill_string.bodies.values())
     def available(need: Need) -> bool:
-        return need.effects <= built and need.bodies <= bodies and _has_piston_data(scene, need)
+        return need.effects <= built and need.bodies <= bodies and _has_piston_data(scene, need) and \
+            (rods or "rods" not in need.data)
     return Outputs(metrics=[m for m, n in METRICS.items() if available(n)],
                    timeseries=[s for s, n in SERIES.items() if available(n)])

@@ -10,6 +10,7 @@ import numpy as np
 from ..definition.scene import Scene
 from ..drill.chain import AxialChain
 from .parts import link_series
+from .rod_outputs import stress_columns
 
 if TYPE_CHECKING:
     from ..drill.piston import PistonHistory
@@ -109,6 +110,7 @@ class SimulationResult:
             out[f"{body.name}_velocity_m_per_s"] = self.velocity_m_per_s[:, i]
         out.update(link_series(self.chain, self.position_m, self.velocity_m_per_s,
                                None if self.waves is None else self.waves.joint_force_n))
+        out.update(stress_columns(self))
         optional = {
             "borehole_bottom_m": self.bottom_m,
             "rock_force_n": self.rock_force_n,

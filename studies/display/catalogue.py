@@ -89,6 +89,9 @@ METRICS: dict[str, Quantity] = {
     "energy_transfer_efficiency": _q("energy transfer efficiency", r"\eta", "%", 100.0, "1", merit=True),
     "energy_balance_relative_error": _q("energy balance error", r"\epsilon_E", "%", 100.0, "1"),
     "piston_rebound_energy_j": _q("piston rebound energy per blow", r"E_{reb}", "J"),
+    "rod_stress_max_pa": _q("largest rod stress", r"\hat{\sigma}", "MPa", 1e-6, "Pa"),
+    "rock_energy_per_blow_j": _q("rock energy per blow", r"W_r", "J"),
+    "rock_transfer_efficiency": _q("energy transfer to the rock", r"\eta_r", "%", 100.0, "1", merit=True),
     "penetration_per_blow_energy_m_per_j": _q("penetration per blow energy", r"v_p / (E_{blow} f)", "mm/kJ", 1e6,
                                               "m/J", merit=True),
     "window_start_s": _q("averaging window start", "t_0", "s"),
@@ -111,11 +114,17 @@ SERIES: dict[str, Quantity] = {
     "*_force_n": _q("{name} force (compression)", "F", "kN", 1e-3, "N"),
     "*_compression_m": _q("{name} compression", r"\delta", "mm", 1e3, "m"),
     "*_gap_opening_m": _q("{name} gap opening", "g", "mm", 1e3, "m"),
+    "*_top_stress_pa": _q("{name} stress at its top (compression)", r"\sigma", "MPa", 1e-6, "Pa"),
+    "*_bottom_stress_pa": _q("{name} stress at its bottom (compression)", r"\sigma", "MPa", 1e-6, "Pa"),
 }
 # a body's metrics by its name (models.definition.outputs.BODY_METRICS)
 BODY_METRICS: dict[str, Quantity] = {
     "*_velocity_peak_m_per_s": _q("peak {name} velocity", r"\hat{v}", "m/s", merit=True),
     "*_velocity_rms_m_per_s": _q("RMS {name} velocity", r"\tilde{v}", "m/s", merit=True),
+    "*_compressive_stress_max_pa": _q("largest compressive stress in {name}", r"\hat{\sigma}_c", "MPa", 1e-6, "Pa"),
+    "*_tensile_stress_max_pa": _q("largest tensile stress in {name}", r"\hat{\sigma}_t", "MPa", 1e-6, "Pa"),
+    "*_energy_in_per_blow_j": _q("energy into {name} per blow", r"E_{in}", "J"),
+    "*_energy_out_per_blow_j": _q("energy out of {name} per blow", r"E_{out}", "J"),
 }
 
 PARAMETERS: dict[str, Quantity] = {
