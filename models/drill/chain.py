@@ -7,7 +7,7 @@ solver cannot disagree on the topology. The chain owns the first-order form of i
 ``name[0]`` .. ``name[N-1]`` joined by springs E A N / L; connectors attach to a rod's first
 segment (``to``) and last segment (``from``). A rod with ``model: waves`` becomes its two end faces,
 massless nodes ``name[top]`` and ``name[bottom]``, and a wave element between them
-(``AxialChain.waves``, models.waves.rods); a connector without a stiffness that joins only rigid faces
+(``AxialChain.waves``, models.drill.wave_rod); a connector without a stiffness that joins only rigid faces
 (a wave rod's, a rigid body's) is rigid (stiffness infinite: :attr:`Link.rigid`).
 """
 
@@ -25,7 +25,7 @@ from ..definition.drill_string import EVERY_BODY, GROUND, Body, Connector
 from ..definition.links import CLOSED as CLOSED_MODE
 from ..definition.links import LINK_TYPES, RATE, STRETCH, Link
 from ..definition.scene import Scene, Torsion
-from ..waves.rods import WaveRod, wave_rod
+from .wave_rod import WaveRod, wave_rod
 
 
 @dataclass(frozen=True)

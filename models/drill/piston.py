@@ -48,8 +48,8 @@ from ...rocklaw.modes import ONE, Mode, ModeTable, Switch
 from ..definition.drill_string import Body
 from ..definition.links import CLOSED, OPEN, STRETCH, Coupling, Link
 from ..definition.scene import Piston, Scene
-from ..waves.rods import wave_rod
 from .chain import AxialChain, ChainBody
+from .wave_rod import wave_rod
 
 PISTON = "piston"
 CONTACT = "piston_contact"

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -14,7 +14,6 @@ from .rod_outputs import stress_columns
 
 if TYPE_CHECKING:
     from ..drill.piston import PistonHistory
-    from ..waves.record import WaveRecord
     from .prepared_run import PreparedRun
 
 
@@ -51,7 +50,8 @@ class SimulationResult:
     # a piston scene: the piston's states, contact force (also impact_force_n), jumps and rebounds (models.drill.piston)
     piston: PistonHistory | None = None
     # a scene with wave rods: the rods' ends at the samples, per-blow section figures, rigid joints' forces
-    waves: WaveRecord | None = None
+    # (models.waves.record.WaveRecord)
+    waves: Any = None
 
     @property
     def scene(self) -> Scene:

@@ -4,7 +4,7 @@ compression and tension there and the energy through them, and the rock's energy
 A rod is any body with a rod geometry, carried as waves or lumped. Its end's axial force P (positive in
 compression) is
 
-* a wave rod's: from its waves, P = sigma Z (outgoing - incoming) (models.waves.rods), and its per-blow
+* a wave rod's: from its waves, P = sigma Z (outgoing - incoming) (models.drill.wave_rod), and its per-blow
   figures integrated by the formulation over every step of the characteristics (models.waves.record);
 * a lumped rod's: the sum of what acts on that end, the connectors joined there (their force, positive
   in compression), at the top the pulse or the piston's contact on the impact body, at the bottom the

@@ -127,10 +127,10 @@ class ExudynModel:
     symbolic_functions: list[Any] = field(default_factory=list)  # kept alive with the system
     blows: BlowStarts | None = None  # the blow starts of this run (models.drill.indexing)
     piston: ExudynPiston | None = None  # the piston's strikes and catches (models.drill.piston)
-    waves: WaveExudyn | None = None  # wave rods: the element updated before every step (models.waves.exudyn_waves)
     scene_formulation: str = "exudyn"  # the formulation the scene named (the model is always Exudyn's)
     symbolic: bool = True
     pre_steps: list[Callable[[Any, float], bool]] = field(default_factory=list)
+    waves: WaveExudyn | None = None  # wave rods: the element updated before every step (models.waves.exudyn_waves)
     _built_items: dict[str, int] = field(default_factory=dict)
     _ran: bool = False
 
@@ -428,7 +428,8 @@ def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: di
     settings = simulation.settings
     if model.waves is not None:
         actions = ([] if progress is None else [_progress_reporter(settings.end_time_s, progress)]) + model.pre_steps
-        result = model.waves.solve(model.settings, SOLVER_TYPES[settings.type], actions)
+        with no_cyclic_gc(), exudyn_messages_as_warnings(simulation.name):
+            result = model.waves.solve(model.settings, SOLVER_TYPES[settings.type], actions)
         if added or model.scene_formulation != "exudyn":
             result.info["exudyn_model"] = {"scene_formulation": model.scene_formulation, "user_items": added,
                                            "note": USER_ITEMS_NOTE}

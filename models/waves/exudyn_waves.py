@@ -48,7 +48,6 @@ from ...rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 from ..drill.pulse import impact_force
 from ..evaluation.results import SimulationResult
 from ..evaluation.stability import SimulationFailed
-from ..solvers.exudyn_messages import exudyn_messages_as_warnings, no_cyclic_gc
 from .exact_waves import result
 from .stepping import Stepper
 
@@ -232,19 +231,19 @@ class WaveExudyn:
 
     def solve(self, settings: Any, solver_type: Any, actions: list[Callable[[Any, float], bool]],
               cpu_start_s: float | None = None) -> SimulationResult:
-        """Run the system with the element and ``actions`` (progress, a user's hooks) before every step."""
+        """Run the system with the element and ``actions`` (progress, a user's hooks) before every step (the
+        caller holds Exudyn's printed messages and the garbage collector: models.solvers.exudyn_messages)."""
         simulation, mbs = self.simulation, self.mbs
         self.failed_at_s = None
         hooks = ([self.rock.update_bottom] if self.rock is not None and self.rock.rock.crushes else []) + \
             [self.pre_step] + actions
         mbs.SetPreStepUserFunction(lambda mbs, t: all(hook(mbs, t) for hook in hooks))
-        with no_cyclic_gc(), exudyn_messages_as_warnings(simulation.name):
-            start = time.process_time() if cpu_start_s is None else cpu_start_s
-            ok = mbs.SolveDynamic(settings, solverType=solver_type)
-            self._sync()
-            stepper = self.stepper
-            stepper._record(stepper.step_index * stepper.step_s, stepper.w, stepper.key())
-            cpu = time.process_time() - start
+        start = time.process_time() if cpu_start_s is None else cpu_start_s
+        ok = mbs.SolveDynamic(settings, solverType=solver_type)
+        self._sync()
+        stepper = self.stepper
+        stepper._record(stepper.step_index * stepper.step_s, stepper.w, stepper.key())
+        cpu = time.process_time() - start
         if not ok or self.failed_at_s is not None or stepper.step_index < stepper.steps:
             at = self.failed_at_s if self.failed_at_s is not None else stepper.step_index * stepper.step_s
             raise SimulationFailed(f"scene '{simulation.name}': solver {simulation.settings.type} with the wave step "

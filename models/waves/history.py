@@ -21,7 +21,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .rods import WaveRod
+from ..drill.wave_rod import WaveRod
 
 
 def delays(rods: Sequence[WaveRod], step_s: float) -> tuple[int, ...]:
@@ -71,6 +71,7 @@ class WaveLines:
         self.square_sum = np.zeros(ports)  # over the N steps before the next one stored
         self.mean_sum = np.zeros(ports)
         self.port_delays = np.repeat(self.delays, 2)
+        self.impedances = np.array([rod.impedance_n_s_per_m for rod in self.rods])
         self.sources = np.arange(ports) ^ 1  # the other end of the same rod
         for rod in range(len(self.rods)):
             for port in (2 * rod, 2 * rod + 1):
@@ -113,6 +114,10 @@ class WaveLines:
         """Z int (d^2 + u^2) over the waves in flight: the rod's kinetic and strain energy."""
         return float(self.rods[rod].impedance_n_s_per_m * self.step_s * (self.square_sum[2 * rod]
                                                                          + self.square_sum[2 * rod + 1]))
+
+    def energies_j(self) -> np.ndarray:
+        """:meth:`energy_j` of every rod."""
+        return self.impedances * self.step_s * (self.square_sum[::2] + self.square_sum[1::2])
 
     def momentum_n_s(self, rod: int) -> float:
         """Z int (d + u) over the waves in flight: the rod's momentum mu int v dx."""

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .rods import WaveRod
+from ..drill.wave_rod import WaveRod
 
 
 @dataclass

@@ -21,7 +21,6 @@ negative at a step's end: at most a step late, its energy kept (models.drill.pis
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -31,10 +30,13 @@ from scipy.optimize import brentq
 from ..definition.links import CLOSED, OPEN
 from ..drill.piston import CAUGHT, CONTACT, PARK_M, PistonJumps
 from ..drill.pulse import generator_states, phase_pieces, phase_row
+from ..drill.wave_rod import SIGMA, TOP
 from ..evaluation.stability import POSITION_LIMIT_M, SimulationFailed
+from .fast_path import SWITCH, run_fast
 from .history import WaveLines
-from .rods import SIGMA, TOP
+from .kernels import CATCH
 from .system import Key, Modes, WaveSystem
+from .works import step_grams
 
 MAX_SWITCHES_PER_STEP = 64
 
@@ -90,7 +92,7 @@ class Stepper:
                                 and rod.top >= self.string_size), None)
         self.system = WaveSystem(chain, simulation.rock, simulation.torsion, simulation.impact, kinematic,
                                  catch_by_row=self.piston_rod is None)
-        layout = self.layout = self.system.layout
+        self.layout = self.system.layout
         self.lines = WaveLines(chain.waves, step_s, initial_outgoing(simulation, chain))
         end = simulation.settings.end_time_s
         self.steps = max(1, round(end / step_s))
@@ -140,7 +142,7 @@ class Stepper:
     def key(self) -> Key:
         return self.system.key(self.modes, self.phases[self.phase_index])
 
-    def _propagator(self, key: Key, span_s: float) -> tuple[np.ndarray, np.ndarray | None]:
+    def propagator(self, key: Key, span_s: float) -> tuple[np.ndarray, np.ndarray | None]:
         """(expm(A s), int_0^s expm(A u) du with kinematic nodes, whose loads need the impulse over the step):
         one exponential of [[A, I], [0, 0]] s; cached for a whole step."""
         whole = abs(span_s - self.step_s) <= 1e-12 * self.step_s
@@ -161,13 +163,41 @@ class Stepper:
     def _impulse(self, key: Key, w0: np.ndarray, span_s: float, integral: np.ndarray | None) -> None:
         if self.kinematic:
             if integral is None:
-                integral = self._propagator(key, span_s)[1]
+                integral = self.propagator(key, span_s)[1]
             self._step_impulse += key.body_forces @ (integral @ w0)
 
     # -- one step -------------------------------------------------------------------------------------
 
     def advance(self) -> None:
-        """Step ``step_index`` (module doc)."""
+        """Step ``step_index`` (module doc): in the compiled kernel when nothing happens in it (no blow
+        start, pulse phase change or switch), else here."""
+        if self._quiet(self.step_index):
+            if self.record_inputs:
+                self._set_inputs(self.step_index)
+                self._record(self.step_index * self.step_s, self.w, self.key(), after=True)
+            status, _ = run_fast(self, self.step_index + 1)
+            if status != SWITCH:
+                self._after(status == CATCH)
+                return
+        self._step()
+
+    def _quiet(self, k: int) -> bool:
+        """Whether step k has no blow start and no pulse phase change (the kernel's steps)."""
+        if k % self.period_steps == 0:
+            return False
+        t0, t1 = k * self.step_s, (k + 1) * self.step_s
+        later = self.phase_changes[self.phase_index + 1:self.phase_index + 2]
+        return not (len(later) and later[0] <= t1 + 1e-12 * self.step_s and later[0] > t0 - 1e-12 * self.step_s)
+
+    def _after(self, caught: bool) -> None:
+        """Once a step is done: the sample at its end when one is due (or a catch there)."""
+        self.caught_at_end = caught
+        k = self.step_index
+        if self.record_steps and (caught or k % self.sample_every == 0 or k == self.steps):
+            self._record(k * self.step_s, self.w, self.key(), after=caught)
+
+    def _step(self) -> None:
+        """Step ``step_index`` here (module doc)."""
         k, h, layout = self.step_index, self.step_s, self.layout
         t0 = k * h
         w = self.w
@@ -188,7 +218,7 @@ class Stepper:
             boundary = min(t1, self.phase_changes[later[0]]) if len(later) else t1
             key = self.key()
             span = boundary - t
-            propagator, integral = self._propagator(key, span)
+            propagator, integral = self.propagator(key, span)
             w1 = propagator @ w
             hit = self._first_switch(key, w, w1, span)
             if hit is None:
@@ -214,13 +244,11 @@ class Stepper:
         if not np.all(np.isfinite(w)) or np.max(np.abs(w[:layout.n])) > POSITION_LIMIT_M:
             raise SimulationFailed(f"scene '{self.simulation.name}': the wave solution diverged at t = {t1:.6g} s")
         caught = self._close_step(k, x0, a0, key)
-        self.caught_at_end = caught
         if self.kinematic:  # the loads on the Exudyn bodies over the step: its end value and its mean
             end = key.body_forces @ w
             self.body_loads = np.array([2.0 * self._step_impulse / h - end, end])
         self.step_index += 1
-        if self.record_steps and (caught or self.step_index % self.sample_every == 0 or self.step_index == self.steps):
-            self._record(self.step_index * h, self.w, self.key(), after=caught)
+        self._after(caught)
 
     def _set_inputs(self, k: int) -> None:
         """The arriving waves of step k as (a, b) of every port."""
@@ -231,9 +259,27 @@ class Stepper:
         self.w[inputs::2], self.w[inputs + 1::2] = left, (right - left) / self.step_s
 
     def run(self) -> None:
+        """Every step, runs of quiet steps in the kernel up to the next blow start, phase change or sample."""
         self._record(0.0, self.w, self.key())
         while self.step_index < self.steps:
-            self.advance()
+            k = self.step_index
+            if not self._quiet(k) or self.record_inputs:
+                self.advance()
+                continue
+            stop = min(self.steps, (k // self.period_steps + 1) * self.period_steps,
+                       (k // self.sample_every + 1) * self.sample_every, self._phase_step(k))
+            status, _ = run_fast(self, stop)
+            if status == SWITCH:
+                self._step()
+            elif self.step_index == stop or status == CATCH:
+                self._after(status == CATCH)
+
+    def _phase_step(self, k: int) -> int:
+        """The first step from k on that holds the next pulse phase change (the kernel stops before it)."""
+        later = self.phase_changes[self.phase_index + 1:self.phase_index + 2]
+        if not len(later):
+            return self.steps
+        return max(k + 1, int(np.floor(later[0] / self.step_s - 1e-9)))
 
     def _close_step(self, k: int, x0: np.ndarray, a0: np.ndarray, key: Key) -> bool:
         """The outgoing waves of step k (at its end before any change there: ``key`` that of its last
@@ -245,7 +291,7 @@ class Stepper:
             self.close_ports(k, self.own_ports, w[nodes] - x0[nodes], key.velocity[nodes] @ w, a0, a1,
                              provisional=True)
         if self.piston_rod is not None and self._wave_piston_done(key):
-            self._catch_wave_piston(k + 1)
+            self.catch_wave_piston(k + 1)
             return True
         return False
 
@@ -282,79 +328,16 @@ class Stepper:
 
     def _integrate(self, key: Key, w0: np.ndarray, span_s: float) -> None:
         """The works over a piece from its start w0, exactly: int_0^s w^T Q w = w0^T G(s) w0 (:meth:`_grams`)."""
-        grams = self._grams(key, span_s)
+        grams = step_grams(self, key, span_s)
         works = (grams.reshape(-1, len(w0)) @ w0).reshape(3, -1) @ w0
         self.works += works[:2]
         self.statistics.rock_work_j[-1] += works[2]
 
-    def _grams(self, key: Key, span_s: float) -> np.ndarray:
-        """G_q(s) = int_0^s expm(A^T u) Q_q expm(A u) du of the three power forms (:meth:`_forms`): Van
-        Loan's block exponential over s / 2^j with ||A|| s / 2^j <= 1/2 (the block's expm(-A^T u) would
-        overflow on a stiff mode), doubled j times, G(2 s) = G(s) + expm(A s)^T G(s) expm(A s); cached
-        for a whole step."""
-        whole = abs(span_s - self.step_s) <= 1e-12 * self.step_s
-        if whole and "grams" in key.cache:
-            return key.cache["grams"]
-        forms = key.cache.get("forms")
-        if forms is None:
-            forms = key.cache["forms"] = self._forms(key)
-        matrix = key.matrix
-        m = matrix.shape[0]
-        doublings = max(0, math.ceil(math.log2(max(np.linalg.norm(matrix, 1) * span_s / 0.5, 1.0))))
-        small = span_s / 2**doublings
-        block = np.zeros((4 * m, 4 * m))
-        block[:m, :m] = -matrix.T
-        for q in range(3):
-            block[:m, m * (q + 1):m * (q + 2)] = forms[q]
-            block[m * (q + 1):m * (q + 2), m * (q + 1):m * (q + 2)] = matrix
-        exponential = expm(block * small)
-        step = exponential[m:2 * m, m:2 * m]  # expm(A s / 2^j)
-        grams = np.array([step.T @ exponential[:m, m * (q + 1):m * (q + 2)] for q in range(3)])
-        for _ in range(doublings):
-            grams = grams + step.T @ grams @ step
-            step = step @ step
-        if whole:
-            key.cache["grams"] = grams
-        return grams
-
-    def _forms(self, key: Key) -> np.ndarray:
-        """(Q_impact, Q_internal, Q_rock) with power = w^T Q w: F_d v_impact; what the string's links, rock,
-        torsion line and rods absorb (F u over each: a link's force and stretch rate, the rock's force and
-        the bit's velocity, Z (v - 2 a) v into a rod); F_r v_bit."""
-        system, layout, velocity = self.system, self.layout, key.velocity
-        m = layout.size
-
-        def pair(force: np.ndarray, rate: np.ndarray) -> np.ndarray:
-            return 0.5 * (np.outer(force, rate) + np.outer(rate, force))
-        rock = pair(key.rock_force, velocity[self.chain.bit_body])
-        internal = rock.copy()
-        for link in system.springs:
-            if link.body_b < self.string_size:
-                rate = velocity[link.body_b] - (0.0 if link.body_a is None else velocity[link.body_a])
-                internal += pair(key.link_forces[link.name] + link.damping_n_s_per_m * rate, rate)
-        for index, piece in enumerate(system.pieces[1:], start=1):
-            row = key.element_forces[index]
-            if row is not None and piece.name != CONTACT:
-                link = piece.law
-                internal += pair(row, velocity[link.body_b] - (0.0 if link.body_a is None else velocity[link.body_a]))
-        if layout.torsion:
-            torsion, force, rate = self.simulation.torsion, np.zeros(m), np.zeros(m)
-            force[layout.angle], force[layout.angle + 1] = torsion.stiffness_n_m_per_rad, torsion.damping_n_m_s_per_rad
-            rate[layout.angle + 1] = 1.0
-            internal += pair(force, rate)
-        for p in self.string_ports:
-            port = self.ports[p]
-            arriving = np.zeros(m)
-            arriving[layout.inputs + 2 * p] = 2.0
-            internal += port.impedance_n_s_per_m * pair(velocity[port.node] - arriving, velocity[port.node])
-        impact = pair(self._impact_row(key), velocity[self.chain.impact_body])
-        return np.array([impact, internal, rock])
-
     def impact_force(self, key: Key, w: np.ndarray) -> float:
         """F_d on the impact body along +x: the pulse, or the piston's contact (-F of the link)."""
-        return float(self._impact_row(key) @ w)
+        return float(self.impact_row(key) @ w)
 
-    def _impact_row(self, key: Key) -> np.ndarray:
+    def impact_row(self, key: Key) -> np.ndarray:
         if self.contact is None:
             row = np.zeros(self.layout.size)
             row[self.layout.one:self.layout.one + 3] = phase_row(self.simulation.impact, key.phase)
@@ -445,7 +428,7 @@ class Stepper:
             self.lines.fill(self.piston_rod, k, 0.5 * setup.strike_velocity_m_per_s)
         self.modes = self.modes[:self.contact] + (CLOSED,) + self.modes[self.contact + 1:]
 
-    def _catch_wave_piston(self, k: int) -> None:
+    def catch_wave_piston(self, k: int) -> None:
         rod = self.chain.waves[self.piston_rod]
         t = k * self.step_s
         self.jumps.note(t, "catch", self.lines.energy_j(self.piston_rod),
@@ -462,19 +445,27 @@ class Stepper:
     # -- records --------------------------------------------------------------------------------------
 
     def _record(self, t: float, w: np.ndarray, key: Key, after: bool = False) -> None:
-        samples, layout = self.samples, self.layout
+        """A sample: the state, every node's velocity, the forces (rock, impact, rigid joints), the works,
+        the energy in the string's rods and in a wave piston, every port's compression."""
+        samples, layout, n = self.samples, self.layout, self.layout.n
+        if "record" not in key.cache:  # velocities, forces and compressions as one matrix over w
+            ports = self.port_signs[:, None] * key.velocity[self.port_nodes]
+            ports[np.arange(len(self.ports)), layout.inputs + 2 * np.arange(len(self.ports))] -= 2.0 * self.port_signs
+            rows = [key.velocity, key.rock_force[None], self.impact_row(key)[None],
+                    np.array([key.constraints[name] for name in self.rigid_names]).reshape(-1, layout.size), ports]
+            key.cache["record"] = np.vstack(rows)
+        values = key.cache["record"] @ w
+        forces = 2 + len(self.rigid_names)
         samples.time_s.append(t)
         samples.after.append(after)
         samples.states.append(w.copy())
-        velocity = key.velocity @ w
-        samples.velocity.append(velocity)
-        forces = [float(key.rock_force @ w), self.impact_force(key, w)]
-        forces += [float(key.constraints[name] @ w) for name in self.rigid_names]
-        samples.forces.append(np.array(forces))
+        samples.velocity.append(values[:n])
+        samples.forces.append(values[n:n + forces])
+        samples.compression.append(values[n + forces:])
         samples.works.append(self.works.copy())
-        samples.waves_j.append(sum(self.lines.energy_j(r) for r in range(len(self.chain.waves)) if r != self.piston_rod))
-        samples.piston_j.append(0.0 if self.piston_rod is None else self.lines.energy_j(self.piston_rod))
-        samples.compression.append(self.port_signs * (velocity[self.port_nodes] - 2.0 * w[layout.inputs::2]))
+        energies = self.lines.energies_j()
+        samples.piston_j.append(0.0 if self.piston_rod is None else energies[self.piston_rod])
+        samples.waves_j.append(float(np.sum(energies)) - samples.piston_j[-1])
 
 
 def initial_outgoing(simulation, chain) -> np.ndarray:

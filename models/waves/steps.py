@@ -15,9 +15,9 @@ from dataclasses import replace
 
 from ..definition.formulations import DEFAULT_PRESET
 from ..definition.scene import Impact, Solver
+from ..drill.wave_rod import WaveRod
 from ..evaluation.solver_settings import EXUDYN_PRESETS, ExactSettings, Settings
 from .history import wave_step_s
-from .rods import WaveRod
 
 STEPS_PER_TRANSIT = {"fast": 20, "standard": 50, "reference": 200}
 STEPS_PER_PULSE = {"fast": 50, "standard": 100, "reference": 400}

@@ -13,7 +13,7 @@ here, never written by hand:
 
 * every force on a node is a row over z = (w, v of every node): the chain's linear links, each
   piecewise element in its mode (the rock law, couplings, the piston's contact: rocklaw.modes), the feed,
-  the pulse, and each rod end (port) on its node: F = Z (2 a_p - v) (models.waves.rods);
+  the pulse, and each rod end (port) on its node: F = Z (2 a_p - v) (models.drill.wave_rod);
 * nodes joined by a rigid link (a connector without stiffness between rigid faces) or by a rigid
   contact that is closed form a group that moves as one: with the group's body (at most one node with
   mass) or, without one, at the velocity that balances the forces on its massless members; the
@@ -45,7 +45,7 @@ from ..definition.scene import Impact, Torsion
 from ..drill.chain import AxialChain, torsion_first_order_matrix
 from ..drill.piecewise import Element
 from ..drill.pulse import phase_generator, phase_row
-from .rods import BOTTOM, TOP
+from ..drill.wave_rod import BOTTOM, TOP
 
 Modes = tuple[str, ...]
 CONSTRAINT = "constraint"  # a rigid element's closed mode: its force is the constraint force

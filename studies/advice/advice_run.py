@@ -26,7 +26,7 @@ from .advice_search import (
 def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float]], metric: str = METRICS[0],
                  rocks: list[str] | None = None, power_kw: float | None = None, max_thrust_ratio: float = 1.0,
                  search: AdviceSearch | None = None, workers: int | None = None,
-                 dask: str | None = None) -> list[Advice]:
+                 dask: str | None = None, max_rod_stress_pa: float | None = None) -> list[Advice]:
     """Maximise ``metric`` over ``bounds`` (``{"impact.frequency_hz": (45, 70), "feed.force_n": (35e3,
     60e3)}``, optionally ``"impact.amplitude_n"``; SI units) for the scene's rock, or for each Table 1
     rock of ``rocks``; ``power_kw``: a fixed hammer power (a piston scene, the blow energy P / f). One
@@ -50,7 +50,7 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
         raise InputError(f"{source}: rocks: {', '.join(unknown)}: not a Table 1 rock; allowed: {', '.join(TABLE_1)}")
     ordered = {entry.path: tuple(map(float, bounds[entry.path])) for entry in PARAMETERS if entry.path in bounds}
     request = Request(metric, ordered, max_thrust_ratio, search or AdviceSearch(),
-                      power_w=power_kw * 1e3 if power_kw else None)
+                      power_w=power_kw * 1e3 if power_kw else None, max_rod_stress_pa=max_rod_stress_pa)
     scenes = [(rock, runnable_scene(data, rock, request, source)) for rock in rocks or [None]]
     with pool(dask, workers) as (_, runner):
         return [advise(prepared, rock, request, runner) for rock, prepared in scenes]

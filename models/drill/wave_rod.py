@@ -22,7 +22,7 @@ for a single wave). Two rods joined end to end (an impedance step Z1 -> Z2) tran
 of a massless joint, not a separate rule.
 
 A formulation integrates the ends (the bodies or massless faces joined to them) and carries the
-waves between them (models.waves.history): the rod itself has no state.
+waves between them (models.waves: history, stepping): the rod itself has no state.
 """
 
 from __future__ import annotations
