@@ -48,7 +48,7 @@ from ...rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 from ..drill.pulse import impact_force
 from ..evaluation.results import SimulationResult
 from ..evaluation.stability import SimulationFailed
-from .exact_waves import result
+from .exact_waves import BLAS, result
 from .stepping import Stepper
 
 
@@ -239,7 +239,8 @@ class WaveExudyn:
             [self.pre_step] + actions
         mbs.SetPreStepUserFunction(lambda mbs, t: all(hook(mbs, t) for hook in hooks))
         start = time.process_time() if cpu_start_s is None else cpu_start_s
-        ok = mbs.SolveDynamic(settings, solverType=solver_type)
+        with BLAS.limit(limits=1, user_api="blas"):  # the element's small matrices: threads cost more than they save
+            ok = mbs.SolveDynamic(settings, solverType=solver_type)
         self._sync()
         stepper = self.stepper
         stepper._record(stepper.step_index * stepper.step_s, stepper.w, stepper.key())
@@ -260,6 +261,7 @@ class WaveExudyn:
             out.bottom_events = tuple(np.array(column) for column in zip(*self.rock.bottom_history, strict=True))
             if self.rock_blows:
                 out.info["fresh_fractions"] = self.rock_blows.fresh_fractions
+            out.waves.blow_rock_work_j = np.empty(0)  # not the element's: the outputs integrate the samples
         if "energy" in simulation.needed_data:
             out.works_j = None  # the element's works cover its own forces only: the account integrates the samples
         return out

@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.linalg import expm
-from scipy.optimize import brentq
 
 from ..definition.links import CLOSED, OPEN
 from ..drill.piston import CAUGHT, CONTACT, PARK_M, PistonJumps
@@ -35,6 +34,7 @@ from ..evaluation.stability import POSITION_LIMIT_M, SimulationFailed
 from .fast_path import SWITCH, run_fast
 from .history import WaveLines
 from .kernels import CATCH
+from .levels import key_levels
 from .system import Key, Modes, WaveSystem
 from .works import step_grams
 
@@ -229,7 +229,7 @@ class Stepper:
                     self.phase_index = int(later[0])
                 continue
             s, exit_ = hit
-            w_s = expm(key.matrix * s) @ w
+            w_s = key_levels(self, key).propagate(w, s)
             self._integrate(key, w, s)
             self._impulse(key, w, s, None)
             t += s
@@ -348,37 +348,19 @@ class Stepper:
     # -- switches -------------------------------------------------------------------------------------
 
     def _first_switch(self, key: Key, w0: np.ndarray, w1: np.ndarray, span_s: float) -> tuple[float, int] | None:
-        """(time into the piece, exit) of the first switch in the piece, None without one."""
-        best = None
-        tiny = getattr(self.simulation.settings, "min_switch_interval_s", 1e-12)
+        """(time into the piece, exit) of the first switch in the piece, None without one: an exit function
+        on its crossed side at the piece's end, or one whose slopes show a maximum inside, located on the
+        key's levels (models.waves.levels)."""
         if "exit_rows" not in key.cache:
             rows = np.array([direction * row for row, direction, *_ in key.exits]).reshape(len(key.exits), len(w0))
             key.cache["exit_rows"], key.cache["exit_slopes"] = rows, rows @ key.matrix
         rows, slopes = key.cache["exit_rows"], key.cache["exit_slopes"]
         start, end = rows @ w0, rows @ w1
         returning = (start < 0.0) & (end <= 0.0) & (slopes @ w0 > 0.0) & (slopes @ w1 < 0.0)
-        xtol = 1e-15 * span_s + 1e-300
-        for e in np.flatnonzero((end > 0.0) | returning):
-            row = rows[e]
-
-            def g(s: float, row=row) -> float:
-                return float(row @ (expm(key.matrix * s) @ w0))
-            found = None
-            if end[e] > 0.0:
-                if start[e] < 0.0:
-                    found = brentq(g, 0.0, span_s, xtol=xtol)
-                elif g(min(tiny, span_s)) > 0.0:
-                    found = min(tiny, span_s)
-                else:
-                    found = brentq(g, min(tiny, span_s), span_s, xtol=xtol)
-            else:  # a crossing and its return within the piece: test the top between them
-                slope = slopes[e]
-                top = brentq(lambda s, slope=slope: float(slope @ (expm(key.matrix * s) @ w0)), 0.0, span_s, xtol=xtol)
-                if g(top) > 0.0:
-                    found = brentq(g, 0.0, top, xtol=xtol)
-            if found is not None and (best is None or found < best[0]):
-                best = (found, int(e))
-        return best
+        candidates = (end > 0.0) | returning
+        if not np.any(candidates):
+            return None
+        return key_levels(self, key).first_switch(rows, slopes, w0, span_s, candidates)
 
     def _switch(self, t: float, w: np.ndarray, key: Key, exit_: int) -> np.ndarray:
         """Enter the exit's modes: its entry resets (the borehole bottom never decreases)."""
