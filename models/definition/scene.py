@@ -455,7 +455,8 @@ def built_effects(scene: Scene) -> BuiltEffects:
 
 def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
     """The scene's outputs, or without an outputs section every metric and history of the effects
-    built and the bodies present."""
+    built and the bodies present (a scene with rods: each rod's figures too, ``<rod>_compressive_stress_max_pa``
+    ...: models.definition.outputs.BODY_METRICS of the rods' data)."""
     if scene.outputs is not None:
         return scene.outputs
     built = {effect for effect, on in effects.as_dict().items() if on}
@@ -464,5 +465,7 @@ def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
     def available(need: Need) -> bool:
         return need.effects <= built and need.bodies <= bodies and _has_piston_data(scene, need) and \
             (rods or "rods" not in need.data)
-    return Outputs(metrics=[m for m, n in METRICS.items() if available(n)],
+    per_rod = [f"{name}{suffix}" for name, body in scene.drill_string.bodies.items() if body.is_rod
+               for suffix, need in BODY_METRICS.items() if "rods" in need.data]
+    return Outputs(metrics=[m for m, n in METRICS.items() if available(n)] + per_rod,
                    timeseries=[s for s, n in SERIES.items() if available(n)])

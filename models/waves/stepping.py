@@ -123,6 +123,7 @@ class Stepper:
         self.record_steps = record_steps  # False: the Exudyn model records at its step starts
         self.record_inputs = False  # True: a sample after the arriving waves are set at every step start
         self.caught_at_end = False  # the last step ended with a wave piston's catch
+        self._set_inputs(0)  # the waves arriving at the start (a preload's), for the first sample
         self.body_loads = np.zeros((2, len(self.kinematic)))  # (start, end) of the force on each over the step
 
     # -- state ----------------------------------------------------------------------------------------
@@ -226,7 +227,11 @@ class Stepper:
                 self._impulse(key, w, span, integral)
                 w, t = w1, boundary
                 if len(later) and boundary >= self.phase_changes[later[0]] - 1e-12 * h:
+                    if self.record_inputs:  # the pulse may jump here: both sides (the trapezoidal account)
+                        self._record(t, w, key)
                     self.phase_index = int(later[0])
+                    if self.record_inputs:
+                        self._record(t, w, self.key())
                 continue
             s, exit_ = hit
             w_s = key_levels(self, key).propagate(w, s)

@@ -32,7 +32,10 @@ def target_step_s(preset: str, rods: tuple[WaveRod, ...], pulse_duration_s: floa
 
 def wave_settings(settings: Settings, solver: Solver, rods: tuple[WaveRod, ...], impact: Impact,
                   pulse_duration_s: float) -> Settings:
-    """``settings`` with the run's wave step (module doc): ``wave_step_s`` (exact) or ``step_s`` (Exudyn)."""
+    """``settings`` with the run's wave step (module doc): ``wave_step_s`` (exact) or ``step_s`` (Exudyn); the
+    ode formulation's unchanged (it refuses wave rods)."""
+    if settings.formulation == "ode":
+        return settings
     given = solver.wave_step_s if isinstance(settings, ExactSettings) else solver.step_s
     target = given or target_step_s(settings.preset or DEFAULT_PRESET, rods, pulse_duration_s)
     durations = [rod.transit_time_s for rod in rods]
