@@ -13,11 +13,11 @@ import pytest
 from pydantic import ValidationError
 
 from rpdrill.models.definition.scene import Scene
+from rpdrill.models.definition.validation import InputError
 from rpdrill.models.drill.piston import rigid_piston_pulse_n
 from rpdrill.models.drill.wave_rod import reflected_force_share, transmitted_force_share
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.models.definition.validation import InputError
 from rpdrill.models.solvers.simulation import SceneError, prepare
 from rpdrill.studies.inputs.reading import prepare_scene
 

@@ -36,7 +36,7 @@ class KeyLevels:
 
     def propagate(self, w: np.ndarray, span_s: float) -> np.ndarray:
         """w after ``span_s`` (<= h): the levels of the binary digits of span / h."""
-        return self.propagate_units(w, int(round(span_s / self.step_s * 2**LEVELS)))
+        return self.propagate_units(w, round(float(span_s) / self.step_s * 2**LEVELS))
 
     def first_switch(self, rows: np.ndarray, slopes: np.ndarray, w0: np.ndarray, span_s: float,
                      candidates: np.ndarray) -> tuple[float, int] | None:
@@ -45,7 +45,7 @@ class KeyLevels:
         inside), to one finest step (module doc); None when there is none (a maximum that stays below)."""
         rows, slopes = rows[candidates], slopes[candidates]
         exits = np.flatnonzero(candidates)
-        span = int(round(span_s / self.step_s * 2**LEVELS))  # in finest steps: exact integer arithmetic
+        span = round(float(span_s) / self.step_s * 2**LEVELS)  # in finest steps: exact integer arithmetic
         w = self.steps[LEVELS] @ w0
         crossed = rows @ w
         if np.any(crossed > 0.0):  # on its crossed side already at the start: a switch there
