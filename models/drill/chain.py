@@ -70,6 +70,11 @@ class AxialChain:
                 return i
         raise KeyError(f"no body {name!r} in the drill string; bodies: {', '.join(b.name for b in self.bodies)}")
 
+    def rigid_pairs(self) -> list[tuple[int, int]]:
+        """The (a, b) nodes of every rigid link (rigid faces joined without a stiffness)."""
+        return [(link.body_a, link.body_b) for link in self.links
+                if link.linear and link.rigid and link.body_a is not None]
+
     def mass_matrix(self) -> np.ndarray:
         return np.diag([b.mass_kg for b in self.bodies])
 
@@ -149,6 +154,22 @@ class AxialChain:
             elastic += spring**2 * (0.5 / link.stiffness_n_per_m)
             damping += (link.force_n(delta, delta_rate) - spring) * delta_rate
         return elastic, damping
+
+
+def joined(size: int, pairs: list[tuple[int, int]], keep: frozenset[int] = frozenset()) -> list[int]:
+    """The representative node of each of ``size`` nodes joined through ``pairs`` (a node of ``keep``
+    represents its group when one is in it)."""
+    parent = list(range(size))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            i = parent[i]
+        return i
+    for a, b in pairs:
+        a, b = find(a), find(b)
+        if a != b:
+            parent[b if b not in keep else a] = a if b not in keep else b
+    return [find(i) for i in range(size)]
 
 
 def _derived_stiffness_n_per_m(ends: list[Body]) -> float:

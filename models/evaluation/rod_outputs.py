@@ -23,9 +23,8 @@ from typing import Any
 
 import numpy as np
 
+from ..drill.wave_rod import BOTTOM, TOP
 from .parts import link_series
-
-TOP, BOTTOM = "top", "bottom"
 
 
 @dataclass(frozen=True)

@@ -45,6 +45,7 @@ from exudyn.itemInterface import (
 
 from ...rocklaw.backends import SCALAR, SymbolicBackend
 from ...rocklaw.exudyn_element import ExudynRockContact, attach_user_function
+from ..drill.chain import joined
 from ..drill.pulse import impact_force
 from ..evaluation.results import SimulationResult
 from ..evaluation.stability import SimulationFailed
@@ -130,17 +131,8 @@ class WaveExudyn:
         a dashpot Z in Exudyn (implicit in its integrator) and the arriving waves 2 Z w_in in the body's load;
         their outgoing waves are closed from the body's motion after each step (:meth:`pre_step`)."""
         stepper, chain = self.stepper, self.simulation.dynamic_chain
-        parent = list(range(chain.size))
-
-        def find(i: int) -> int:
-            while parent[i] != i:
-                i = parent[i]
-            return i
-        for link in chain.links:
-            if link.linear and link.rigid and link.body_a is not None:
-                a, b = find(link.body_a), find(link.body_b)
-                parent[a if a not in kinematic else b] = b if a not in kinematic else a
-        self.attached = {node: find(node) for node in range(chain.size) if node not in kinematic and find(node) in kinematic}
+        owner = joined(chain.size, chain.rigid_pairs(), frozenset(kinematic))
+        self.attached = {node: owner[node] for node in range(chain.size) if node not in kinematic and owner[node] in kinematic}
         body_ports = [p for p, port in enumerate(stepper.ports) if port.node in self.attached]
         stepper.own_ports = np.array([p for p in range(len(stepper.ports)) if p not in body_ports], dtype=int)
         self.body_ports = np.array(body_ports, dtype=int)

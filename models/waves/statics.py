@@ -10,27 +10,13 @@ import numpy as np
 
 from ...rocklaw import RockLaw
 from ..definition.links import Link
-from ..drill.chain import AxialChain, ChainBody, static_preload_m
-
-
-def _groups(chain: AxialChain) -> list[int]:
-    """The representative node of every node: nodes joined by rigid links are one point."""
-    parent = list(range(chain.size))
-
-    def find(i: int) -> int:
-        while parent[i] != i:
-            i = parent[i]
-        return i
-    for link in chain.links:
-        if link.linear and link.rigid and link.body_a is not None:
-            parent[find(link.body_a)] = find(link.body_b)
-    return [find(i) for i in range(chain.size)]
+from ..drill.chain import AxialChain, ChainBody, joined, static_preload_m
 
 
 def wave_preload_m(chain: AxialChain, law: RockLaw) -> np.ndarray:
     """The node positions of the static equilibrium under the feed (module doc; ValueError as
     static_preload_m)."""
-    owner = _groups(chain)
+    owner = joined(chain.size, chain.rigid_pairs())
     points = sorted(set(owner))
     index = {node: points.index(owner[node]) for node in range(chain.size)}
     forces = np.zeros(len(points))

@@ -42,7 +42,7 @@ from ...rocklaw.base import POSITION, VELOCITY
 from ...rocklaw.modes import Mode, ModeTable
 from ..definition.links import CLOSED, OPEN, RATE, STRETCH, Link
 from ..definition.scene import Impact, Torsion
-from ..drill.chain import AxialChain, torsion_first_order_matrix
+from ..drill.chain import AxialChain, joined, torsion_first_order_matrix
 from ..drill.piecewise import Element
 from ..drill.pulse import phase_generator, phase_row
 from ..drill.wave_rod import BOTTOM, TOP
@@ -193,20 +193,14 @@ class WaveSystem:
 
     def _groups(self, modes: Modes) -> list[list[int]]:
         """The nodes joined by rigid links and closed rigid contacts."""
-        parent = list(range(self.layout.n))
-
-        def find(i: int) -> int:
-            while parent[i] != i:
-                parent[i] = parent[parent[i]]
-                i = parent[i]
-            return i
-        for a, b in self._rigid_pairs(modes):
-            if a is None:
-                raise ValueError(f"a rigid joint to ground at node {self.chain.bodies[b].name}")
-            parent[find(a)] = find(b)
+        pairs = self._rigid_pairs(modes)
+        grounded = [b for a, b in pairs if a is None]
+        if grounded:
+            raise ValueError(f"a rigid joint to ground at node {self.chain.bodies[grounded[0]].name}")
+        owner = joined(self.layout.n, pairs)
         groups: dict[int, list[int]] = {}
         for i in range(self.layout.n):
-            groups.setdefault(find(i), []).append(i)
+            groups.setdefault(owner[i], []).append(i)
         return list(groups.values())
 
     def _rigid_pairs(self, modes: Modes) -> list[tuple[int | None, int]]:
