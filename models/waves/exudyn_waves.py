@@ -19,7 +19,9 @@ element
 A body joined to a face is so coupled explicitly, first order in the step (the step is the
 characteristics' step, a fraction of a rod's transit time: small against a body's own periods).
 The histories come from the element's samples, taken at step starts; the rock on a bit with mass from
-Exudyn's rock element.
+Exudyn's rock element. The works (the energy account's, the rock's per blow) are the element's, integrated
+exactly over its steps (models.waves.works), and those of what Exudyn integrates by the trapezoidal rule
+on every step's ends.
 """
 
 from __future__ import annotations
@@ -68,10 +70,8 @@ class WaveExudyn:
         ground = mbs.AddNode(NodePointGround())
         self.ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
         kinematic = tuple(i for i in range(string) if chain.bodies[i].mass_kg > 0)
-        every_step = "energy" in simulation.needed_data
-        self.stepper = Stepper(simulation, settings.step_s, settings.step_s if every_step else settings.output_interval_s,
-                               kinematic=kinematic, record_steps=False)
-        self.stepper.record_inputs = every_step  # both sides of the waves' jumps at step starts: the trapezoidal account
+        self.stepper = Stepper(simulation, settings.step_s, settings.output_interval_s, kinematic=kinematic,
+                               record_steps=False)
         positions = simulation.initial_positions_m
         self.bodies: dict[int, tuple[Any, Any, Any, Any]] = {}
         for i in kinematic:
@@ -122,6 +122,9 @@ class WaveExudyn:
         self._ports(kinematic)
         self._couple(symbolic)
         mbs.Assemble()
+        self.exudyn_links = [link for _, link in self.connectors.values()]
+        self.pulse_on_body = chain.impact_body in self.bodies and impact.piston is None
+        self.last_powers: np.ndarray | None = None
         self.indices = np.array([mbs.GetNodeODE2Index(self.bodies[i][0]) for i in kinematic], dtype=int)
         self.velocity_index = [self.stepper.layout.velocity[i] for i in kinematic]
         self.closed, self.previous = 0, self.stepper.w[:self.stepper.layout.n].copy()
@@ -207,9 +210,11 @@ class WaveExudyn:
         if not np.all(np.isfinite(stepper.w)):
             self.failed_at_s = k * stepper.step_s
             return False
+        self._add_works(k * stepper.step_s)
         if k % stepper.sample_every == 0 or stepper.caught_at_end:
             stepper._record(k * stepper.step_s, stepper.w, stepper.key(), after=stepper.caught_at_end)
         stepper.advance()
+        self._port_start()
         start, end = stepper.body_loads + self.dashpots * stepper.w[self.velocity_index]  # the dashpots are Exudyn's
         slope = (end - start) / stepper.step_s
         self.step_start_s = k * stepper.step_s
@@ -220,6 +225,50 @@ class WaveExudyn:
                 a.SetValue(float(value_a))
                 b.SetValue(float(value_b))
         return True
+
+    def _powers(self, t: float) -> np.ndarray:
+        """(impact, internal, rock) powers of what Exudyn integrates itself: the pulse on a body with mass, the
+        links between bodies, the rock on a bit with mass (the element integrates its own: models.waves.works)."""
+        w, velocity, chain = self.stepper.w, self.stepper.key().velocity @ self.stepper.w, self.stepper.chain
+        impact = impact_force(self.simulation.impact, t) * velocity[chain.impact_body] if self.pulse_on_body else 0.0
+        internal = 0.0
+        for link in self.exudyn_links:
+            rate = link.stretch(velocity)
+            internal += float(link.force_n(link.stretch(w), rate)) * rate
+        rock = 0.0
+        if self.rock is not None:
+            rock = float(self.rock.rock.force(w[chain.bit_body], velocity[chain.bit_body], self.rock.state)) \
+                * velocity[chain.bit_body]
+        return np.array([impact, internal + rock, rock])
+
+    def _port_power(self, arriving: np.ndarray) -> float:
+        """sum Z (v - 2 w_in) v into the rods at the bodies' ports, at the bodies' velocities now."""
+        if not len(self.body_ports):
+            return 0.0
+        stepper = self.stepper
+        velocity = (stepper.key().velocity @ stepper.w)[stepper.port_nodes[self.body_ports]]
+        return float(np.sum(stepper.port_impedances[self.body_ports] * (velocity - 2.0 * arriving[self.body_ports])
+                            * velocity))
+
+    def _add_works(self, t: float) -> None:
+        """The works of what Exudyn integrates over the step that ended at ``t``, by the trapezoidal rule on
+        the states at its ends (smooth: bodies with mass; a port's arriving wave on each side of its jumps),
+        added to the element's (its works and the blow's rock work), so that the run's works are whole."""
+        powers = self._powers(t)
+        stepper = self.stepper
+        if self.last_powers is not None:
+            powers_end = powers.copy()
+            if len(self.body_ports):
+                powers_end[1] += self._port_power(stepper.w[stepper.layout.inputs::2])  # arriving waves' step ends
+            done = 0.5 * stepper.step_s * (self.last_powers + powers_end)
+            stepper.works += done[:2]
+            stepper.statistics.rock_work_j[-1] += done[2]
+        self.last_powers = powers
+
+    def _port_start(self) -> None:
+        """The ports' power at the start of the step just set (its arriving waves: models.waves.stepping)."""
+        if len(self.body_ports) and self.last_powers is not None:
+            self.last_powers[1] += self._port_power(self.stepper.last_inputs[0])
 
     def solve(self, settings: Any, solver_type: Any, actions: list[Callable[[Any, float], bool]],
               cpu_start_s: float | None = None) -> SimulationResult:
@@ -235,6 +284,7 @@ class WaveExudyn:
             ok = mbs.SolveDynamic(settings, solverType=solver_type)
         self._sync()
         stepper = self.stepper
+        self._add_works(stepper.step_index * stepper.step_s)
         stepper._record(stepper.step_index * stepper.step_s, stepper.w, stepper.key())
         cpu = time.process_time() - start
         if not ok or self.failed_at_s is not None or stepper.step_index < stepper.steps:
@@ -248,14 +298,10 @@ class WaveExudyn:
             law, states = self.rock.rock, self.rock.state_at(out.time_s)
             out.rock_state_m = states
             out.bottom_m = states[:, law.bottom_index]
-            out.rock_force_n = np.array([law.force(x, v, tuple(state)) for x, v, state in
-                                         zip(out.bit_position_m, out.bit_velocity_m_per_s, states, strict=True)])
+            out.rock_force_n = np.asarray(law.force(out.bit_position_m, out.bit_velocity_m_per_s, tuple(states.T)))
             out.bottom_events = tuple(np.array(column) for column in zip(*self.rock.bottom_history, strict=True))
             if self.rock_blows:
                 out.info["fresh_fractions"] = self.rock_blows.fresh_fractions
-            out.waves.blow_rock_work_j = np.empty(0)  # not the element's: the outputs integrate the samples
-        if "energy" in simulation.needed_data:
-            out.works_j = None  # the element's works cover its own forces only: the account integrates the samples
         return out
 
 

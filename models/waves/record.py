@@ -28,7 +28,7 @@ class WaveRecord:
     blow_compression_n: np.ndarray  # blows x ports, the largest compression of each blow
     blow_tension_n: np.ndarray  # blows x ports, the largest tension (a positive number)
     blow_energy_j: np.ndarray  # blows x ports, int P v dt along +x
-    blow_rock_work_j: np.ndarray  # blows, int F_r v_bit dt (empty when the rock is not the element's: Exudyn's)
+    blow_rock_work_j: np.ndarray  # blows, int F_r v_bit dt
     energy_j: np.ndarray  # samples: the energy of the string's waves in flight
     joint_force_n: dict[str, np.ndarray] = field(default_factory=dict)  # rigid joint -> samples (F > 0 pulls)
 

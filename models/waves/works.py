@@ -77,7 +77,7 @@ def power_forms(stepper, key: Key) -> np.ndarray:
         force[layout.angle], force[layout.angle + 1] = torsion.stiffness_n_m_per_rad, torsion.damping_n_m_s_per_rad
         rate[layout.angle + 1] = 1.0
         internal += pair(force, rate)
-    for p in stepper.string_ports:
+    for p in np.intersect1d(stepper.string_ports, stepper.own_ports):  # a body's ports: the Exudyn element's works
         port = stepper.ports[p]
         arriving = np.zeros(m)
         arriving[layout.inputs + 2 * p] = 2.0
