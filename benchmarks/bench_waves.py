@@ -11,9 +11,10 @@ through a contact ten times a 240-segment rod's segment stiffness (against the c
 and with a rigid impact (against Z v_p exp(-Z t / m_p)); the equal-impedance rod piston's rectangular
 pulse; an impedance step 45 -> 55 mm. CPU: the run of the check's blow, after one warm-up run (numba's
 compiled kernels load from disk once per process).
-``--strings``: studies/scenes/top_hammer_waves.yaml (and its lumped twin top_hammer_piston.yaml at 4, 16
-and 64 segments per rod) and four_rod_string.yaml with wave rods (and lumped at 4, 16, 64): penetration
-rate, largest rod stress, the rock's share of the blow energy, peak rock force, CPU.
+``--strings``: studies/scenes/top_hammer_waves.yaml (and its lumped twin top_hammer_piston.yaml at 4 and 16
+segments per rod, the piston at twice that) and four_rod_string.yaml with wave rods (and lumped at 4 and 16):
+penetration rate, largest rod stress, the rock's share of the blow energy, peak rock force, CPU (64 segments
+per rod would take Exudyn's standard preset about an hour per run on this machine).
 ``--lumped-lundberg``: Lundberg's check on lumped rods of 64 to 512 segments (Exudyn, reference preset),
 the dispersion the wave element removes.
 """
@@ -154,10 +155,12 @@ def strings() -> None:
     print("| scene | model | formulation | penetration rate mm/s | largest rod stress MPa | rock energy / blow energy "
           "| peak rock force kN | CPU s |")
     print("|---|---|---|---|---|---|---|---|")
-    cases = [("top_hammer_waves", "waves", "exact", None), ("top_hammer_waves", "waves", "exudyn", None)]
-    cases += [("top_hammer_piston", "lumped", "exudyn", n) for n in (4, 16, 64)]
-    cases += [("four_rod_string", "waves", "exact", None), ("four_rod_string", "waves", "exudyn", None)]
-    cases += [("four_rod_string", "lumped", "exudyn", n) for n in (4, 16, 64)]
+    cases = [("top_hammer_waves", "waves", "exact", None), ("top_hammer_waves", "waves", "exudyn", None),
+             ("top_hammer_piston", "lumped", "exact", 4)]
+    cases += [("top_hammer_piston", "lumped", "exudyn", n) for n in (4, 16)]
+    cases += [("four_rod_string", "waves", "exact", None), ("four_rod_string", "waves", "exudyn", None),
+              ("four_rod_string", "lumped", "exact", 4)]
+    cases += [("four_rod_string", "lumped", "exudyn", n) for n in (4, 16)]
     for name, model, formulation, segments in cases:
         data = read_yaml(f"studies/scenes/{name}.yaml")
         bodies = data["drill_string"]["bodies"]

@@ -249,3 +249,23 @@ def test_the_rod_outputs_of_a_blow(both):
     assert metrics["rod_energy_out_per_blow_j"] == pytest.approx(metrics["rock_energy_per_blow_j"], rel=1e-2)
     assert metrics["rock_energy_per_blow_j"] < metrics["shank_energy_in_per_blow_j"] < metrics["impact_energy_j"]
     assert metrics["rock_transfer_efficiency"] == pytest.approx(metrics["rock_energy_per_blow_j"] / 150.0, rel=1e-9)
+
+
+def test_an_item_of_ones_own_on_a_body_acts_through_the_wave_element(both):
+    """build_exudyn of a scene with wave rods: the bodies with mass are Exudyn's, an item a user joins to
+    one acts on it, and the waves see the body move (a 50 kg mass on a 300 Hz spring on the bit)."""
+    from exudyn.itemInterface import MarkerNodePosition, NodePoint, ObjectConnectorSpringDamper, ObjectMassPoint
+
+    from rpdrill.models.solvers.exudyn_model import build_exudyn
+
+    model = build_exudyn(Scene.model_validate(bit_on_rods("exudyn")))
+    assert sorted(model.bodies) == ["bit", "carriage"] and model.waves is not None
+    node = model.mbs.AddNode(NodePoint(referenceCoordinates=[1.0, 0.0, 0.0]))
+    model.mbs.AddObject(ObjectMassPoint(physicsMass=50.0, nodeNumber=node))
+    k = 50.0 * (2 * math.pi * 300.0) ** 2
+    model.mbs.AddObject(ObjectConnectorSpringDamper(
+        markerNumbers=[model.bodies["bit"].marker_position, model.mbs.AddMarker(MarkerNodePosition(nodeNumber=node))],
+        stiffness=k, damping=0.2 * math.sqrt(k * 50.0), referenceLength=1.0))
+    result = model.run()
+    assert result.info["exudyn_model"]["user_items"] == {"nodes": 1, "objects": 2, "markers": 1}
+    assert result.metrics["advance_per_blow_m"] < 0.5 * summary_metrics(both["exudyn"])["advance_per_blow_m"]
