@@ -254,7 +254,12 @@ def test_the_rod_outputs_of_a_blow(both):
 def test_an_item_of_ones_own_on_a_body_acts_through_the_wave_element(both):
     """build_exudyn of a scene with wave rods: the bodies with mass are Exudyn's, an item a user joins to
     one acts on it, and the waves see the body move (a 50 kg mass on a 300 Hz spring on the bit)."""
-    from exudyn.itemInterface import MarkerNodePosition, NodePoint, ObjectConnectorSpringDamper, ObjectMassPoint
+    from exudyn.itemInterface import (
+        MarkerNodePosition,
+        NodePoint,
+        ObjectConnectorSpringDamper,
+        ObjectMassPoint,
+    )
 
     from rpdrill.models.solvers.exudyn_model import build_exudyn
 
