@@ -278,6 +278,9 @@ class PistonJumps:
 
     setup: PistonSetup
     log: list[tuple[float, str, float, float]] = field(default_factory=list)
+    # what a strike puts in when it is not m_p v_p^2 / 2: a wave piston's, over its transit time as run
+    # (models.waves: a whole number of steps)
+    blow_energy_j: float | None = None
     rows: list[int] = field(default_factory=list)  # per log entry, the first sample after it (if known)
     caught: bool = True  # no blow before the first strike
 
@@ -317,7 +320,7 @@ class PistonJumps:
 
     @property
     def events(self) -> list[tuple[float, float]]:
-        blow = self.setup.blow_energy_j
+        blow = self.setup.blow_energy_j if self.blow_energy_j is None else self.blow_energy_j
         return [(t, blow - energy if kind == "strike" else -energy) for t, kind, energy, _ in self._ordered()]
 
     @property
@@ -332,7 +335,7 @@ class PistonJumps:
     def input_by_row(self, samples: int) -> np.ndarray:
         """The energy the jumps put in up to each of ``samples`` samples, from the first sample after each
         jump (every jump noted with its ``row``)."""
-        blow = self.setup.blow_energy_j
+        blow = self.setup.blow_energy_j if self.blow_energy_j is None else self.blow_energy_j
         put_in = np.zeros(samples + 1)
         for (_, kind, energy, _), row in zip(self.log, self.rows, strict=True):
             put_in[row] += blow - energy if kind == "strike" else -energy

@@ -8,8 +8,8 @@ import numpy as np
 
 from ..definition.links import CLOSED, OPEN
 from .kernels import CATCH, PISTON_CLOSED, PISTON_NONE, PISTON_OPEN, SWITCH, run_steps
+from .levels import key_levels
 from .system import Key
-from .works import step_grams
 
 
 def key_arrays(stepper, key: Key) -> tuple[np.ndarray, ...]:
@@ -17,10 +17,11 @@ def key_arrays(stepper, key: Key) -> tuple[np.ndarray, ...]:
     impact row) of ``key`` for a whole step, cached."""
     if "kernel" not in key.cache:
         m = key.matrix.shape[0]
-        propagator, integral = stepper.propagator(key, stepper.step_s)
+        levels = key_levels(stepper, key)
+        propagator, integral = levels.steps[0], levels.integral(0) if levels.impulses else None
         rows = np.array([direction * row for row, direction, *_ in key.exits]).reshape(len(key.exits), m)
         key.cache["kernel"] = (
-            np.ascontiguousarray(propagator), np.ascontiguousarray(step_grams(stepper, key, stepper.step_s)),
+            np.ascontiguousarray(propagator), np.ascontiguousarray(levels.gram(0)[:3]),
             np.ascontiguousarray(rows), np.ascontiguousarray(rows @ key.matrix),
             np.ascontiguousarray(key.velocity[stepper.port_nodes]).reshape(len(stepper.ports), m),
             np.zeros((m, m)) if integral is None else np.ascontiguousarray(integral),

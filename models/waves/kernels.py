@@ -117,3 +117,64 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
                 if abs(force) <= force_tolerance:
                     return CATCH, step
     return STEPS_DONE, step
+
+
+@njit(cache=True)
+def _crossed(rows, w):
+    """The row with the largest positive value at w, -1 if none is positive."""
+    best, top = -1, 0.0
+    for e in range(rows.shape[0]):
+        g = 0.0
+        for j in range(w.shape[0]):
+            g += rows[e, j] * w[j]
+        if g > top:
+            best, top = e, g
+    return best
+
+
+@njit(cache=True)
+def first_crossing(steps, rows, slopes, w0, span, levels):
+    """(finest steps, exit) of the first crossing of rows . w > 0 within ``span`` finest steps from w0,
+    (0, -1) if none (models.waves.levels): bisection on the levels' grid, a step refused where an exit
+    crosses at its end or its slopes show a maximum inside (a crossing and its return); a maximum that
+    stays below zero restarts the search after it."""
+    w = steps[levels] @ w0
+    crossed = _crossed(rows, w)
+    if crossed >= 0:  # on its crossed side already at the start: a switch there
+        return 1, crossed
+    reached = 1
+    while reached < span:
+        limit = span
+        point = w.copy()
+        for j in range(1, levels + 1):
+            length = 1 << (levels - j)
+            while reached + length <= limit:
+                trial = steps[j] @ point
+                refused = _crossed(rows, trial) >= 0
+                for e in range(rows.shape[0]):
+                    if refused:
+                        break
+                    g = 0.0
+                    s0 = 0.0
+                    s1 = 0.0
+                    for i in range(point.shape[0]):
+                        g += rows[e, i] * point[i]
+                        s0 += slopes[e, i] * point[i]
+                        s1 += slopes[e, i] * trial[i]
+                    refused = s0 > 0.0 and s1 < 0.0 and g < 0.0
+                if refused:
+                    limit = reached + length
+                    break
+                point = trial
+                reached += length
+        crossed = _crossed(rows, steps[levels] @ point)
+        if crossed >= 0:
+            return reached + 1, crossed
+        if limit >= span:
+            return 0, -1
+        w = w0.copy()
+        for j in range(levels + 1):
+            if (limit >> (levels - j)) & 1:
+                w = steps[j] @ w
+        reached = limit
+    return 0, -1

@@ -24,7 +24,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg import expm
 
 from ..definition.links import CLOSED, OPEN
 from ..drill.piston import CAUGHT, CONTACT, PARK_M, PistonJumps
@@ -36,7 +35,6 @@ from .history import WaveLines
 from .kernels import CATCH
 from .levels import key_levels
 from .system import Key, Modes, WaveSystem
-from .works import step_grams
 
 MAX_SWITCHES_PER_STEP = 64
 
@@ -102,6 +100,10 @@ class Stepper:
         self.blows = simulation.blow_starts()
         self.jumps = PistonJumps(self.setup) if self.setup is not None else None
         self.contact = next((i for i, piece in enumerate(self.system.pieces) if piece.name == CONTACT), None)
+        if self.piston_rod is not None:  # the strike fills the rod as run: N h long
+            rod = chain.waves[self.piston_rod]
+            self.jumps.blow_energy_j = 0.5 * rod.impedance_n_s_per_m * self.lines.delays[self.piston_rod] * step_s \
+                * self.setup.strike_velocity_m_per_s**2
         self.ports = self.system.ports
         self.port_nodes = np.array([port.node for port in self.ports], dtype=int)
         self.port_impedances = np.array([port.impedance_n_s_per_m for port in self.ports])
@@ -124,6 +126,7 @@ class Stepper:
         self.record_inputs = False  # True: a sample after the arriving waves are set at every step start
         self.caught_at_end = False  # the last step ended with a wave piston's catch
         self._set_inputs(0)  # the waves arriving at the start (a preload's), for the first sample
+        self._step_flux = np.zeros(2)  # energy into the string's rods and a wave piston since the step's start
         self.body_loads = np.zeros((2, len(self.kinematic)))  # (start, end) of the force on each over the step
 
     # -- state ----------------------------------------------------------------------------------------
@@ -143,29 +146,16 @@ class Stepper:
     def key(self) -> Key:
         return self.system.key(self.modes, self.phases[self.phase_index])
 
-    def propagator(self, key: Key, span_s: float) -> tuple[np.ndarray, np.ndarray | None]:
-        """(expm(A s), int_0^s expm(A u) du with kinematic nodes, whose loads need the impulse over the step):
-        one exponential of [[A, I], [0, 0]] s; cached for a whole step."""
-        whole = abs(span_s - self.step_s) <= 1e-12 * self.step_s
-        if whole and "step" in key.cache:
-            return key.cache["step"]
-        m = key.matrix.shape[0]
-        if self.kinematic:
-            block = np.zeros((2 * m, 2 * m))
-            block[:m, :m], block[:m, m:] = key.matrix, np.eye(m)
-            exponential = expm(block * span_s)
-            out = (exponential[:m, :m], exponential[:m, m:])
-        else:
-            out = (expm(key.matrix * span_s), None)
-        if whole:
-            key.cache["step"] = out
-        return out
-
-    def _impulse(self, key: Key, w0: np.ndarray, span_s: float, integral: np.ndarray | None) -> None:
-        if self.kinematic:
-            if integral is None:
-                integral = self.propagator(key, span_s)[1]
-            self._step_impulse += key.body_forces @ (integral @ w0)
+    def _piece(self, key: Key, w0: np.ndarray, span_s: float) -> np.ndarray:
+        """w after a piece of ``span_s`` (<= h) from w0 on the key's levels, its works and the kinematic
+        bodies' impulse added (models.waves.levels)."""
+        w, works, moved = key_levels(self, key).advance(w0, span_s)
+        self.works += works[:2]
+        self.statistics.rock_work_j[-1] += works[2]
+        self._step_flux += works[3:]  # into the rods since the step's start (not in their waves in flight yet)
+        if moved is not None:
+            self._step_impulse += key.body_forces @ moved
+        return w
 
     # -- one step -------------------------------------------------------------------------------------
 
@@ -219,13 +209,10 @@ class Stepper:
             boundary = min(t1, self.phase_changes[later[0]]) if len(later) else t1
             key = self.key()
             span = boundary - t
-            propagator, integral = self.propagator(key, span)
-            w1 = propagator @ w
+            w1 = key_levels(self, key).propagate(w, span)
             hit = self._first_switch(key, w, w1, span)
             if hit is None:
-                self._integrate(key, w, span)
-                self._impulse(key, w, span, integral)
-                w, t = w1, boundary
+                w, t = self._piece(key, w, span), boundary
                 if len(later) and boundary >= self.phase_changes[later[0]] - 1e-12 * h:
                     if self.record_inputs:  # the pulse may jump here: both sides (the trapezoidal account)
                         self._record(t, w, key)
@@ -234,9 +221,7 @@ class Stepper:
                         self._record(t, w, self.key())
                 continue
             s, exit_ = hit
-            w_s = key_levels(self, key).propagate(w, s)
-            self._integrate(key, w, s)
-            self._impulse(key, w, s, None)
+            w_s = self._piece(key, w, s)
             t += s
             self._record(t, w_s, key)
             w = self._switch(t, w_s, key, exit_)
@@ -289,6 +274,7 @@ class Stepper:
     def _close_step(self, k: int, x0: np.ndarray, a0: np.ndarray, key: Key) -> bool:
         """The outgoing waves of step k (at its end before any change there: ``key`` that of its last
         piece), the blow's section statistics, a wave piston's catch (True then)."""
+        self._step_flux[:] = 0.0  # in the waves in flight from now on
         if self.ports:
             w, nodes = self.w, self.port_nodes
             a1 = w[self.layout.inputs::2].copy()
@@ -330,13 +316,6 @@ class Stepper:
         scale = setup.strike_velocity_m_per_s
         return abs(momentum) <= 1e-9 * setup.momentum_n_s and \
             abs(self.impact_force(key, self.w)) <= 1e-9 * rod.impedance_n_s_per_m * scale
-
-    def _integrate(self, key: Key, w0: np.ndarray, span_s: float) -> None:
-        """The works over a piece from its start w0, exactly: int_0^s w^T Q w = w0^T G(s) w0 (:meth:`_grams`)."""
-        grams = step_grams(self, key, span_s)
-        works = (grams.reshape(-1, len(w0)) @ w0).reshape(3, -1) @ w0
-        self.works += works[:2]
-        self.statistics.rock_work_j[-1] += works[2]
 
     def impact_force(self, key: Key, w: np.ndarray) -> float:
         """F_d on the impact body along +x: the pulse, or the piston's contact (-F of the link)."""
@@ -451,8 +430,9 @@ class Stepper:
         samples.compression.append(values[n + forces:])
         samples.works.append(self.works.copy())
         energies = self.lines.energies_j()
-        samples.piston_j.append(0.0 if self.piston_rod is None else energies[self.piston_rod])
-        samples.waves_j.append(float(np.sum(energies)) - samples.piston_j[-1])
+        piston = 0.0 if self.piston_rod is None else energies[self.piston_rod]
+        samples.piston_j.append(piston + self._step_flux[1])
+        samples.waves_j.append(float(np.sum(energies)) - piston + self._step_flux[0])
 
 
 def initial_outgoing(simulation, chain) -> np.ndarray:
