@@ -274,3 +274,19 @@ def test_an_item_of_ones_own_on_a_body_acts_through_the_wave_element(both):
     result = model.run()
     assert result.info["exudyn_model"]["user_items"] == {"nodes": 1, "objects": 2, "markers": 1}
     assert result.metrics["advance_per_blow_m"] < 0.5 * summary_metrics(both["exudyn"])["advance_per_blow_m"]
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_the_pulse_on_a_face_is_the_prescribed_one_at_every_blow(formulation):
+    """A half-sine on a wave rod's face, three blows: the impact force is F_d(t) of models.drill.pulse at
+    every sample (its generator restarts at every blow)."""
+    from rpdrill.models.drill.pulse import impact_force
+
+    data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4}, {"name": "sandstone"}, 1e-3,
+                    formulation)
+    data["impact"]["frequency_hz"], data["solver"]["end_time_s"] = 3e3, 1e-3
+    result = run(data)
+    expected = impact_force(result.scene.impact, result.time_s)
+    jumps = np.isin(np.round(result.time_s * 3e3 * 1e9), np.round(np.arange(4) * 1e9))  # a blow's start: 0 either side
+    assert np.allclose(result.impact_force_n[~jumps], expected[~jumps], rtol=0, atol=1e-6 * 1e5)
+    assert result.impact_force_n.min() > -1e-6 * 1e5

@@ -53,17 +53,19 @@ def rod_end(result: Any, rod: str, end: str) -> RodEnd:
     waves = result.waves
     if waves is not None and (rod, end) in waves.ports:
         return RodEnd(rod, end, body.area_m2, waves.compression_n[:, waves.port(rod, end)], velocity)
-    return RodEnd(rod, end, body.area_m2, _attached_compression_n(result, node, end), velocity)
+    return RodEnd(rod, end, body.area_m2, _attached_compression_n(result, node, end, range(first, last + 1)), velocity)
 
 
-def _attached_compression_n(result: Any, node: int, end: str) -> np.ndarray:
-    """The compression at a lumped rod's end: the connectors there, the pulse or contact at the top of the
-    impact body, the rock at the bottom of the rock body."""
+def _attached_compression_n(result: Any, node: int, end: str, own: range) -> np.ndarray:
+    """The compression at a lumped rod's end: the connectors there (not the rod's own links between its
+    segments ``own``), the pulse or contact at the top of the impact body, the rock at the bottom of the
+    rock body."""
     chain, columns = result.chain, None
     total = np.zeros(len(result.time_s))
     for link in chain.links:
-        if (end == TOP and link.body_b == node and link.body_a != node - 1) or \
-                (end == BOTTOM and link.body_a == node and link.body_b != node + 1):
+        if link.body_a in own and link.body_b in own:
+            continue
+        if (end == TOP and link.body_b == node) or (end == BOTTOM and link.body_a == node):
             columns = columns or _link_forces(result)
             total = total + columns[f"{link.name}_force_n"]
     if end == TOP and node == chain.impact_body and result.impact_force_n is not None:

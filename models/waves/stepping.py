@@ -217,6 +217,7 @@ class Stepper:
                     if self.record_inputs:  # the pulse may jump here: both sides (the trapezoidal account)
                         self._record(t, w, key)
                     self.phase_index = int(later[0])
+                    self._start_phase(w, t)
                     if self.record_inputs:
                         self._record(t, w, self.key())
                 continue
@@ -239,6 +240,13 @@ class Stepper:
             self.body_loads = np.array([2.0 * self._step_impulse / h - end, end])
         self.step_index += 1
         self._after(caught)
+
+    def _start_phase(self, w: np.ndarray, t: float) -> None:
+        """The pulse generator's states (u1, u2) at the start of the phase piece beginning at ``t``."""
+        period = self.simulation.impact.period_s
+        local = t - np.floor(t / period + 1e-9) * period
+        one = self.layout.one
+        w[one + 1:one + 3] = generator_states(self.simulation.impact, np.array([max(local, 0.0)]))[0]
 
     def _set_inputs(self, k: int) -> None:
         """The arriving waves of step k as (a, b) of every port."""
