@@ -16,27 +16,48 @@ three formulations), ``studies`` (YAML inputs, scans, analyses, reports and the 
 dependencies run one way, studies -> models -> rocklaw (``docs/architecture.md``).
 """
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from .models.definition.scene import Scene
-from .models.definition.validation import InputError
-from .models.evaluation.run_result import Result
-from .models.evaluation.stability import SimulationFailed
-from .studies.advice.advice_run import Advice, AdviceSearch
-from .studies.advice.advice_run import advise_scene as advise
-from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
-from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
-from .studies.runtime.budgets import BudgetError
-from .studies.scan.study import Study
-
-# Names that load Exudyn (or matplotlib) when first used, not at ``import rpdrill``: so that the command
-# line can still choose Exudyn's build (rocklaw.exudyn_build) and a user's ``import exudyn`` gets the
-# regular one.
-_LAZY = {"build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
+# Every public name is imported when first used, not at ``import rpdrill``: the ``rpdrill`` program starts
+# (and takes its Ctrl-C handler, studies.cli.main.console) before NumPy, pydantic or Exudyn load; the command
+# line can still choose Exudyn's build (rocklaw.exudyn_build) and a user's ``import exudyn`` gets the regular one.
+_LAZY = {"Scene": ("models.definition.scene", "Scene"),
+         "InputError": ("models.definition.validation", "InputError"),
+         "Result": ("models.evaluation.run_result", "Result"),
+         "SimulationFailed": ("models.evaluation.stability", "SimulationFailed"),
+         "Advice": ("studies.advice.advice_run", "Advice"),
+         "AdviceSearch": ("studies.advice.advice_run", "AdviceSearch"),
+         "advise": ("studies.advice.advice_run", "advise_scene"),
+         "load_scene": ("studies.api", "load_scene"),
+         "load_study": ("studies.api", "load_study"),
+         "run_study": ("studies.api", "run_study"),
+         "save_result": ("studies.api", "save_result"),
+         "simulate": ("studies.api", "simulate"),
+         "table_frame": ("studies.api", "table_frame"),
+         "Crosscheck": ("studies.crosscheck.crosscheck_run", "Crosscheck"),
+         "crosscheck": ("studies.crosscheck.crosscheck_run", "crosscheck"),
+         "BudgetError": ("studies.runtime.budgets", "BudgetError"),
+         "Study": ("studies.scan.study", "Study"),
+         "build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
          "ExudynModel": ("models.solvers.exudyn_model", "ExudynModel"),
          "draw": ("studies.figures.drill_drawing", "draw"),
          "write_animation": ("studies.figures.drill_animation", "write_animation"),
          "view_solution": ("studies.figures.drill_animation", "view_solution")}
+
+if TYPE_CHECKING:  # the names as type checkers and editors see them
+    from .models.definition.scene import Scene
+    from .models.definition.validation import InputError
+    from .models.evaluation.run_result import Result
+    from .models.evaluation.stability import SimulationFailed
+    from .models.solvers.exudyn_model import ExudynModel, build_exudyn
+    from .studies.advice.advice_run import Advice, AdviceSearch
+    from .studies.advice.advice_run import advise_scene as advise
+    from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
+    from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
+    from .studies.figures.drill_animation import view_solution, write_animation
+    from .studies.figures.drill_drawing import draw
+    from .studies.runtime.budgets import BudgetError
+    from .studies.scan.study import Study
 
 
 def __getattr__(name: str) -> Any:
@@ -44,8 +65,14 @@ def __getattr__(name: str) -> Any:
         import importlib
 
         module, attribute = _LAZY[name]
-        return getattr(importlib.import_module(f".{module}", __name__), attribute)
+        value = getattr(importlib.import_module(f".{module}", __name__), attribute)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'rpdrill' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})
 
 
 __all__ = ["Advice", "AdviceSearch", "BudgetError", "Crosscheck", "ExudynModel", "InputError", "Result", "Scene", "SimulationFailed", "Study", "advise", "build_exudyn",

@@ -41,6 +41,11 @@ ROLES = {
                     "stored per rod end), the linear system of bodies, massless faces and arriving waves between "
                     "two grid times integrated exactly (its compiled fast path, its works), the static preload "
                     "and step of such a drill, and the exact and Exudyn formulations of a scene with wave rods.",
+    "models.steady": "The drill's steady state found, not waited for: the periodic orbit relative to the borehole "
+                     "bottom by shooting (the exact map's Jacobian from matrix exponentials and saltation "
+                     "matrices, finite differences for the other formulations), its Floquet multipliers, the "
+                     "regime of a scene (period-1, period-n, none), continuation along a scan and its "
+                     "bifurcations, and the run a scene's solver.steady_state asks for.",
     "models.solvers": "Preparing a scene for a run and the three formulations of one model: the Exudyn "
                       "multibody system, the exact piecewise-linear propagation (its linear system and "
                       "compiled kernels), the paper's Eq. 4 as a SciPy ODE; a run's cost estimate.",

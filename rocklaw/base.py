@@ -21,7 +21,15 @@ and the state:
   ``resets_at_blows`` whether it changes anything (the formulations apply it at every blow start
   only then);
 * energy: the rock stores F_spring^2 / (2 k_unload) and dissipates the plastic (crushing) work
-  W_p = int F_spring d(x_n) (:meth:`RockLaw.plastic_work_j`).
+  W_p = int F_spring d(x_n) (:meth:`RockLaw.plastic_work_j`);
+* optional, ``step_update(bit_position_m, bit_velocity_m_per_s, state, step_s)``: the state after one
+  Exudyn step of ``step_s`` from the bit's state at its start, for a law whose state moves at a finite
+  rate (a visco-plastic slider, which ``return_map`` - no time passing - leaves where it is); the Exudyn
+  element calls it instead of ``return_map`` when the law has it.
+
+What each formulation needs (:data:`MEMBERS`, :func:`missing_members`): the Exudyn formulation everything
+but the mode table; the exact and ODE formulations the mode table too (``modes``, ``initial_mode``).
+A law of one's own names its class by import path in a scene (``rock.law: module:Class``).
 
 Implementations: :class:`rocklaw.jenkins.JenkinsRock` (the paper's Eq. 1, 2) and
 :class:`rocklaw.bilinear.BilinearRock`.
@@ -114,6 +122,26 @@ class RockLaw(Protocol):
     def initial_mode(self, values: Mapping[str, float]) -> str:
         """The mode of a start at these values of position, velocity and the states."""
         ...
+
+
+# what every formulation needs of a law (the Exudyn element, the energy account, the metrics), and what the
+# exact and ODE formulations need besides (their switching and matrices come from the mode table)
+MEMBERS = ("name", "state_names", "bottom_index", "crushes", "loading_stiffness_n_per_m",
+           "unloading_stiffness_n_per_m", "threshold_n", "damping_n_s_per_m", "crushing_penetration_m",
+           "initial_state", "force", "spring_force", "return_map", "fresh_fraction", "modes_follow_fresh_fraction",
+           "resets_at_blows", "start_blow", "plastic_work_j")
+PIECEWISE_MEMBERS = ("modes", "initial_mode")
+
+
+def missing_members(law: object, members: tuple[str, ...] = MEMBERS) -> list[str]:
+    """The names of ``members`` that ``law`` lacks (an attribute that raises counts as missing)."""
+    missing = []
+    for name in members:
+        try:
+            getattr(law, name)
+        except Exception:  # noqa: BLE001 - a property that fails is as good as absent
+            missing.append(name)
+    return missing
 
 
 def local_values(law: RockLaw, bit_position_m: float, bit_velocity_m_per_s: float,

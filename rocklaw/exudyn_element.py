@@ -5,7 +5,8 @@ The force is an Exudyn *symbolic* user function recorded from the law's ``force`
 expression tree, no Python call per evaluation; ``symbolic=False`` gives the same law as a
 Python callback, for benchmarks). The law's states are named symbolic ``Real`` variables
 ``rock_<state name>`` of the expression (plain Python floats with ``symbolic=False``), updated
-once per accepted step, before the step, by the law's return map (a pre-step function), and at the
+once per accepted step, before the step, by the law's return map (a pre-step function; a law whose state
+moves at a finite rate by its ``step_update`` over the step), and at the
 first step that starts at or after each blow start by ``start_blow`` (the state the blow meets), when
 the law resets at blow starts.
 """
@@ -27,6 +28,7 @@ from .backends import SCALAR, SymbolicBackend
 from .base import RockLaw, State
 
 COORDINATE = exu.OutputVariableType.Coordinates
+RATE = exu.OutputVariableType.Coordinates_t
 
 
 def attach_user_function(mbs: Any, item: Any, parameter: str, function: Any, symbolic: bool) -> Any:
@@ -65,7 +67,7 @@ class ExudynRockContact:
         self.rock = rock
         self._start_blow, self._blow_period_s, self._blows = start_blow, blow_period_s, 0
         self._bit_node = bit_node
-        self._return_map = rock.return_map
+        self._return_map, self._step_update = rock.return_map, getattr(rock, "step_update", None)
         if initial_state is None:
             initial_position = mbs.GetNodeParameter(bit_node, "initialCoordinates")[0]
             initial_state = rock.return_map(initial_position, rock.initial_state())
@@ -116,7 +118,7 @@ class ExudynRockContact:
         """Go on with ``rock`` (the same law with another eta: models.drill.indexing), in the expression too."""
         if self._fresh_fraction is not None and rock.fresh_fraction != self.rock.fresh_fraction:
             self._fresh_fraction.SetValue(rock.fresh_fraction)
-        self.rock, self._return_map = rock, rock.return_map
+        self.rock, self._return_map, self._step_update = rock, rock.return_map, getattr(rock, "step_update", None)
 
     def state_at(self, times_s: np.ndarray) -> np.ndarray:
         """The state (samples x states) at ``times_s``: the last change at or before each time."""
@@ -125,13 +127,18 @@ class ExudynRockContact:
         return states[np.clip(np.searchsorted(stamps, times_s, side="right") - 1, 0, None)]
 
     def update_bottom(self, mbs: Any, t: float) -> bool:
-        """The law's return map at the current bit position, called once before each step.
+        """The law's return map at the current bit position (a law with ``step_update``: its update over
+        the coming step from the bit's position and velocity), called once before each step.
 
         Exudyn passes the pre-step function the time at the *end* of the coming step while the
         state is still that of its start; the history is stamped with the start time.
         """
         position = mbs.GetNodeOutput(self._bit_node, COORDINATE)
-        state = self._return_map(position, self.state)
+        if self._step_update is None:
+            state = self._return_map(position, self.state)
+        else:  # a law whose state moves at a finite rate: its update over the coming step
+            state = self._step_update(position, mbs.GetNodeOutput(self._bit_node, RATE), self.state,
+                                      t - self._step_start_s)
         # a step start a round-off before a blow start is that blow start
         if self._start_blow is not None and self._step_start_s >= (self._blows - 1e-9) * self._blow_period_s:
             state = self._start_blow(position, state)

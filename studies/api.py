@@ -13,15 +13,30 @@ import dataclasses
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+from ..models.definition.formulations import FORMULATIONS
 from ..models.definition.scene import Scene
 from ..models.evaluation.run_result import Result
 from ..models.evaluation.run_status import run_status
 from ..models.solvers.cost import Cause
+from .inputs.arguments import (
+    boolean_problem,
+    callable_problem,
+    check,
+    choice_problem,
+    dask_problem,
+    either,
+    file_problem,
+    folder_problem,
+    instance_problem,
+    optional,
+    rows_problem,
+    workers_problem,
+)
 from .inputs.reading import InputError, load_scene, prepare_scene, scene_and_source
 from .runtime.budgets import DEFAULT_BUDGET, Budget
-from .runtime.output_files import write_columns_csv, write_json, write_resolved
+from .runtime.output_files import check_out, write_columns_csv, write_json, write_resolved
 from .scan.study import Study, load_study
 from .study_runs import Outcome, run_studies, run_study_files, study_folders
 
@@ -35,27 +50,47 @@ __all__ = ["InputError", "Result", "load_scene", "load_study", "run_study", "run
 def save_result(result: Result, folder: str | Path, animate: bool = False) -> list[Path]:
     """What ``rpdrill simulate`` writes into ``folder`` (made if missing): ``timeseries.csv``,
     ``summary.json``, ``scene.resolved.yaml``, the ``timeseries.png``/``.svg`` figure, the drawing of the
-    drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified. The files written."""
+    drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified. A scene with extensions is drawn
+    (and, from a run with a solution file, animated) as its built Exudyn model, every item of the extensions
+    included (studies.figures.system_drawing). The files written."""
     from .figures.drill_animation import write_animation  # matplotlib only when saving
     from .figures.drill_drawing import draw
     from .figures.timeseries_figure import plot_timeseries
 
-    folder = Path(folder)
+    check("rpdrill.save_result", "result", result, instance_problem(Result, "the Result of rpdrill.simulate"))
+    check("rpdrill.save_result", "folder", folder, folder_problem)
+    check("rpdrill.save_result", "animate", animate, boolean_problem)
+    folder = check_out(folder, overwrite=True, option="rpdrill.save_result: folder")
     folder.mkdir(parents=True, exist_ok=True)
     columns = {name: values.to_numpy() for name, values in result.timeseries.items()}
     write_columns_csv(folder / "timeseries.csv", columns)
     write_json(folder / "summary.json", {"scene": result.scene.name, "formulation": result.formulation,
-                                         "status": run_status(result.raw)[0], "metrics": result.metrics,
-                                         "run": result.raw.info,
+                                         "status": run_status(result.raw, result.metrics)[0], "metrics": result.metrics,
+                                         "run": {key: value for key, value in result.raw.info.items()
+                                                 if key != "solution_file"},  # a scratch file of the run
                                          "provenance": result.provenance})
     write_resolved(folder / "scene.resolved.yaml", result.raw.simulation.resolved_scene())
     written = [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml",
                *plot_timeseries(columns, result.scene, folder / "timeseries.png"),
                draw(result.scene, folder / "drill.png")]
     if animate:
-        write_animation(result.raw, folder / "drill.gif")
+        write_animation(_animated(result), folder / "drill.gif")
         written.append(folder / "drill.gif")
     return written
+
+
+def _animated(result: Result) -> Any:
+    """What the animation of a run draws: an Exudyn run of a scene with extensions, from its solution file
+    (``simulate(..., solution_file=...)``), as its model rebuilt (every item of the extensions drawn); any
+    other run as the drill string of its scene."""
+    solution = result.raw.info.get("solution_file")
+    if not result.scene.extensions or result.formulation != "exudyn" or not solution or not Path(solution).exists():
+        return result.raw
+    from ..models.solvers.exudyn_model import build_exudyn
+
+    model = build_exudyn(result.scene)
+    model.solution_path = Path(solution)
+    return model
 
 
 def simulate(scene: Scene | str | Path, formulation: str | None = None,
@@ -69,7 +104,11 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     (for its SolutionViewer: studies.figures.drill_animation.view_solution)."""
     from .figures.drill_animation import run_with_solution
 
-    scene, source = scene_and_source(scene)
+    check("rpdrill.simulate", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
+    check("rpdrill.simulate", "progress", progress, callable_problem)
+    check("rpdrill.simulate", "budget", budget, instance_problem(Budget, "a rpdrill Budget or None", optional=True))
+    check("rpdrill.simulate", "solution_file", solution_file, optional(file_problem))
+    scene, source = scene_and_source(scene, "rpdrill.simulate")
     if formulation is not None:
         scene = scene.with_solver(formulation)
     simulation = prepare_scene(scene, source)
@@ -77,7 +116,7 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
     raw = run_with_solution(simulation, progress, solution_file)
-    return Result(scene, raw, {"source": source})
+    return Result(scene, raw, {"source": source, **simulation.code_records()})
 
 
 def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
@@ -85,6 +124,7 @@ def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
     (status, error, a rock's name) as text; one row a point, indexed by ``point``."""
     import pandas as pd  # 0.3 s to import: only where a table is asked for
 
+    check("rpdrill.table_frame", "rows", rows, rows_problem)
     frame = pd.DataFrame(list(rows))
     if frame.empty:
         return frame
@@ -103,12 +143,18 @@ def run_study(study: Study | str | Path, workers: int | None = None, out: str | 
     removed after (no plots). The results table as a DataFrame, one row a point."""
     from .runtime.pools import pool
 
+    check("rpdrill.run_study", "study", study, either(file_problem, instance_problem(Study, "a rpdrill Study or a "
+                                                                                    "study file's path")))
+    check("rpdrill.run_study", "workers", workers, optional(workers_problem))
+    check("rpdrill.run_study", "out", out, optional(folder_problem))
+    check("rpdrill.run_study", "dask", dask, dask_problem)
+    check("rpdrill.run_study", "quiet", quiet, boolean_problem)
     if not isinstance(study, Study):
         study = load_study(study)
     with tempfile.TemporaryDirectory(prefix="rpdrill-study-") as scratch:
         folder = study_folders([str(study.source)], str(out or scratch))[0]
         if out is None:  # a scratch folder keeps no plots
             study = dataclasses.replace(study, spec=study.spec.model_copy(update={"plots": []}))
-        with pool(dask, workers) as runner:
+        with pool(dask, workers, "rpdrill.run_study: dask") as runner:
             outcome: Outcome = run_studies([study], [folder], runner, dask is not None, quiet)[0]
     return table_frame(outcome[2])

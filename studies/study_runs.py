@@ -15,6 +15,7 @@ from .runtime.output_files import check_out, write_json, write_rows_csv
 from .runtime.point_runs import run_point
 from .runtime.pools import Runner, pool, sequential
 from .runtime.resumable import RECORD, STATUS_COLUMNS, Row, Table, run_tables
+from .scan.continuation_runs import follow_study, given_outcome
 from .scan.study import Study, load_study
 from .scan.study_optima import Record, csv_rows, study_optima
 
@@ -57,12 +58,21 @@ def run_studies(studies: list[Study], folders: list[Path], runner: tuple[str, Ru
         optima = write_optima(studies[i], folders[i], rows)
         started[i] = optima, start_plots(studies[i], rows, optima, folders[i], sequential if plots_here else runner[1])
 
-    tables = [Table(study, out, "results.csv", ["point", *study.axes, *STATUS_COLUMNS, *study.spec.metrics],
-                    lambda p: (p.index, p.simulation), run_point, scene_keys=study.scene_keys)
-              for study, out in zip(studies, folders, strict=True)]
+    tables = [_table(study, out, runner) for study, out in zip(studies, folders, strict=True)]
     all_rows = run_tables(tables, runner, quiet, finished)
     return [(study, out, rows, started[i][0], *started[i][1]())
             for i, (study, out, rows) in enumerate(zip(studies, folders, all_rows, strict=True))]
+
+
+def _table(study: Study, out: Path, runner: tuple[str, Runner]) -> Table:
+    """The results table of a study: each point run by a worker, or, for a continuation study, its chains
+    followed first (studies.scan.continuation_runs) and each point's outcome taken from them."""
+    columns = ["point", *study.axes, *STATUS_COLUMNS, *study.spec.metrics]
+    if study.spec.steady_state == "continuation":
+        followed = follow_study(study, out, runner)
+        return Table(study, out, "results.csv", columns, lambda p: followed[p.index], given_outcome)
+    return Table(study, out, "results.csv", columns, lambda p: (p.index, p.simulation), run_point,
+                 scene_keys=study.scene_keys)
 
 
 def run_study_files(paths: Sequence[str | Path], out: str | Path, formulation: str | None = None,

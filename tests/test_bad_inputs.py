@@ -98,7 +98,7 @@ def problems(path: str, case: dict, status: int, message: str, out: Path, before
         found.append(f"the message does not name {named}")
     if any(len(line) > LONGEST_LINE for line in message.splitlines()):
         found.append(f"a message line longer than {LONGEST_LINE} characters")
-    if snapshot(out) != before:
+    if snapshot(out) != before and not case.get("runs"):  # (runs: a case whose points run, into --out)
         found.append(f"{out} changed")
     return found
 

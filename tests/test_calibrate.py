@@ -199,10 +199,10 @@ def test_nelder_mead_stays_within_its_budget(tmp_path):
 
 
 def test_every_simulation_failing_exits_1_without_a_scene(tmp_path, monkeypatch, capsys):
-    def failing(task):
-        return {"point": task[0], "status": "failed", "error": "RuntimeError: diverged", "wall_time_s": 0.0,
-                "metrics": {}}
-    monkeypatch.setattr(targets, "run_point", failing)  # runs in this process (--workers 1)
+    def failing(key, simulation, guess=None, cold_newton=True):
+        return {"point": key, "status": "failed", "error": "RuntimeError: diverged", "wall_time_s": 0.0,
+                "metrics": {}}, None
+    monkeypatch.setattr(targets, "run_prepared", failing)  # runs in this process (--workers 1)
     path = write(tmp_path / "c.yaml", spec(search={"popsize": 2, "max_generations": 0, "seed": 3}))
     assert calibrate(path, tmp_path / "out") == 1
     assert "RuntimeError: diverged" in capsys.readouterr().err

@@ -23,6 +23,8 @@ WORDS = re.compile(r"[a-z]+(?:[._][a-z0-9]+)+")  # snake_case or dotted keys
 def scene_leaf_paths(prefix: tuple[str, ...] = ()) -> list[str]:
     """Every key path of a scene file that holds a value ('*' for a name in a mapping of models)."""
     keys = allowed_keys(Scene, (*prefix, "x"))
+    if keys == ["x"] and allowed_keys(Scene, (*prefix, "y")) == ["y"]:  # a mapping of plain values: one leaf
+        return [".".join(prefix)]
     if keys is None:
         named = allowed_keys(Scene, (*prefix, "NAME", "x")) is not None
         return scene_leaf_paths((*prefix, "*")) if named else [".".join(prefix)]

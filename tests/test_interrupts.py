@@ -219,6 +219,9 @@ def test_an_advice_stops_within_2_s_and_resumes_to_the_same_advice(tmp_path):
         subprocess.run(advise(folder), cwd=ROOT, check=True, capture_output=True)
     first, second = (json.loads((f / "advice.json").read_text())["results"][0] for f in (out, whole))
     assert first["replayed"] >= stopped.kept_at_signal and second["replayed"] == 0
+    sessions = json.loads((out / "checkpoint.json").read_text())["sessions"]  # recorded as calibrate's are
+    assert [s["interrupted"] for s in sessions] == [True, False] and sessions[0]["points_run"] >= stopped.kept_at_signal
+    assert sessions[1]["points_replayed"] == first["replayed"]
     assert (first["best"], first["best_value"]) == (second["best"], second["best_value"])
 
 
@@ -242,3 +245,33 @@ with process_pool(1):
 """
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=60)
     assert "InvalidStateError" not in done.stderr and "ValueError: a real one" in done.stderr
+
+
+@pytest.mark.parametrize("after_s", [0.2, 0.5, 1.0])
+def test_a_ctrl_c_while_the_program_starts_prints_one_line(tmp_path, after_s):
+    """The program takes its Ctrl-C handler before its libraries load (a second or two): a Ctrl-C then
+    prints one line (it printed Python's KeyboardInterrupt traceback) and nothing is written."""
+    out = tmp_path / "out"
+    process = subprocess.Popen(command("simulate", str(PAPER_BASE), "--out", str(out), "--quiet"), cwd=ROOT,
+                               start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    time.sleep(after_s)
+    sent = time.monotonic()
+    os.killpg(process.pid, signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130 and time.monotonic() - sent < EXIT_WITHIN_S, err
+    assert len(err.splitlines()) == 1 and "interrupted" in err and "Traceback" not in err, err
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_a_study_on_a_dask_local_cluster_stops_within_2_s_without_worker_tracebacks(tmp_path):
+    """The cluster's workers are forked ignoring Ctrl-C (studies.runtime.pools): a Ctrl-C of the whole
+    process group reaches the command only, which ends them; it printed two workers' tracebacks and
+    took up to 4 s."""
+    out = tmp_path / "out"
+    stopped = stop(command("study", str(study_file(tmp_path)), "--out", str(out), "--dask", "--workers", "2",
+                           "--quiet"), lambda: len(csv_rows(out / "results.csv")), signal.SIGINT, at_least=1)
+    kept = csv_rows(out / "results.csv")
+    assert_stopped_cleanly(stopped, 130, len(kept))
+    assert len(stopped.err.splitlines()) == 2, stopped.err  # what it runs, and the one line of the stop
+    assert json.loads((out / "study.json").read_text())["sessions"][-1]["interrupted"] is True

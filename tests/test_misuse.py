@@ -9,9 +9,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import yaml
 from scenes import PAPER_BASE
 
+from rpdrill import InputError
 from rpdrill.studies.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -140,3 +142,94 @@ def test_what_exudyn_prints_comes_out_as_a_warning_line(tmp_path):
     assert "Python WARNING" not in done.stdout + done.stderr
     warned = [line for line in done.stderr.splitlines() if "minStepSize" in line]
     assert len(warned) == 1 and warned[0].startswith("rpdrill: warning: scene 'bad_input_base': Exudyn: ")
+
+
+def _strict_json(path: Path) -> dict:
+    """The JSON in ``path``, refusing NaN and Infinity (Python's json reads them; JSON has no such values)."""
+    def refuse(constant: str) -> None:
+        raise AssertionError(f"{path} holds {constant}: not valid JSON")
+    return json.loads(path.read_text(encoding="utf-8"), parse_constant=refuse)
+
+
+def test_a_run_whose_figures_are_not_numbers_is_not_ok_and_its_summary_is_valid_json(tmp_path):
+    """A rock threshold of 1e-3 N: the impact does no work, so the efficiency is 0 / 0; the run's status says
+    so in one warning line and summary.json, which holds null (valid JSON), not NaN."""
+    scene = yaml.safe_load((CORPUS / "valid" / "drill.yaml").read_text())
+    scene["rock"]["threshold_n"] = 1e-3
+    path = tmp_path / "weak_rock.yaml"
+    path.write_text(yaml.safe_dump(scene), encoding="utf-8")
+    out = tmp_path / "out"
+    done = subprocess.run(command("simulate", str(path), "--out", str(out), "--quiet"), cwd=ROOT, capture_output=True,
+                          text=True, timeout=300, check=False)
+    assert done.returncode == 0, done.stderr
+    summary = _strict_json(out / "summary.json")
+    assert summary["status"] == "not_finite" and summary["metrics"]["energy_transfer_efficiency"] is None
+    warned = [line for line in done.stderr.splitlines() if line.startswith("rpdrill: warning:")]
+    assert len(warned) == 1 and "energy_transfer_efficiency nan: not a finite number" in warned[0]
+
+
+def test_a_run_whose_energy_balance_is_off_is_not_ok(tmp_path):
+    """An impact of 1e-3 N against a 30 kN feed: the balance of the impact work cannot close (4 times the
+    impact work on the paper drill, 1.3e7 % reported); the status says which bound it exceeds."""
+    import rpdrill
+    from rpdrill.models.evaluation.run_status import ENERGY_BALANCE_BOUND, run_status
+
+    scene = rpdrill.load_scene(PAPER_BASE).with_({"impact.amplitude_n": 1e-3, "solver.end_time_s": 0.15,
+                                                  "metrics.transient_blows": 2, "metrics.block_blows": 2})
+    result = rpdrill.simulate(scene, formulation="ode")
+    status, why = run_status(result.raw, result.metrics)
+    assert result.metrics["energy_balance_relative_error"] > ENERGY_BALANCE_BOUND
+    assert status == "unbalanced" and f"bound {ENERGY_BALANCE_BOUND:g}" in why
+
+
+def test_a_resumed_table_with_non_finite_cells_runs_them_again(tmp_path, capsys):
+    """A penetration rate edited to inf in results.csv is damage: the point runs again (it moved the
+    optimum's band when kept)."""
+    study = write_study(tmp_path / "inf.yaml", [40, 50])
+    out = tmp_path / "out"
+    assert main(["study", str(study), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    original = sorted(rows(out), key=lambda r: int(r["point"]))
+    edited = [dict(r) for r in original]
+    edited[1]["penetration_rate_m_per_s"] = "inf"
+    with (out / "results.csv").open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, list(original[0]))
+        writer.writeheader()
+        writer.writerows(edited)
+    capsys.readouterr()
+    with pytest.warns(UserWarning, match=r"1 row\(s\) damaged or edited.*'inf': not a finite number"):
+        assert main(["study", str(study), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    assert "1 finished earlier, running 1" in capsys.readouterr().err
+    again = sorted(rows(out), key=lambda r: int(r["point"]))
+    assert again[1]["penetration_rate_m_per_s"] == original[1]["penetration_rate_m_per_s"]
+    _strict_json(out / "study.json")
+
+
+def test_a_figure_of_one_requested_series_draws_it(tmp_path):
+    """outputs.timeseries: [piston_contact_force_n] and none of the usual panels recorded: the figure draws
+    the series asked for (it crashed: 'Number of rows must be a positive integer')."""
+    import numpy as np
+
+    import rpdrill
+    from rpdrill.studies.figures.timeseries_figure import plot_timeseries
+
+    scene = rpdrill.load_scene(ROOT / "studies" / "scenes" / "top_hammer_piston.yaml").with_(
+        {"outputs": {"timeseries": ["piston_contact_force_n"]}})
+    t = np.linspace(0.0, 0.3, 301)
+    written = plot_timeseries({"time_s": t, "piston_contact_force_n": np.sin(40 * t) ** 8 * 4e5}, scene,
+                              tmp_path / "timeseries.png")
+    assert written and all(path.stat().st_size > 0 for path in written)
+
+
+def test_a_checkpoint_line_edited_to_nan_is_refused_not_replayed(tmp_path):
+    """rpdrill writes null for a number that is not finite; a NaN or Infinity in evaluations.jsonl was
+    put there by hand: refused naming the line (it would be replayed as a result)."""
+    from rpdrill.studies.runtime.evaluation_log import EVALUATIONS, EvaluationLog
+
+    identity, source = {"hash": "0" * 64}, tmp_path / "search.yaml"
+    log = EvaluationLog(tmp_path, identity, source)
+    log.append({"point": {"impact.frequency_hz": 50.0}, "value": float("nan")})
+    log.close()
+    assert json.loads((tmp_path / EVALUATIONS).read_text())["value"] is None  # written as null
+    (tmp_path / EVALUATIONS).write_text('{"point": {"impact.frequency_hz": 50.0}, "value": Infinity}\n')
+    with pytest.raises(InputError, match="line 1 is not an evaluation rpdrill wrote"):
+        EvaluationLog(tmp_path, identity, source)

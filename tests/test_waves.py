@@ -91,6 +91,25 @@ def test_the_wave_step_divides_the_period_and_makes_the_transit_times_whole():
     assert abs(transit / step - round(transit / step)) / (transit / step) < 1e-3
 
 
+def test_a_periodic_steady_state_falls_back_to_the_time_run_with_a_note():
+    """Shooting needs a state vector; the waves in flight are a history: the time run, and the reason."""
+    import rpdrill
+    data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4, "frequency_hz": 1000.0},
+                    {"name": "sandstone"}, 3e-3, "exact", steady_state="periodic")
+    result = rpdrill.simulate(Scene.model_validate(data))
+    assert result.info["regime"] != "period-1" and "waves in flight" in result.info["steady_state_note"]
+
+
+def test_the_cost_of_a_wave_run_counts_the_steps_of_the_characteristics():
+    from rpdrill.models.solvers.cost import run_cost
+    for formulation in FORMULATIONS:
+        data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4}, {"name": "sandstone"}, 1e-3,
+                        formulation)
+        simulation = prepare(Scene.model_validate(data))
+        cost = run_cost(simulation)
+        assert cost.steps == pytest.approx(1e-3 / cost.step_s) and cost.steps_cause.key == "impact.duration_s"
+
+
 # ---- closed forms -----------------------------------------------------------------------------------
 
 def lundberg(alpha: float, ratio: float, formulation: str) -> tuple[float, float]:
@@ -266,7 +285,7 @@ def test_an_item_of_ones_own_on_a_body_acts_through_the_wave_element(both):
     model = build_exudyn(Scene.model_validate(bit_on_rods("exudyn")))
     assert sorted(model.bodies) == ["bit", "carriage"] and model.waves is not None
     node = model.mbs.AddNode(NodePoint(referenceCoordinates=[1.0, 0.0, 0.0]))
-    model.mbs.AddObject(ObjectMassPoint(physicsMass=50.0, nodeNumber=node))
+    model.mbs.AddObject(ObjectMassPoint(mass=50.0, nodeNumber=node))
     k = 50.0 * (2 * math.pi * 300.0) ** 2
     model.mbs.AddObject(ObjectConnectorSpringDamper(
         markerNumbers=[model.bodies["bit"].marker_position, model.mbs.AddMarker(MarkerNodePosition(nodeNumber=node))],

@@ -47,4 +47,9 @@ FORMULATIONS: dict[str, Formulation] = {f.name: f for f in (
                 ("method", "relative_tolerance", "absolute_tolerance", "sample_interval_s"),
                 "the paper's Eq. 4 as an event-located SciPy ODE"),
 )}
-COMMON_SOLVER_KEYS = ("formulation", "preset", "end_time_s", "output_interval_s")
+COMMON_SOLVER_KEYS = ("formulation", "preset", "end_time_s", "output_interval_s", "steady_state")
+# how a run reaches the drill's steady drilling (models.steady): ``time`` runs from the scene's start to its
+# end time and averages after the transient blows; ``periodic`` solves for the periodic orbit (the time run
+# the fallback where none is found)
+STEADY_STATES = ("time", "periodic")
+DEFAULT_STEADY_STATE = "time"

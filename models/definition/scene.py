@@ -14,11 +14,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Field, field_validator, model_validator
-from pydantic_core import ValidationError
+from pydantic import Field, field_validator, model_validator
 
-from ...rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
-from ...rocklaw.catalog import TABLE_1
 from .drill_string import (
     EVERY_BODY,
     MAX_COUNT,
@@ -26,23 +23,28 @@ from .drill_string import (
     Body,
     DrillString,
     Feed,
-    NonNegative,
+    Name,
     Positive,
     Rotation,
     Strict,
     Torsion,
     _key_error,
-    _problem,
 )
+from .extensions import Extension
 from .formulations import (
     COMMON_SOLVER_KEYS,
+    DEFAULT_STEADY_STATE,
     EXUDYN_SOLVERS,
     FORMULATIONS,
     ODE_METHODS,
     PRESETS,
+    STEADY_STATES,
 )
 from .outputs import BODY_METRICS, METRICS, SERIES, Need, body_metric, metric_need, needs
-from .validation import with_changes
+from .rock import JENKINS_VALUES, ROCK_LAW_KEYS, Rock, refuse_foreign_keys
+from .validation import InputError, parse, short, with_changes
+
+__all__ = ["JENKINS_VALUES", "ROCK_LAW_KEYS", "Rock", "Scene"]
 
 
 class Piston(Body):
@@ -121,88 +123,6 @@ class Impact(Strict):
         return self
 
 
-JENKINS_VALUES = ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n")
-# the keys of each rock law (``law`` itself is common)
-ROCK_LAW_KEYS = {
-    "jenkins": ("name", "stiffness_n_per_m", "damping_n_s_per_m", "threshold_n", "damping_mode"),
-    "bilinear": ("loading_stiffness_n_per_m", "unloading_stiffness_n_per_m"),
-}
-
-
-class Rock(Strict):
-    """The rock under the bit: ``law`` and that law's keys (keys of another law are errors).
-
-    ``jenkins`` (default; the paper's Eq. 1, 2): a Table 1 ``name``, explicit values, or a name
-    with overrides; ``damping_mode`` ``contact`` (default) or ``always``. ``bilinear``: loading
-    stiffness k_l and unloading stiffness k_u > k_l (rocklaw.bilinear).
-    """
-
-    law: Literal[tuple(LAWS)] = "jenkins"  # type: ignore[valid-type]
-    name: Literal[tuple(TABLE_1)] | None = None  # type: ignore[valid-type]
-    stiffness_n_per_m: Positive | None = None
-    damping_n_s_per_m: NonNegative | None = None
-    threshold_n: Positive | None = None
-    damping_mode: Literal["contact", "always"] | None = None
-    loading_stiffness_n_per_m: Positive | None = Field(None, description="bilinear: k_l")
-    unloading_stiffness_n_per_m: Positive | None = Field(None, description="bilinear: k_u > k_l")
-
-    @model_validator(mode="after")
-    def _complete(self) -> Rock:
-        _refuse_foreign_keys(self, "rock law", self.law, {law: ("law", *keys) for law, keys in ROCK_LAW_KEYS.items()},
-                             "Rock")
-        if self.law == "bilinear":
-            return self._check_bilinear()
-        if self.name is None:
-            missing = [k for k in JENKINS_VALUES if getattr(self, k) is None]
-            if missing:
-                raise ValueError(f"give a Table 1 name ({', '.join(TABLE_1)}) or all of: {', '.join(missing)}")
-        return self
-
-    def _check_bilinear(self) -> Rock:
-        for key in ROCK_LAW_KEYS["bilinear"]:
-            if getattr(self, key) is None:
-                raise _key_error("Rock", (key,), None, "missing: rock law 'bilinear' needs {key}", key=key)
-        if self.unloading_stiffness_n_per_m <= self.loading_stiffness_n_per_m:
-            raise _key_error("Rock", ("unloading_stiffness_n_per_m",), self.unloading_stiffness_n_per_m,
-                             "must be greater than loading_stiffness_n_per_m ({loading})",
-                             loading=f"{self.loading_stiffness_n_per_m:g}")
-        return self
-
-    def completed(self) -> Rock:
-        """This rock with every value of its law filled in: a Jenkins rock's Table 1 values where a
-        named rock gives none, and damping_mode ``contact`` (a new object; the scene is not changed)."""
-        if self.law != "jenkins":
-            return self
-        row = TABLE_1[self.name] if self.name else None
-        filled = {key: getattr(row, key) for key in JENKINS_VALUES if getattr(self, key) is None}
-        return self.model_copy(update={**filled, "damping_mode": self.damping_mode or "contact"})
-
-    def build(self, damping: bool = True, plasticity: bool = True, indexed: bool = False) -> RockLaw:
-        """The law; without ``damping`` no rock damper, without ``plasticity`` an elastic rock at the
-        loading stiffness (Jenkins: F_th infinite; bilinear: k_u = k_l); ``indexed`` (under an indexing
-        model): a Jenkins rock with the blow's threshold as a state (rocklaw.jenkins)."""
-        rock = self.completed()
-        if rock.law == "bilinear":
-            loading = rock.loading_stiffness_n_per_m
-            return BilinearRock(loading, rock.unloading_stiffness_n_per_m if plasticity else loading)
-        return JenkinsRock(rock.stiffness_n_per_m, rock.damping_n_s_per_m if damping else 0.0,
-                           rock.threshold_n if plasticity else math.inf, rock.damping_mode,
-                           indexed=indexed and plasticity)
-
-
-def _refuse_foreign_keys(model: BaseModel, what: str, chosen: str, keys: dict[str, tuple[str, ...]],
-                         title: str) -> None:
-    """A ValidationError for every key of another ``what`` (rock law, formulation) than ``chosen``
-    that ``model`` gives, naming the keys ``chosen`` allows."""
-    allowed = ", ".join(keys[chosen])
-    foreign = [_problem((key,), getattr(model, key), "a key of {what} '{other}', not of '{chosen}'; "
-                        "allowed keys here: {allowed}", what=what, other=other, chosen=chosen, allowed=allowed)
-               for other, other_keys in keys.items() if other != chosen
-               for key in other_keys if key not in keys[chosen] and getattr(model, key) is not None]
-    if foreign:
-        raise ValidationError.from_exception_data(title, foreign)
-
-
 class Solver(Strict):
     """How the scene is integrated: the ``formulation`` (models.definition.formulations), an accuracy
     ``preset`` (fast, standard, reference) and/or that formulation's explicit options, the end time
@@ -215,7 +135,10 @@ class Solver(Strict):
     ``min_switch_interval_s``, ``max_switches_per_blow``, ``wave_step_s`` (the step of the
     characteristics of wave rods, models.waves; Exudyn's wave step is its ``step_s``). A preset fills the options not given;
     without a preset and without explicit accuracy options the ``standard`` preset applies
-    (models.evaluation.solver_settings resolves them once per run).
+    (models.evaluation.solver_settings resolves them once per run). ``steady_state`` (every formulation):
+    ``time`` (default) runs from the start to the end time and averages the blocks after the transient;
+    ``periodic`` solves for the drill's periodic orbit by shooting (models.steady: period-1, period-n, or,
+    where none is found, the time run as with ``time``).
     """
 
     formulation: Literal[tuple(FORMULATIONS)] = "exudyn"  # type: ignore[valid-type]
@@ -232,11 +155,12 @@ class Solver(Strict):
     min_switch_interval_s: Positive | None = None
     max_switches_per_blow: Annotated[int, Field(ge=1, le=MAX_COUNT)] | None = None
     wave_step_s: Positive | None = None
+    steady_state: Literal[STEADY_STATES] = DEFAULT_STEADY_STATE  # type: ignore[valid-type]
 
     @model_validator(mode="after")
     def _options_of_the_formulation(self) -> Solver:
         keys = {name: (*COMMON_SOLVER_KEYS, *f.option_keys) for name, f in FORMULATIONS.items()}
-        _refuse_foreign_keys(self, "formulation", self.formulation, keys, "Solver")
+        refuse_foreign_keys(self, "formulation", self.formulation, keys, "Solver")
         return self
 
 
@@ -317,6 +241,8 @@ class Scene(Strict):
     start: Literal["rest", "preloaded"] = Field(
         "rest", description="rest: every coordinate zero (Eq. 4 from rest); preloaded: the static "
         "equilibrium under the feed (and torque) with the bit pressed on the rock")
+    extensions: dict[Name, Extension] | None = Field(
+        None, description="Python extensions of the Exudyn model by name (models.definition.extensions)")
 
     def with_(self, changes: dict[str, Any], source: str = "Scene.with_") -> Scene:
         """A validated copy with ``changes``: dotted key paths of the scene file -> values
@@ -330,9 +256,12 @@ class Scene(Strict):
         options (a new, validated scene)."""
         solver = self.solver.model_dump(exclude_none=True)
         if formulation is not None:
+            if not isinstance(formulation, str) or formulation not in FORMULATIONS:
+                raise InputError(f"Scene.with_solver: formulation: {short(formulation)}: not a formulation; "
+                                 f"allowed: {', '.join(FORMULATIONS)}")
             solver = switch_formulation(solver, formulation)
         data = self.model_dump(by_alias=True, exclude_none=True)
-        return Scene.model_validate({**data, "solver": {**solver, **options}})
+        return parse(Scene, {**data, "solver": {**solver, **options}}, "Scene.with_solver")
 
     @model_validator(mode="after")
     def _feed_body_exists(self) -> Scene:
@@ -353,9 +282,15 @@ class Scene(Strict):
         if effects.indexing and self.rotation is None and not effects.torsion:
             raise ValueError("the indexing effect needs the angle turned between blows: a rotation section "
                              "(speed_rpm) or the torsion effect")
-        if effects.rock_damping and self.rock.law == "bilinear":
+        if effects.rock_damping and self.rock.law != "jenkins":
             raise _key_error("Scene", ("effects", "rock_damping"), True,
-                             "rock law 'bilinear' has no rock damping; set it false or use law: jenkins")
+                             "rock law '{law}' has no rock damping effect (a law of one's own is built as its "
+                             "parameters say); set it false or use law: jenkins", law=self.rock.law)
+        if self.rock.own_law and (self.effects and self.effects.rock_plasticity is False or effects.indexing):
+            key = "indexing" if effects.indexing else "rock_plasticity"
+            raise _key_error("Scene", ("effects", key), getattr(effects, key),
+                             "a built-in law's effect; a law of one's own ('{law}') is built as its parameters say",
+                             law=self.rock.law)
         outputs = self.outputs or Outputs()
         pistonless = [o for o in outputs.metrics + outputs.timeseries if not _has_piston_data(self, _need(o))]
         if pistonless:
@@ -424,7 +359,8 @@ def _available(scene: Scene, effect: str) -> bool:
         "rock_damping": scene.rock.law == "jenkins" and scene.rock.completed().damping_n_s_per_m > 0,
         "rock_plasticity": True,
         "joint_damping": any(c.damping_n_s_per_m > 0 for c in scene.drill_string.connectors.values()),
-        "indexing": scene.bit is not None and (scene.rotation is not None or scene.torsion is not None),
+        "indexing": scene.bit is not None and (scene.rotation is not None or scene.torsion is not None)
+        and not scene.rock.own_law,
     }[effect]
 
 

@@ -10,15 +10,19 @@ from __future__ import annotations
 
 import copy
 import re
+import types
+import typing
+from collections.abc import Mapping
 from typing import Any, TypeVar, get_args, get_origin
 
 from pydantic import BaseModel, ValidationError
 
 ModelT = TypeVar("ModelT", bound=BaseModel)
+UNIONS = (typing.Union, types.UnionType)
 SHORT_VALUE_CHARS = 80  # a value longer than this is shortened in a message
 
 
-LONG_QUOTED = re.compile(r"(['\"])([^'\"\n]{78})[^'\"\n]{3,}\1")  # a quoted value beyond 80 characters
+LONG_QUOTED = re.compile(r"(?<!\w)(['\"])([^'\"\n]{78})[^'\"\n]{3,}\1(?!\w)")  # a quoted value beyond 80 characters
 
 
 class InputError(ValueError):
@@ -34,12 +38,21 @@ def shortened(message: str) -> str:
     return LONG_QUOTED.sub(lambda m: f"{m[1]}{m[2][:74]}...{m[1]}", message)
 
 
-def _inner_model(annotation: Any) -> tuple[type[BaseModel] | None, bool]:
-    """The model inside a field's annotation (``Model``, ``Model | None``, ``dict[str, Model]``) and
-    whether it sits behind a free mapping key (the dict case)."""
+FREE = "free values"  # what a mapping of plain values (an extension's parameters) holds: any key
+
+
+def _inner_model(annotation: Any) -> tuple[type[BaseModel] | str | None, bool]:
+    """The model inside a field's annotation (``Model``, ``Model | None``, ``dict[str, Model]``, optional
+    too) and whether it sits behind a free mapping key (the dict case); a mapping of plain values
+    (``dict[str, Any]``) is :data:`FREE`, any key."""
+    options = [a for a in get_args(annotation) if a is not type(None)] if get_origin(annotation) in UNIONS else []
+    if len(options) == 1:
+        annotation = options[0]
     keyed = get_origin(annotation) is dict
     candidates = get_args(annotation)[1:] if keyed else getattr(annotation, "__args__", (annotation,))
     model = next((a for a in candidates if isinstance(a, type) and issubclass(a, BaseModel)), None)
+    if keyed and model is None:
+        return FREE, False
     return model, keyed
 
 
@@ -48,19 +61,20 @@ def _field(model: type[BaseModel], key: Any) -> Any:
     return next((f for name, f in model.model_fields.items() if key in (name, f.alias)), None)
 
 
-def _parent_model(model: type[BaseModel], location: tuple[Any, ...]) -> type[BaseModel] | None:
-    """The model that holds the last key of ``location`` inside ``model`` (None if not a model there).
+def _parent_model(model: type[BaseModel], location: tuple[Any, ...]) -> type[BaseModel] | str | None:
+    """The model that holds the last key of ``location`` inside ``model`` (None if not a model there;
+    :data:`FREE` inside a mapping of plain values, where any key goes).
 
     Keys are the names a scene file uses (field aliases such as ``from``); a mapping of models
     (``drill_string.bodies``) takes any name, after which its model's keys apply again.
     """
-    current: type[BaseModel] | None = model
+    current: type[BaseModel] | str | None = model
     keyed = False
     for part in location[:-1]:
         if keyed:  # a free name in a mapping of models
             keyed = False
             continue
-        if isinstance(part, int) or current is None:
+        if isinstance(part, int) or current is None or current is FREE:
             return None
         field = _field(current, part)
         if field is None:
@@ -70,15 +84,28 @@ def _parent_model(model: type[BaseModel], location: tuple[Any, ...]) -> type[Bas
 
 
 def allowed_keys(model: type[BaseModel], location: tuple[Any, ...]) -> list[str] | None:
-    """Keys allowed at the parent of ``location`` inside ``model`` (None if not a model there)."""
+    """Keys allowed at the parent of ``location`` inside ``model`` (None if not a model there; a mapping
+    of plain values allows any key: [``location``'s last])."""
     parent = _parent_model(model, location)
+    if parent is FREE:
+        return [location[-1]]
     return None if parent is None else [field.alias or name for name, field in parent.model_fields.items()]
 
 
+def _field_keyed(model: type[BaseModel], location: tuple[Any, ...]) -> bool:
+    """Whether ``location`` names a mapping of models (``drill_string.bodies``)."""
+    parent = _parent_model(model, location) if location else None
+    if parent is None or parent is FREE:
+        return False
+    field = _field(parent, location[-1])
+    return field is not None and _inner_model(field.annotation)[1]
+
+
 def field_at(model: type[BaseModel], location: tuple[Any, ...]) -> Any:
-    """The pydantic field (FieldInfo) at the key path ``location`` inside ``model``, None if none."""
+    """The pydantic field (FieldInfo) at the key path ``location`` inside ``model``, None if none (a key
+    of a mapping of plain values has none)."""
     parent = _parent_model(model, location)
-    return None if parent is None else _field(parent, location[-1])
+    return None if parent is None or parent is FREE else _field(parent, location[-1])
 
 
 def short(value: Any) -> str:
@@ -146,14 +173,17 @@ def set_path(data: dict[str, Any], path: str, value: Any) -> None:
 def check_path(model: type[BaseModel], source: str, key: str, path: str, base: dict[str, Any] | None = None,
                base_name: str = "the base scene", value_only: bool = False) -> None:
     """``path`` must name a key of ``model`` (a scene key path); a name in a mapping of models
-    (``drill_string.bodies.X``) must exist in ``base`` (a typo there would add a body, not change one).
+    (``drill_string.bodies.X``) must exist in ``base`` when the path goes into it (a typo there would add a
+    body, not change one); the path of a whole entry (``drill_string.bodies.clamp``) may add a new one;
+    any key goes in a mapping of plain values (``extensions.NAME.parameters.KEY``).
     ``key``: where the path was given (``scan``, ``base_overrides``), prefixed to it in the message;
     ``base_name``: what the message calls ``base``; ``value_only`` (a scan axis): the key must hold a
     value, not a whole section."""
     parts = tuple(path.split("."))
     where = f"{key}.{path}" if key else path
     allowed = allowed_keys(model, parts)
-    if allowed is None or parts[-1] not in allowed:
+    new_entry = _field_keyed(model, parts[:-1])  # a whole body, connector or extension, new or replaced
+    if (allowed is None or parts[-1] not in allowed) and not new_entry:
         hint = f"allowed keys here: {', '.join(allowed)}" if allowed else "not a path to a scene key"
         raise InputError(f"{source}: {where}: unknown scene key path; {hint}")
     inner = allowed_keys(model, (*parts, "?"))
@@ -169,13 +199,17 @@ def check_path(model: type[BaseModel], source: str, key: str, path: str, base: d
         if free_name and part not in node:
             names = ", ".join(node)
             raise InputError(f"{source}: {where}: {part!r} is not in {base_name}'s "
-                             f"{'.'.join(parts[:depth])}; there: {names}")
+                             f"{'.'.join(parts[:depth])}; there: {names} (a new one is given whole: "
+                             f"{'.'.join(parts[:depth + 1])}: {{...}})")
         node = node.get(part)
 
 
 def with_changes(model: ModelT, changes: dict[str, Any], source: str) -> ModelT:
     """A validated copy of ``model`` with ``changes`` (dotted key path -> value, the keys of its file
     format, ``None`` removes a key), or InputError naming ``source``, the key path and the value."""
+    if not isinstance(changes, Mapping):
+        raise InputError(f"{source}: changes: {short(changes)}: give a mapping of key paths to values, e.g. "
+                         "{'impact.frequency_hz': 70.0}")
     data = model.model_dump(by_alias=True, exclude_none=True)
     for path, value in changes.items():
         if not isinstance(path, str) or not path:

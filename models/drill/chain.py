@@ -242,6 +242,9 @@ def torsion_first_order_matrix(torsion: Torsion) -> np.ndarray:
 
 
 Modes = tuple[str, ...]  # a mode of each nonlinear link, in chain order
+# The static system K q = F is solved when cond(K) is below this (double precision: 16 digits, 2 kept);
+# beyond it a body has no rest position, or the stiffnesses are too far apart to solve for one.
+STATIC_CONDITION_LIMIT = 1e14
 
 
 def _static_system(chain: AxialChain, law: RockLaw, modes: Modes, contact: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -270,7 +273,7 @@ def _consistent(chain: AxialChain, positions: np.ndarray, modes: Modes, contact:
 
 def _solve_static(chain: AxialChain, law: RockLaw, modes: Modes, contact: bool) -> np.ndarray | None:
     stiffness, forces = _static_system(chain, law, modes, contact)
-    if np.linalg.cond(stiffness) > 1e14:  # a body with no rest position (held by an open coupling only)
+    if np.linalg.cond(stiffness) > STATIC_CONDITION_LIMIT:  # a body with no rest position (held by an open coupling only)
         return None
     return np.linalg.solve(stiffness, forces)
 

@@ -90,9 +90,13 @@ def undeclared(chain: AxialChain, rock: RockLaw) -> str | None:
     for name, law in (("rock law " + rock.name, rock), *((f"connector {link.name}", link) for link in chain.nonlinear_links())):
         try:
             law.modes()
-        except NotImplementedError:
+        except (NotImplementedError, AttributeError):
             missing.append(name)
-    return f"{', '.join(missing)} declare no modes (rocklaw.modes)" if missing else None
+            continue
+        if not callable(getattr(law, "initial_mode", None)):
+            missing.append(name)
+    return (f"{', '.join(missing)} declare no modes (the mode table: modes() and initial_mode(values), "
+            "rocklaw.modes; docs/extending.md)") if missing else None
 
 
 def elements(chain: AxialChain, rock: RockLaw, size: int) -> tuple[Element, ...]:

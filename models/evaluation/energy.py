@@ -11,6 +11,10 @@ With a piston (models.drill.piston) F_d is its contact force, and the balance ta
 blows instead: W_piston = what the strikes and catches put in (blow energies less rebound energies)
 less the piston's energy E_piston held at the time, from its value at the start, in place of W_impact (the two agree
 when the contact's work is computed right: the balance then covers the piston too).
+Items a user added to an Exudyn model enter with what they hold, dissipate and put in
+(``SimulationResult.user_energy``, models.solvers.exudyn_user_items: Exudyn's masses, spring-dampers and
+constant loads automatically, other items by the energy terms an extension declares); where an item is
+not accounted for, the balance is not a number.
 The powers are integrated by the trapezoidal rule over every stored solver step, unless the
 formulation integrated the works exactly (``SimulationResult.works_j``, the exact formulation): then
 W_impact is its impact work and D_damping what the links, the rock and the torsion line absorb less
@@ -26,7 +30,7 @@ import numpy as np
 
 from ...rocklaw.base import cumulative_trapezoid
 from ..drill.piston import piston_energy_j
-from .results import SimulationResult
+from .results import SimulationResult, UserEnergy
 
 
 @dataclass
@@ -41,16 +45,29 @@ class EnergyAccount:
     damping_j: np.ndarray
     crushing_work_j: np.ndarray
     piston_work_j: np.ndarray | None = None  # W_piston (module doc), with a piston
+    user: UserEnergy | None = None  # the items a user added to an Exudyn model (module doc)
+
+    @property
+    def complete(self) -> bool:
+        """Whether every item of the run is accounted for (module doc: items of one's own)."""
+        return self.user is None or not self.user.unaccounted
 
     @property
     def residual_j(self) -> np.ndarray:
         """Work in minus energy accounted for; zero for an exact solution."""
         stored = (self.kinetic_j - self.kinetic_j[0]) + (self.elastic_j - self.elastic_j[0])
         work_in = self.impact_work_j if self.piston_work_j is None else self.piston_work_j
-        return work_in + self.feed_work_j - stored - self.damping_j - self.crushing_work_j
+        residual = work_in + self.feed_work_j - stored - self.damping_j - self.crushing_work_j
+        if self.user is not None:
+            residual = residual + self.user.work_in_j - (self.user.stored_j - self.user.stored_j[0]) \
+                - self.user.dissipated_j
+        return residual
 
     def relative_residual(self) -> float:
-        """Largest |residual| over the run divided by the total impact work."""
+        """Largest |residual| over the run divided by the total impact work; not a number when an item of
+        one's own is not accounted for (the result's info names it)."""
+        if not self.complete:
+            return float("nan")
         return float(np.max(np.abs(self.residual_j)) / max(self.impact_work_j[-1], 1e-300))
 
 
@@ -96,4 +113,5 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
         net = result.piston.input_j - piston_energy_j(result.piston, x[:, chain.impact_body])
         piston = net - net[0]
     return EnergyAccount(time_s=t, impact_work_j=impact_work_j(result), feed_work_j=feed, kinetic_j=kinetic,
-                         elastic_j=elastic, damping_j=damping, crushing_work_j=crushing, piston_work_j=piston)
+                         elastic_j=elastic, damping_j=damping, crushing_work_j=crushing, piston_work_j=piston,
+                         user=result.user_energy)

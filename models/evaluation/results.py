@@ -17,6 +17,21 @@ if TYPE_CHECKING:
     from .prepared_run import PreparedRun
 
 
+@dataclass(frozen=True)
+class UserEnergy:
+    """The energy of the items a user added to an Exudyn model (models.solvers.exudyn_user_items), at the
+    stored steps: ``stored_j`` held (kinetic and elastic), ``dissipated_j`` and ``work_in_j`` cumulative
+    from the start; ``unaccounted`` the items it has no way to account for (the balance is then not a
+    number), ``accounted`` those it took in, ``declared`` the terms extensions declared."""
+
+    stored_j: np.ndarray
+    dissipated_j: np.ndarray
+    work_in_j: np.ndarray
+    unaccounted: tuple[str, ...] = ()
+    accounted: tuple[str, ...] = ()
+    declared: tuple[str, ...] = ()
+
+
 @dataclass
 class SimulationResult:
     """State histories at the stored solver steps (rows) of one run.
@@ -49,6 +64,9 @@ class SimulationResult:
     works_j: dict[str, np.ndarray] | None = None
     # a piston scene: the piston's states, contact force (also impact_force_n), jumps and rebounds (models.drill.piston)
     piston: PistonHistory | None = None
+    # an Exudyn model with items of one's own: their energy, and the user's sensors by name at the stored steps
+    user_energy: UserEnergy | None = None
+    user_series: dict[str, np.ndarray] = field(default_factory=dict)
     # a scene with wave rods: the rods' ends at the samples, per-blow section figures, rigid joints' forces
     # (models.waves.record.WaveRecord)
     waves: Any = None
@@ -103,7 +121,8 @@ class SimulationResult:
 
     def columns(self) -> dict[str, np.ndarray]:
         """Named histories the scene asked for, units in the names: time, every body's position and
-        velocity and every link's force and compression always (models.evaluation.parts)."""
+        velocity and every link's force and compression always (models.evaluation.parts), and the sensors
+        of one's own of an Exudyn model by their names (``sensor <name>`` where a column has that name)."""
         out = {"time_s": self.time_s}
         for i, body in enumerate(self.chain.bodies):
             out[f"{body.name}_position_m"] = self.position_m[:, i]
@@ -123,6 +142,7 @@ class SimulationResult:
                             piston_velocity_m_per_s=self.piston.mean_velocity_m_per_s)
         wanted = self.simulation.outputs.timeseries
         out.update({name: values for name, values in optional.items() if name in wanted and values is not None})
+        out.update({name if name not in out else f"sensor {name}": values for name, values in self.user_series.items()})
         return out
 
     def resampled(self, interval_s: float) -> dict[str, np.ndarray]:

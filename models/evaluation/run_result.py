@@ -34,11 +34,11 @@ class Result:
     @cached_property
     def timeseries(self) -> pd.DataFrame:
         """Time series every ``solver.output_interval_s`` (x_n held between its changes, the rest
-        interpolated), columns with units in their names; ``time_s`` the index and a column."""
+        interpolated), columns with units in their names, the sensors of one's own of an Exudyn model by
+        their names; ``time_s`` a column, the index a plain range (``pd.merge_asof(..., on="time_s")``)."""
         import pandas as pd  # 0.3 s to import: only where a table is asked for
 
-        columns = self.raw.resampled(self.scene.solver.output_interval_s)
-        return pd.DataFrame(columns).set_index("time_s", drop=False)
+        return pd.DataFrame(self.raw.resampled(self.scene.solver.output_interval_s))
 
     def __getattr__(self, name: str) -> Any:  # only for names the Result itself lacks
         if name.startswith("__"):

@@ -15,7 +15,7 @@ from statistics import median
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.linalg import block_diag
+from scipy.linalg import block_diag, eigvals
 
 from ...rocklaw import RockLaw
 from ..definition.scene import Scene, Torsion
@@ -75,10 +75,29 @@ def spectral_radius_per_s(chain: AxialChain, law: RockLaw, torsion: Torsion | No
 
 def step_scales(chain: AxialChain, law: RockLaw, torsion: Torsion | None, blow_period_s: float) -> StepScales:
     """The :class:`StepScales` of a drill on its rock, blows ``blow_period_s`` apart."""
-    eigenvalues = contact_eigenvalues_per_s(chain, law, torsion)
+    return scales_of(contact_eigenvalues_per_s(chain, law, torsion), blow_period_s,
+                     law.damping_n_s_per_m / chain.bodies[chain.bit_body].mass_kg)
+
+
+def scales_of(eigenvalues: np.ndarray, blow_period_s: float, damper_rate_per_s: float) -> StepScales:
+    """The :class:`StepScales` of a system of these first-order eigenvalues, blows ``blow_period_s`` apart:
+    |lambda|_max, the largest |lambda| still ringing at the next blow (-Re(lambda) T < 1) and c_n / m_bit."""
     ringing = np.abs(eigenvalues[-eigenvalues.real * blow_period_s < 1.0])
-    return StepScales(float(np.abs(eigenvalues).max()), float(ringing.max(initial=0.0)),
-                      law.damping_n_s_per_m / chain.bodies[chain.bit_body].mass_kg)
+    return StepScales(float(np.abs(eigenvalues).max(initial=0.0)), float(ringing.max(initial=0.0)), damper_rate_per_s)
+
+
+def second_order_eigenvalues_per_s(mass: np.ndarray, stiffness: np.ndarray, damping: np.ndarray) -> np.ndarray:
+    """The finite eigenvalues lambda of M q'' + D q' + K q = 0 (any system: an assembled Exudyn one), from
+    the pencil [[0, I], [-K, -D]] z = lambda [[I, 0], [0, M]] z (a coordinate without mass gives an infinite
+    one, left out: it sets no step of an explicit solver, which cannot run it anyway)."""
+    n = len(mass)
+    with np.errstate(all="ignore"):
+        if not (np.isfinite(mass).all() and np.isfinite(stiffness).all() and np.isfinite(damping).all()):
+            return np.array([math.inf])
+        system = np.block([[np.zeros((n, n)), np.eye(n)], [-stiffness, -damping]])
+        weights = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), mass]])
+        eigenvalues = eigvals(system, weights)
+    return eigenvalues[np.isfinite(eigenvalues)]
 
 
 @dataclass(frozen=True)
@@ -159,6 +178,25 @@ def element_rates(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsio
     return candidates
 
 
+def spring_spread(scene: Scene, chain: AxialChain, law: RockLaw) -> tuple[str, float, float, float]:
+    """The stiffest spring of the drill and the rock (its key, the key's value, its stiffness [N/m]) and
+    the softest spring's stiffness (a rod segment's from its Young's modulus: the key is the modulus)."""
+    owner = {i: name for name, (first, last) in chain.groups.items() for i in range(first, last + 1)}
+    rock_key = "rock.unloading_stiffness_n_per_m" if scene.rock.law == "bilinear" else "rock.stiffness_n_per_m"
+    rock = max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m)
+    springs = [(rock, rock_key, getattr(scene.rock, rock_key.split(".")[1]))]
+    for link in chain.links:
+        if link.stiffness_n_per_m > 0:
+            connector = scene.drill_string.connectors.get(link.name)
+            key = f"drill_string.connectors.{link.name}.stiffness_n_per_m" if connector is not None else \
+                f"drill_string.bodies.{owner[link.body_b]}.youngs_modulus_pa"
+            value = link.stiffness_n_per_m if connector is not None else \
+                scene.drill_string.bodies[owner[link.body_b]].youngs_modulus_pa
+            springs.append((link.stiffness_n_per_m, key, value))
+    stiffest = max(springs)
+    return stiffest[1], stiffest[2], stiffest[0], min(springs)[0]
+
+
 def largest_stable_step_s(simulation: PreparedRun, solver_type: str | None = None) -> float | None:
     """h_max of a fixed-step explicit solver (default: the simulation's); None for implicit or
     adaptive ones."""
@@ -186,13 +224,18 @@ def step_warning(simulation: PreparedRun) -> str | None:
 
 
 def _remedy(simulation: PreparedRun) -> str:
+    """What to try after a run failed: never a step larger than half the one that failed."""
     settings = simulation.settings
+    smaller = 0.5 * settings.step_s
     if settings.type in STABLE_STEP_FACTOR:
         limit = largest_stable_step_s(simulation) or 0.0
         if limit > 0 and settings.step_s > limit:
-            return f"try solver.step_s {0.5 * limit:.3g} (stability limit {limit:.3g} s)"
-        return (f"try solver.type {SUGGESTED} with solver.step_s "
-                f"{0.5 * largest_stable_step_s(simulation, SUGGESTED):.3g}")
+            return f"try solver.step_s {min(0.5 * limit, smaller):.3g} (stability limit {limit:.3g} s)"
+        suggested = 0.5 * largest_stable_step_s(simulation, SUGGESTED)
+        if settings.type != SUGGESTED and suggested < settings.step_s:
+            return f"try solver.type {SUGGESTED} with solver.step_s {suggested:.3g}"
+        return (f"try solver.step_s {smaller:.3g} (the step was within the stability limit of the linearised "
+                "system, so what diverged is stiffer than it: a contact, or an item of one's own)")
     return f"try solver.step_s {settings.step_s / 4:g} or solver.type {SUGGESTED}"
 
 
@@ -200,7 +243,10 @@ def _energy_blow_up_index(result: SimulationResult) -> int | None:
     """First step at which the energy accounted for (stored, dissipated, crushing) exceeds 1.5 times
     the work put in, plus one blow's energy scale: energy created by the integrator."""
     account = energy_account(result)
-    work_in = np.maximum.accumulate(np.abs(account.impact_work_j) + np.abs(account.feed_work_j))
+    if not account.complete:  # an item of one's own unaccounted for: no balance to check
+        return None
+    user_work = 0.0 if account.user is None else np.abs(account.user.work_in_j)
+    work_in = np.maximum.accumulate(np.abs(account.impact_work_j) + np.abs(account.feed_work_j) + user_work)
     created = -account.residual_j  # accounted - work in
     chain = result.chain
     blow_scale_j = impulse_per_blow_n_s(result.scene.impact) ** 2 / (2 * chain.bodies[chain.impact_body].mass_kg)

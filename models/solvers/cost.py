@@ -6,7 +6,8 @@ of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2
 + 2 (torsion) + 3 (the constant and the pulse generator) values:
 
 * exudyn: T / ``step_s`` steps (for dopri5 and ode23 ``step_s`` is the largest step: a lower
-  bound); it stores every step when an energy output is asked for, else every
+  bound; a scene with extensions: the step of its built model, sized for the assembled system); it
+  stores every step when an energy output is asked for, else every
   ``output_interval_s``, two values (time, value) per sensor of 2 n + 4;
 * exact: T / h sub-grid points, h the exact solver's own sub-step (models.solvers.exact_system.sub_step:
   the sample interval over ceil(sample interval x ||A_bal||_1)); it stores m + 2 values per
@@ -14,6 +15,9 @@ of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2
   the rock law;
 * ode: T r ODE_STEPS_PER_RADIAN steps (measured), DOP853's dense output (ODE_STAGES
   states per step) and m values per sample.
+
+* a scene with wave rods (models.waves), either formulation: T / h steps of the characteristics, h the
+  wave step (models.waves.steps), at a measured cost per step and body; it stores its samples only.
 
 Histories resampled after the run (``rpdrill simulate``: every ``output_interval_s``) add 2 n + 8
 columns. Memory is 8 bytes per value times the copies held at the peak (MEMORY_COPIES,
@@ -30,9 +34,11 @@ import math
 from dataclasses import dataclass
 
 from ..definition.formulations import DEFAULT_PRESET
+from ..drill.piston import PISTON
 from ..drill.pulse import phase_pieces
 from ..evaluation.solver_settings import EXUDYN_PRESETS
 from ..evaluation.stability import element_rates
+from ..waves.steps import STEPS_PER_PULSE, STEPS_PER_TRANSIT
 from .exact_system import sub_step
 from .simulation import Simulation
 
@@ -40,7 +46,9 @@ from .simulation import Simulation
 # (a, b, p) of a + b n^p; the exact formulation with its energy works (an energy output asked for), and
 # without (a scan of the penetration rate)
 CPU_S_PER_STEP = {"exudyn": (3e-6, 6e-7, 1), "exact": (2.6e-7, 3.2e-9, 2), "exact without energy": (1e-7, 2.9e-9, 2),
-                  "ode": (4.5e-4, 0.0, 1)}
+                  "ode": (4.5e-4, 0.0, 1),
+                  # a step of the characteristics (benchmarks/bench_waves.py --strings: 14 and 12 bodies)
+                  "exact waves": (0.0, 2e-6, 1), "exudyn waves": (0.0, 1.7e-5, 1)}
 ODE_STEPS_PER_RADIAN = 2.0  # DOP853 steps per unit of r T
 ODE_STAGES = 10  # state vectors per step kept by DOP853's dense output
 OPERATOR_VALUES = 55  # values per state^2 of one exact propagator key (expm, anchors, read-outs, Taylor)
@@ -85,6 +93,21 @@ def _fastest(simulation: Simulation) -> Cause:
     return Cause(simulation.fastest.key, simulation.fastest.value)
 
 
+def _pulse(simulation: Simulation) -> Cause:
+    """The key of the impact pulse's duration (a piston's contact: the piston)."""
+    if simulation.piston is None:
+        return Cause("impact.duration_s", simulation.scene.impact.duration_s)
+    return Cause("impact.piston", f"a contact of {simulation.pulse_duration_s:.3g} s")
+
+
+def _fastest_or_pulse(simulation: Simulation) -> Cause:
+    """The key of the fastest rate of the exact formulation's matrices: the drill's fastest element, or the
+    pulse generator's pi / duration (a half-sine's angular rate) when that is faster (a 1 ns pulse)."""
+    if math.pi / simulation.pulse_duration_s > simulation.fastest.rate_per_s:
+        return _pulse(simulation)
+    return _fastest(simulation)
+
+
 def _rock_damper(simulation: Simulation) -> Cause:
     """The key of the rock damper's rate c_n / m_bit that departs more from the drill's other values."""
     damper = next(e for e in element_rates(simulation.scene, simulation.chain, simulation.rock, simulation.torsion)
@@ -102,16 +125,30 @@ def _interval(simulation: Simulation) -> Cause:
 Part = tuple[Cause, float, float | None]
 
 
+def _extended(simulation: Simulation) -> tuple[Simulation, Cause | None]:
+    """The simulation as the Exudyn model of a scene with extensions sizes it (the step of the assembled
+    system, models.solvers.exudyn_model), and the extensions as the cause when they made it faster."""
+    if not simulation.scene.extensions:
+        return simulation, None
+    from .exudyn_model import build_exudyn  # Exudyn only for a scene with extensions
+
+    sized = build_exudyn(simulation).simulation
+    faster = sized.spectral_radius_per_s > simulation.spectral_radius_per_s * (1 + 1e-9)
+    return sized, Cause("extensions", ", ".join(simulation.scene.extensions)) if faster else None
+
+
 def _exudyn(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
+    simulation, extended = _extended(simulation)
     settings, scene, n = simulation.settings, simulation.scene, simulation.dynamic_chain.size
     step = settings.step_s
     limits = EXUDYN_PRESETS[settings.preset or DEFAULT_PRESET].step_limits(simulation.pulse_duration_s,
                                                                           simulation.step_scales)
     if scene.solver.step_s is not None:
         cause = Cause("solver.step_s", step)
+    elif extended is not None and min(limits["stability"], limits["ringing"]) <= step * (1 + 1e-9):
+        cause = extended
     elif math.isclose(step, limits["pulse"]):
-        cause = Cause("impact.duration_s", scene.impact.duration_s) if simulation.piston is None else \
-            Cause("impact.piston", f"a contact of {simulation.pulse_duration_s:.3g} s")
+        cause = _pulse(simulation)
     elif math.isclose(step, limits["damper"]):
         cause = _rock_damper(simulation)
     else:
@@ -132,7 +169,7 @@ def _exact(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     _, _, step = sub_step(simulation, one_period)
     switches = settings.max_switches_per_blow * math.ceil(settings.end_time_s * simulation.impact.frequency_hz)
     keys = len(simulation.rock.modes()) * len(set(one_period))
-    return step, sampled if step == settings.sample_interval_s else _fastest(simulation), [
+    return step, sampled if step == settings.sample_interval_s else _fastest_or_pulse(simulation), [
         (sampled, settings.end_time_s / settings.sample_interval_s * (m + 2), settings.sample_interval_s),
         (Cause("solver.max_switches_per_blow", settings.max_switches_per_blow), 2 * switches * (m + 3), None),
         (Cause("drill_string.bodies", f"{simulation.dynamic_chain.size} lumped bodies"), keys * OPERATOR_VALUES * m**2, None)]
@@ -145,6 +182,28 @@ def _ode(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     return settings.end_time_s / steps, fastest, [
         (sampled, settings.end_time_s / settings.sample_interval_s * m, settings.sample_interval_s),
         (fastest, steps * ODE_STAGES * m, settings.end_time_s / steps)]
+
+
+def _waves(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
+    """A scene with wave rods (models.waves.steps): T / h steps of the characteristics in either formulation,
+    h the scene's step or the shortest rod transit (or the pulse) over the preset's steps per transit;
+    its samples hold the state, two ends per rod and the rigid joints' forces."""
+    settings, scene, waves = simulation.settings, simulation.scene, simulation.dynamic_chain.waves
+    step = settings.wave_step_s if settings.formulation == "exact" else settings.step_s
+    given = "wave_step_s" if settings.formulation == "exact" else "step_s"
+    if getattr(scene.solver, given) is not None:
+        cause = Cause(f"solver.{given}", step)
+    else:
+        preset = settings.preset or DEFAULT_PRESET
+        shortest = min(waves, key=lambda rod: rod.transit_time_s)
+        where = "impact.piston" if shortest.name == PISTON else f"drill_string.bodies.{shortest.name}"
+        cause = Cause(f"{where}.length_m", shortest.length_m)
+        if simulation.pulse_duration_s / STEPS_PER_PULSE[preset] < shortest.transit_time_s / STEPS_PER_TRANSIT[preset]:
+            cause = _pulse(simulation)
+    sampled = _interval(simulation) if settings.formulation == "exact" else \
+        Cause("solver.output_interval_s", settings.output_interval_s)
+    values = _state_size(simulation) + 2 + 2 * len(waves) + len(simulation.dynamic_chain.links)
+    return step, cause, [(sampled, settings.end_time_s / sampled.value * values, sampled.value)]
 
 
 ESTIMATES = {"exudyn": _exudyn, "exact": _exact, "ode": _ode}
@@ -164,13 +223,14 @@ def run_cost(simulation: Simulation, resampled: Cause | None = None) -> RunCost:
     interval ``resampled`` names (``rpdrill simulate``: ``solver.output_interval_s``) or not (None)."""
     settings, n = simulation.settings, simulation.dynamic_chain.size
     end = settings.end_time_s
-    step, cause, parts = ESTIMATES[settings.formulation](simulation)
+    waves = bool(simulation.dynamic_chain.waves) and settings.formulation != "ode"
+    step, cause, parts = (_waves if waves else ESTIMATES[settings.formulation])(simulation)
     values = sum(part[1] for part in parts) * MEMORY_COPIES[settings.formulation]
     if resampled is not None:
         parts.append((resampled, end / resampled.value * (2 * n + 8), resampled.value))
         values += parts[-1][1] * OUTPUT_COPIES
     largest, _, interval = max(parts, key=lambda part: part[1])
-    a, b, power = CPU_S_PER_STEP[cost_key(simulation)]
+    a, b, power = CPU_S_PER_STEP[f"{settings.formulation} waves" if waves else cost_key(simulation)]
     return RunCost(steps=end / step, step_s=step, steps_cause=_named(cause, step, USUAL_STEP_S, end),
                    memory_bytes=values * BYTES_PER_VALUE, memory_cause=_named(largest, interval, USUAL_INTERVAL_S, end),
                    cpu_s=end / step * (a + b * n**power))

@@ -54,6 +54,7 @@ mode found again, and the loop goes on.
 
 from __future__ import annotations
 
+import copy
 import math
 import time
 from collections import Counter, OrderedDict
@@ -246,17 +247,36 @@ class ExactSolver:
         self.model = Model(simulation)
         self.layout = self.model.layout
         self.min_switch_interval_s = settings.min_switch_interval_s
-        self.max_switches = settings.max_switches_per_blow * math.ceil(settings.end_time_s * self.impact.frequency_hz)
-        self.phase_times, self.phases = phase_pieces(self.impact, settings.end_time_s)
+        self.blows = simulation.blow_starts()
+        self.piston = None if simulation.piston is None else PistonJumps(simulation.piston)
+        self.contact = next((i for i, e in enumerate(self.model.pieces) if e.name == CONTACT), None)
+        self.retime(settings.end_time_s)
         norm, self.per_sample, self.step_s = sub_step(simulation, self.phases, self.model)
         self.operators = Operators(self.model, self.step_s, self.per_sample, taylor_order(norm * self.step_s),
                                    len(self.model.pieces[0].table) * len(set(self.phases)),
                                    "energy" in simulation.needed_data)
-        self.blows = simulation.blow_starts()
-        self.piston = None if simulation.piston is None else PistonJumps(simulation.piston)
-        self.contact = next((i for i, e in enumerate(self.model.pieces) if e.name == CONTACT), None)
+
+    def with_frequency(self, simulation: Simulation, end_time_s: float | None = None) -> ExactSolver:
+        """This solver for ``simulation``, whose scene differs from its own in the impact frequency only:
+        the matrices, the sub-step and the operators built do not depend on it (the pulse's shape,
+        amplitude and duration do), so a frequency scan builds them once (models.steady); it runs to
+        ``end_time_s`` (default the simulation's end time)."""
+        twin = copy.copy(self)
+        twin.simulation, twin.impact = simulation, simulation.impact
+        twin.blows = simulation.blow_starts()
+        twin.piston = None if simulation.piston is None else PistonJumps(simulation.piston)
+        twin.retime(simulation.settings.end_time_s if end_time_s is None else end_time_s)
+        return twin
+
+    def retime(self, end_time_s: float) -> None:
+        """Run from 0 to ``end_time_s`` (the operators built so far stay: models.steady runs one solver over
+        orbits of different lengths)."""
+        self.end_time_s = end_time_s
+        self.max_switches = self.simulation.settings.max_switches_per_blow * math.ceil(
+            end_time_s * self.impact.frequency_hz)
+        self.phase_times, self.phases = phase_pieces(self.impact, end_time_s)
         starts = self.blows or self.piston  # the kernel stops at every blow start for them
-        blows = blow_start_times(self.impact, settings.end_time_s) if starts else np.empty(0)
+        blows = blow_start_times(self.impact, end_time_s) if starts else np.empty(0)
         self.blow_phases = np.isin(self.phase_times[:, 0], blows).astype(np.int64)
 
     def start_blow(self, w: np.ndarray, mode_id: int, time_s: float, row: int) -> int:
@@ -309,24 +329,28 @@ class ExactSolver:
         impact, internal = np.cumsum(powers, axis=0).T
         return {"impact": impact, "internal": internal}
 
-    def run(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Modes]]:
-        """From the simulation's start (rest, off the bottom; or preloaded, in contact) through every
-        pulse phase to the end time: (sample times; rows w, F_r, F_d; switch times; modes entered); the
-        key propagating from each row in ``row_keys``. The kernel returns when it reaches a key not built
-        yet, and resumes once it is built."""
+    def run(self, start: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Modes]]:
+        """From the simulation's start (rest, off the bottom; or preloaded, in contact; or the augmented
+        state ``start``) through every pulse phase to the end time: (sample times; rows w, F_r, F_d; switch
+        times; modes entered); the key propagating from each row in ``row_keys``. The kernel returns when
+        it reaches a key not built yet, and resumes once it is built."""
         layout, ops, period, simulation = self.layout, self.operators, self.impact.period_s, self.simulation
         n = layout.n
         w = np.zeros(layout.size)
         w[layout.one] = 1.0
         setup = simulation.piston
         w[:n] = simulation.initial_positions_m if setup is None else setup.parked(simulation.initial_positions_m)
+        w[n:n + simulation.chain.size] = simulation.initial_velocities
         w[2 * n:2 * n + layout.rock_states] = simulation.initial_rock_state
         if layout.torsion:
             w[layout.angle] = simulation.initial_torsion_angle_rad
+            w[layout.angle + 1] = simulation.initial_torsion_rate_rad_per_s
+        if start is not None:  # a given state (models.steady: the period map)
+            w[:] = start
         starts = self.phase_times[:, 0]
         pulse = generator_states(self.impact, starts - np.floor(starts / period + 1e-9) * period)
         phase_ids = np.array([PHASES.index(p) for p in self.phases])
-        capacity = (math.floor(simulation.settings.end_time_s / (self.step_s * self.per_sample)) + 4
+        capacity = (math.floor(self.end_time_s / (self.step_s * self.per_sample)) + 4
                     + 2 * len(self.phases) + 2 * self.max_switches + ANCHORS * PER_ANCHOR)
         time_s, rows, row_keys = np.empty(capacity), np.empty((capacity, ops.width)), np.empty(capacity, dtype=np.int64)
         switch_times = np.empty(self.max_switches + 1)
@@ -391,11 +415,21 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     start = time.process_time()
     with BLAS.limit(limits=1, user_api="blas"):
         solver = ExactSolver(simulation)
-        time_s, rows, switch_times, entered = solver.run()
+    return solver_result(solver, simulation, start, progress)
+
+
+def solver_result(solver: ExactSolver, simulation: Simulation, cpu_start: float,
+                  progress: Callable[[float], None] | None = None, start: np.ndarray | None = None,
+                  ran: tuple[np.ndarray, np.ndarray, np.ndarray, list[Modes]] | None = None) -> SimulationResult:
+    """Run ``solver`` from ``start`` (default the simulation's initial state) to its end time into the result
+    of ``simulation`` (the solver's own, or one that differs from it in its start and end only); ``ran``:
+    the solver's run just made (models.steady reads its rows first)."""
+    with BLAS.limit(limits=1, user_api="blas"):
+        time_s, rows, switch_times, entered = ran or solver.run(start)
         works = solver.works_j(time_s, rows) if "energy" in simulation.needed_data else None
     layout = solver.layout
     n, angle, states = layout.n, layout.angle, slice(2 * layout.n, 2 * layout.n + layout.rock_states)
-    cpu = time.process_time() - start
+    cpu = time.process_time() - cpu_start
     impact_force, piston = rows[:, layout.size + 1], None
     if solver.piston is not None:
         solver.note_catches(time_s, rows, switch_times, entered)

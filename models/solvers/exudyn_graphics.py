@@ -16,8 +16,9 @@ from typing import Any
 
 from exudyn import graphics  # rocklaw.exudyn_module imported it first (models.solvers.exudyn_model)
 
+from ..definition.drill_string import STEEL_DENSITY_KG_PER_M3
 from ..drill.chain import AxialChain, Link
-from ..drill.shapes import Cylinder, Layout
+from ..drill.shapes import DEFAULT_DIAMETER_M, Cylinder, Layout
 
 BODY_COLOUR = graphics.color.steelblue
 ROD_COLOUR = graphics.color.lightgrey
@@ -101,3 +102,15 @@ class DrillGraphics:
         import exudyn
 
         return exudyn.ConfigurationType.Visualization
+
+
+def chain_cylinders(shapes: Layout, chain: AxialChain) -> list[Cylinder]:
+    """The drawn cylinder of every body of the dynamic chain: the string's from its layout, a piston's
+    bodies (after the string's) as steel cylinders of the default diameter behind the string."""
+    cylinders = list(shapes.cylinders)
+    start_m = min((c.start_m for c in cylinders), default=0.0)
+    for body in chain.bodies[len(cylinders):]:
+        length_m = body.mass_kg / (STEEL_DENSITY_KG_PER_M3 * math.pi * DEFAULT_DIAMETER_M**2 / 4)
+        start_m -= length_m + shapes.joint_gap_m
+        cylinders.append(Cylinder(body.name, "piston", start_m, length_m, DEFAULT_DIAMETER_M))
+    return cylinders

@@ -1,5 +1,7 @@
 """What surrounds an Exudyn solve: what Exudyn prints, as one warning a line (the command line shows
-each as ``rpdrill: warning: ...``), and Python's cyclic garbage collector paused while it runs."""
+each as ``rpdrill: warning: ...``), Python's cyclic garbage collector paused while it runs, and the
+per-step functions that watch it (the guard of an automatic step, progress reports), the one
+pre-step function that runs them all in order, and Exudyn's simulation settings of a run."""
 
 from __future__ import annotations
 
@@ -8,7 +10,15 @@ import gc
 import io
 import re
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Sequence
+from typing import TYPE_CHECKING, Any
+
+from ...rocklaw.exudyn_module import exu
+from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
+from ..evaluation.stability import SimulationFailed
+
+if TYPE_CHECKING:
+    from .simulation import Simulation
 
 
 @contextlib.contextmanager
@@ -43,3 +53,93 @@ def exudyn_messages_as_warnings(name: str) -> Iterator[None]:
         lines = [EXUDYN_PREFIX.sub("", line).strip() for line in printed.getvalue().splitlines()]
         for line in dict.fromkeys(line for line in lines if line):
             warnings.warn(f"scene '{name}': Exudyn: {line}", ExudynMessage, stacklevel=3)
+
+
+class MinimumStepGuard:
+    """Stops an automatic-step run whose step fell to Exudyn's minimum (Exudyn would go on with
+    errors beyond the tolerance, or crawl for hours at that step) and remembers when. The step
+    is the solver's own (rejected attempts also call the pre-step function)."""
+
+    def __init__(self, minimum_step_s: float) -> None:
+        self.minimum_step_s, self.reached_at_s = minimum_step_s, None
+
+    def __call__(self, mbs: Any, t: float) -> bool:
+        if mbs.sys["dynamicSolver"].it.currentStepSize <= self.minimum_step_s * (1 + 1e-6):
+            self.reached_at_s = t
+            return False
+        return True
+
+    def check(self, name: str, solver: Any) -> None:
+        """SimulationFailed, with a remedy, when the run of scene ``name`` reached the minimum step."""
+        if self.reached_at_s is not None:
+            raise SimulationFailed(
+                f"scene '{name}': solver {solver.type} with relative_tolerance {solver.relative_tolerance:g} reached "
+                f"the minimum step {self.minimum_step_s:g} s at t = {self.reached_at_s:.6g} s; try relative_tolerance "
+                f"{solver.relative_tolerance * 100:g} or a fixed-step preset (solver: {{preset: standard}})")
+
+
+def progress_reporter(end_time_s: float, progress: Callable[[float], None]) -> Callable[[Any, float], bool]:
+    """A pre-step function calling ``progress(t)`` about 100 times over the run."""
+    every = end_time_s / 100
+    next_report = [every]
+
+    def report(mbs: Any, t: float) -> bool:
+        if t >= next_report[0]:
+            next_report[0] += every
+            progress(t)
+        return True
+    return report
+
+
+def pre_step(actions: Sequence[Callable[[Any, float], bool]]) -> Callable[[Any, float], bool] | None:
+    """One Exudyn pre-step function running ``actions`` in order (the one action itself when there is
+    one, None when there are none); a False stops the run."""
+    if len(actions) <= 1:
+        return actions[0] if actions else None
+    actions = tuple(actions)
+
+    def run_all(mbs: Any, t: float) -> bool:
+        return all(action(mbs, t) for action in actions)
+    return run_all
+
+
+def replaced_pre_step(mbs: Any, installed: Any) -> dict[str, Any] | None:
+    """Exudyn's record of the pre-step function on ``mbs`` when it is not ``installed`` (one a user set with
+    ``mbs.SetPreStepUserFunction``), else None."""
+    current = mbs.GetPreStepUserFunction()
+    function = current.get("function") if isinstance(current, dict) else None
+    return None if function is None or function is installed else current
+
+
+def simulation_settings(simulation: Simulation) -> Any:
+    """Exudyn's simulation settings of a prepared run (its solver, step, tolerances, sensor storage)."""
+    solver = simulation.settings
+    settings = exu.SimulationSettings()
+    integration = settings.timeIntegration
+    integration.endTime = solver.end_time_s
+    set_step(settings, solver)
+    integration.verboseMode = 0
+    integration.generalizedAlpha.spectralRadius = solver.spectral_radius
+    integration.newton.useModifiedNewton = True
+    if solver.type in AUTOMATIC_STEP_SOLVERS:
+        integration.automaticStepSize = True
+        integration.relativeTolerance = solver.relative_tolerance
+        integration.absoluteTolerance = solver.absolute_tolerance
+    else:
+        integration.automaticStepSize = False
+        integration.adaptiveStep = False
+    # the explicit solvers' extra right-hand side per step computes accelerations for output only (none
+    # is stored; the states are bitwise the same without it, and a rk44 step costs ~12 % less)
+    integration.explicit.computeEndOfStepAccelerations = False
+    settings.show.statistics = False
+    settings.solution.file.write = False
+    # energies are integrated over every step; otherwise store only at the output interval
+    settings.solution.sensors.writePeriod = 0.0 if "energy" in simulation.needed_data else solver.output_interval_s
+    return settings
+
+
+def set_step(settings: Any, solver: Any) -> None:
+    """Exudyn's settings at the step of the run's ``solver`` settings (an automatic step: its first, a tenth)."""
+    integration = settings.timeIntegration
+    integration.numberOfSteps = round(solver.end_time_s / solver.step_s)
+    integration.initialStepSize = solver.step_s / 10

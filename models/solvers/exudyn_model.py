@@ -11,17 +11,24 @@ unless an output asks for them. Every body carries its graphics to scale (models
 
 :func:`build_exudyn` returns the assembled system before it runs (:class:`ExudynModel`: ``SC``,
 ``mbs``, ``bodies[name]`` with their node, object and markers, ``connectors[name]``) for a user to
-add Exudyn items of their own; ``model.run()`` runs it. A normal run is the same build and run
-(:func:`simulate`).
+add Exudyn items of their own, after the scene's extensions (models.definition.extensions) have added
+theirs; ``model.run()`` runs it, and so does Exudyn's own ``exu.SolveDynamic(mbs, model.settings,
+solverType=model.solver_type)``: the model's per-step functions (the rock's state, the piston's strikes,
+``add_pre_step``) are part of the built system. What a user adds is seen by the model's services
+(models.solvers.exudyn_user_items): the step rule and the stability bounds take the assembled system,
+the energy account its masses, spring-dampers and loads, the result's time series its sensors. A
+normal run is the same build and run (:func:`simulate`). A scene with wave rods builds the string's bodies
+with mass only, the rods an element of their own updated before every step (models.waves.exudyn_waves).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 import warnings
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -32,9 +39,7 @@ from ...rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled 
 # isort: split
 from exudyn.itemInterface import (
     LoadCoordinate,
-    MarkerBodyPosition,
     MarkerNodeCoordinate,
-    Node1D,
     NodePointGround,
     ObjectConnectorCoordinateSpringDamper,
     ObjectGround,
@@ -51,56 +56,36 @@ from exudyn.itemInterface import (
 
 from ...rocklaw.backends import SCALAR, SymbolicBackend
 from ...rocklaw.exudyn_element import ExudynRockContact, attach_user_function
-from ..definition.drill_string import STEEL_DENSITY_KG_PER_M3
 from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
 from ..definition.scene import Scene
-from ..drill.chain import AxialChain, Link
+from ..definition.validation import InputError, short
+from ..drill.chain import AxialChain
 from ..drill.indexing import BlowStarts
 from ..drill.pulse import impact_force
-from ..drill.shapes import DEFAULT_DIAMETER_M, Cylinder, Layout, layout
+from ..drill.shapes import layout
 from ..evaluation.results import SimulationResult
 from ..evaluation.run_result import Result
-from ..evaluation.stability import SimulationFailed, StepLimitWarning, check_result, step_warning
+from ..evaluation.stability import StepLimitWarning, check_result, step_warning
 from ..waves.exudyn_waves import WaveExudyn
-from .exudyn_graphics import DrillGraphics, body_graphics, torsion_graphics
-from .exudyn_messages import exudyn_messages_as_warnings, no_cyclic_gc
+from .exudyn_graphics import DrillGraphics, body_graphics, chain_cylinders, torsion_graphics
+from .exudyn_items import SOLVER_TYPES, ExudynBody, ExudynConnector, add_body, link_force_function
+from .exudyn_messages import (
+    MinimumStepGuard,
+    exudyn_messages_as_warnings,
+    no_cyclic_gc,
+    pre_step,
+    progress_reporter,
+    replaced_pre_step,
+    set_step,
+    simulation_settings,
+)
 from .exudyn_piston import ExudynPiston
-from .simulation import SceneError, Simulation, as_simulation, prepare
+from .exudyn_user_items import EnergyTerm, UserAccount, assembled_scales, item_counts, user_outcome
+from .simulation import Simulation, as_simulation, prepare, solver_settings
 
-SOLVER_TYPES = {
-    "rk67": exu.DynamicSolverType.RK67,
-    "rk44": exu.DynamicSolverType.RK44,
-    "rk33": exu.DynamicSolverType.RK33,
-    "explicit_midpoint": exu.DynamicSolverType.ExplicitMidpoint,
-    "explicit_euler": exu.DynamicSolverType.ExplicitEuler,
-    "generalized_alpha": exu.DynamicSolverType.GeneralizedAlpha,
-    "trapezoidal_index2": exu.DynamicSolverType.TrapezoidalIndex2,
-    "dopri5": exu.DynamicSolverType.DOPRI5,
-    "ode23": exu.DynamicSolverType.ODE23,
-}
 COORDINATE = exu.OutputVariableType.Coordinates
 RATE = exu.OutputVariableType.Coordinates_t
 AXIS_X_FROM_Z = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]  # a rotational node's local z onto the drilling axis
-
-
-@dataclass(frozen=True)
-class ExudynBody:
-    """One axial body (a rod segment ``rod[0]`` too), or the torsion line, as Exudyn items."""
-
-    name: str
-    node: Any  # Node1D: the body's axial displacement (the torsion line: its angle)
-    object: Any  # ObjectMass1D (torsion: ObjectRotationalMass1D)
-    marker_coordinate: Any  # MarkerNodeCoordinate: for coordinate connectors and loads
-    marker_position: Any  # MarkerBodyPosition at the body's centre: a 3-D point for Exudyn's spatial connectors
-
-
-@dataclass(frozen=True)
-class ExudynConnector:
-    """One link of the chain (a scene connector, a rod's inner link ``rod[0-1]``) as its Exudyn object."""
-
-    name: str
-    object: Any  # ObjectConnectorCoordinateSpringDamper
-    link: Link
 
 
 @dataclass
@@ -109,8 +94,10 @@ class ExudynModel:
 
     ``mbs`` is open to any Exudyn item of a user's own: join it to ``bodies[name].marker_position``
     (spatial connectors) or ``.marker_coordinate`` (coordinate connectors, loads); ``run()`` assembles
-    what was added and runs it with the scene's solver settings. ``add_pre_step(function)`` adds a
-    per-step hook (``mbs.SetPreStepUserFunction`` would replace the model's own).
+    what was added and runs it with the scene's solver settings, its step sized for the assembled system.
+    ``add_pre_step(function)`` adds a per-step function; a function set with ``mbs.SetPreStepUserFunction``
+    replaces the model's own (the rock would never crush), so ``run()`` runs it after them and
+    :meth:`result` refuses a solve it replaced. ``add_energy_term`` declares an energy of one's own.
     """
 
     simulation: Simulation
@@ -123,108 +110,176 @@ class ExudynModel:
     torsion: ExudynBody | None
     graphics: DrillGraphics
     sensors: dict[str, Any]
-    settings: Any
+    _settings: Any
     symbolic_functions: list[Any] = field(default_factory=list)  # kept alive with the system
     blows: BlowStarts | None = None  # the blow starts of this run (models.drill.indexing)
     piston: ExudynPiston | None = None  # the piston's strikes and catches (models.drill.piston)
     scene_formulation: str = "exudyn"  # the formulation the scene named (the model is always Exudyn's)
     symbolic: bool = True
     pre_steps: list[Callable[[Any, float], bool]] = field(default_factory=list)
-    waves: WaveExudyn | None = None  # wave rods: the element updated before every step (models.waves.exudyn_waves)
     _built_items: dict[str, int] = field(default_factory=dict)
     _ran: bool = False
+    _account: UserAccount | None = None
+    _prepared_items: dict[str, int] = field(default_factory=dict)
+    _watch: list[Callable[[Any, float], bool]] = field(default_factory=list)  # the run's guard and progress
+    _installed: Any = None  # the pre-step function the model set on mbs
+    _foreign: Any = None  # a pre-step function of the user's, set on mbs, run after the model's
+    solution_path: Path | None = None
+    waves: WaveExudyn | None = None  # wave rods: the element updated before every step (models.waves.exudyn_waves)
+
+    def __post_init__(self) -> None:
+        self._account = UserAccount(*(self._built_items[kind] for kind in ("objects", "loads", "sensors")))
+        self._install()
 
     @property
-    def system_container(self) -> Any:
-        return self.SC
+    def has_run(self) -> bool:
+        """Whether the system has been solved (by :meth:`run` or Exudyn's ``SolveDynamic``)."""
+        return self._ran or self.mbs.systemData.GetTime() > 0
+
+    @property
+    def built_items(self) -> dict[str, int]:
+        """How many items of each kind the build made (a user's items are numbered from there)."""
+        return dict(self._built_items)
 
     @property
     def coordinate_count(self) -> int:
         return len(self.mbs.systemData.GetODE2Coordinates())
 
+    @property
+    def settings(self) -> Any:
+        """Exudyn's simulation settings of the run, its step sized for the system as assembled now
+        (:meth:`prepare`): ``exu.SolveDynamic(model.mbs, model.settings, solverType=model.solver_type)``
+        runs what :meth:`run` runs."""
+        self.prepare()
+        return self._settings
+
+    @property
+    def solver_type(self) -> Any:
+        """Exudyn's ``DynamicSolverType`` of the scene's solver."""
+        return SOLVER_TYPES[self.simulation.settings.type]
+
     def add_pre_step(self, function: Callable[[Any, float], bool]) -> None:
-        """Call ``function(mbs, t)`` before every step, after the model's own hooks (False stops the run)."""
+        """Call ``function(mbs, t)`` before every step, after the model's own functions (False stops the run)."""
         self.pre_steps.append(function)
+        self._install()
+
+    def add_energy_term(self, name: str, kind: str, joules: Callable[[ExudynModel, np.ndarray], np.ndarray],
+                        items: Sequence[Any] = ()) -> None:
+        """Declare an energy of one's own for the energy account: ``kind`` ``stored`` (held at each time),
+        ``dissipated`` or ``work_in`` (cumulative from the start); ``joules(model, time_s)`` its value at the
+        run's stored steps (read from sensors of one's own after the run); ``items`` the Exudyn items it
+        accounts for (taken out of the automatic account; an item no term covers and the account cannot
+        take makes the balance not a number)."""
+        self._account.declare(EnergyTerm(name, kind, joules, tuple(items)))
 
     def write_solution(self, path: str | Path, period_s: float | None = None) -> None:
         """Have the run write Exudyn's coordinates solution file to ``path`` every ``period_s`` (default: the
         output interval), for ``exudyn.interactive.SolutionViewer`` (``exudyn.utilities.LoadSolutionFile``)."""
-        solution = self.settings.solution.file
+        solution = self._settings.solution.file
         solution.write = True
         solution.name = str(path)
         solution.writePeriod = period_s or self.simulation.settings.output_interval_s
         solution.export.velocities = solution.export.accelerations = False
+        self.solution_path = Path(path)
 
     def user_items(self) -> dict[str, int]:
-        """The Exudyn items added to ``mbs`` since the model was built, by kind (none: empty)."""
-        counts = _item_counts(self.mbs)
-        return {kind: counts[kind] - self._built_items[kind] for kind in counts if counts[kind] != self._built_items[kind]}
+        """The Exudyn items added to ``mbs`` since the model was built (by the scene's extensions too), by
+        kind (none: empty); the sensors the energy account adds are not counted."""
+        return self._account.added(self.mbs, self._built_items)
+
+    def prepare(self) -> None:
+        """Take in the items added since the last call: assemble the system, size the step for it (the
+        assembled system's eigenvalues, models.solvers.exudyn_user_items, where a solver.step_s does not
+        fix it) and add the sensors of their energy account. :meth:`run` and :attr:`settings` call it."""
+        if item_counts(self.mbs) == self._prepared_items:
+            return
+        self.mbs.Assemble()
+        if self.user_items().keys() - {"sensors"}:
+            self._size_step()
+        self._account.watch(self.mbs, "energy" in self.simulation.needed_data)
+        self.mbs.Assemble()
+        self._prepared_items = item_counts(self.mbs)
+
+    def _size_step(self) -> None:
+        if self.waves is not None:  # the step is the characteristics' (models.waves.steps)
+            return
+        scales = assembled_scales(self)
+        settings = solver_settings(self.simulation.scene, self.simulation.piston, scales)
+        self.simulation = replace(self.simulation, step_scales=scales, settings=settings)
+        set_step(self._settings, settings)
+
+    def _install(self) -> None:
+        """Set the one pre-step function of the model's own functions, the user's and the run's watchers."""
+        actions = [*self._own_actions(), *self.pre_steps, *self._watch]
+        if self._foreign is not None:
+            actions.append(self._foreign)
+        self._installed = pre_step(actions)
+        self.mbs.SetPreStepUserFunction(self._installed or 0)
+
+    def _own_actions(self) -> list[Callable[[Any, float], bool]]:
+        actions: list[Callable[[Any, float], bool]] = [self.piston] if self.piston is not None else []
+        actions += [self.rock.update_bottom] if self.rock is not None and self.rock.rock.crushes else []
+        return actions + ([self.waves.pre_step] if self.waves is not None else [])
+
+    def _replaced(self) -> dict[str, Any] | None:
+        """The pre-step function on ``mbs`` when it is not the model's (a user's mbs.SetPreStepUserFunction)."""
+        return replaced_pre_step(self.mbs, self._installed)
 
     def run(self, progress: Callable[[float], None] | None = None) -> Result:
         """Run the system (with any items added) by the scene's solver settings; ``progress(t)`` about
         100 times. The result is ``rpdrill.Result``, as ``rpdrill.simulate`` returns; a model runs once."""
-        return Result(self.simulation.scene, self.solve(progress), {"source": "build_exudyn"})
+        raw = self.solve(progress)  # the step may change with what was added: the simulation after the run
+        return Result(self.simulation.scene, raw, {"source": "build_exudyn", **self.simulation.code_records()})
 
     def solve(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
         """Run the system and return the formulation's raw result (:meth:`run` wraps it)."""
-        if self._ran:
+        if self.has_run:
             raise RuntimeError("an ExudynModel runs once (its rock state has moved on): build_exudyn(scene) again")
         self._ran = True
-        added = self.user_items()
-        if added:
-            self.mbs.Assemble()
-        return _run(self, progress, added)
+        replaced = self._replaced()
+        if replaced is not None:
+            if replaced.get("type") != "Python":
+                raise ValueError("mbs.SetPreStepUserFunction replaced the model's per-step functions (the rock's "
+                                 "state) with a symbolic one, which cannot run beside them; add it with "
+                                 "model.add_pre_step(function) instead")
+            self._foreign = replaced["function"]
+        settings = self.settings  # prepared for what was added
+        guard = None
+        if self.simulation.settings.type in AUTOMATIC_STEP_SOLVERS:
+            guard = MinimumStepGuard(settings.timeIntegration.minimumStepSize)
+            self._watch.append(guard)
+        if progress is not None:
+            self._watch.append(progress_reporter(self.simulation.settings.end_time_s, progress))
+        self._install()
+        warning = step_warning(self.simulation) if self.waves is None else None
+        if warning:
+            warnings.warn(warning, StepLimitWarning, stacklevel=3)
+        blas = self.waves.single_threaded() if self.waves is not None else contextlib.nullcontext()
+        with no_cyclic_gc(), exudyn_messages_as_warnings(self.simulation.name), blas:
+            start = time.process_time()
+            ok = self.mbs.SolveDynamic(settings, solverType=self.solver_type)
+            cpu = time.process_time() - start
+        self._watch.clear()
+        self._install()
+        if guard is not None:
+            guard.check(self.simulation.name, self.simulation.settings)
+        return _read_result(self, bool(ok), cpu)
 
-
-def _item_counts(mbs: Any) -> dict[str, int]:
-    data = mbs.systemData
-    return {"nodes": data.NumberOfNodes(), "objects": data.NumberOfObjects(), "markers": data.NumberOfMarkers(),
-            "loads": data.NumberOfLoads(), "sensors": data.NumberOfSensors()}
-
-
-def _add_body(mbs: Any, name: str, make_object: Callable[[Any], Any], initial: float = 0.0) -> ExudynBody:
-    node = mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[initial], initialVelocities=[0.0]))
-    body = make_object(node)
-    return ExudynBody(name, node, body, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0)),
-                      mbs.AddMarker(MarkerBodyPosition(bodyNumber=body, localPosition=[0.0, 0.0, 0.0])))
-
-
-def _store(mbs: Any, sensor: Any) -> Any:
-    return mbs.AddSensor(sensor)
-
-
-def _simulation_settings(simulation: Simulation) -> Any:
-    solver = simulation.settings
-    settings = exu.SimulationSettings()
-    integration = settings.timeIntegration
-    integration.endTime = solver.end_time_s
-    integration.numberOfSteps = round(solver.end_time_s / solver.step_s)
-    integration.verboseMode = 0
-    integration.generalizedAlpha.spectralRadius = solver.spectral_radius
-    integration.newton.useModifiedNewton = True
-    if solver.type in AUTOMATIC_STEP_SOLVERS:
-        integration.automaticStepSize = True
-        integration.relativeTolerance = solver.relative_tolerance
-        integration.absoluteTolerance = solver.absolute_tolerance
-        integration.initialStepSize = solver.step_s / 10
-    else:
-        integration.automaticStepSize = False
-        integration.adaptiveStep = False
-    # the explicit solvers' extra right-hand side per step computes accelerations for output only (none
-    # is stored; the states are bitwise the same without it, and a rk44 step costs ~12 % less)
-    integration.explicit.computeEndOfStepAccelerations = False
-    settings.show.statistics = False
-    settings.solution.file.write = False
-    # energies are integrated over every step; otherwise store only at the output interval
-    settings.solution.sensors.writePeriod = 0.0 if "energy" in simulation.needed_data else solver.output_interval_s
-    return settings
-
-
-def _link_force_function(link: Link, backend: Any) -> Callable[..., Any]:
-    """A connector's spring-force user function carrying the link's own law (:meth:`Link.force_n`)."""
-    def link_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        return link.force_n(displacement, velocity, backend)
-    return link_force
+    def result(self) -> Result:
+        """The result of a run by Exudyn's own ``exu.SolveDynamic(model.mbs, model.settings, ...)`` (as
+        :meth:`run` returns it). RuntimeError when the system has not run, or when a function set with
+        ``mbs.SetPreStepUserFunction`` replaced the model's per-step functions (the rock's state never
+        moved): add such a function with ``model.add_pre_step`` instead."""
+        if self.mbs.systemData.GetTime() <= 0:
+            raise RuntimeError("model.result(): the system has not run; call model.run() or "
+                               "exu.SolveDynamic(model.mbs, model.settings, solverType=model.solver_type) first")
+        if self._replaced() is not None and self._own_actions():
+            raise RuntimeError("model.result(): mbs.SetPreStepUserFunction replaced the model's per-step functions, "
+                               "so the rock's state never moved during that solve; add per-step functions with "
+                               "model.add_pre_step(function), or run model.run(), which runs both")
+        self._ran = True
+        return Result(self.simulation.scene, _read_result(self, True, math.nan),
+                      {"source": "exu.SolveDynamic", **self.simulation.code_records()})
 
 
 def _exudyn_simulation(run: Scene | Simulation) -> tuple[Simulation, str]:
@@ -244,9 +299,16 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     ``symbolic=False`` uses Python callbacks for the impact and rock forces (same law, slower:
     kept for the benchmark that measures what the symbolic functions save).
     """
+    if not isinstance(run, (Scene, Simulation)):
+        raise InputError(f"rpdrill.build_exudyn: run: {short(run)}: give a rpdrill.Scene (rpdrill.load_scene) or a "
+                         "prepared simulation")
     simulation, named = _exudyn_simulation(run)
-    if simulation.dynamic_chain.waves:
-        return _wave_model(simulation, named, symbolic)
+    if simulation.dynamic_chain.waves:  # the string's bodies with mass, the rods an element (models.waves)
+        model = WaveExudyn(simulation, symbolic).model(ExudynModel, ExudynBody, ExudynConnector,
+                                                       simulation_settings(simulation), named)
+        _apply_extensions(model)
+        model.prepare()
+        return model
     chain, impact, piston = simulation.dynamic_chain, simulation.impact, simulation.piston
     initial_positions = simulation.initial_positions_m if piston is None else piston.parked(simulation.initial_positions_m)
     shapes = layout(simulation.scene)
@@ -257,10 +319,13 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
 
     bodies: list[ExudynBody] = []
     rods = {name for name, body in simulation.scene.drill_string.bodies.items() if body.is_rod}
-    for body, cylinder, initial in zip(chain.bodies, _cylinders(shapes, chain), initial_positions, strict=True):
+    velocities = np.zeros(chain.size)
+    velocities[:simulation.chain.size] = simulation.initial_velocities
+    for body, cylinder, initial, speed in zip(chain.bodies, chain_cylinders(shapes, chain), initial_positions, velocities,
+                                              strict=True):
         shown = VObjectMass1D(graphicsData=body_graphics(cylinder, cylinder.group in rods))
-        bodies.append(_add_body(mbs, body.name, lambda n, m=body.mass_kg, x=cylinder.centre_m, v=shown: mbs.AddObject(
-            ObjectMass1D(nodeNumber=n, mass=m, referencePosition=[x, 0.0, 0.0], visualization=v)), initial))
+        bodies.append(add_body(mbs, body.name, lambda n, m=body.mass_kg, x=cylinder.centre_m, v=shown: mbs.AddObject(
+            ObjectMass1D(nodeNumber=n, mass=m, referencePosition=[x, 0.0, 0.0], visualization=v)), initial, speed))
         if body.constant_force_n:
             mbs.AddLoad(LoadCoordinate(markerNumber=bodies[-1].marker_coordinate, load=body.constant_force_n))
     markers = [body.marker_coordinate for body in bodies]
@@ -280,7 +345,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
         connectors[link.name] = ExudynConnector(link.name, connector, link)
         if not link.linear:
             user_functions.append(attach_user_function(
-                mbs, connector, "springForceUserFunction", _link_force_function(link, backend), symbolic))
+                mbs, connector, "springForceUserFunction", link_force_function(link, backend), symbolic))
 
     impact_load = mbs.AddLoad(LoadCoordinate(markerNumber=markers[chain.impact_body], load=0.0))
 
@@ -293,9 +358,10 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     if tor is not None:  # before the rock: the blow start reads its angle
         bit = shapes.cylinders[chain.bit_body]
         shown = VObjectRotationalMass1D(graphicsData=torsion_graphics(bit.diameter_m))
-        torsion = _add_body(mbs, "torsion", lambda n: mbs.AddObject(ObjectRotationalMass1D(
+        torsion = add_body(mbs, "torsion", lambda n: mbs.AddObject(ObjectRotationalMass1D(
             nodeNumber=n, inertia=tor.inertia_kg_m2, referencePosition=[bit.centre_m, 0.0, 0.0],
-            referenceRotation=AXIS_X_FROM_Z, visualization=shown)), simulation.initial_torsion_angle_rad)
+            referenceRotation=AXIS_X_FROM_Z, visualization=shown)), simulation.initial_torsion_angle_rad,
+            simulation.initial_torsion_rate_rad_per_s)
     blows = simulation.blow_starts()
     start_blow = None
     if blows is not None:
@@ -312,12 +378,12 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
 
     sensors: dict[str, Any] = {}
     for i, body in enumerate(bodies):
-        sensors[f"x{i}"] = _store(mbs, SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=COORDINATE))
-        sensors[f"v{i}"] = _store(mbs, SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=RATE))
+        sensors[f"x{i}"] = mbs.AddSensor(SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=COORDINATE))
+        sensors[f"v{i}"] = mbs.AddSensor(SensorNode(nodeNumber=body.node, storeInternal=True, outputVariableType=RATE))
     if "forces" in simulation.needed_data:
-        sensors["rock"] = _store(mbs, SensorObject(objectNumber=rock.object, storeInternal=True,
+        sensors["rock"] = mbs.AddSensor(SensorObject(objectNumber=rock.object, storeInternal=True,
                                                    outputVariableType=exu.OutputVariableType.Force))
-        sensors["impact"] = _store(mbs, SensorLoad(loadNumber=impact_load, storeInternal=True))
+        sensors["impact"] = mbs.AddSensor(SensorLoad(loadNumber=impact_load, storeInternal=True))
 
     if torsion is not None:
         mbs.AddObject(
@@ -330,86 +396,36 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
         )
         mbs.AddLoad(LoadCoordinate(markerNumber=torsion.marker_coordinate,
                                    load=tor.drive_torque_n_m - tor.resisting_torque_n_m))
-        sensors["phi"] = _store(mbs, SensorNode(nodeNumber=torsion.node, storeInternal=True,
+        sensors["phi"] = mbs.AddSensor(SensorNode(nodeNumber=torsion.node, storeInternal=True,
                                                 outputVariableType=COORDINATE))
-        sensors["omega"] = _store(mbs, SensorNode(nodeNumber=torsion.node, storeInternal=True, outputVariableType=RATE))
+        sensors["omega"] = mbs.AddSensor(SensorNode(nodeNumber=torsion.node, storeInternal=True, outputVariableType=RATE))
 
     drawn = DrillGraphics(simulation.chain, shapes, [body.node for body in bodies[:simulation.chain.size]], COORDINATE)
     mbs.AddObject(ObjectGround(visualization=VObjectGround(graphicsData=drawn.static(),
                                                            graphicsDataUserFunction=drawn)))
     mbs.Assemble()
     hook = None if piston is None else ExudynPiston(piston, [body.node for body in bodies], mbs, impact.period_s)
-    return ExudynModel(simulation, chain, container, mbs, {body.name: body for body in bodies}, connectors, rock,
-                       torsion, drawn, sensors, _simulation_settings(simulation), [impact_function, *user_functions],
-                       blows, hook, named, symbolic, _built_items=_item_counts(mbs))
+    model = ExudynModel(simulation, chain, container, mbs, {body.name: body for body in bodies}, connectors, rock,
+                        torsion, drawn, sensors, simulation_settings(simulation), [impact_function, *user_functions],
+                        blows, hook, named, symbolic, _built_items=item_counts(mbs), _prepared_items=item_counts(mbs))
+    _apply_extensions(model)
+    model.prepare()
+    return model
 
 
-def _wave_model(simulation: Simulation, named: str, symbolic: bool) -> ExudynModel:
-    """The Exudyn model of a scene with wave rods: the string's bodies with mass in ``mbs``, the wave rods an
-    element of their own (models.waves.exudyn_waves); ``bodies`` and ``connectors`` hold the Exudyn items."""
-    if simulation.settings.type in AUTOMATIC_STEP_SOLVERS:
-        raise SceneError(("solver", "type"), simulation.settings.type, "wave rods step at the characteristics' "
-                         "fixed step (every step advances the waves once): use a fixed-step type such as rk44")
-    element = WaveExudyn(simulation, symbolic)
-    chain = simulation.dynamic_chain
-    bodies = {chain.bodies[i].name: ExudynBody(chain.bodies[i].name, *items) for i, items in element.bodies.items()}
-    connectors = {name: ExudynConnector(name, connector, link) for name, (connector, link) in element.connectors.items()}
-    return ExudynModel(simulation, chain, element.SC, element.mbs, bodies, connectors, element.rock, None, None, {},
-                       _simulation_settings(simulation), element.functions, waves=element, scene_formulation=named,
-                       symbolic=symbolic, _built_items=_item_counts(element.mbs))
+def _apply_extensions(model: ExudynModel) -> None:
+    """The scene's extensions (models.definition.extensions) applied to the built model."""
+    simulation = model.simulation
+    for name, extension in (simulation.scene.extensions or {}).items():
+        try:
+            extension.apply(model)
+        except Exception as error:
+            raise ExtensionFailed(f"scene '{simulation.name}': extensions.{name} ({extension.function}) failed on the "
+                                  f"built model: {type(error).__name__}: {error}") from error
 
 
-def _cylinders(shapes: Layout, chain: AxialChain) -> list[Cylinder]:
-    """The drawn cylinder of every body of the dynamic chain: the string's from its layout, a piston's
-    bodies (after the string's) as steel cylinders of the default diameter behind the string."""
-    cylinders = list(shapes.cylinders)
-    start_m = min((c.start_m for c in cylinders), default=0.0)
-    for body in chain.bodies[len(cylinders):]:
-        length_m = body.mass_kg / (STEEL_DENSITY_KG_PER_M3 * math.pi * DEFAULT_DIAMETER_M**2 / 4)
-        start_m -= length_m + shapes.joint_gap_m
-        cylinders.append(Cylinder(body.name, "piston", start_m, length_m, DEFAULT_DIAMETER_M))
-    return cylinders
-
-
-class _MinimumStepGuard:
-    """Stops an automatic-step run whose step fell to Exudyn's minimum (Exudyn would go on with
-    errors beyond the tolerance, or crawl for hours at that step) and remembers when. The step
-    is the solver's own (rejected attempts also call the pre-step function)."""
-
-    def __init__(self, minimum_step_s: float) -> None:
-        self.minimum_step_s, self.reached_at_s = minimum_step_s, None
-
-    def __call__(self, mbs: Any, t: float) -> bool:
-        if mbs.sys["dynamicSolver"].it.currentStepSize <= self.minimum_step_s * (1 + 1e-6):
-            self.reached_at_s = t
-            return False
-        return True
-
-
-def _progress_reporter(end_time_s: float, progress: Callable[[float], None]) -> Callable[[Any, float], bool]:
-    every = end_time_s / 100
-    next_report = [every]
-
-    def report(mbs: Any, t: float) -> bool:
-        if t >= next_report[0]:
-            next_report[0] += every
-            progress(t)
-        return True
-    return report
-
-
-def _pre_step(actions: list[Callable[[Any, float], bool]]) -> Callable[[Any, float], bool] | None:
-    """One Exudyn pre-step hook running ``actions`` in order; a False stops the run."""
-    if len(actions) <= 1:
-        return actions[0] if actions else None
-
-    def pre_step(mbs: Any, t: float) -> bool:
-        return all(action(mbs, t) for action in actions)
-    return pre_step
-
-
-def _sensor(mbs: Any, sensor: Any) -> np.ndarray:
-    return mbs.GetSensorStoredData(sensor)
+class ExtensionFailed(RuntimeError):
+    """An extension of the scene (models.definition.extensions) raised while it was applied to the model."""
 
 
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None,
@@ -418,44 +434,16 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     return build_exudyn(run, symbolic).solve(progress)
 
 
-USER_ITEMS_NOTE = ("items added to model.mbs are seen only by the Exudyn formulation (the exact and ODE "
-                   "formulations and the energy account know the scene's drill only)")
-
-
-def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: dict[str, int]) -> SimulationResult:
-    """Solve the built system and read its sensors into a result (module doc)."""
-    simulation = model.simulation
-    settings = simulation.settings
+def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
+    """The solved system's sensors read into a result (module doc), checked (models.evaluation.stability)."""
     if model.waves is not None:
-        actions = ([] if progress is None else [_progress_reporter(settings.end_time_s, progress)]) + model.pre_steps
-        with no_cyclic_gc(), exudyn_messages_as_warnings(simulation.name):
-            result = model.waves.solve(model.settings, SOLVER_TYPES[settings.type], actions)
-        if added or model.scene_formulation != "exudyn":
-            result.info["exudyn_model"] = {"scene_formulation": model.scene_formulation, "user_items": added,
-                                           "note": USER_ITEMS_NOTE}
+        result = model.waves.finish(ok, cpu)
+        extra, result.user_energy, result.user_series = user_outcome(model, result.time_s)
+        result.info.update(extra)
         return result
-    warning = step_warning(simulation)
-    if warning:
-        warnings.warn(warning, StepLimitWarning, stacklevel=3)
-    mbs = model.mbs
-    actions = [model.rock.update_bottom] if model.rock.rock.crushes else []
-    if model.piston is not None:
-        actions.insert(0, model.piston)
-    guard = None
-    if settings.type in AUTOMATIC_STEP_SOLVERS:
-        guard = _MinimumStepGuard(model.settings.timeIntegration.minimumStepSize)
-        actions.append(guard)
-    if progress is not None:
-        actions.append(_progress_reporter(settings.end_time_s, progress))
-    pre_step = _pre_step(actions + model.pre_steps)
-    if pre_step is not None:
-        mbs.SetPreStepUserFunction(pre_step)
-    with no_cyclic_gc(), exudyn_messages_as_warnings(simulation.name):
-        start = time.process_time()
-        ok = mbs.SolveDynamic(model.settings, solverType=SOLVER_TYPES[settings.type])
-        cpu = time.process_time() - start
+    simulation, mbs = model.simulation, model.mbs
     reached_s = mbs.systemData.GetTime()
-    data = {name: _sensor(mbs, sensor) for name, sensor in model.sensors.items()}
+    data = {name: mbs.GetSensorStoredData(sensor) for name, sensor in model.sensors.items()}
     time_s = data["x0"][:, 0]
     n = model.chain.size
     position = np.column_stack([data[f"x{i}"][:, 1] for i in range(n)])
@@ -464,11 +452,10 @@ def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: di
     piston = None if model.piston is None else model.piston.history(time_s, position, velocity)
     position, velocity = position[:, :simulation.chain.size], velocity[:, :simulation.chain.size]
     rock_state = model.rock.state_at(time_s)
-    info: dict[str, Any] = {"solver_success": bool(ok), "coordinates": model.coordinate_count,
+    info: dict[str, Any] = {"solver_success": ok, "coordinates": model.coordinate_count,
                             **({"fresh_fractions": model.blows.fresh_fractions} if model.blows else {})}
-    if added or model.scene_formulation != "exudyn":
-        info["exudyn_model"] = {"scene_formulation": model.scene_formulation, "user_items": added,
-                                "note": USER_ITEMS_NOTE}
+    extra, energy, series = user_outcome(model, time_s)
+    info.update(extra)
     result = SimulationResult(
         simulation=simulation,
         formulation="exudyn",
@@ -486,12 +473,8 @@ def _run(model: ExudynModel, progress: Callable[[float], None] | None, added: di
         bottom_events=(history[:, 0], history[:, 1]),
         rock_state_m=rock_state,
         piston=piston,
+        user_energy=energy,
+        user_series=series,
     )
-    if guard is not None and guard.reached_at_s is not None:
-        raise SimulationFailed(
-            f"scene '{simulation.name}': solver {settings.type} with relative_tolerance "
-            f"{settings.relative_tolerance:g} reached the minimum step "
-            f"{guard.minimum_step_s:g} s at t = {guard.reached_at_s:.6g} s; try relative_tolerance "
-            f"{settings.relative_tolerance * 100:g} or a fixed-step preset (solver: {{preset: standard}})")
-    check_result(result, solver_ok=bool(ok), reached_s=reached_s)
+    check_result(result, solver_ok=ok, reached_s=reached_s)
     return result

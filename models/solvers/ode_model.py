@@ -319,9 +319,11 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     y = np.zeros(system.state_size)
     setup = simulation.piston
     y[:system.n] = simulation.initial_positions_m if setup is None else setup.parked(simulation.initial_positions_m)
+    y[system.n:system.n + simulation.chain.size] = simulation.initial_velocities
     y[system.rock_states] = simulation.initial_rock_state
     if system.torsion is not None:
         y[-2] = simulation.initial_torsion_angle_rad
+        y[-1] = simulation.initial_torsion_rate_rad_per_s
     modes = tuple(element.initial_mode(y) for element in system.pieces)
     record = _Record([], [], [], {})
     start = time.process_time()

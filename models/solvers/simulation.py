@@ -20,6 +20,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...rocklaw import RockLaw, State
+from ..definition.extensions import record, refusal
+from ..definition.extensions import records as extension_records
+from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
 from ..definition.outputs import needs
 from ..definition.scene import (
     BuiltEffects,
@@ -30,12 +33,19 @@ from ..definition.scene import (
     built_effects,
     requested_outputs,
 )
-from ..drill.chain import AxialChain, axial_chain, static_preload_m, static_torsion_angle_rad
+from ..drill.chain import (
+    STATIC_CONDITION_LIMIT,
+    AxialChain,
+    axial_chain,
+    static_preload_m,
+    static_torsion_angle_rad,
+)
 from ..drill.indexing import BlowStarts, Indexing
 from ..drill.piston import PistonSetup, piston_setup
 from ..drill.pulse import impulse_per_blow_n_s
+from ..drill.wave_rod import WaveRod
 from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_settings
-from ..evaluation.stability import FastestElement, StepScales, fastest_element, step_scales
+from ..evaluation.stability import FastestElement, StepScales, fastest_element, spring_spread, step_scales
 from ..waves.statics import wave_preload_m
 from ..waves.steps import wave_settings
 from .dispatch import implementation
@@ -69,6 +79,15 @@ class Simulation:
     fastest: FastestElement  # the element of the highest rate and the keys that set it
     indexing: Indexing | None = None
     piston: PistonSetup | None = None  # a piston striking the impact body (models.drill.piston), or the pulse
+    # a start in motion (models.steady: a periodic orbit's state at a blow start); None and 0: at rest
+    initial_velocities_m_per_s: np.ndarray | None = None
+    initial_torsion_rate_rad_per_s: float = 0.0
+
+    @property
+    def initial_velocities(self) -> np.ndarray:
+        """The chain's initial velocities (zero at rest)."""
+        given = self.initial_velocities_m_per_s
+        return np.zeros(self.chain.size) if given is None else given
 
     @property
     def dynamic_chain(self) -> AxialChain:
@@ -125,8 +144,22 @@ class Simulation:
 
     def run(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
         """Simulate with the scene's formulation (models.solvers.dispatch); ``progress(t)`` as simulated
-        time advances."""
+        time advances. SceneError naming the extension when the formulation builds no Exudyn model and
+        the scene has an extension that changes the motion (models.definition.extensions)."""
+        refused = refusal(self.scene.extensions, self.settings.formulation)
+        if refused:
+            raise SceneError(("extensions", refused[0]), self.scene.extensions[refused[0]].function, refused[1])
         return implementation(self.settings.formulation).simulate(self, progress)
+
+    def code_records(self) -> dict[str, Any]:
+        """The code of one's own the run imports, as provenance keeps it: every extension (import path,
+        package and version where it has one, the file, its parameters) and a rock law of one's own."""
+        records: dict[str, Any] = {}
+        if self.scene.extensions:
+            records["extensions"] = extension_records(self.scene.extensions)
+        if self.scene.rock.own_law:
+            records["rock_law"] = record(self.scene.rock.law)
+        return records
 
     def resolved_scene(self) -> dict[str, Any]:
         """The scene as run: rock values filled in, the effects built and why, the outputs, and the
@@ -136,6 +169,9 @@ class Simulation:
         data["effects"] = {**self.effects.as_dict(), "reasons": dict(self.effects.reasons)}
         data["outputs"] = self.outputs.model_dump(mode="json")
         data["solver"] = {key: value for key, value in vars(self.settings).items() if value is not None}
+        for name, recorded in self.code_records().get("extensions", {}).items():  # informational (Extension)
+            data["extensions"][name]["recorded"] = {key: value for key, value in recorded.items() if key != "parameters"}
+        data["solver"]["steady_state"] = self.scene.solver.steady_state
         if self.piston is not None:  # the coupling across the contact as run
             given = self.scene.impact.piston.contact_stiffness_n_per_m
             faces = "rigid faces" if given is None else f"the faces' contact {given:.6g} N/m"
@@ -146,9 +182,29 @@ class Simulation:
 
 
 def unsupported(name: str, simulation: Simulation) -> str | None:
-    """Why formulation ``name`` cannot run ``simulation``, or None if it can."""
+    """Why formulation ``name`` cannot run ``simulation``, or None if it can: an extension that changes the
+    motion of the Exudyn model, or what the formulation's own check says."""
+    refused = refusal(simulation.scene.extensions, name)
+    if refused:
+        return refused[1]
     check = getattr(implementation(name, checks=True), "unsupported", None)
     return check(simulation) if check else None
+
+
+def solver_settings(scene: Scene, piston: PistonSetup | None, scales: StepScales | None,
+                    waves: tuple[WaveRod, ...] = ()) -> Settings:
+    """The settings of the scene's formulation for a drill of these step scales (an Exudyn preset's step
+    follows them; models.evaluation.solver_settings), and with wave rods the characteristics' step
+    (models.waves.steps: blows start on its grid)."""
+    pulse_s = scene.impact.duration_s if piston is None else piston.pulse_duration_s
+    settings = resolve_settings(scene.solver, pulse_s, scales)
+    if waves:
+        return wave_settings(settings, scene.solver, waves, scene.impact, pulse_s)
+    if piston is not None and isinstance(settings, ExudynSettings) and scene.solver.step_s is None:
+        # the strikes fall on step starts: a whole number of steps per period (a strike one step late
+        # shifts the blow against the string's ringing; 2 % in the rate of the top-hammer scene)
+        settings = replace(settings, step_s=scene.impact.period_s / math.ceil(scene.impact.period_s / settings.step_s))
+    return settings
 
 
 def prepare(scene: Scene) -> Simulation:
@@ -172,20 +228,21 @@ def prepare(scene: Scene) -> Simulation:
         raise SceneError(tuple(fastest.key.split(".")), fastest.value,
                          f"with {fastest.other_key} {fastest.other_value:g} the model's fastest rate overflows "
                          f"(k/m or c/m beyond {sys.float_info.max:.3g}); give values of a physical drill")
-    settings = resolve_settings(scene.solver, scene.impact.duration_s if piston is None else piston.pulse_duration_s,
-                                scales)
-    if waves:  # the characteristics' step (models.waves.steps): blows start on its grid
-        settings = wave_settings(settings, scene.solver, waves, scene.impact,
-                                 scene.impact.duration_s if piston is None else piston.pulse_duration_s)
-    elif piston is not None and isinstance(settings, ExudynSettings) and scene.solver.step_s is None:
-        # the strikes fall on step starts: a whole number of steps per period (a strike one step late
-        # shifts the blow against the string's ringing; 2 % in the rate of the top-hammer scene)
-        settings = replace(settings, step_s=scene.impact.period_s / math.ceil(scene.impact.period_s / settings.step_s))
+    settings = solver_settings(scene, piston, scales, waves)
+    if waves and settings.formulation == "exudyn" and settings.type in AUTOMATIC_STEP_SOLVERS:
+        raise SceneError(("solver", "type"), settings.type, "wave rods step at the characteristics' fixed step "
+                         "(every step advances the waves once): use a fixed-step type such as rk44")
     positions, angle = np.zeros(chain.size), 0.0
     if scene.start == "preloaded":
         try:
             positions = static_preload_m(chain, rock) if not chain.waves else wave_preload_m(chain, rock)
         except ValueError as err:
+            key, value, stiffest, softest = spring_spread(scene, chain, rock)
+            if stiffest > STATIC_CONDITION_LIMIT * softest:  # the cause, rather than a body with no rest position
+                raise SceneError(tuple(key.split(".")), value, (
+                    f"a spring of {stiffest:.3g} N/m against the softest one's {softest:.3g} N/m: more than "
+                    f"{STATIC_CONDITION_LIMIT:.0e} apart, the static preload (start: preloaded) cannot be solved in "
+                    "double precision; give the values of a physical drill, or use start: rest")) from None
             raise SceneError(("start",), scene.start, str(err)) from None
         if effects.torsion:
             angle = static_torsion_angle_rad(scene.torsion)

@@ -26,7 +26,6 @@ on every step's ends.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from typing import Any
 
@@ -128,6 +127,7 @@ class WaveExudyn:
         self.indices = np.array([mbs.GetNodeODE2Index(self.bodies[i][0]) for i in kinematic], dtype=int)
         self.velocity_index = [self.stepper.layout.velocity[i] for i in kinematic]
         self.closed, self.previous = 0, self.stepper.w[:self.stepper.layout.n].copy()
+        self.failed_at_s: float | None = None
 
     def _ports(self, kinematic: tuple[int, ...]) -> None:
         """The faces joined rigidly to a body with mass move with it: their rods' ends are the body's ports,
@@ -270,30 +270,41 @@ class WaveExudyn:
         if len(self.body_ports) and self.last_powers is not None:
             self.last_powers[1] += self._port_power(self.stepper.last_inputs[0])
 
-    def solve(self, settings: Any, solver_type: Any, actions: list[Callable[[Any, float], bool]],
-              cpu_start_s: float | None = None) -> SimulationResult:
-        """Run the system with the element and ``actions`` (progress, a user's hooks) before every step (the
-        caller holds Exudyn's printed messages and the garbage collector: models.solvers.exudyn_messages)."""
-        simulation, mbs = self.simulation, self.mbs
-        self.failed_at_s = None
-        hooks = ([self.rock.update_bottom] if self.rock is not None and self.rock.rock.crushes else []) + \
-            [self.pre_step] + actions
-        mbs.SetPreStepUserFunction(lambda mbs, t: all(hook(mbs, t) for hook in hooks))
-        start = time.process_time() if cpu_start_s is None else cpu_start_s
-        with BLAS.limit(limits=1, user_api="blas"):  # the element's small matrices: threads cost more than they save
-            ok = mbs.SolveDynamic(settings, solverType=solver_type)
+    def model(self, model_type: type, body_type: type, connector_type: type, settings: Any, named: str) -> Any:
+        """The built model (models.solvers.exudyn_model.ExudynModel, its types given: this package sits below
+        it) holding the bodies with mass, the links between them, the rock element on a bit with mass and
+        this element; refused (SceneError) for an automatic-step solver."""
+        simulation = self.simulation
+        if simulation.settings.type in ("dopri5", "ode23"):
+            raise ValueError(f"solver.type {simulation.settings.type}: wave rods step at the characteristics' fixed "
+                             "step (every step advances the waves once): use a fixed-step type such as rk44")
+        chain = simulation.dynamic_chain
+        bodies = {chain.bodies[i].name: body_type(chain.bodies[i].name, *items) for i, items in self.bodies.items()}
+        connectors = {name: connector_type(name, connector, link) for name, (connector, link) in self.connectors.items()}
+        counts = {"nodes": self.mbs.systemData.NumberOfNodes(), "objects": self.mbs.systemData.NumberOfObjects(),
+                  "markers": self.mbs.systemData.NumberOfMarkers(), "loads": self.mbs.systemData.NumberOfLoads(),
+                  "sensors": self.mbs.systemData.NumberOfSensors()}
+        return model_type(simulation, chain, self.SC, self.mbs, bodies, connectors, self.rock, None, None, {}, settings,
+                          self.functions, scene_formulation=named, symbolic=self.symbolic, _built_items=dict(counts),
+                          _prepared_items=dict(counts), waves=self)
+
+    def single_threaded(self) -> Any:
+        """BLAS on one thread while the element runs (its small matrices: threads cost more than they save)."""
+        return BLAS.limit(limits=1, user_api="blas")
+
+    def finish(self, ok: bool, cpu_s: float) -> SimulationResult:
+        """The run's result once Exudyn has solved the system (module doc); SimulationFailed where it stopped."""
+        simulation, mbs, stepper = self.simulation, self.mbs, self.stepper
         self._sync()
-        stepper = self.stepper
         self._add_works(stepper.step_index * stepper.step_s)
         stepper._record(stepper.step_index * stepper.step_s, stepper.w, stepper.key())
-        cpu = time.process_time() - start
         if not ok or self.failed_at_s is not None or stepper.step_index < stepper.steps:
             at = self.failed_at_s if self.failed_at_s is not None else stepper.step_index * stepper.step_s
             raise SimulationFailed(f"scene '{simulation.name}': solver {simulation.settings.type} with the wave step "
                                    f"{stepper.step_s:g} s failed at t = {at:.6g} s; try solver.step_s "
                                    f"{stepper.step_s / 2:g}")
-        out = result(stepper, "exudyn", cpu, {"coordinates": len(mbs.systemData.GetODE2Coordinates()),
-                                               "solver_success": bool(ok)})
+        out = result(stepper, "exudyn", cpu_s, {"coordinates": len(mbs.systemData.GetODE2Coordinates()),
+                                                "solver_success": bool(ok)})
         if self.rock is not None:  # the rock on a bit with mass is Exudyn's
             law, states = self.rock.rock, self.rock.state_at(out.time_s)
             out.rock_state_m = states

@@ -8,6 +8,17 @@ from pathlib import Path
 
 from ...models.definition.scene import Scene
 from ...rocklaw.catalog import TABLE_1
+from ..inputs.arguments import (
+    bounds_problem,
+    check,
+    choice_problem,
+    dask_problem,
+    instance_problem,
+    names_problem,
+    optional,
+    positive_problem,
+    workers_problem,
+)
 from ..inputs.reading import InputError, scene_and_source
 from ..runtime.pools import pool
 from .advice_search import (
@@ -28,32 +39,44 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
                  search: AdviceSearch | None = None, workers: int | None = None,
                  dask: str | None = None, max_rod_stress_pa: float | None = None) -> list[Advice]:
     """Maximise ``metric`` over ``bounds`` (``{"impact.frequency_hz": (45, 70), "feed.force_n": (35e3,
-    60e3)}``, optionally ``"impact.amplitude_n"``; SI units) for the scene's rock, or for each Table 1
+    60e3)}``, optionally ``"impact.amplitude_n"`` and an extension's ``"extensions.NAME.parameters.KEY"``; SI
+    units) for the scene's rock, or for each Table 1
     rock of ``rocks``; ``power_kw``: a fixed hammer power (a piston scene, the blow energy P / f). One
     :class:`Advice` per rock (SI units). InputError before anything runs when an input cannot be used."""
-    validated, source = scene_and_source(scene)
+    where = "rpdrill.advise"
+    check(where, "bounds", bounds, bounds_problem)
+    check(where, "metric", metric, choice_problem(METRICS, "metric"))
+    check(where, "rocks", rocks, optional(names_problem(TABLE_1, "Table 1 rock")))
+    check(where, "power_kw", power_kw, optional(positive_problem))
+    check(where, "max_thrust_ratio", max_thrust_ratio, positive_problem)
+    check(where, "search", search, instance_problem(AdviceSearch, "a rpdrill.AdviceSearch or None", optional=True))
+    check(where, "workers", workers, optional(workers_problem))
+    check(where, "dask", dask, dask_problem)
+    validated, source = scene_and_source(scene, where)
     data = validated.model_dump(by_alias=True, exclude_none=True)
     allowed = [entry.path for entry in PARAMETERS]
-    for path, (low, high) in bounds.items():
-        if path not in allowed:
+    own = [f"extensions.{name}.parameters.KEY" for name in validated.extensions or {}]  # an extension's parameter
+    for path in bounds:
+        if path not in allowed and not _extension_parameter(path, validated):
             raise InputError(f"{source}: bounds: {path!r}: not a parameter advise searches; allowed: "
-                             f"{', '.join(allowed)}")
-        if not low < high:
-            raise InputError(f"{source}: bounds: {path}: ({low:g}, {high:g}): the lower bound must be below the upper")
+                             f"{', '.join(allowed + own)}")
     missing = [path for path in (FREQUENCY, FEED) if path not in bounds]
     if missing:
         raise InputError(f"{source}: bounds: give {' and '.join(missing)} (low, high)")
-    if metric not in METRICS:
-        raise InputError(f"{source}: metric {metric!r}: allowed: {', '.join(METRICS)}")
-    unknown = [rock for rock in rocks or [] if rock not in TABLE_1]
-    if unknown:
-        raise InputError(f"{source}: rocks: {', '.join(unknown)}: not a Table 1 rock; allowed: {', '.join(TABLE_1)}")
-    ordered = {entry.path: tuple(map(float, bounds[entry.path])) for entry in PARAMETERS if entry.path in bounds}
+    ordered = {path: tuple(map(float, bounds[path])) for path in [*allowed, *sorted(set(bounds) - set(allowed))]
+               if path in bounds}
     request = Request(metric, ordered, max_thrust_ratio, search or AdviceSearch(),
                       power_w=power_kw * 1e3 if power_kw else None, max_rod_stress_pa=max_rod_stress_pa)
     scenes = [(rock, runnable_scene(data, rock, request, source)) for rock in rocks or [None]]
-    with pool(dask, workers) as (_, runner):
+    with pool(dask, workers, f"{where}: dask") as (_, runner):
         return [advise(prepared, rock, request, runner) for rock, prepared in scenes]
+
+
+def _extension_parameter(path: str, scene: Scene) -> bool:
+    """Whether ``path`` is ``extensions.NAME.parameters.KEY`` of an extension of ``scene``."""
+    parts = path.split(".")
+    return len(parts) == 4 and parts[0] == "extensions" and parts[2] == "parameters" and \
+        parts[1] in (scene.extensions or {})
 
 
 __all__ = ["Advice", "AdviceSearch", "advise_scene"]

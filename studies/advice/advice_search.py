@@ -60,6 +60,7 @@ from ...models.definition.validation import InputError, describe_validation_erro
 from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
 from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter
+from ..inputs.arguments import check, count_problem, positive_problem, seed_problem
 from ..inputs.specs import set_path
 from ..runtime.evaluation_log import EvaluationLog
 from ..runtime.pools import Runner
@@ -125,6 +126,11 @@ class AdviceSearch:
     max_generations: int = 30
     tolerance: float = 0.01
     seed: int = 1
+
+    def __post_init__(self) -> None:
+        for name, problem in (("popsize", count_problem), ("max_generations", count_problem),
+                              ("tolerance", positive_problem), ("seed", seed_problem)):
+            check("rpdrill.AdviceSearch", name, getattr(self, name), problem)
 
 
 @dataclass(frozen=True)
@@ -209,7 +215,7 @@ def runnable_scene(scene: dict[str, Any], rock: str | None, request: Request, so
     data = checked.with_solver(formulation).model_dump(by_alias=True, exclude_none=True)
     blows = checked.metrics.transient_blows + checked.metrics.block_blows
     data["solver"]["end_time_s"] = max(checked.solver.end_time_s, blows / request.bounds[FREQUENCY][0])
-    options = {p.path: p.option for p in PARAMETERS}
+    options = {path: path for path in request.bounds} | {p.path: p.option for p in PARAMETERS}
     for corner in itertools.product(*request.bounds.values()):
         point = dict(zip(request.bounds, corner, strict=True))
         try:

@@ -17,11 +17,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from ...models.evaluation.workprecision import non_dominated
 from ..runtime.evaluation_log import Record
-from ..runtime.output_files import write_json, write_rows_csv
+from ..runtime.output_files import write_json, write_resolved, write_rows_csv
 from .calibration_search import CalibrationResult
 from .calibration_spec import Calibration
 
@@ -93,7 +92,7 @@ def write_report(directory: Path, calibration: Calibration, result: CalibrationR
     """Every output file of a calibration with a best evaluation (module docstring)."""
     best, final = result.best, result.final
     scene = calibration.scene(best["parameters"])
-    (directory / "calibrated_scene.yaml").write_text(yaml.safe_dump(scene, sort_keys=False), encoding="utf-8")
+    write_resolved(directory / "calibrated_scene.yaml", scene)
     rows = target_rows(calibration, final.results)
     write_rows_csv(directory / "targets.csv", rows, list(TARGET_COLUMNS))
     step = calibration.spec.refine_hz

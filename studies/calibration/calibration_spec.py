@@ -316,7 +316,9 @@ def _check_parameters(spec: CalibrationSpec, base: dict[str, Any], source: str) 
                                  f"(e.g. {{impact.amplitude_n: {name}}}) or drop it")
             continue
         check_scene_path(source, "parameters", name, base)
-        if not _takes_numbers(field_at(Scene, tuple(name.split("."))).annotation):
+        field = field_at(Scene, tuple(name.split(".")))  # None: a parameter of one's own (an extension's)
+        numeric = isinstance(_get(base, name), (int, float)) and not isinstance(_get(base, name), bool)
+        if not (numeric if field is None else _takes_numbers(field.annotation)):
             raise InputError(f"{source}: parameters.{name}: {_get(base, name)!r} in the base scene: a scene key "
                              "that does not take a real number; a fitted parameter is a key that does")
         if name == FREQUENCY or all(name in target.overrides for target in spec.targets):

@@ -10,7 +10,10 @@ import argparse
 import contextlib
 import shlex
 import sys
+import time
+from datetime import datetime, timezone
 from pathlib import Path
+from typing import Any
 
 from tqdm import tqdm
 
@@ -29,11 +32,12 @@ from ..advice.advice_search import (
 )
 from ..display.catalogue import metric, parameter
 from ..figures.advice_figures import plot_curves, plot_feed_map
+from ..inputs.arguments import choice_problem, cli_type
 from ..inputs.reading import load_scene
 from ..runtime.evaluation_log import CHECKPOINT, EVALUATIONS, EvaluationLog
-from ..runtime.output_files import check_file_target, check_out, staged_directory, write_json
+from ..runtime.output_files import check_file_target, check_out, staged_directory, write_atomic, write_json
 from ..runtime.pools import pool
-from .options import add_runner_arguments, positive_count, positive_number
+from .options import add_runner_arguments, positive_count, positive_number, seed
 
 FILES = f"""files written to DIR (an interrupted advice keeps its points there: the same command again
 replays them and runs the rest):
@@ -64,13 +68,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                             required=entry.required,
                             help=f"bounds of the {q.name} [{q.unit}]" + ("" if entry.required else
                                                                         " (default: fixed at the scene's value)"))
-    parser.add_argument("--metric", choices=METRICS, default=METRICS[0],
+    parser.add_argument("--metric", type=cli_type(choice_problem(METRICS, "metric")), default=METRICS[0],
+                        metavar="{" + ",".join(METRICS) + "}",
                         help=f"what to maximise (default {METRICS[0]}; {METRICS[1]}: penetration rate / impact power; "
                              f"{METRICS[2]}: penetration rate / hammer power, a piston scene)")
     parser.add_argument("--power-kw", type=positive_number, metavar="P",
                         help="a fixed hammer power [kW] (a piston scene): at every point the blow energy is P / f, "
                              "so the search trades frequency against blow energy")
-    parser.add_argument("--rock", nargs="+", choices=tuple(TABLE_1), metavar="NAME",
+    parser.add_argument("--rock", nargs="+", type=cli_type(choice_problem(TABLE_1, "Table 1 rock")), metavar="NAME",
                         help=f"search again for each Table 1 rock ({', '.join(TABLE_1)}; default: the scene's rock)")
     parser.add_argument("--max-thrust-ratio", type=positive_number, default=1.0,
                         help="run only points whose mean thrust (feed + frequency x impulse per blow) is below this "
@@ -83,7 +88,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"differential evolution: population per parameter (default {AdviceSearch.popsize})")
     parser.add_argument("--generations", type=positive_count, default=AdviceSearch.max_generations,
                         help=f"differential evolution: at most this many generations (default {AdviceSearch.max_generations})")
-    parser.add_argument("--seed", type=int, default=AdviceSearch.seed, help=f"random seed (default {AdviceSearch.seed})")
+    parser.add_argument("--seed", type=seed, default=AdviceSearch.seed, help=f"random seed (default {AdviceSearch.seed})")
     parser.add_argument("--markdown", type=Path, help="also write advice.md to this file (e.g. docs/advice.md)")
     add_runner_arguments(parser)
 
@@ -101,6 +106,14 @@ def command_line(args: argparse.Namespace) -> str:
     words += ["--popsize", str(args.popsize), "--generations", str(args.generations), "--seed", str(args.seed)]
     words += ["--out", args.out] + (["--markdown", str(args.markdown)] if args.markdown else [])
     return shlex.join(words)
+
+
+def session(runner: str, points_run: int, advices: list[Any], start: float, interrupted: bool) -> dict[str, Any]:
+    """One session of an advice, for its checkpoint (as a calibration records its sessions)."""
+    return {"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"), "runner": runner,
+            "interrupted": interrupted, "points_run": points_run,
+            "points_replayed": sum(advice.replayed for advice in advices), "rocks_done": len(advices),
+            "wall_time_s": round(time.perf_counter() - start, 3)}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -123,9 +136,15 @@ def run(args: argparse.Namespace) -> int:
         print(f"advise: maximising {metric(args.metric).name} over {', '.join(parameter(p).name for p in bounds)} "
               f"for {len(rocks)} rock(s) on {label}" + (f"; {len(log.records)} points recorded earlier in {out}"
                                                          if log.records else ""), file=sys.stderr)
-        for rock, data in zip(rocks, scenes, strict=True):
-            advices.append(advise(data, rock, request, runner, bar.update, log))
-            tqdm.write(advice_text(advices[-1]), file=sys.stdout)
+        earlier, start = len(log.records), time.perf_counter()
+        try:
+            for rock, data in zip(rocks, scenes, strict=True):
+                advices.append(advise(data, rock, request, runner, bar.update, log))
+                tqdm.write(advice_text(advices[-1]), file=sys.stdout)
+        except KeyboardInterrupt:  # the points run are kept (evaluations.jsonl); the session says where it stopped
+            log.add_session(session(label, len(log.records) - earlier, advices, start, interrupted=True))
+            raise
+        log.add_session(session(label, len(log.records) - earlier, advices, start, interrupted=False))
     command = command_line(args)
     with staged_directory(args.out) as stage:
         write_json(stage / "advice.json", advice_record(advices, command))
@@ -135,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
             plot_curves(advice, stage / f"{name}_curves.png")
             plot_feed_map(advice, stage / f"{name}_feed_frequency_map.png")
     if args.markdown:
-        args.markdown.write_text(advice_markdown(advices, command), encoding="utf-8")
+        write_atomic(args.markdown, advice_markdown(advices, command))
     print(best_table(advices))
     print(f"wrote {args.out}" + (f", {args.markdown}" if args.markdown else ""), file=sys.stderr)
     failed = [a for a in advices if a.failed_runs == a.runs]

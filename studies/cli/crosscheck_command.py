@@ -11,6 +11,7 @@ from ...models.evaluation.stability import SimulationFailed
 from ..crosscheck.crosscheck_run import crosscheck
 from ..crosscheck.crosscheck_windows import DEFAULT_STEP_S
 from ..figures.crosscheck_figure import plot_overlay
+from ..inputs.arguments import choice_problem, cli_type
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import check_out, staged_directory, write_json
 from .options import add_budget_arguments, budget, positive_count, positive_number
@@ -23,7 +24,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--blows", type=positive_count, default=20, help="compared window in impact periods (default 20)")
     parser.add_argument("--step", type=positive_number, default=DEFAULT_STEP_S,
                         help=f"Exudyn step [s] (default {DEFAULT_STEP_S:g}; solver type from the scene)")
-    parser.add_argument("--method", choices=ODE_METHODS, default="DOP853", help="ODE method (default DOP853)")
+    parser.add_argument("--method", type=cli_type(choice_problem(ODE_METHODS, "method")), default="DOP853",
+                        metavar="{" + ",".join(ODE_METHODS) + "}", help="ODE method (default DOP853)")
     parser.add_argument("--rtol", type=positive_number, default=1e-10, help="ODE relative tolerance (default 1e-10)")
     add_budget_arguments(parser, many_runs=False)
 

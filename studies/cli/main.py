@@ -7,27 +7,35 @@ Ctrl-C, finished results kept). An unexpected exception is a bug: one line namin
 where it was raised, exit status 1, no traceback. While a command runs, a warning prints as one
 line, ``rpdrill: warning: ...`` (warnings of worker processes come back to this process and print
 here, once each: studies.runtime.pools).
+
+Errors of the operating system: ``--out`` that cannot be written (read-only, no permission, a full
+disk when the lock is written) is refused with exit status 2 before anything runs
+(studies.runtime.out_lock, studies.runtime.output_files.check_out); a write that fails later (a disk
+that fills up) ends the command with one line naming the file and the error, exit status 1, every
+file written whole or not at all (studies.runtime.output_files), so that the same command resumes
+once the cause is gone. A closed standard output (``| head -n 0``) is not an error: what the command
+prints there is dropped and it ends with its own status. A Ctrl-C or SIGTERM at any moment, from the
+program's first import on, prints one line (:func:`console`).
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
-import importlib.metadata
+import errno
 import os
 import shlex
+import signal
 import sys
 import traceback
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
-from types import ModuleType
+from types import FrameType, ModuleType
+from typing import Any
 
-from ...rocklaw.exudyn_build import use_fast_build
-from ..inputs.reading import InputError
-from ..runtime.budgets import BudgetError
-from ..runtime.interrupts import Terminated, WorkerLost, raise_if_stopped, stops_handled
-from ..runtime.out_lock import out_locked
+# Only the standard library at import: the program takes its signal handlers (console) before the
+# libraries load (a second or two); main imports the rest.
 
 # name: one-line help; a command's module is imported only when it runs (:func:`command_module`)
 COMMANDS = {
@@ -92,10 +100,17 @@ def one_line_warnings() -> Iterator[None]:
 
 
 def _version() -> str:
+    import importlib.metadata
+
     return f"rpdrill {importlib.metadata.version('rpdrill')} (Exudyn {importlib.metadata.version('exudyn')})"
 
 
 def main(argv: list[str] | None = None) -> int:
+    from ..inputs.reading import InputError
+    from ..runtime.budgets import BudgetError
+    from ..runtime.interrupts import Terminated, WorkerLost, raise_if_stopped, stops_handled
+    from ..runtime.out_lock import out_locked
+
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = _Parser(prog="rpdrill", description="Rotary-percussive drilling simulator on Exudyn")
     parser.add_argument("--version", action="version", version=_version())
@@ -125,6 +140,11 @@ def main(argv: list[str] | None = None) -> int:
             "terminated (SIGTERM)" if terminated else "interrupted"
         print(f"rpdrill: {why}; finished results are kept", file=sys.stderr)
         return 143 if terminated else 130
+    except OSError as err:  # the operating system's: a disk that filled up, a folder made read-only meanwhile
+        where = f" ({err.filename})" if err.filename else f" (--out {args.out})" if getattr(args, "out", None) else ""
+        print(f"rpdrill {args.command}: could not finish: {err.strerror or err}{where}; the files written are whole "
+              "and finished results are kept: run the same command again once the cause is gone", file=sys.stderr)
+        return 1
     except Exception as err:  # noqa: BLE001 - a bug, not bad input: one line naming the input, no traceback
         where = traceback.extract_tb(err.__traceback__)[-1]
         source = next((getattr(args, key) for key in ("scene", "study", "calibration") if hasattr(args, key)), "")
@@ -133,17 +153,77 @@ def main(argv: list[str] | None = None) -> int:
         return 1
 
 
+def _stopped_while_starting(signum: int, frame: FrameType | None) -> None:
+    """Ctrl-C or SIGTERM before a command runs (its libraries loading, its arguments read): nothing
+    was written; one line, and out."""
+    why = "terminated (SIGTERM)" if signum == signal.SIGTERM else "interrupted"
+    os.write(2, f"rpdrill: {why} while starting; nothing was written\n".encode())
+    os._exit(143 if signum == signal.SIGTERM else 130)
+
+
+class ClosedPipeQuiet:
+    """A standard stream whose reader went away (``| head -n 0``): what is printed after is dropped (the
+    stream's descriptor then points to /dev/null), not raised, so that the command ends with its own
+    status once its files are written."""
+
+    def __init__(self, stream: Any) -> None:
+        self.stream = stream
+
+    def _closed_pipe(self) -> None:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, self.stream.fileno())
+        os.close(devnull)
+
+    def write(self, text: str) -> int:
+        try:
+            return self.stream.write(text)
+        except BrokenPipeError:
+            self._closed_pipe()
+            return len(text)
+        except OSError as error:
+            if error.errno != errno.EPIPE:
+                raise
+            self._closed_pipe()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self.stream.flush()
+        except BrokenPipeError:
+            self._closed_pipe()
+            with contextlib.suppress(OSError, ValueError):
+                self.stream.flush()
+
+    def __getattr__(self, name: str) -> Any:  # encoding, fileno, isatty, ... of the stream
+        return getattr(self.stream, name)
+
+    def fileno(self) -> int:
+        return self.stream.fileno()
+
+    def isatty(self) -> bool:
+        return self.stream.isatty()
+
+
 def console() -> None:
-    """The ``rpdrill`` program: :func:`main`, then exit with its status. Tests call :func:`main`. The
-    program and its workers load Exudyn's build without range checks (rocklaw.exudyn_build: a process
-    rpdrill owns; a user's process that imports rpdrill does not). A stopped command (130, 143) has
-    written what it keeps and ended its workers: it exits at once, without the interpreter's teardown
-    of its modules (a second or more on a busy machine)."""
+    """The ``rpdrill`` program: :func:`main`, then exit with its status. Tests call :func:`main`. A
+    Ctrl-C or SIGTERM while the program starts prints one line (the command's own handling takes over
+    when it runs: studies.runtime.interrupts). The program and its workers load Exudyn's build without
+    range checks (rocklaw.exudyn_build: a process rpdrill owns; a user's process that imports rpdrill does
+    not). A closed standard output or error is no error (:class:`ClosedPipeQuiet`). A stopped command
+    (130, 143) has written what it keeps and ended its workers: it exits at once, without the
+    interpreter's teardown of its modules (a second or more on a busy machine)."""
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _stopped_while_starting)
+    sys.stdout, sys.stderr = ClosedPipeQuiet(sys.stdout), ClosedPipeQuiet(sys.stderr)
+    from ...rocklaw.exudyn_build import use_fast_build
+
     use_fast_build()  # before anything imports Exudyn; the workers inherit it (rocklaw.exudyn_build)
     status = main()
+    for signum in (signal.SIGINT, signal.SIGTERM):  # the command has ended: its status stands
+        signal.signal(signum, signal.SIG_IGN)
+    sys.stdout.flush()
+    sys.stderr.flush()
     if status in (130, 143):
-        sys.stdout.flush()
-        sys.stderr.flush()
         os._exit(status)
     sys.exit(status)
 

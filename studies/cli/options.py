@@ -4,39 +4,28 @@ A command parses, calls the domain modules of rpdrill.studies and prints; it hol
 from __future__ import annotations
 
 import argparse
-import os
 
+from ..inputs.arguments import (
+    WORKERS_PER_CORE,
+    cli_type,
+    count_problem,
+    dask_problem,
+    number,
+    positive_problem,
+    seed_problem,
+    whole_number,
+    workers_problem,
+)
 from ..runtime.budgets import DEFAULT_MAX_MEMORY_GB, DEFAULT_MAX_STEPS, MAX_CPU_HOURS, Budget
 
+# The options' types: the library's checks of the same arguments (studies.inputs.arguments), same words
+positive_number = cli_type(positive_problem, number)  # a positive finite number
+positive_count = cli_type(count_problem, whole_number)  # a whole number of at least 1
+worker_count = cli_type(workers_problem, whole_number)  # 1 to WORKERS_PER_CORE x the machine's cores
+seed = cli_type(seed_problem, whole_number)  # 0 to 2^32 - 1
+dask_address = cli_type(dask_problem)  # tcp://host:port or host:port
 
-def positive_number(text: str) -> float:
-    """An argument that must be a positive finite number."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not 0 < value < float("inf"):
-        raise argparse.ArgumentTypeError(f"{text}: must be a positive number")
-    return value
-
-
-def positive_count(text: str) -> int:
-    """An argument that must be a whole number of at least 1."""
-    if not text.isdigit() or int(text) < 1:
-        raise argparse.ArgumentTypeError(f"{text}: must be a whole number of at least 1")
-    return int(text)
-
-
-WORKERS_PER_CORE = 4  # more workers only share the cores, each holding its own copy of the model
-
-
-def worker_count(text: str) -> int:
-    """A number of worker processes: 1 to WORKERS_PER_CORE x the machine's cores."""
-    most = WORKERS_PER_CORE * (os.cpu_count() or 1)
-    count = positive_count(text)
-    if count > most:
-        raise argparse.ArgumentTypeError(f"{text}: more than {most} ({WORKERS_PER_CORE} per core of this machine)")
-    return count
+__all__ = ["WORKERS_PER_CORE", "dask_address", "positive_count", "positive_number", "seed", "worker_count"]
 
 
 def add_budget_arguments(parser: argparse.ArgumentParser, many_runs: bool = True) -> None:
@@ -67,7 +56,7 @@ def add_resumable_arguments(parser: argparse.ArgumentParser, name: str, help: st
 def add_runner_arguments(parser: argparse.ArgumentParser, dask: bool = True) -> None:
     """Where a command's many runs go (studies.runtime.pools.select) and whether it shows progress."""
     if dask:
-        parser.add_argument("--dask", nargs="?", const="", metavar="ADDRESS",
+        parser.add_argument("--dask", nargs="?", const="", metavar="ADDRESS", type=dask_address,
                             help="run on a Dask cluster at ADDRESS, or on a LocalCluster when no address is given")
     parser.add_argument("--workers", type=worker_count, help="worker processes (default: all cores; 1: in this process)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -22,6 +22,7 @@ from ...models.evaluation.stability import SimulationFailed
 from ..api import save_result, simulate
 from ..display.catalogue import metric
 from ..figures.drill_animation import SOLUTION_FILE
+from ..inputs.arguments import choice_problem, cli_type
 from ..inputs.reading import load_scene
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import (
@@ -39,7 +40,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="scene YAML file")
     parser.add_argument("--out", required=True, help="output directory (new or empty)")
     parser.add_argument("--overwrite", action="store_true", help="write into --out although it holds other files")
-    parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
+    parser.add_argument("--formulation", type=cli_type(choice_problem(FORMULATIONS, "formulation")),
+                        metavar="{" + ",".join(FORMULATIONS) + "}",
                         help="run with this formulation (default: the scene's solver.formulation; the scene's "
                              "options of another formulation are dropped)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -52,26 +54,30 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite)
     scene = load_scene(args.scene)
-    try:
-        with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress, \
-                tempfile.TemporaryDirectory() as scratch:
-            solution = Path(scratch) / SOLUTION_FILE if args.animate else None
-            result = simulate(args.scene, args.formulation, progress, budget(args), solution_file=solution)
-            solution = solution.read_bytes() if solution is not None and solution.exists() else None
-    except SimulationFailed as err:
-        raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
-        print(f"{args.scene}: {err}", file=sys.stderr)
-        return 1
-    status, why = run_status(result.raw)
-    if status == "unsettled":  # (an unstable step was said as the run started: models.solvers.exudyn_model)
-        warnings.warn(why, UnsettledWarning, stacklevel=1)
-    with staged_directory(args.out) as stage:
-        save_result(result, stage, animate=args.animate)
-        if solution is not None:
-            (stage / SOLUTION_FILE).write_bytes(solution)
+    with tempfile.TemporaryDirectory() as scratch:  # the solution file, kept until the animation is drawn
+        try:
+            with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
+                solution = Path(scratch) / SOLUTION_FILE if args.animate else None
+                result = simulate(args.scene, args.formulation, progress, budget(args), solution_file=solution)
+                solution = solution if solution is not None and solution.exists() else None
+        except SimulationFailed as err:
+            raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
+            print(f"{args.scene}: {err}", file=sys.stderr)
+            return 1
+        status, why = run_status(result.raw, result.metrics)
+        if status not in ("ok", "unstable"):  # (an unstable step was said as the run started: models.solvers.exudyn_model)
+            warnings.warn(why, UnsettledWarning, stacklevel=1)
+        with staged_directory(args.out) as stage:
+            save_result(result, stage, animate=args.animate)
+            if solution is not None:
+                (stage / SOLUTION_FILE).write_bytes(solution.read_bytes())
     shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}"
                       for name, value in result.metrics.items() if name in HEADLINE)
-    print(f"{result.scene.name} ({result.formulation}): {shown}; wrote {args.out}")
+    info = result.raw.info
+    regime = "" if info.get("steady_state") != "periodic" else (
+        f", {info['regime']}" + (f" (|mu|max {info['floquet_max_abs']:.4g})" if info.get("period_blows") else
+                                 f": {info.get('steady_state_note', '')}"))
+    print(f"{result.scene.name} ({result.formulation}{regime}): {shown or 'no metrics asked for'}; wrote {args.out}")
     if solution is not None:
         print(f"Exudyn's viewer: python -c \"from rpdrill.studies.figures.drill_animation import view_solution; "
               f"view_solution('{args.out}')\"")

@@ -7,7 +7,8 @@ the budgets before any runs (studies.runtime.budgets). Several studies run on on
 run, each into DIR/<its file name without .yaml>: the workers go from one study's points to the
 next, a point whose scene equals another's runs once (the paper's impulse scan repeats the
 frequency scan at 220 kN), and a study's plots are drawn by the workers once its points are done.
-The exit status is 1 when some point failed. What DIR holds: FILES below.
+The exit status is 1 when some point failed, or no point of a study is usable (its status ok or
+unsettled: models.evaluation.run_status). What DIR holds: FILES below.
 """
 
 from __future__ import annotations
@@ -17,7 +18,9 @@ import sys
 from pathlib import Path
 
 from ...models.definition.formulations import FORMULATIONS
+from ...models.evaluation.run_status import STATUSES, USABLE
 from ..api import run_study_files
+from ..inputs.arguments import choice_problem, cli_type
 from ..runtime.resumable import Row
 from ..scan.study import Study
 from ..scan.study_optima import Record, optima_table
@@ -37,7 +40,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.epilog = FILES
     add_resumable_arguments(parser, "study", "study YAML file(s)", many=True)
-    parser.add_argument("--formulation", choices=tuple(FORMULATIONS),
+    parser.add_argument("--formulation", type=cli_type(choice_problem(FORMULATIONS, "formulation")),
+                        metavar="{" + ",".join(FORMULATIONS) + "}",
                         help="run every point with this formulation (default: the scene's solver.formulation)")
 
 
@@ -46,7 +50,7 @@ def report(study: Study, out: Path, rows: list[Row], optima: list[Record], writt
     """What a study wrote and its failed points (stderr), its optima table (stdout)."""
     failed = [row for row in rows if row["status"] == "failed"]
     flagged = [row for row in rows if row["status"] not in ("ok", "failed")]
-    kinds = ", ".join(f"{sum(r['status'] == kind for r in flagged)} {kind}" for kind in ("unstable", "unsettled")
+    kinds = ", ".join(f"{sum(r['status'] == kind for r in flagged)} {kind}" for kind in STATUSES[1:]
                       if any(r["status"] == kind for r in flagged))
     print(f"{study.spec.name}: {len(rows) - len(failed) - len(flagged)} points ok, {kinds + ', ' if kinds else ''}"
           f"{len(failed)} failed; wrote "
@@ -66,4 +70,8 @@ def run(args: argparse.Namespace) -> int:
                                workers=args.workers, dask=args.dask, quiet=args.quiet)
     for outcome in outcomes:
         report(*outcome)
-    return 1 if any(row["status"] == "failed" for outcome in outcomes for row in outcome[2]) else 0
+    useless = [outcome[0].source for outcome in outcomes if not any(r["status"] in USABLE for r in outcome[2])]
+    for source in useless:
+        print(f"{source}: no point gave figures that stand (status {' or '.join(USABLE)}); nothing to compare: "
+              "see the errors in results.csv", file=sys.stderr)
+    return 1 if useless or any(row["status"] == "failed" for outcome in outcomes for row in outcome[2]) else 0

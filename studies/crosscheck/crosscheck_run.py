@@ -8,9 +8,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ...models.definition.formulations import ODE_METHODS
 from ...models.definition.scene import Scene
 from ...models.evaluation.compare import compare_runs, verdict
 from ...models.evaluation.run_result import Result
+from ..inputs.arguments import check, choice_problem, count_problem, instance_problem, positive_problem
 from ..inputs.reading import prepare_scene, scene_and_source
 from ..runtime.budgets import DEFAULT_BUDGET, Budget
 from .crosscheck_windows import DEFAULT_STEP_S, comparison_table, window_scenes
@@ -44,7 +46,13 @@ def crosscheck(scene: Scene | str | Path, blows: int = 20, step_s: float = DEFAU
     """The Exudyn model (the scene's solver type at ``step_s``) against the ODE (``method`` at relative
     tolerance ``rtol``) over the first ``blows`` impact periods. InputError or BudgetError before
     anything runs; SimulationFailed when a run diverges."""
-    scene, source = scene_and_source(scene)
+    where = "rpdrill.crosscheck"
+    check(where, "blows", blows, count_problem)
+    check(where, "step_s", step_s, positive_problem)
+    check(where, "method", method, choice_problem(ODE_METHODS, "method"))
+    check(where, "rtol", rtol, positive_problem)
+    check(where, "budget", budget, instance_problem(Budget, "a rpdrill Budget or None", optional=True))
+    scene, source = scene_and_source(scene, where)
     windows = window_scenes(scene, blows, step_s, method, rtol, source)
     simulations = [prepare_scene(window, source) for window in windows]
     if budget is not None:

@@ -171,6 +171,10 @@ PARAMETERS: dict[str, Quantity] = {
     "impact.piston.energy_j": _q("blow energy", r"E_{blow}", "J"),
     "impact.piston.contact_stiffness_n_per_m": _q("piston contact stiffness", "k_c", "MN/m", 1e-6, "N/m"),
     "rock.law": _category("rock law"),
+    "rock.parameters": _category("rock law parameters"),  # each by its key: _own_parameter
+    "extensions.*.function": _category("{name} extension"),
+    "extensions.*.parameters": _category("{name} parameters"),  # each by its key: _own_parameter
+    "extensions.*.recorded": _category("{name} as recorded"),
     "rock.name": _category("rock"),
     "rock.stiffness_n_per_m": _q("rock stiffness", "k_n", "MN/m", 1e-6, "N/m"),
     "rock.damping_n_s_per_m": _q("rock damping", "c_n", "kN s/m", 1e-3, "N s/m"),
@@ -185,6 +189,7 @@ PARAMETERS: dict[str, Quantity] = {
     "rotation.speed_rpm": _q("rotation speed", "n", "rpm"),
     "solver.formulation": _category("formulation"),
     "solver.preset": _category("accuracy preset"),
+    "solver.steady_state": _category("steady state"),
     "solver.end_time_s": _q("end time", r"t_{end}", "s"),
     "solver.output_interval_s": _q("output interval", r"\Delta t_{out}", "ms", 1e3, "s"),
     "solver.type": _category("solver"),
@@ -242,10 +247,36 @@ def series(column: str) -> Quantity:
     return found
 
 
+# the SI unit of a key of one's own (an extension's or a rock law's parameter) by its name's ending, longest first
+UNIT_SUFFIXES = (("_n_s_per_m", "N s/m"), ("_n_m_per_rad", "N m/rad"), ("_n_per_m", "N/m"), ("_kg_m2", "kg m²"),
+                 ("_kg", "kg"), ("_m_per_s", "m/s"), ("_hz", "Hz"), ("_rpm", "rpm"), ("_pa", "Pa"), ("_j", "J"),
+                 ("_n", "N"), ("_m", "m"), ("_s", "s"))
+
+
+def _own_parameter(path: str) -> Quantity | None:
+    """A parameter of one's own (``extensions.NAME.parameters.KEY``, ``rock.parameters.KEY``): its key as its
+    name (and the extension's), SI units read off the key's ending (none: a number without a unit)."""
+    parts = path.split(".")
+    if len(parts) == 4 and parts[0] == "extensions" and parts[2] == "parameters":
+        owner = f" ({parts[1]})"
+    elif len(parts) == 3 and parts[:2] == ["rock", "parameters"]:
+        owner = " (rock)"
+    else:
+        return None
+    key = parts[-1]
+    unit = next((unit for suffix, unit in UNIT_SUFFIXES if key.endswith(suffix)), "-")
+    name = key.removesuffix(next((suffix for suffix, _ in UNIT_SUFFIXES if key.endswith(suffix)), ""))
+    return _q(name.replace("_", " ") + owner, "", unit, si_unit=unit)
+
+
 def parameter(path: str) -> Quantity:
-    """The entry of a dotted scene path ('drill_string.bodies.collar.mass_kg': 'collar mass')."""
+    """The entry of a dotted scene path ('drill_string.bodies.collar.mass_kg': 'collar mass'; a parameter of
+    one's own by its key, :func:`_own_parameter`)."""
     if path in PARAMETERS:
         return PARAMETERS[path]
+    own = _own_parameter(path)
+    if own is not None:
+        return own
     parts = path.split(".")
     for i, name in enumerate(parts):
         pattern = ".".join([*parts[:i], "*", *parts[i + 1:]])
@@ -270,13 +301,15 @@ def _shown(scene: Scene, path: str, varied: Collection[str], text: str = "{}") -
 
 
 def describe_scene(scene: Scene, varied: Collection[str] = ()) -> str:
-    """The scene, its rock, impact and feed in one line for a title, leaving out the ``varied`` paths:
-    'paper_base: rock sandstone (k_n 510 MN/m, F_th 210 kN), impact 220 kN half-sine of 1.6 ms at 65 Hz,
+    """The scene, its rock, impact, feed and extensions in one line for a title, leaving out the ``varied``
+    paths: 'paper_base: rock sandstone (k_n 510 MN/m, F_th 210 kN), impact 220 kN half-sine of 1.6 ms at 65 Hz,
     feed 75 kN'."""
     rock = scene.rock.completed()
     filled = scene.model_copy(update={"rock": rock})
     if "rock.name" in varied:
         rock_text = "rock varied"
+    elif rock.own_law:
+        rock_text = f"rock law {rock.law}"
     else:
         symbols = {"stiffness_n_per_m": "k_n", "threshold_n": "F_th", "loading_stiffness_n_per_m": "k_l",
                    "unloading_stiffness_n_per_m": "k_u"}
@@ -294,4 +327,6 @@ def describe_scene(scene: Scene, varied: Collection[str] = ()) -> str:
         impact = " ".join(["impact", *_shown(scene, "impact.amplitude_n", varied), scene.impact.shape.replace("_", "-"),
                            *_shown(scene, "impact.duration_s", varied, "of {}"),
                            *_shown(scene, "impact.frequency_hz", varied, "at {}")])
-    return f"{scene.name}: " + ", ".join([rock_text, impact, *_shown(scene, "feed.force_n", varied, "feed {}")])
+    extensions = [f"extension {name} ({extension.function})" for name, extension in (scene.extensions or {}).items()]
+    return f"{scene.name}: " + ", ".join([rock_text, impact, *_shown(scene, "feed.force_n", varied, "feed {}"),
+                                          *extensions])

@@ -10,25 +10,45 @@ power of ten). A ``.gif`` is written with Pillow; an ``.mp4`` needs ffmpeg (:fun
 :func:`view_solution` opens a run folder written by ``rpdrill simulate --animate`` (its
 ``scene.resolved.yaml`` and Exudyn's coordinates solution file ``solution.txt``) in
 ``exudyn.interactive.SolutionViewer``: the scene's Exudyn model is built again (the same items, with
-their graphics) and the stored coordinates are played on it. It needs a display.
+their graphics, its extensions applied) and the stored coordinates are played on it; or a model that
+ran with ``model.write_solution(path)``. It needs a display.
+
+A built Exudyn model (``rpdrill.build_exudyn``, items of one's own added) is animated from its own
+graphics (:func:`model_animation`, studies.figures.system_drawing) at the coordinates of its solution file.
 """
 
 from __future__ import annotations
 
 import math
 import shutil
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
+from matplotlib.animation import AbstractMovieWriter, FFMpegWriter, PillowWriter
+from matplotlib.figure import Figure
 
 from ...models.evaluation.results import SimulationResult
+from ...models.evaluation.run_result import Result
 from ...models.solvers.simulation import Simulation
-from ..inputs.reading import load_scene
+from ...models.steady.steady_run import run_scene
+from ..inputs.arguments import (
+    built_model_problem,
+    check,
+    count_problem,
+    either,
+    file_problem,
+    folder_problem,
+    instance_problem,
+    optional,
+    positive_problem,
+)
+from ..inputs.reading import InputError, load_scene
 from .drill_drawing import BODY_HEIGHT, draw_string, drawn_layout, figure_title
 from .figure_style import plt
+from .system_drawing import SystemPicture
 
 if TYPE_CHECKING:
     from ...models.solvers.exudyn_model import ExudynModel
@@ -54,9 +74,29 @@ def movie_writer(path: Path) -> PillowWriter | FFMpegWriter:
     return FFMpegWriter(fps=FRAMES_PER_SECOND)
 
 
-def write_animation(result: SimulationResult, path: str | Path, blows: int = 3,
+def save_frames(fig: Figure, frame: Callable[[int], None], count: int, path: Path, writer: AbstractMovieWriter) -> None:
+    """Write ``count`` frames of ``fig`` to ``path``, ``frame(k)`` drawing the k-th: each drawn once (a
+    FuncAnimation draws each frame twice when it saves)."""
+    with writer.saving(fig, str(path), fig.dpi):
+        for k in range(count):
+            frame(k)
+            writer.grab_frame()
+
+
+def write_animation(result: SimulationResult | Result | ExudynModel, path: str | Path, blows: int = 3,
                     magnification: float | None = None) -> float:
-    """Write the last ``blows`` blows of ``result`` to ``path`` (module doc); the magnification drawn."""
+    """Write the last ``blows`` blows of ``result`` (a run's raw result, or its rpdrill.Result) to ``path``
+    (module doc); the magnification drawn. A built Exudyn model is drawn from its own graphics, every item of
+    one's own included (:func:`model_animation`)."""
+    where = "rpdrill.write_animation"
+    result = result.raw if isinstance(result, Result) else result
+    check(where, "result", result, either(built_model_problem, instance_problem(
+        SimulationResult, "the Result of rpdrill.simulate or a built model (rpdrill.build_exudyn)")))
+    check(where, "path", path, file_problem)
+    check(where, "blows", blows, count_problem)
+    check(where, "magnification", magnification, optional(positive_problem))
+    if not isinstance(result, SimulationResult):
+        return model_animation(result, path, blows, magnification)
     path = Path(path)
     writer = movie_writer(path)
     scene, drawing = result.scene, drawn_layout(result.scene)
@@ -86,40 +126,115 @@ def write_animation(result: SimulationResult, path: str | Path, blows: int = 3,
                      f"{1e3 * (positions[k, result.chain.bit_body] - positions[0, result.chain.bit_body]):+.3f} mm, "
                      f"borehole bottom {1e3 * (bottom[k] - bottom[0]):+.3f} mm since the window's start", fontsize=9)
 
-    animation = FuncAnimation(fig, frame, frames=len(times))
-    animation.save(path, writer=writer)
+    save_frames(fig, frame, len(times), path, writer)
     plt.close(fig)
     return factor
 
 
 def run_with_solution(simulation: Simulation, progress: Callable[[float], None] | None = None,
                       solution: Path | None = None) -> SimulationResult:
-    """Run ``simulation``; with ``solution`` and the Exudyn formulation, write Exudyn's coordinates solution
+    """Run ``simulation`` as its scene asks (models.steady.steady_run.run_scene: a time run, or its steady
+    state); with ``solution``, a time run and the Exudyn formulation, write Exudyn's coordinates solution
     file there during the run (every output interval). The other formulations write none."""
-    if solution is None or simulation.settings.formulation != "exudyn":
-        return simulation.run(progress)
+    if solution is None or simulation.settings.formulation != "exudyn" \
+            or simulation.scene.solver.steady_state != "time":
+        return run_scene(simulation, progress=progress)
     from ...models.solvers.exudyn_model import build_exudyn
 
     model = build_exudyn(simulation)
     model.write_solution(solution)
-    return model.solve(progress)
+    result = model.solve(progress)
+    result.info["solution_file"] = str(solution)
+    return result
 
 
-def load_solution(run_dir: str | Path) -> tuple[ExudynModel, dict]:
-    """The run folder's scene rebuilt as an Exudyn model and its solution file as Exudyn reads it."""
+def load_solution(run: str | Path | ExudynModel) -> tuple[ExudynModel, dict]:
+    """A run's Exudyn model and its solution file as Exudyn reads it: a run folder's scene rebuilt (its
+    extensions applied) and its ``solution.txt``, or a model that ran with ``model.write_solution(path)``.
+    InputError when the solution does not fit the model (a run with items added in Python that its scene
+    does not name)."""
     from exudyn.utilities import LoadSolutionFile
 
     from ...models.solvers.exudyn_model import build_exudyn
 
-    run_dir = Path(run_dir)
-    model = build_exudyn(load_scene(run_dir / RESOLVED_SCENE))
-    return model, LoadSolutionFile(str(run_dir / SOLUTION_FILE), verbose=False)
+    if isinstance(run, (str, Path)):
+        check("rpdrill.view_solution", "run", run, folder_problem)
+        source, model = Path(run) / SOLUTION_FILE, build_exudyn(load_scene(Path(run) / RESOLVED_SCENE))
+    elif built_model_problem(run) is not None:
+        check("rpdrill.view_solution", "run", run, built_model_problem)
+    elif run.solution_path is None:
+        raise InputError("the model wrote no solution file: call model.write_solution(path) before model.run()")
+    else:
+        source, model = run.solution_path, run
+    solution = LoadSolutionFile(str(source), verbose=False)
+    stored, built = solution["columnsExported"][0], model.coordinate_count
+    if stored != built:
+        raise InputError(f"{source}: {stored} coordinates, but the model built from its scene has {built}: the run "
+                         "had items added in Python that the scene does not name; give them as an extension "
+                         "(docs/extending.md) or pass the model that ran: view_solution(model)")
+    return model, solution
 
 
-def view_solution(run_dir: str | Path) -> None:
-    """Play a run folder's ``solution.txt`` on its scene's Exudyn model in Exudyn's SolutionViewer (module doc;
-    it needs a display: without one Exudyn's renderer aborts the process)."""
+def view_solution(run: str | Path | ExudynModel) -> None:
+    """Play a run folder's ``solution.txt`` on its scene's Exudyn model (its extensions applied), or a model's
+    own solution file, in Exudyn's SolutionViewer (module doc; it needs a display: without one Exudyn's
+    renderer aborts the process)."""
     import exudyn.interactive
 
-    model, solution = load_solution(run_dir)
+    model, solution = load_solution(run)
     exudyn.interactive.SolutionViewer(model.mbs, solution)
+
+
+def model_animation(model: ExudynModel, path: str | Path, blows: int = 3, magnification: float | None = None) -> float:
+    """The last ``blows`` blows of a built model drawn from its own graphics (studies.figures.system_drawing)
+    at the coordinates of its solution file (``model.write_solution``), displacements magnified; a model that
+    has not run and has no solution file is run first, writing one into a scratch folder. The magnification
+    drawn."""
+    path = Path(path)
+    writer = movie_writer(path)
+    if model.solution_path is not None and model.solution_path.exists():
+        _, solution = load_solution(model)
+    elif model.has_run:
+        raise InputError("the model ran without a solution file: call model.write_solution(path) before model.run()")
+    else:
+        with tempfile.TemporaryDirectory(prefix="rpdrill-animation-") as scratch:
+            model.write_solution(Path(scratch) / SOLUTION_FILE)
+            model.run()
+            _, solution = load_solution(model)
+            model.solution_path = None  # the scratch folder goes
+    data = solution["data"]
+    period = model.simulation.impact.period_s
+    end = data[-1, 0]
+    start = max(data[0, 0], end - blows * period)
+    rows = np.unique(np.searchsorted(data[:, 0], np.linspace(start, end, max(2, round((end - start) / period *
+                                                                                  FRAMES_PER_BLOW)))).clip(0, len(data) - 1))
+    coordinates = data[rows, 1:1 + model.coordinate_count]
+    moved = coordinates - coordinates[0]
+    own = model.built_items["objects"]
+    names = {int(body.object): name for name, body in model.bodies.items()}
+    fig, ax = plt.subplots(figsize=(14, 3.6), layout="constrained")
+    picture = SystemPicture(ax, model.mbs, own, names)
+    points, _ = picture.show(coordinates[0])
+    shapes = model.graphics.layout
+    low = shapes.cylinders[model.chain.impact_body].start_m
+    low, high = low - 0.15 * (shapes.rock_face_m - low), shapes.rock_face_m + 0.15 * (shapes.rock_face_m - low)
+    half = 1.5 * max(max(c.diameter_m for c in shapes.cylinders), float(np.max(np.abs(points[:, 1]))))
+    reach = max(float(np.max(np.abs(moved))), 1e-12)
+    factor = magnification or nice_factor(0.02 * (high - low) / reach)
+
+    ax.set_xlim(low, high)
+    ax.set_ylim(-half, half)
+    ax.set_xlabel("x along the drilling axis (m)")
+
+    def frame(k: int) -> None:
+        picture.show(coordinates[0] + factor * moved[k])
+        ax.set_title(f"{model.simulation.name}: the Exudyn system from its graphics, the last {blows} blows, "
+                     f"displacements magnified x {factor:g}\nt = {data[rows[k], 0]:.4f} s "
+                     f"(blow {data[rows[k], 0] / period:.2f}); items of one's own in this colour", fontsize=9)
+
+    frame(0)
+    fig.canvas.draw()
+    fig.set_layout_engine("none")  # laid out once: every frame is drawn as the first (a layout per frame costs)
+    save_frames(fig, frame, len(rows), path, writer)
+    plt.close(fig)
+    return factor

@@ -10,13 +10,16 @@ they join (schematic length): a spring above the axis, a dashpot below when damp
 two open flanges with its gap; a connector from ground ends on a hatched wall. The rock is a
 hatched block at the rock face; the feed and the piston's impact are arrows on the bodies they act on.
 :func:`draw` writes the drawing (``.png`` or ``.svg`` by the suffix); :func:`drawn_layout` is where
-every body is drawn (the animation, studies.figures.drill_animation, moves them from there).
+every body is drawn (the animation, studies.figures.drill_animation, moves them from there). A built
+Exudyn model, or a scene with extensions, is drawn from the system's own graphics instead, every item of
+one's own included (studies.figures.system_drawing).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -26,7 +29,12 @@ from ...models.definition.drill_string import EVERY_BODY, GROUND
 from ...models.definition.links import Link
 from ...models.definition.scene import Scene
 from ...models.drill.shapes import DEFAULT_DIAMETER_M, Layout, axial_order, layout
+from ..inputs.arguments import built_model_problem, check, either, file_problem, instance_problem
 from .figure_style import OKABE_ITO, plt
+from .system_drawing import draw_model
+
+if TYPE_CHECKING:
+    from ...models.solvers.exudyn_model import ExudynModel
 
 BREAK_SHARE = 0.35  # the most of the drawing's length one body takes; longer ones are drawn shortened
 MIN_SHORTENING = 1.5  # a body is shortened by this factor at least, or drawn to scale
@@ -289,6 +297,8 @@ def _impact_text(scene: Scene) -> str:
 
 def _rock_text(scene: Scene) -> str:
     rock = scene.rock.completed()
+    if rock.own_law:
+        return f"law {rock.law.partition(':')[2]}"
     if rock.law == "bilinear":
         return (f"k_l {_number(rock.loading_stiffness_n_per_m / 1e6)} MN/m\n"
                 f"k_u {_number(rock.unloading_stiffness_n_per_m / 1e6)} MN/m")
@@ -306,9 +316,18 @@ def figure_title(scene: Scene, drawing: DrawnLayout) -> str:
     return "\n".join(parts)
 
 
-def draw(scene: Scene, path: str | Path) -> Path:
-    """Write the drawing of ``scene``'s drill string to ``path`` (PNG or SVG by its suffix; module doc)."""
+def draw(scene: Scene | ExudynModel, path: str | Path) -> Path:
+    """Write the drawing of ``scene``'s drill string to ``path`` (PNG or SVG by its suffix; module doc). A built
+    Exudyn model (``rpdrill.build_exudyn``), or a scene with extensions (drawn as its built model), is drawn
+    from the system's own graphics with every item of one's own (studies.figures.system_drawing)."""
+    check("rpdrill.draw", "scene", scene, either(built_model_problem, instance_problem(
+        Scene, "a rpdrill.Scene (rpdrill.load_scene) or a built model (rpdrill.build_exudyn)")))
+    check("rpdrill.draw", "path", path, file_problem)
     path = Path(path)
+    if not isinstance(scene, Scene) or scene.extensions:
+        from ...models.solvers.exudyn_model import build_exudyn  # Exudyn only for a model
+
+        return draw_model(build_exudyn(scene) if isinstance(scene, Scene) else scene, path)
     drawing = drawn_layout(scene)
     width = drawing.rock_face + 2.5 * drawing.gap - drawing.start
     fig, ax = plt.subplots(figsize=(14, 4.6), layout="constrained")

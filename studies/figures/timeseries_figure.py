@@ -17,10 +17,13 @@ ZOOM_BLOWS = 3
 
 
 def plot_timeseries(columns: dict[str, np.ndarray], scene: Scene, path: Path) -> list[Path]:
-    """Bit velocity, borehole bottom x_n, rock force and impact force (those recorded) against time:
-    the whole run (left) and its last ZOOM_BLOWS impact periods (right). The files written."""
+    """Bit velocity, borehole bottom x_n, rock force and impact force (those recorded) and the histories
+    the scene's outputs ask for besides (a piston's contact force) against time: the whole run (left) and
+    its last ZOOM_BLOWS impact periods (right). The files written."""
     t = columns["time_s"]
-    panels = [name for name in PANELS if name in columns]
+    asked = scene.outputs.timeseries if scene.outputs is not None else []
+    panels = [name for name in (*PANELS, *asked) if name in columns]
+    panels = list(dict.fromkeys(panels)) or [next(name for name in columns if name != "time_s")]
     zoom = t >= t[-1] - ZOOM_BLOWS * scene.impact.period_s
     time = series("time_s")
     fig, axes = plt.subplots(len(panels), 2, sharex="col", figsize=(11, 2 * len(panels) + 0.8), squeeze=False,

@@ -25,6 +25,7 @@ from ...models.drill.indexing import Indexing
 from ..display.catalogue import metric
 from ..figures.rotation_map import draw_rotation_map
 from ..inputs.reading import InputError
+from ..runtime.output_files import write_atomic
 
 RATE, ADVANCE = "penetration_rate_m_per_s", "advance_per_blow_m"
 SPEED, FREQUENCY, ROCK = "rotation.speed_rpm", "impact.frequency_hz", "rock.name"
@@ -44,7 +45,8 @@ def manual_speed_rpm(bit: Bit, frequency_hz: float) -> float:
 
 def _rows(results: Path) -> list[dict[str, str]]:
     with results.open(newline="") as handle:
-        return [row for row in csv.DictReader(handle) if row["status"] != "failed"]  # (unsettled: models.evaluation.run_status)
+        # (unsettled rows have their values; a metric that is not a finite number is empty: models.evaluation.run_status)
+        return [row for row in csv.DictReader(handle) if row["status"] != "failed" and row[RATE] != ""]
 
 
 def _study(run: Path) -> dict:
@@ -205,5 +207,5 @@ def write_report(runs: Path, out: Path, rock: str, made_by: str) -> list[Path]:
     draw_rotation_map(rows, figure, f"{rock}: {metric(RATE).label()}",
                       lambda f: Indexing(bit, None, f).best_speed_rpm(), lambda f: manual_speed_rpm(bit, f), DRILLED)
     note = out / "rotation.md"
-    note.write_text(render(runs, figure, rock, made_by), encoding="utf-8")
+    write_atomic(note, render(runs, figure, rock, made_by))
     return [note, figure, figure.with_suffix(".svg")]

@@ -12,12 +12,11 @@ starts afresh). A line cut by a kill is dropped.
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 from typing import Any, TextIO
 
 from ...models.definition.validation import InputError
-from .output_files import write_json
+from .output_files import json_text, write_atomic, write_json
 from .resumable import checked_record
 
 Record = dict[str, Any]
@@ -30,6 +29,10 @@ def unit_key(unit: Any) -> tuple[float, ...]:
     return tuple(float(u) for u in unit)
 
 
+def _not_json(constant: str) -> None:
+    raise json.JSONDecodeError(f"{constant} is not JSON", constant, 0)
+
+
 def _complete_records(path: Path) -> list[Record]:
     """The records of whole lines (a last line cut by a kill is left out); InputError naming the file
     and line when a whole line is not a record."""
@@ -39,8 +42,8 @@ def _complete_records(path: Path) -> list[Record]:
     except UnicodeDecodeError:
         raise InputError(f"--out: {path}: not evaluations rpdrill wrote (not UTF-8 text)") from None
     for number, line in enumerate(lines, 1):
-        try:
-            records.append(json.loads(line))
+        try:  # (rpdrill writes null for a number that is not finite: a NaN or Infinity was edited in)
+            records.append(json.loads(line, parse_constant=_not_json))
         except json.JSONDecodeError:
             if line.endswith("\n"):
                 raise InputError(f"--out: {path}: line {number} is not an evaluation rpdrill wrote") from None
@@ -56,9 +59,7 @@ class EvaluationLog:
         self.checkpoint, resumed = self._checkpoint(identity, source, overwrite)
         path = out / EVALUATIONS
         self.records = _complete_records(path) if resumed else []
-        temporary = path.with_suffix(".jsonl.tmp")
-        temporary.write_text("".join(json.dumps(r) + "\n" for r in self.records), encoding="utf-8")
-        os.replace(temporary, path)
+        write_atomic(path, "".join(json_text(r) + "\n" for r in self.records))
         self._handle: TextIO = path.open("a", encoding="utf-8")
 
     def _checkpoint(self, identity: dict[str, Any], source: Path, overwrite: bool) -> tuple[dict[str, Any], bool]:
@@ -71,7 +72,7 @@ class EvaluationLog:
 
     def append(self, record: Record) -> None:
         """Record an evaluation now (one line, flushed)."""
-        self._handle.write(json.dumps(record) + "\n")
+        self._handle.write(json_text(record) + "\n")
         self._handle.flush()
         self.records.append(record)
 

@@ -16,8 +16,10 @@ from pydantic import ValidationError
 from ...models.definition.scene import Scene
 from ...models.definition.validation import problem, short
 from ...models.evaluation.metrics import summary_metrics
+from ...models.evaluation.results import SimulationResult
 from ...models.evaluation.run_status import run_status
 from ...models.solvers.simulation import Simulation
+from ...models.steady.steady_run import OrbitGuess, regime_columns, run_scene
 from ..inputs.reading import InputError, prepare_scene
 
 
@@ -52,18 +54,29 @@ def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]
     return prepare_scene(validated, source, _point(parameters))
 
 
-def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
-    """Worker: run one prepared point ``(key, simulation)`` and collect its outputs' metrics and its
-    status (models.evaluation.run_status: ok, unstable or unsettled, the reason in ``error``); a failure is
-    returned, not raised."""
-    key, simulation = task
+def run_prepared(key: Any, simulation: Simulation, guess: OrbitGuess | None = None, cold_newton: bool = True
+                 ) -> tuple[dict[str, Any], SimulationResult | None]:
+    """Run one prepared point as its scene asks (models.steady.steady_run.run_scene: a time run, or its
+    steady state from ``guess``, a neighbour's orbit) and collect its outputs' metrics, its status
+    (models.evaluation.run_status: ok, unstable, unsettled, not_finite or unbalanced, the reason in
+    ``error``) and its steady-state
+    columns (regime, period_blows, floquet_max_abs); a failure is returned, not raised. The outcome and
+    the run (None if it failed). ``cold_newton``: models.steady.steady_run.run_scene."""
     start = time.perf_counter()
     try:
-        result = simulation.run()
+        result = run_scene(simulation, guess, cold_newton=cold_newton)
         metrics = summary_metrics(result)
-        status, why = run_status(result)
+        status, why = run_status(result, metrics)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
         return {"point": key, "status": "failed", "error": f"{type(err).__name__}: {err}",
-                "wall_time_s": time.perf_counter() - start, "metrics": {}}
+                "wall_time_s": time.perf_counter() - start, "metrics": {}, **regime_columns(None),
+                "steady_state": simulation.scene.solver.steady_state}, None
+    if result.info.get("steady_state_note") and status == "ok":
+        why = result.info["steady_state_note"]
     return {"point": key, "status": status, "error": why, "wall_time_s": time.perf_counter() - start,
-            "metrics": metrics}
+            "metrics": metrics, **regime_columns(result)}, result
+
+
+def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
+    """Worker: run one prepared point ``(key, simulation)`` (:func:`run_prepared`)."""
+    return run_prepared(*task)[0]

@@ -24,6 +24,8 @@ import contextlib
 import itertools
 import logging
 import os
+import signal
+import sys
 import threading
 import warnings
 from collections.abc import Callable, Iterator, Sequence
@@ -33,6 +35,8 @@ from typing import Any, TypeVar
 
 from threadpoolctl import threadpool_limits
 
+from ..inputs.arguments import dask_unreachable
+from ..inputs.reading import InputError
 from .interrupts import WorkerLost, raise_if_stopped, worker_ends_with_its_command
 
 Arg = TypeVar("Arg")
@@ -42,6 +46,8 @@ Caught = list[tuple[str, type[Warning], str, int]]
 
 # Child processes a Dask LocalCluster starts: one BLAS thread each (set before they load NumPy).
 ONE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+DASK_CLOSE_S = 1  # a LocalCluster and its client close within this (after a stop: its workers ended first)
+DASK_ANSWER_S = 10  # a scheduler that accepts the connection answers within this (Dask's default: 30 s)
 BATCHES_PER_WORKER = 4  # enough to even out unequal points; few enough that a batch costs ~nothing to send
 
 def batches(arguments: Sequence[Arg], workers: int) -> list[list[Arg]]:
@@ -187,20 +193,36 @@ def _terminate_workers(executor: ProcessPoolExecutor) -> None:
 
 
 @contextlib.contextmanager
-def dask_pool(address: str | None = None, workers: int | None = None) -> Iterator[Runner[Any, Any]]:
+def dask_pool(address: str | None = None, workers: int | None = None, option: str = "--dask") -> Iterator[Runner[Any, Any]]:
     """A runner bound to one Dask client, kept for many calls: a cluster at ``address``
-    (``tcp://host:8786``), or a LocalCluster of single-thread workers."""
+    (``tcp://host:8786``), or a LocalCluster of single-thread workers. InputError naming ``option``
+    when no scheduler answers at ``address`` (studies.inputs.arguments.dask_unreachable: at once when the
+    connection is refused, after DASK_CONNECT_S when it is not answered; DASK_ANSWER_S for the
+    scheduler's own answer)."""
     from dask.distributed import Client, LocalCluster
     from dask.distributed import as_completed as dask_completed
 
     with contextlib.ExitStack() as stack:
         if address:
-            client = stack.enter_context(Client(address))
+            why = dask_unreachable(address)
+            if why is None:
+                try:
+                    client = stack.enter_context(Client(address, timeout=DASK_ANSWER_S))
+                except (OSError, TimeoutError) as error:
+                    why = f"{address}: no Dask scheduler answers there ({error}); start one (dask scheduler) or give " \
+                          "its address"
+            if why is not None:
+                raise InputError(f"{option}: {why}")
         else:
-            cluster = stack.enter_context(LocalCluster(
-                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                dashboard_address=":0", silence_logs=logging.ERROR, env=ONE_THREAD))
-            client = stack.enter_context(Client(cluster))
+            import dask
+
+            _forkserver_without_interrupts()
+            with dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"}):
+                cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                                       dashboard_address=":0", silence_logs=logging.ERROR, env=ONE_THREAD)
+            stack.callback(_close_cluster, cluster)
+            client = Client(cluster)
+            stack.callback(client.close, DASK_CLOSE_S)
         slots = sum(client.nthreads().values()) or 1
         registry: dict[Any, Any] = {}
 
@@ -211,12 +233,45 @@ def dask_pool(address: str | None = None, workers: int | None = None) -> Iterato
         yield run
 
 
+def _forkserver_without_interrupts() -> None:
+    """Start multiprocessing's fork server (if not running) ignoring Ctrl-C, so that the processes it forks
+    (a LocalCluster's workers) ignore it from their first instruction: a Ctrl-C of the whole process group
+    then reaches the command's process only, which ends them (no worker prints a traceback). The
+    disposition is inherited only as 'ignored' (a handler is reset by exec), so this process ignores
+    Ctrl-C while the server starts (milliseconds) and takes it again after. The resource tracker it starts
+    (a process that cleans up the workers' semaphores) says nothing of those a stop leaves it to clean
+    up: its warning filter, given to it as -W, ignores that one warning."""
+    import multiprocessing.forkserver
+
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    quiet_tracker = "ignore:resource_tracker:UserWarning"
+    sys.warnoptions.append(quiet_tracker)
+    try:
+        multiprocessing.forkserver.ensure_running()
+    finally:
+        sys.warnoptions.remove(quiet_tracker)
+        signal.signal(signal.SIGINT, previous)
+
+
+def _close_cluster(cluster: Any) -> None:
+    """Close a LocalCluster: at once after a stop (its worker processes ended first: what they run is
+    not waited for), within DASK_CLOSE_S otherwise."""
+    if sys.exc_info()[0] is not None:  # a stop or an error is on its way out
+        for nanny in list(getattr(cluster, "workers", {}).values()):
+            process = getattr(getattr(nanny, "process", None), "process", None)
+            with contextlib.suppress(Exception):
+                process.terminate()
+    with contextlib.suppress(Exception):
+        cluster.close(timeout=DASK_CLOSE_S)
+
+
 @contextlib.contextmanager
-def pool(dask_address: str | None, workers: int | None) -> Iterator[tuple[str, Runner[Any, Any]]]:
+def pool(dask_address: str | None, workers: int | None, option: str = "--dask") -> Iterator[tuple[str, Runner[Any, Any]]]:
     """A runner kept for many calls, for the command line options: its description and the callable
-    (``--workers 1``: in this process; ``--dask [ADDRESS]``: Dask; otherwise a process pool)."""
+    (``--workers 1``: in this process; ``--dask [ADDRESS]``: Dask; otherwise a process pool);
+    ``option`` names the Dask address in a message (:func:`dask_pool`)."""
     if dask_address is not None:
-        with dask_pool(dask_address or None, workers) as run:
+        with dask_pool(dask_address or None, workers, option) as run:
             yield f"dask ({dask_address or 'LocalCluster'})", run
     elif workers == 1:
         yield "sequential", sequential

@@ -21,7 +21,7 @@ import csv
 import importlib.metadata
 import io
 import json
-import os
+import math
 import sys
 import time
 import warnings
@@ -33,16 +33,17 @@ from typing import Any, Protocol
 
 from tqdm import tqdm
 
+from ...models.evaluation.run_status import STATUSES
 from ..inputs.reading import InputError, short
 from .budgets import duration
 from .interrupts import raise_if_stopped
-from .output_files import write_json
+from .output_files import atomic_file, write_json
 from .pools import Runner
 
-STATUS_COLUMNS = ("status", "error", "wall_time_s")
-# a finished point's status: ok; failed (its error says why); unstable or unsettled (metrics written,
-# but the stability check flags the run, or its blocks have not settled: models.evaluation.metrics)
-FINISHED = ("ok", "failed", "unstable", "unsettled")
+STATUS_COLUMNS = ("status", "error", "steady_state", "regime", "wall_time_s", "period_blows", "floquet_max_abs")
+# a finished point's status: ok; failed (its error says why); unstable, unsettled, not_finite or
+# unbalanced (metrics written, but the run's figures do not stand as they are: models.evaluation.run_status)
+FINISHED = ("failed", *STATUSES)
 RECORD = "study.json"
 Row = dict[str, str]
 
@@ -104,22 +105,39 @@ def provenance(study: ResumableStudy, out: Path, table: str) -> dict[str, Any]:
     fresh = {"study": study.spec.name, "study_file": str(study.source), "hash": study.hash,
              "rpdrill_version": importlib.metadata.version("rpdrill"),
              "exudyn_version": importlib.metadata.version("exudyn"),
-             "points": len(study.points), "resolved_study": study.resolved(), "sessions": [], "point_wall_time_s": {}}
+             "points": len(study.points), "resolved_study": study.resolved(), "sessions": [], "point_wall_time_s": {},
+             **code_records(study.points)}
     return checked_record(out / RECORD, fresh, study.source, [out / table])
 
 
-def _is_number(text: str) -> bool:
+def code_records(points: Sequence[Any]) -> dict[str, Any]:
+    """The code of one's own the points import (models.solvers.simulation.Simulation.code_records): every
+    extension by name (import path, package and version where it has one, file) and a rock law of one's own,
+    over all points (their parameters left out: the results table holds the scanned ones)."""
+    records: dict[str, Any] = {}
+    for point in points:
+        simulation = getattr(point, "simulation", None)
+        for kind, found in ({} if simulation is None else simulation.code_records()).items():
+            if kind == "extensions":
+                records.setdefault(kind, {}).update({name: {key: value for key, value in record.items()
+                                                            if key != "parameters"} for name, record in found.items()})
+            else:
+                records.setdefault(kind, found)
+    return records
+
+
+def _is_finite(text: str) -> bool:
     try:
-        float(text)
+        return math.isfinite(float(text))
     except ValueError:
         return False
-    return True
 
 
 def damage(row: Row, columns: list[str], points: Sequence[TablePoint]) -> str | None:
     """Why a finished row of a table is not one rpdrill wrote for its point (None: it is): its columns,
     status and point index; its parameters those of the point; its wall time and every column after it
-    (the metrics) a number, or empty."""
+    (the metrics) a finite number, or empty (rpdrill writes a metric that is not a finite number as empty:
+    an edited 'inf' is damage)."""
     if list(row) != columns or None in row.values():
         return "not the table's columns"
     if not row["point"].isdigit() or int(row["point"]) >= len(points):
@@ -131,8 +149,8 @@ def damage(row: Row, columns: list[str], points: Sequence[TablePoint]) -> str | 
         if name in point.parameters and row[name] != str(point.parameters[name]):
             return f"{name} {short(row[name])}: the point's is {short(point.parameters[name])}"
     numeric = columns[columns.index("wall_time_s"):] if "wall_time_s" in columns else []
-    bad = next((name for name in numeric if row[name] != "" and not _is_number(row[name])), None)
-    return None if bad is None else f"{bad} {short(row[bad])}: not a number"
+    bad = next((name for name in numeric if row[name] != "" and not _is_finite(row[name])), None)
+    return None if bad is None else f"{bad} {short(row[bad])}: not a finite number"
 
 
 def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint]) -> dict[int, Row]:
@@ -149,19 +167,18 @@ def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint]) 
                 rows.setdefault(int(row["point"]), row)
             else:
                 damaged.append(f"line {line}: {why}")
-    except (UnicodeDecodeError, csv.Error) as error:
-        raise InputError(f"--out: {path}: not a results table rpdrill wrote ({error}); use a new --out directory") \
+    except (UnicodeDecodeError, csv.Error, OSError) as error:
+        why = error.strerror if isinstance(error, OSError) and error.strerror else error
+        raise InputError(f"--out: {path}: not a results table rpdrill wrote ({why}); use a new --out directory") \
             from None
     if damaged:
         more = f" and {len(damaged) - 3} more" if len(damaged) > 3 else ""
         warnings.warn(f"{path}: {len(damaged)} row(s) damaged or edited, dropped and their points run again "
                       f"({'; '.join(damaged[:3])}{more})", stacklevel=2)
-    temporary = path.with_suffix(".csv.tmp")
-    with temporary.open("w", newline="", encoding="utf-8") as handle:
+    with atomic_file(path) as handle:
         writer = csv.DictWriter(handle, columns)
         writer.writeheader()
         writer.writerows(rows[i] for i in sorted(rows))
-    os.replace(temporary, path)
     return rows
 
 
@@ -171,9 +188,20 @@ def read_rows(path: Path) -> list[Row]:
 
 
 def result_row(point: TablePoint, outcome: dict[str, Any]) -> dict[str, Any]:
-    """A table row: the point, its parameters, status, error, wall time and the outcome's metrics."""
+    """A table row: the point, its parameters, status, error, wall time and the outcome's metrics (empty
+    where not a finite number: its status says so, models.evaluation.run_status)."""
     return {"point": point.index, **point.parameters, "status": outcome["status"], "error": outcome["error"],
-            "wall_time_s": f"{outcome['wall_time_s']:.4g}", **outcome["metrics"]}
+            "steady_state": outcome.get("steady_state", ""), "regime": outcome.get("regime", ""),
+            "wall_time_s": f"{outcome['wall_time_s']:.4g}", "period_blows": cell(outcome.get("period_blows")),
+            "floquet_max_abs": cell(outcome.get("floquet_max_abs")), **{k: cell(v) for k, v in outcome["metrics"].items()}}
+
+
+def cell(value: Any) -> Any:
+    """A table's cell of a value: empty where it is not a finite number (NaN, infinite; also as text)."""
+    try:
+        return value if math.isfinite(float(value)) else ""
+    except (TypeError, ValueError):
+        return value
 
 
 @dataclass

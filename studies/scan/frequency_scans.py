@@ -11,7 +11,6 @@ optima must follow (the paper's 3.1 b: the optimum rises with the impulse).
 
 from __future__ import annotations
 
-import copy
 import itertools
 import json
 import math
@@ -22,9 +21,10 @@ from typing import Any
 from pydantic import Field
 
 from ...models.drill.modal import rock_mode_frequency_hz
+from ...models.steady.continuation import Continuation, branch_point
 from ..inputs.reading import InputError
-from ..inputs.specs import MetricName, StrictSpec, set_path
-from ..runtime.point_runs import prepare_point, run_point
+from ..inputs.specs import MetricName, StrictSpec
+from ..runtime.point_runs import prepare_point, run_prepared
 from ..runtime.pools import Runner
 from .curve_optima import curve_optimum
 
@@ -44,9 +44,10 @@ class Scan(StrictSpec):
 
 
 def set_frequency(scene: dict[str, Any], frequency_hz: float) -> dict[str, Any]:
-    point = copy.deepcopy(scene)
-    set_path(point, FREQUENCY, frequency_hz)
-    return point
+    """``scene`` at ``frequency_hz``: a new mapping and ``impact`` section, the other sections shared with
+    ``scene`` (nothing changes them: a point is validated into a new Scene), so that a scan of many points
+    does not copy the whole scene for each."""
+    return {**scene, "impact": {**scene.get("impact", {}), FREQUENCY.split(".")[1]: frequency_hz}}
 
 
 def scan_scene(scene: dict[str, Any], frequency_hz: float, metrics: Sequence[str]) -> dict[str, Any]:
@@ -62,6 +63,7 @@ def scan_target(task: ScanTask) -> dict[str, Any]:
     start = time.process_time()
     values: dict[str, list[float]] = {metric: [] for metric in metrics}
     errors, resonance = [], None
+    branch = Continuation()  # solver.steady_state periodic: each orbit from its neighbours' (models.steady)
     for frequency in frequencies:
         try:
             simulation = prepare_point("frequency scan", scan_scene(scene, frequency, metrics), {})
@@ -69,7 +71,9 @@ def scan_target(task: ScanTask) -> dict[str, Any]:
             outcome = {"status": "failed", "error": str(error), "metrics": {}}
         else:
             resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock) or None
-            outcome = run_point((key, simulation))
+            outcome, result = run_prepared(key, simulation, branch.guess(frequency), branch.cold_newton)
+            if result is not None:
+                branch.add(branch_point(frequency, result.info, math.nan))
         for metric in metrics:
             values[metric].append(outcome["metrics"].get(metric, math.nan))
         if outcome["status"] == "failed":  # (an unsettled or unstable run has its values: models.evaluation.run_status)

@@ -41,9 +41,11 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
+from ...models.definition.formulations import FORMULATIONS
 from ...models.definition.scene import Scene, switch_formulation
 from ...models.definition.validation import short
 from ...models.solvers.simulation import Simulation
+from ..inputs.arguments import check, choice_problem, file_problem, instance_problem, optional
 from ..inputs.reading import InputError, parse, read_yaml
 from ..inputs.specs import (
     METRIC_NAMES,
@@ -95,6 +97,10 @@ class StudySpec(SceneSpec):
     metrics: list[MetricName] = Field(list(METRIC_NAMES), min_length=1)
     plots: list[Plot] = Field(default_factory=list)
     format: Literal["png", "svg", "pdf"] = "png"  # an SVG is written beside a PNG or PDF
+    # continuation: every point's periodic orbit (solver.steady_state periodic) followed along one scan axis
+    # from both ends (studies.scan.continuation_runs); continuation_axis default: the first scan axis
+    steady_state: Literal["continuation"] | None = None
+    continuation_axis: str | None = None
 
 
 @dataclass(frozen=True)
@@ -123,6 +129,11 @@ class Study:
         data = self.spec.model_dump(mode="json", by_alias=True)
         data.update(base_scene=Scene.model_validate(self.base).model_dump(mode="json", by_alias=True), scan=self.axes)
         return data
+
+    @property
+    def continuation_axis(self) -> str:
+        """The axis a continuation study follows (``continuation_axis``, else the first scan axis)."""
+        return self.spec.continuation_axis or next(iter(self.spec.scan))
 
     def zipped_with(self, axis: str) -> list[str]:
         """The scan axes that change together with ``axis`` (its ``combine`` group, itself included)."""
@@ -194,6 +205,9 @@ def load_study(path: str | Path, formulation: str | None = None, budget: Budget 
     """Read, validate and expand a study file, every point with ``formulation`` when given (the base
     scene's solver options of another formulation dropped) and checked against the ``budget`` before it
     runs; InputError naming the file and key path, BudgetError naming the cost, otherwise."""
+    check("rpdrill.load_study", "path", path, file_problem)
+    check("rpdrill.load_study", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
+    check("rpdrill.load_study", "budget", budget, instance_problem(Budget, "a rpdrill Budget"))
     path = Path(path)
     source = str(path)
     spec = parse(StudySpec, read_yaml(path), source)
@@ -202,6 +216,11 @@ def load_study(path: str | Path, formulation: str | None = None, budget: Budget 
         base["solver"] = switch_formulation(base.get("solver", {}), formulation)
     for axis in spec.scan:
         check_scene_path(source, "scan", axis, base, value_only=True)
+    if spec.continuation_axis is not None and spec.steady_state != "continuation":
+        raise InputError(f"{source}: continuation_axis: {spec.continuation_axis!r}: only with steady_state: continuation")
+    if spec.steady_state == "continuation":
+        _check_continuation(spec, source)
+        base["solver"] = {**base.get("solver", {}), "steady_state": "periodic"}
     _check_rock_name_axis(spec, base, source)
     groups = _groups(spec, source)
     count = _point_count(groups, spec, source)
@@ -228,6 +247,16 @@ def load_study(path: str | Path, formulation: str | None = None, budget: Budget 
     _check_plots(spec, axes, source)
     budget.check_total(source, what, count, sum(p.cpu_s for p in points))
     return Study(path, spec, base, axes, points)
+
+
+def _check_continuation(spec: StudySpec, source: str) -> None:
+    """A continuation follows a numeric scan axis."""
+    axis = spec.continuation_axis or next(iter(spec.scan))
+    if axis not in spec.scan:
+        raise InputError(f"{source}: continuation_axis: {axis!r}: not a scan axis; scan axes: {', '.join(spec.scan)}")
+    values = spec.scan[axis].expand()
+    if len(values) < 2 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        raise InputError(f"{source}: scan.{axis}: a continuation follows an axis of at least two numbers")
 
 
 def _check_rock_name_axis(spec: StudySpec, base: dict[str, Any], source: str) -> None:

@@ -5,7 +5,8 @@ labelled ``scans`` (studies.scan.frequency_scans.Scan), the ``rising`` trends, t
 each scan's metric) and
 
 * one at a time: every numeric value of the scene's drill string, feed, impact (not the scanned
-  frequency) and rock (``parameters: all``), or a listed set of dotted paths, each multiplied by
+  frequency), rock and extensions' parameters (``parameters: all``), or a listed set of dotted paths, each
+  multiplied by
   1 +- ``relative_step`` (0.10) in every scan, after the scan's own overrides (a scan that sets the
   rock still has its rock stiffness changed);
 * optionally ``global``: SALib's Morris screening (``method: morris``, ``samples`` trajectories) or
@@ -36,6 +37,7 @@ from ...models.definition.scene import Scene
 from ..inputs.reading import InputError, parse, read_yaml
 from ..inputs.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, base_estimate_s
+from ..runtime.resumable import cell
 from ..scan.frequency_scans import (
     FREQUENCY,
     Scan,
@@ -46,7 +48,7 @@ from ..scan.frequency_scans import (
     set_frequency,
 )
 
-SECTIONS = ("drill_string", "feed", "impact", "rock")
+SECTIONS = ("drill_string", "feed", "impact", "rock", "extensions")
 NOT_VARIED = (FREQUENCY, "segments")  # the scanned axis and counts
 NOMINAL = "nominal"
 ONE_AT_A_TIME_COLUMNS = ("parameter", "change", "scan", "metric", "optimum_hz", "optimum_change", "peak", "peak_change")
@@ -146,8 +148,9 @@ def varied_scene(base: dict[str, Any], overrides: dict[str, Any], factors: dict[
 
 
 def scene_values(scene_data: dict[str, Any]) -> dict[str, float]:
-    """Every numeric value a scene sets in its drill string, feed, impact and rock (the rock's Table 1
-    values filled in), by dotted path; values at their defaults are left out (nothing to vary)."""
+    """Every numeric value a scene sets in its drill string, feed, impact, rock (the rock's Table 1
+    values filled in) and its extensions' parameters, by dotted path; values at their defaults are left out
+    (nothing to vary)."""
     scene = Scene.model_validate(scene_data)
     data = scene.model_dump(mode="json", by_alias=True, exclude_defaults=True)
     data["rock"] = scene.rock.completed().model_dump(mode="json", exclude_defaults=True)
@@ -271,7 +274,7 @@ def row_of(study: SensitivityStudy, outcome: dict[str, Any]) -> dict[str, Any]:
     point = study.points[outcome["point"]]
     return {"point": point.index, "kind": "", "parameter": "", "change": "", "sample": "", **point.parameters,
             "status": outcome["status"], "error": outcome["error"], "wall_time_s": f"{outcome['wall_time_s']:.4g}",
-            **{k: f"{v:.10g}" if isinstance(v, float) else v for k, v in outcome["metrics"].items()}}
+            **{k: cell(f"{v:.10g}" if isinstance(v, float) else v) for k, v in outcome["metrics"].items()}}
 
 
 def _number(text: str) -> float:

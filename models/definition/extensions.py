@@ -1,0 +1,195 @@
+"""Python of one's own named by a scene: extensions of the Exudyn model, and what imports them by name.
+
+A scene's ``extensions`` section names callables by their import path, each with its parameters::
+
+    extensions:
+      clamp:                                   # a name of the user's choosing
+        function: my_rig.clamps:add_clamp      # an importable callable f(model, **parameters)
+        parameters: {mass_kg: 300.0, stiffness_n_per_m: 1.0e9}
+
+The Exudyn builder (models.solvers.exudyn_model) imports each callable by name and calls it on the built
+model before it runs, in every process that runs the scene: a scene is data, and a worker imports the
+callable itself (nothing pickles a built model). The parameters are checked here against the callable's
+signature as strictly as a scene's own keys (unknown or missing keys, types of the annotations), and
+``extensions.NAME.parameters.KEY`` is a key path like any other (``Scene.with_``, scan axes).
+
+An extension changes the motion of the Exudyn model unless its callable says otherwise with the attribute
+``changes_motion = False`` (one that only adds sensors, energy terms or graphics): a scene with an
+extension that changes the motion runs in the Exudyn formulation only (the exact and ODE formulations
+refuse it naming the extension, :func:`refusal`). A rock law of one's own is named the same way
+(``rock.law: module:Class``, models.definition.rock).
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib
+import importlib.metadata
+import inspect
+import re
+import sys
+import typing
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model, model_validator
+
+from .drill_string import Strict, _key_error, _problem
+
+IMPORT_PATH = re.compile(r"[A-Za-z_][\w]*(\.[A-Za-z_][\w]*)*:[A-Za-z_][\w]*(\.[A-Za-z_][\w]*)*")
+
+
+def import_object(path: str) -> Any:
+    """The object an import path ``module.sub:name`` names; ValueError saying what is wrong otherwise."""
+    if not IMPORT_PATH.fullmatch(path):
+        raise ValueError("not an import path 'package.module:name'")
+    module_name, _, attribute = path.partition(":")
+    try:
+        target: Any = importlib.import_module(module_name)
+    except ImportError as error:
+        raise ValueError(f"cannot import module {module_name!r} ({error}); it must be importable where the scene "
+                         "runs (installed, or on PYTHONPATH)") from None
+    for part in attribute.split("."):
+        if not hasattr(target, part):
+            raise ValueError(f"module {module_name!r} has no {attribute!r}")
+        target = getattr(target, part)
+    return target
+
+
+def package_version(path: str) -> dict[str, str]:
+    """The distribution that provides the module of import path ``path`` and its version (importlib.metadata),
+    or an empty mapping for a module of no installed distribution (a file on PYTHONPATH)."""
+    top = path.partition(":")[0].split(".")[0]
+    names = _distributions().get(top, [])
+    if not names:
+        return {}
+    return {"package": names[0], "version": importlib.metadata.version(names[0])}
+
+
+@functools.cache
+def _distributions() -> Mapping[str, list[str]]:
+    return importlib.metadata.packages_distributions()
+
+
+def record(path: str) -> dict[str, str]:
+    """What a run records of the code an import path names: the path and, where it has one, its package and
+    version; ``file`` where the module was loaded from."""
+    module = sys.modules.get(path.partition(":")[0])
+    where = {"file": str(module.__file__)} if module is not None and getattr(module, "__file__", None) else {}
+    return {"import_path": path, **package_version(path), **where}
+
+
+STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, arbitrary_types_allowed=True)
+
+
+@functools.cache
+def signature_model(target: Callable[..., Any], skip: int = 0) -> type[BaseModel]:
+    """A strict pydantic model of the keyword parameters of ``target`` (its first ``skip`` positional
+    parameters left out): each parameter's annotation (Any without one), required unless it has a default;
+    unknown keys are errors unless ``target`` takes ``**kwargs``."""
+    parameters = list(inspect.signature(target).parameters.values())[skip:]
+    hints: dict[str, Any] = {}
+    # a class's annotations resolve in the module of the class that declares each (a dataclass's fields),
+    # its __init__'s in its own; one that does not resolve is checked as Any
+    for source in ((target, target.__init__) if inspect.isclass(target) else (target,)):
+        try:
+            hints = {**typing.get_type_hints(source), **hints}
+        except (NameError, TypeError):
+            continue
+    fields: dict[str, Any] = {}
+    extra = "forbid"
+    for parameter in parameters:
+        if parameter.kind is parameter.VAR_KEYWORD:
+            extra = "allow"
+        elif parameter.kind is not parameter.VAR_POSITIONAL:
+            default = ... if parameter.default is parameter.empty else parameter.default
+            fields[parameter.name] = (hints.get(parameter.name, Any), default)
+    return create_model(f"{getattr(target, '__name__', 'target')}_parameters",
+                        __config__=ConfigDict(STRICT, extra=extra), **fields)
+
+
+def check_parameters(target: Callable[..., Any], parameters: Mapping[str, Any], where: tuple[str, ...],
+                     title: str, skip: int = 0, path: str | None = None) -> dict[str, Any]:
+    """``parameters`` validated against the signature of ``target`` (:func:`signature_model`); a
+    ValidationError at ``where`` + the key otherwise (``title``: the model the error names; ``path``: the
+    import path the messages name it by, default its module and name)."""
+    model = signature_model(target, skip)
+    try:
+        validated = model.model_validate(dict(parameters))
+    except ValidationError as error:
+        details = []
+        for item in error.errors():
+            if item["type"] == "extra_forbidden":  # what the callable takes, not pydantic's words
+                details.append(_problem((*where, *item["loc"]), item["input"], "not a parameter of {name}; its "
+                                        "parameters: {names}", name=path or _name(target),
+                                        names=", ".join(model.model_fields)))
+                continue
+            item = {**item, "loc": (*where, *item["loc"])}
+            item.pop("url", None)
+            if "ctx" in item and "error" in item["ctx"]:  # a validator's exception: pydantic wants its text
+                item["ctx"] = {**item["ctx"], "error": str(item["ctx"]["error"])}
+            details.append(item)
+        raise ValidationError.from_exception_data(title, details) from None
+    return {**validated.model_dump(), **(validated.model_extra or {})}
+
+
+def _name(target: Any) -> str:
+    """A callable or class as a message names it: module:qualified name."""
+    return f"{getattr(target, '__module__', '?')}:{getattr(target, '__qualname__', repr(target))}"
+
+
+class Extension(Strict):
+    """One Python extension of the Exudyn model (module doc): ``function`` 'module:callable', called as
+    ``function(model, **parameters)`` on the built model before it runs."""
+
+    function: str = Field(description="import path 'package.module:callable' of f(model, **parameters)")
+    parameters: dict[str, Any] = Field(default_factory=dict, description="keyword arguments of the callable")
+    recorded: dict[str, str] | None = Field(None, description="informational: what the run that wrote a resolved "
+                                            "scene imported (import path, package, version, file)")
+
+    @model_validator(mode="after")
+    def _importable_and_parameters_fit(self) -> Extension:
+        try:
+            target = import_object(self.function)
+        except ValueError as error:
+            raise _key_error("Extension", ("function",), self.function, "{why}", why=str(error)) from None
+        if not callable(target):
+            raise _key_error("Extension", ("function",), self.function, "not a callable: {kind}",
+                             kind=type(target).__name__)
+        check_parameters(target, self.parameters, ("parameters",), "Extension", skip=1, path=self.function)
+        return self
+
+    @property
+    def target(self) -> Callable[..., Any]:
+        """The function the import path names."""
+        return import_object(self.function)
+
+    @property
+    def changes_motion(self) -> bool:
+        """False when the callable says it adds nothing the exact and ODE formulations miss
+        (``changes_motion = False``: sensors, energy terms, graphics)."""
+        return bool(getattr(self.target, "changes_motion", True))
+
+    def apply(self, model: Any) -> None:
+        """Call the extension on a built model."""
+        self.target(model, **self.parameters)
+
+
+def refusal(extensions: Mapping[str, Extension] | None, formulation: str) -> tuple[str, str] | None:
+    """(the extension's name, why) when ``formulation`` cannot run a scene with these extensions: the exact
+    and ODE formulations run no Exudyn items, so an extension that changes the motion is Exudyn's only."""
+    if formulation == "exudyn":
+        return None
+    for name, extension in (extensions or {}).items():
+        if extension.changes_motion:
+            return name, (f"extension {name!r} ({extension.function}) adds to the Exudyn model, which the {formulation} "
+                          "formulation does not build; use solver.formulation exudyn, or, if the extension changes "
+                          "nothing of the motion (sensors, energy terms, graphics), set changes_motion = False on "
+                          "its callable (docs/extending.md)")
+    return None
+
+
+def records(extensions: Mapping[str, Extension] | None) -> dict[str, dict[str, Any]]:
+    """Every extension's record (:func:`record`) and parameters, by name: what provenance keeps."""
+    return {name: {**record(extension.function), "parameters": dict(extension.parameters)}
+            for name, extension in (extensions or {}).items()}
