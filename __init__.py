@@ -40,9 +40,9 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "Study": ("studies.scan.study", "Study"),
          "build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
          "ExudynModel": ("models.solvers.exudyn_model", "ExudynModel"),
-         "draw": ("studies.figures.drill_drawing", "draw"),
-         "write_animation": ("studies.figures.drill_animation", "write_animation"),
-         "view_solution": ("studies.figures.drill_animation", "view_solution")}
+         "draw": ("studies.drawings.drill_drawing", "draw"),
+         "write_animation": ("studies.drawings.drill_animation", "write_animation"),
+         "view_solution": ("studies.drawings.drill_animation", "view_solution")}
 
 if TYPE_CHECKING:  # the names as type checkers and editors see them
     from .models.definition.scene import Scene
@@ -54,8 +54,8 @@ if TYPE_CHECKING:  # the names as type checkers and editors see them
     from .studies.advice.advice_run import advise_scene as advise
     from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
     from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
-    from .studies.figures.drill_animation import view_solution, write_animation
-    from .studies.figures.drill_drawing import draw
+    from .studies.drawings.drill_animation import view_solution, write_animation
+    from .studies.drawings.drill_drawing import draw
     from .studies.runtime.budgets import BudgetError
     from .studies.scan.study import Study
 

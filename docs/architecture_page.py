@@ -74,6 +74,8 @@ ROLES = {
                             "paper's, the trends checked.",
     "studies.figures": "Every figure (matplotlib): scans, maps, time series, work-precision, tornado, the "
                        "paper's figures redrawn, and the plot tasks a pool's workers draw.",
+    "studies.drawings": "Pictures of the drill itself: the string drawn to scale, its animation over the last "
+                        "blows, a built Exudyn system drawn from its own graphics, Exudyn's solution file.",
     "studies.pages": "The generated documentation pages (reproduction, parameters, sensitivity, figures, "
                      "rotation).",
     "studies.cli": "The `rpdrill` command line: `main.py` (argparse, exit statuses, one-line warnings) and a "

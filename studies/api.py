@@ -52,9 +52,9 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     ``summary.json``, ``scene.resolved.yaml``, the ``timeseries.png``/``.svg`` figure, the drawing of the
     drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified. A scene with extensions is drawn
     (and, from a run with a solution file, animated) as its built Exudyn model, every item of the extensions
-    included (studies.figures.system_drawing). The files written."""
-    from .figures.drill_animation import write_animation  # matplotlib only when saving
-    from .figures.drill_drawing import draw
+    included (studies.drawings.system_drawing). The files written."""
+    from .drawings.drill_animation import write_animation  # matplotlib only when saving
+    from .drawings.drill_drawing import draw
     from .figures.timeseries_figure import plot_timeseries
 
     check("rpdrill.save_result", "result", result, instance_problem(Result, "the Result of rpdrill.simulate"))
@@ -101,8 +101,8 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
     it starts; models.evaluation.stability.SimulationFailed when the run diverges. ``solution_file``:
     with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
-    (for its SolutionViewer: studies.figures.drill_animation.view_solution)."""
-    from .figures.drill_animation import run_with_solution
+    (for its SolutionViewer: studies.drawings.drill_animation.view_solution)."""
+    from .drawings.drill_animation import run_with_solution
 
     check("rpdrill.simulate", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
     check("rpdrill.simulate", "progress", progress, callable_problem)

@@ -1,4 +1,4 @@
-"""The drill string drawn, animated and handed to Exudyn's viewer (studies.figures.drill_drawing, studies.figures.drill_animation)."""
+"""The drill string drawn, animated and handed to Exudyn's viewer (studies.drawings.drill_drawing, studies.drawings.drill_animation)."""
 
 import json
 from pathlib import Path
@@ -11,8 +11,8 @@ from scenes import crushing_scene, scene_dict, simulate
 
 from rpdrill.models.drill.shapes import layout
 from rpdrill.studies.cli.main import main
-from rpdrill.studies.figures.drill_animation import load_solution, nice_factor, write_animation
-from rpdrill.studies.figures.drill_drawing import draw, draw_string, drawn_layout
+from rpdrill.studies.drawings.drill_animation import load_solution, nice_factor, write_animation
+from rpdrill.studies.drawings.drill_drawing import draw, draw_string, drawn_layout
 from rpdrill.studies.figures.figure_style import plt
 from rpdrill.studies.inputs.reading import load_scene
 

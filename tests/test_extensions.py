@@ -253,7 +253,7 @@ def test_draw_an_extended_model_from_its_exudyn_graphics(tmp_path):
     """Why 6: rpdrill.draw(model, ...) raised AttributeError; the drawing showed the scene's bodies only."""
     from matplotlib.figure import Figure
 
-    from rpdrill.studies.figures.system_drawing import SystemPicture
+    from rpdrill.studies.drawings.system_drawing import SystemPicture
 
     model = clamped(PAPER.with_(SHORT), stiffness_n_per_m=1e9)
     assert rpdrill.draw(model, tmp_path / "model.png").stat().st_size > 10_000
@@ -269,7 +269,7 @@ def test_draw_an_extended_model_from_its_exudyn_graphics(tmp_path):
 def test_view_solution_replays_an_extended_run_and_refuses_one_it_cannot_rebuild(tmp_path):
     """Why 6: view_solution of an extended run failed (SetODE2Coords: incompatible size of vectors)."""
     from rpdrill.studies.cli.main import main
-    from rpdrill.studies.figures.drill_animation import load_solution
+    from rpdrill.studies.drawings.drill_animation import load_solution
     from rpdrill.studies.runtime.output_files import write_resolved
 
     scene = PAPER.with_({"extensions": {"clamp": CLAMP}, **SHORT,

@@ -137,7 +137,7 @@ def test_a_periodic_run_gives_every_metric_of_the_orbit():
     # (the period is no multiple of the 1e-4 s output interval), which moves a sampled peak by up to
     # (omega dt)^2 / 8 of it
     assert metrics["bit_velocity_peak_m_per_s"] == pytest.approx(settled["bit_velocity_peak_m_per_s"], rel=5e-3)
-    assert period_s - 1e-4 < result.timeseries.index[-1] <= period_s  # the table spans the orbit's blow
+    assert period_s - 1e-4 < result.timeseries["time_s"].iloc[-1] <= period_s  # the table spans the orbit's blow
 
 
 def test_steady_state_is_a_solver_key_with_a_stated_default_and_a_clear_error():

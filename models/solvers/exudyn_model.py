@@ -210,9 +210,8 @@ class ExudynModel:
 
     def _install(self) -> None:
         """Set the one pre-step function of the model's own functions, the user's and the run's watchers."""
-        actions = [*self._own_actions(), *self.pre_steps, *self._watch]
-        if self._foreign is not None:
-            actions.append(self._foreign)
+        foreign = [] if self._foreign is None else [self._foreign]  # the user's, set on mbs: last
+        actions = [*self._own_actions(), *self.pre_steps, *self._watch, *foreign]
         self._installed = pre_step(actions)
         self.mbs.SetPreStepUserFunction(self._installed or 0)
 
@@ -319,8 +318,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
 
     bodies: list[ExudynBody] = []
     rods = {name for name, body in simulation.scene.drill_string.bodies.items() if body.is_rod}
-    velocities = np.zeros(chain.size)
-    velocities[:simulation.chain.size] = simulation.initial_velocities
+    velocities = np.pad(simulation.initial_velocities, (0, chain.size - simulation.chain.size))  # a piston's: 0
     for body, cylinder, initial, speed in zip(chain.bodies, chain_cylinders(shapes, chain), initial_positions, velocities,
                                               strict=True):
         shown = VObjectMass1D(graphicsData=body_graphics(cylinder, cylinder.group in rods))

@@ -1,9 +1,9 @@
 """Run one scene: time histories, summary figures and a plot.
 
 Writes DIR/timeseries.csv, DIR/summary.json, DIR/scene.resolved.yaml, DIR/timeseries.png (and
-.svg): the whole run beside its last blows, and DIR/drill.png: the drill string (studies.figures.drill_drawing).
+.svg): the whole run beside its last blows, and DIR/drill.png: the drill string (studies.drawings.drill_drawing).
 ``--animate``: DIR/drill.gif, the last blows magnified, and for the Exudyn formulation Exudyn's
-solution file DIR/solution.txt (studies.figures.drill_animation.view_solution opens it in Exudyn's SolutionViewer). DIR must be new or empty (``--overwrite``: write over
+solution file DIR/solution.txt (studies.drawings.drill_animation.view_solution opens it in Exudyn's SolutionViewer). DIR must be new or empty (``--overwrite``: write over
 what it holds). The run's steps and memory are checked against the budgets (studies.runtime.budgets)
 before it starts.
 """
@@ -21,7 +21,7 @@ from ...models.evaluation.run_status import UnsettledWarning, run_status
 from ...models.evaluation.stability import SimulationFailed
 from ..api import save_result, simulate
 from ..display.catalogue import metric
-from ..figures.drill_animation import SOLUTION_FILE
+from ..drawings.drill_animation import SOLUTION_FILE
 from ..inputs.arguments import choice_problem, cli_type
 from ..inputs.reading import load_scene
 from ..runtime.interrupts import raise_if_stopped
@@ -79,6 +79,6 @@ def run(args: argparse.Namespace) -> int:
                                  f": {info.get('steady_state_note', '')}"))
     print(f"{result.scene.name} ({result.formulation}{regime}): {shown or 'no metrics asked for'}; wrote {args.out}")
     if solution is not None:
-        print(f"Exudyn's viewer: python -c \"from rpdrill.studies.figures.drill_animation import view_solution; "
+        print(f"Exudyn's viewer: python -c \"from rpdrill.studies.drawings.drill_animation import view_solution; "
               f"view_solution('{args.out}')\"")
     return 0

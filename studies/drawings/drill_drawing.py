@@ -10,9 +10,9 @@ they join (schematic length): a spring above the axis, a dashpot below when damp
 two open flanges with its gap; a connector from ground ends on a hatched wall. The rock is a
 hatched block at the rock face; the feed and the piston's impact are arrows on the bodies they act on.
 :func:`draw` writes the drawing (``.png`` or ``.svg`` by the suffix); :func:`drawn_layout` is where
-every body is drawn (the animation, studies.figures.drill_animation, moves them from there). A built
+every body is drawn (the animation, studies.drawings.drill_animation, moves them from there). A built
 Exudyn model, or a scene with extensions, is drawn from the system's own graphics instead, every item of
-one's own included (studies.figures.system_drawing).
+one's own included (studies.drawings.system_drawing).
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ from ...models.definition.drill_string import EVERY_BODY, GROUND
 from ...models.definition.links import Link
 from ...models.definition.scene import Scene
 from ...models.drill.shapes import DEFAULT_DIAMETER_M, Layout, axial_order, layout
+from ..figures.figure_style import OKABE_ITO, plt
 from ..inputs.arguments import built_model_problem, check, either, file_problem, instance_problem
-from .figure_style import OKABE_ITO, plt
 from .system_drawing import draw_model
 
 if TYPE_CHECKING:
@@ -319,7 +319,7 @@ def figure_title(scene: Scene, drawing: DrawnLayout) -> str:
 def draw(scene: Scene | ExudynModel, path: str | Path) -> Path:
     """Write the drawing of ``scene``'s drill string to ``path`` (PNG or SVG by its suffix; module doc). A built
     Exudyn model (``rpdrill.build_exudyn``), or a scene with extensions (drawn as its built model), is drawn
-    from the system's own graphics with every item of one's own (studies.figures.system_drawing)."""
+    from the system's own graphics with every item of one's own (studies.drawings.system_drawing)."""
     check("rpdrill.draw", "scene", scene, either(built_model_problem, instance_problem(
         Scene, "a rpdrill.Scene (rpdrill.load_scene) or a built model (rpdrill.build_exudyn)")))
     check("rpdrill.draw", "path", path, file_problem)

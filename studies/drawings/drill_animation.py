@@ -1,6 +1,6 @@
 """The last blows of a run as an animation, and Exudyn's own viewer on a run's solution file.
 
-:func:`write_animation` draws the drill string (studies.figures.drill_drawing) at evenly spaced times over the last
+:func:`write_animation` draws the drill string (studies.drawings.drill_drawing) at evenly spaced times over the last
 blows of a result of any formulation: every body moved by its displacement since the window's start
 and the rock face by the borehole bottom's (from the bit's position at the start: the bit's
 penetration into the rock shows), all magnified by one factor stated in the title (default: the
@@ -14,7 +14,7 @@ their graphics, its extensions applied) and the stored coordinates are played on
 ran with ``model.write_solution(path)``. It needs a display.
 
 A built Exudyn model (``rpdrill.build_exudyn``, items of one's own added) is animated from its own
-graphics (:func:`model_animation`, studies.figures.system_drawing) at the coordinates of its solution file.
+graphics (:func:`model_animation`, studies.drawings.system_drawing) at the coordinates of its solution file.
 """
 
 from __future__ import annotations
@@ -34,6 +34,7 @@ from ...models.evaluation.results import SimulationResult
 from ...models.evaluation.run_result import Result
 from ...models.solvers.simulation import Simulation
 from ...models.steady.steady_run import run_scene
+from ..figures.figure_style import plt
 from ..inputs.arguments import (
     built_model_problem,
     check,
@@ -47,7 +48,6 @@ from ..inputs.arguments import (
 )
 from ..inputs.reading import InputError, load_scene
 from .drill_drawing import BODY_HEIGHT, draw_string, drawn_layout, figure_title
-from .figure_style import plt
 from .system_drawing import SystemPicture
 
 if TYPE_CHECKING:
@@ -186,7 +186,7 @@ def view_solution(run: str | Path | ExudynModel) -> None:
 
 
 def model_animation(model: ExudynModel, path: str | Path, blows: int = 3, magnification: float | None = None) -> float:
-    """The last ``blows`` blows of a built model drawn from its own graphics (studies.figures.system_drawing)
+    """The last ``blows`` blows of a built model drawn from its own graphics (studies.drawings.system_drawing)
     at the coordinates of its solution file (``model.write_solution``), displacements magnified; a model that
     has not run and has no solution file is run first, writing one into a scratch folder. The magnification
     drawn."""

@@ -12,7 +12,7 @@ system is drawn in one panel and the part from the impact body to the rock in a 
 y to their own scales (a drill is thin beside its length).
 
 :func:`draw_model` writes the drawing of a model (``rpdrill.draw`` of a model); :func:`draw_system` draws
-one configuration on axes (the animation of a model, studies.figures.drill_animation, draws each frame).
+one configuration on axes (the animation of a model, studies.drawings.drill_animation, draws each frame).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.collections import PolyCollection
 
-from .figure_style import OKABE_ITO, plt
+from ..figures.figure_style import OKABE_ITO, plt
 
 USER_COLOUR = OKABE_ITO[6]  # items of one's own
 CONNECTOR_KINDS = ("Connector", "Contact")  # objectType prefixes of items joining two markers
