@@ -15,6 +15,8 @@ compiled kernels load from disk once per process).
 segments per rod, the piston at twice that) and four_rod_string.yaml with wave rods (and lumped at 4 and 16):
 penetration rate, largest rod stress, the rock's share of the blow energy, peak rock force, CPU (64 segments
 per rod would take Exudyn's standard preset about an hour per run on this machine).
+``--strings --fine``: the lumped rods of both scenes at 16, 32 and 64 segments per rod in the exact formulation
+(the convergence of the lumped model towards the waves).
 ``--lumped-lundberg``: Lundberg's check on lumped rods of 64 to 512 segments (Exudyn, reference preset),
 the dispersion the wave element removes.
 """
@@ -151,7 +153,7 @@ def checks() -> None:
               f"crossing energy - (1 - R^2) {crossed:+.1e} | {cpu:.2f} |")
 
 
-def strings() -> None:
+def strings(fine: bool = False) -> None:
     print("| scene | model | formulation | penetration rate mm/s | largest rod stress MPa | rock energy / blow energy "
           "| peak rock force kN | CPU s |")
     print("|---|---|---|---|---|---|---|---|")
@@ -161,6 +163,9 @@ def strings() -> None:
     cases += [("four_rod_string", "waves", "exact", None), ("four_rod_string", "waves", "exudyn", None),
               ("four_rod_string", "lumped", "exact", 4)]
     cases += [("four_rod_string", "lumped", "exudyn", n) for n in (4, 16)]
+    if fine:  # the lumped rods refined in the exact formulation: do they go to the waves?
+        cases = [(name, "lumped", "exact", n) for name in ("top_hammer_piston", "four_rod_string")
+                 for n in (16, 32, 64)]
     for name, model, formulation, segments in cases:
         data = read_yaml(f"studies/scenes/{name}.yaml")
         bodies = data["drill_string"]["bodies"]
@@ -194,12 +199,13 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--checks", action="store_true")
     parser.add_argument("--strings", action="store_true")
     parser.add_argument("--lumped-lundberg", action="store_true")
+    parser.add_argument("--fine", action="store_true", help="--strings: lumped rods at 16, 32, 64 segments, exact")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")  # Exudyn's printed notes
     if args.checks or not (args.strings or args.lumped_lundberg):
         checks()
     if args.strings:
-        strings()
+        strings(args.fine)
     if args.lumped_lundberg:
         lumped_lundberg()
 
