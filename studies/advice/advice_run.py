@@ -52,6 +52,7 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     check(where, "search", search, instance_problem(AdviceSearch, "a rpdrill.AdviceSearch or None", optional=True))
     check(where, "workers", workers, optional(workers_problem))
     check(where, "dask", dask, dask_problem)
+    check(where, "max_rod_stress_pa", max_rod_stress_pa, optional(positive_problem))
     validated, source = scene_and_source(scene, where)
     data = validated.model_dump(by_alias=True, exclude_none=True)
     allowed = [entry.path for entry in PARAMETERS]
