@@ -6,10 +6,14 @@ The refinement and CPU figures: benchmarks/bench_waves.py."""
 
 from __future__ import annotations
 
+import itertools
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from pydantic import ValidationError
 
 from rpdrill.models.definition.scene import Scene
@@ -19,7 +23,8 @@ from rpdrill.models.drill.wave_rod import reflected_force_share, transmitted_for
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import SceneError, prepare
-from rpdrill.studies.inputs.reading import prepare_scene
+from rpdrill.studies.cli.main import main
+from rpdrill.studies.inputs.reading import prepare_scene, read_yaml
 
 E_PA, RHO, D = 2.1e11, 7850.0, 0.045
 STEEL = {"diameter_m": D, "youngs_modulus_pa": E_PA, "density_kg_per_m3": RHO}
@@ -309,3 +314,76 @@ def test_the_pulse_on_a_face_is_the_prescribed_one_at_every_blow(formulation):
     jumps = np.isin(np.round(result.time_s * 3e3 * 1e9), np.round(np.arange(4) * 1e9))  # a blow's start: 0 either side
     assert np.allclose(result.impact_force_n[~jumps], expected[~jumps], rtol=0, atol=1e-6 * 1e5)
     assert result.impact_force_n.min() > -1e-6 * 1e5
+
+
+# ---- the shipped top-hammer scene: its rods' outputs, advise's stress bound ----------------------------
+
+SHIPPED = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "top_hammer_waves.yaml"
+RODS = ("shank", "rod1", "rod2", "rod3", "rod4")
+
+
+def test_the_shipped_top_hammer_scene_reports_its_rods_stresses_and_energy_per_blow(tmp_path):
+    """``rpdrill simulate`` of the shipped scene (exact formulation, 20 blows): every rod's stress histories
+    at its ends, its largest stresses and the energy through its ends per blow; a rigid coupling is one
+    section, a rod (lossless) passes on what enters it per blow, and what leaves the last rod is what the
+    rock takes (the bit's kinetic energy aside)."""
+    out = tmp_path / "out"
+    assert main(["simulate", str(SHIPPED), "--formulation", "exact", "--out", str(out), "--quiet"]) == 0
+    metrics = json.loads((out / "summary.json").read_text())["metrics"]
+    header = (out / "timeseries.csv").read_text().splitlines()[0].split(",")
+    largest = []
+    for name in RODS:
+        assert {f"{name}_top_stress_pa", f"{name}_bottom_stress_pa"} <= set(header)
+        compressive, tensile = metrics[f"{name}_compressive_stress_max_pa"], metrics[f"{name}_tensile_stress_max_pa"]
+        assert compressive > 1e8 and tensile >= 0.0
+        largest += [compressive, tensile]
+        assert metrics[f"{name}_energy_out_per_blow_j"] > 0.0  # steady blows: a lossless rod passes them on
+        assert metrics[f"{name}_energy_in_per_blow_j"] == pytest.approx(metrics[f"{name}_energy_out_per_blow_j"],
+                                                                        rel=1e-3)
+    assert metrics["rod_stress_max_pa"] == pytest.approx(max(largest), rel=1e-12)
+    for upper, lower in itertools.pairwise(RODS):  # a rigid coupling: what leaves one rod enters the next
+        assert metrics[f"{upper}_energy_out_per_blow_j"] == pytest.approx(metrics[f"{lower}_energy_in_per_blow_j"],
+                                                                         rel=1e-9)
+    assert metrics["rock_energy_per_blow_j"] == pytest.approx(metrics["rod4_energy_out_per_blow_j"], rel=1e-2)
+    assert 0.0 < metrics["shank_energy_in_per_blow_j"] < 300.0  # the piston's blow, less what it keeps
+    assert metrics["rock_transfer_efficiency"] == pytest.approx(metrics["rock_energy_per_blow_j"] / 300.0, rel=1e-9)
+
+
+@pytest.mark.slow  # ~60 CPU s: about 55 runs of one blow of the shipped scene, ~1 CPU s each
+def test_advise_keeps_the_shipped_scenes_rods_below_the_stress_bound(tmp_path, monkeypatch, capsys):
+    """``rpdrill advise --max-rod-stress-mpa 400`` on the shipped top hammer at a fixed 15 kW (blow energy
+    15 kW / f): the rate is highest at the lowest frequency and largest feed, where the rods see ~440 MPa
+    (one blow of the scene, measured at 40 Hz and 20 kN), so the bound binds: the best of all points run is
+    above it, the advice's best point is below it, slower, at a higher frequency. The scene is the shipped
+    one run for one blow; the curves and the map are coarser than the command's (4 x 4, 5 points a curve)
+    to keep the test at a minute: what is checked is the search's answer, not those grids."""
+    from rpdrill.studies.advice import advice_search
+
+    monkeypatch.setattr(advice_search, "MAP_POINTS", 4)
+    monkeypatch.setattr(advice_search, "SLICE_POINTS", 5)
+    data = read_yaml(str(SHIPPED))
+    data["metrics"], data["solver"]["end_time_s"] = {"transient_blows": 0, "block_blows": 1}, 0.02
+    path = tmp_path / "top_hammer_waves.yaml"
+    path.write_text(yaml.safe_dump(data))
+    out = tmp_path / "out"
+    assert main(["advise", str(path), "--frequency-hz", "40", "80", "--feed-kn", "5", "20", "--power-kw", "15",
+                 "--max-rod-stress-mpa", "400", "--popsize", "4", "--generations", "2", "--workers", "1",
+                 "--quiet", "--out", str(out)]) == 0
+    assert "largest rod stress" in capsys.readouterr().out
+    (advice,) = json.loads((out / "advice.json").read_text())["results"]
+    assert advice["formulation"] == "exact" and advice["max_rod_stress_pa"] == 400e6
+    assert advice["best_rod_stress_pa"] <= 400e6
+    points = [json.loads(line) for line in (out / "evaluations.jsonl").read_text().splitlines()]
+    assert all(p["rod_stress_max_pa"] > 0 for p in points)
+    fastest = max(points, key=lambda p: p["value"])  # the best point without the bound
+    assert fastest["rod_stress_max_pa"] > 400e6 and advice["beyond_stress"] > 0
+    assert fastest["value"] > advice["best_value"]
+    assert advice["best"]["impact.frequency_hz"] > fastest["point"]["impact.frequency_hz"]
+
+
+def test_advise_refuses_a_stress_bound_that_is_not_positive():
+    import rpdrill
+
+    with pytest.raises(rpdrill.InputError, match="max_rod_stress_pa"):
+        rpdrill.advise(str(SHIPPED), {"impact.frequency_hz": (40, 80), "feed.force_n": (5e3, 20e3)},
+                       max_rod_stress_pa=-1.0)
