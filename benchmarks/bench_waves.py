@@ -63,7 +63,7 @@ def rod(length_m: float, **more: Any) -> dict:
 
 def timed(scene: Scene) -> tuple[Any, float]:
     start = time.process_time()
-    result = prepare(scene).run()
+    result = prepare(scene).solve()
     return result, time.process_time() - start
 
 

@@ -55,7 +55,7 @@ def one_blow(bodies: dict, impact: dict, rock: dict, end_time_s: float, formulat
 
 
 def run(data: dict):
-    return prepare(Scene.model_validate(data)).run()
+    return prepare(Scene.model_validate(data)).solve()
 
 
 # ---- scene keys and refusals ------------------------------------------------------------------------

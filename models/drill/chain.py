@@ -75,9 +75,6 @@ class AxialChain:
         return [(link.body_a, link.body_b) for link in self.links
                 if link.linear and link.rigid and link.body_a is not None]
 
-    def mass_matrix(self) -> np.ndarray:
-        return np.diag([b.mass_kg for b in self.bodies])
-
     def _assemble(self, attribute: str, links: tuple[Link, ...]) -> np.ndarray:
         """D^T diag(values) D: the links' stiffness or damping matrix, from their incidence D."""
         incidence = self.incidence(links)
@@ -100,9 +97,6 @@ class AxialChain:
         """K of every link at its full stiffness (couplings closed: the stiffest state), or of the
         linear links only."""
         return self._assemble("stiffness_n_per_m", self.linear_links() if linear_only else self.links)
-
-    def damping_matrix(self, linear_only: bool = False) -> np.ndarray:
-        return self._assemble("damping_n_s_per_m", self.linear_links() if linear_only else self.links)
 
     def constant_forces(self) -> np.ndarray:
         return np.array([b.constant_force_n for b in self.bodies])

@@ -167,7 +167,7 @@ class PistonSetup:
 
     @property
     def momentum_n_s(self) -> float:
-        """m_p v_p, the most impulse a blow can give."""
+        """m_p v_p, the most impulse a blow can give (the scale of a wave piston's rest: models.waves.stepping)."""
         return self.mass_kg * self.strike_velocity_m_per_s
 
     @property

@@ -68,7 +68,6 @@ from ..evaluation.run_result import Result
 from ..evaluation.stability import StepLimitWarning, check_result, step_warning
 from ..waves.exudyn_waves import WaveExudyn
 from .exudyn_graphics import DrillGraphics, body_graphics, chain_cylinders, torsion_graphics
-from .exudyn_items import SOLVER_TYPES, ExudynBody, ExudynConnector, add_body, link_force_function
 from .exudyn_messages import (
     MinimumStepGuard,
     exudyn_messages_as_warnings,
@@ -80,7 +79,18 @@ from .exudyn_messages import (
     simulation_settings,
 )
 from .exudyn_piston import ExudynPiston
-from .exudyn_user_items import EnergyTerm, UserAccount, assembled_scales, item_counts, user_outcome
+from .exudyn_user_items import (
+    SOLVER_TYPES,
+    EnergyTerm,
+    ExudynBody,
+    ExudynConnector,
+    UserAccount,
+    add_body,
+    assembled_scales,
+    item_counts,
+    link_force_function,
+    user_outcome,
+)
 from .simulation import Simulation, as_simulation, prepare, solver_settings
 
 COORDINATE = exu.OutputVariableType.Coordinates
