@@ -15,8 +15,9 @@ blow, after one warm-up run (numba's compiled kernels load from disk once per pr
 segments per rod, the piston at twice that) and four_rod_string.yaml with wave rods (and lumped at 4 and 16):
 penetration rate, largest rod stress, the rock's share of the blow energy, peak rock force, CPU (64 segments
 per rod would take Exudyn's standard preset about an hour per run on this machine).
-``--strings --fine``: the lumped rods of both scenes at 16, 32 and 64 segments per rod in the exact formulation
-(the convergence of the lumped model towards the waves).
+``--strings --fine [--segments 16,32,64] [--scenes top_hammer_piston,four_rod_string]``: the lumped rods of
+the scenes at these segments per rod in the exact formulation (the convergence of the lumped model towards
+the waves).
 ``--lumped-lundberg``: Lundberg's check on lumped rods of 64 to 512 segments (Exudyn, reference preset),
 the dispersion the wave element removes.
 """
@@ -157,7 +158,8 @@ def checks() -> None:
               f"crossing energy - (1 - R^2) {crossed:+.1e} | {cpu:.2f} |")
 
 
-def strings(fine: bool = False) -> None:
+def strings(fine: bool = False, refined: tuple[int, ...] = (16, 32, 64),
+            scenes: tuple[str, ...] = ("top_hammer_piston", "four_rod_string")) -> None:
     print("| scene | model | formulation | penetration rate mm/s | largest rod stress MPa | rock energy / blow energy "
           "| peak rock force kN | CPU s |")
     print("|---|---|---|---|---|---|---|---|")
@@ -168,8 +170,7 @@ def strings(fine: bool = False) -> None:
               ("four_rod_string", "lumped", "exact", 4)]
     cases += [("four_rod_string", "lumped", "exudyn", n) for n in (4, 16)]
     if fine:  # the lumped rods refined in the exact formulation: do they go to the waves?
-        cases = [(name, "lumped", "exact", n) for name in ("top_hammer_piston", "four_rod_string")
-                 for n in (16, 32, 64)]
+        cases = [(name, "lumped", "exact", n) for name in scenes for n in refined]
     for name, model, formulation, segments in cases:
         data = read_yaml(f"studies/scenes/{name}.yaml")
         bodies = data["drill_string"]["bodies"]
@@ -203,13 +204,17 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--checks", action="store_true")
     parser.add_argument("--strings", action="store_true")
     parser.add_argument("--lumped-lundberg", action="store_true")
-    parser.add_argument("--fine", action="store_true", help="--strings: lumped rods at 16, 32, 64 segments, exact")
+    parser.add_argument("--fine", action="store_true", help="--strings: lumped rods refined (--segments), exact")
+    parser.add_argument("--segments", type=lambda text: tuple(int(n) for n in text.split(",")), default=(16, 32, 64),
+                        help="--fine: segments per rod (default 16,32,64)")
+    parser.add_argument("--scenes", type=lambda text: tuple(text.split(",")),
+                        default=("top_hammer_piston", "four_rod_string"), help="--fine: these scenes only")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")  # Exudyn's printed notes
     if args.checks or not (args.strings or args.lumped_lundberg):
         checks()
     if args.strings:
-        strings(args.fine)
+        strings(args.fine, args.segments, args.scenes)
     if args.lumped_lundberg:
         lumped_lundberg()
 
