@@ -356,7 +356,8 @@ def test_advise_keeps_the_shipped_scenes_rods_below_the_stress_bound(tmp_path, m
     (one blow of the scene, measured at 40 Hz and 20 kN), so the bound binds: the best of all points run is
     above it, the advice's best point is below it, slower, at a higher frequency. The scene is the shipped
     one run for one blow; the curves and the map are coarser than the command's (4 x 4, 5 points a curve)
-    to keep the test at a minute: what is checked is the search's answer, not those grids."""
+    to keep the test at a minute: what is checked is the search's answer, not those grids. The library call
+    with the same inputs and folder gives the same advice, replaying every point."""
     from rpdrill.studies.advice import advice_search
 
     monkeypatch.setattr(advice_search, "MAP_POINTS", 4)
@@ -379,6 +380,13 @@ def test_advise_keeps_the_shipped_scenes_rods_below_the_stress_bound(tmp_path, m
     assert fastest["rod_stress_max_pa"] > 400e6 and advice["beyond_stress"] > 0
     assert fastest["value"] > advice["best_value"]
     assert advice["best"]["impact.frequency_hz"] > fastest["point"]["impact.frequency_hz"]
+    import rpdrill  # the library call with the same inputs: the same advice, every point replayed from out
+
+    (library,) = rpdrill.advise(str(path), {"impact.frequency_hz": (40.0, 80.0), "feed.force_n": (5e3, 20e3)},
+                                power_kw=15.0, search=rpdrill.AdviceSearch(popsize=4, max_generations=2), workers=1,
+                                out=str(out), max_rod_stress_pa=400e6)
+    assert library.replayed == library.runs > 0
+    assert library.best == advice["best"] and library.best_rod_stress_pa == advice["best_rod_stress_pa"] <= 400e6
 
 
 def test_advise_refuses_a_stress_bound_that_is_not_positive():
