@@ -35,10 +35,14 @@ ROLES = {
                          "the registry of formulations and their solver keys.",
     "models.drill": "The drill string's mechanics: the chain of bodies and connectors (incidence, stiffness, "
                     "static preload), its modes, its piecewise-linear modes of contact, the impact pulse, bit "
-                    "indexing.",
+                    "indexing, the piston, a rod as a wave element (impedance, transit time, its ends' law).",
     "models.evaluation": "What a run gives: the result and its time series, the energy account, metrics, "
                          "stability checks and step bounds, the solver presets, comparisons between runs, "
                          "work-precision fronts, stress-wave checks.",
+    "models.waves": "Rods carried as waves: the characteristics at a stated step (the waves in flight, "
+                    "stored per rod end), the linear system of bodies, massless faces and arriving waves between "
+                    "two grid times integrated exactly (its compiled fast path, its works), the static preload "
+                    "and step of such a drill, and the exact and Exudyn formulations of a scene with wave rods.",
     "models.steady": "The drill's steady state found, not waited for: the periodic orbit relative to the borehole "
                      "bottom by shooting (the exact map's Jacobian from matrix exponentials and saltation "
                      "matrices, finite differences for the other formulations), its Floquet multipliers, the "

@@ -100,10 +100,10 @@ def test_points_run_on_a_base_scene_with_default_solver(tmp_path):
 
 def test_a_study_collects_every_metric_a_run_gives():
     """Without ``metrics`` a study collects every metric (models.definition.outputs.METRICS), the same a
-    run of its scene gives (those of a piston scene left out)."""
+    run of its scene gives (those of a piston scene and of a scene with rods left out)."""
     scene = rpdrill.Scene.model_validate({**scene_dict(), "metrics": SHORT["metrics"], "solver": {"end_time_s": 0.1}})
-    piston_only = {name for name, need in METRICS.items() if "piston" in need.data}  # a piston scene's
-    assert piston_only and set(rpdrill.simulate(scene).metrics) == set(METRICS) - piston_only
+    elsewhere = {name for name, need in METRICS.items() if {"piston", "rods"} & need.data}  # outputs: RODS
+    assert elsewhere and set(rpdrill.simulate(scene).metrics) == set(METRICS) - elsewhere
 
 
 def test_study_hash_is_the_json_of_its_scenes_and_metrics(tmp_path):

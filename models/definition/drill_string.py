@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Annotated
+from typing import Annotated, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
@@ -63,6 +63,12 @@ class Body(Strict):
     masses joined by springs E A N / L (a discrete wave-guide, docs/extending.md). A pipe given by
     ``length_m`` and ``mass_per_length_kg_per_m`` alone is a rigid body of that mass (no E A). A rigid
     ``mass_kg`` may state its ``diameter_m``: only its drawings use it (models.drill.shapes).
+
+    ``model`` chooses how a rod is carried: ``lumped`` (default) as its ``segments`` lumped masses, or
+    ``waves`` as an exact 1-D wave element between its two end faces (models.waves: d'Alembert's waves,
+    impedance Z = A sqrt(E rho), transit time L / c; no segments). A wave rod's faces are massless and
+    rigid: a connector without a stiffness joins them rigidly (a wave rod on a wave rod of another
+    section is an impedance step).
     """
 
     mass_kg: Positive | None = Field(None, description="rigid body mass; not with a rod geometry")
@@ -73,6 +79,7 @@ class Body(Strict):
     youngs_modulus_pa: Positive = STEEL_YOUNGS_MODULUS_PA
     density_kg_per_m3: Positive = STEEL_DENSITY_KG_PER_M3
     segments: Annotated[int, Field(ge=1, le=MAX_CHAIN_BODIES)] = 1
+    model: Literal["lumped", "waves"] = Field("lumped", description="a rod as lumped segments or as waves")
 
     @model_validator(mode="after")
     def _mass_or_geometry(self) -> Body:
@@ -87,7 +94,17 @@ class Body(Strict):
             raise ValueError(f"bore_diameter_m {self.bore_diameter_m} must be smaller than diameter_m {self.diameter_m}")
         if self.segments > 1 and not self.is_rod:
             raise ValueError("segments > 1 needs a rod geometry (length_m, diameter_m)")
+        if self.model == "waves" and not self.is_rod:
+            raise _key_error("Body", ("model",), self.model, "a wave rod needs a rod geometry (length_m, diameter_m)")
+        if self.model == "waves" and self.segments > 1:
+            raise _key_error("Body", ("segments",), self.segments, "segments are the lumped model's; a rod with "
+                             "model: waves carries its waves exactly and has none (leave segments out)")
         return self
+
+    @property
+    def is_wave(self) -> bool:
+        """Whether the rod is carried as waves (``model: waves``)."""
+        return self.model == "waves"
 
     @property
     def is_rod(self) -> bool:
@@ -114,8 +131,9 @@ class Body(Strict):
         return math.sqrt(self.youngs_modulus_pa / self.density_kg_per_m3)
 
     def half_segment_compliance_m_per_n(self) -> float:
-        """(L/N) / (2 E A): the compliance of half a segment (0 for a rigid body)."""
-        if not self.is_rod:
+        """(L/N) / (2 E A): the compliance of half a segment (0 for a rigid body and for a wave rod, whose
+        faces are rigid)."""
+        if not self.is_rod or self.is_wave:
             return 0.0
         return self.length_m / self.segments / (2 * self.youngs_modulus_pa * self.area_m2)
 
@@ -180,6 +198,10 @@ class DrillString(Strict):
             ends = [self.bodies[b] for b in (connector.from_body, connector.to_body) if b != GROUND]
             if connector.stiffness_n_per_m is None and not any(b.is_rod for b in ends):
                 raise ValueError(f"connectors.{name} needs stiffness_n_per_m: neither end is a rod with a geometry")
+            if connector.stiffness_n_per_m is None and all(b.half_segment_compliance_m_per_n() == 0 for b in ends) \
+                    and connector.from_body == GROUND:
+                raise _key_error("DrillString", ("connectors", name, "stiffness_n_per_m"), None, "needed: a wave rod's "
+                                 "face joined to ground without a stiffness would be held fixed")
         total = sum(body.segments for body in self.bodies.values())
         if total > MAX_CHAIN_BODIES:
             largest = max(self.bodies, key=lambda name: self.bodies[name].segments)

@@ -41,7 +41,7 @@ FORMULATIONS: dict[str, Formulation] = {f.name: f for f in (
                 ("type", "step_s", "spectral_radius", "relative_tolerance", "absolute_tolerance"),
                 "the Exudyn multibody model"),
     Formulation("exact", "exact_model",
-                ("sample_interval_s", "min_switch_interval_s", "max_switches_per_blow"),
+                ("sample_interval_s", "min_switch_interval_s", "max_switches_per_blow", "wave_step_s"),
                 "exact piecewise-linear propagation between located switches", checks="exact_system"),
     Formulation("ode", "ode_model",
                 ("method", "relative_tolerance", "absolute_tolerance", "sample_interval_s"),

@@ -41,6 +41,11 @@ class Link:
 
     linear: ClassVar[bool] = True
 
+    @property
+    def rigid(self) -> bool:
+        """Infinitely stiff (rigid faces joined without a stiffness: models.waves): a constraint, not a spring."""
+        return self.stiffness_n_per_m == float("inf")
+
     def stretch(self, values: Any) -> Any:
         """delta = x_b - x_a (x_a = 0 for ground) from a state's positions, or its rate from velocities."""
         return values[self.body_b] - (0.0 if self.body_a is None else values[self.body_a])

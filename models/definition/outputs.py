@@ -30,6 +30,9 @@ FORCES = _need(data=("forces",))
 ENERGY = _need(data=("forces", "energy"))
 # a piston scene's piston histories (models.drill.piston); an output that needs them needs impact.piston
 PISTON = _need(data=("forces", "piston"))
+# the rods' figures per blow (models.evaluation.rod_outputs): every step stored, forces; a default output only of a
+# scene with rods (a drill without rods, the paper's, keeps its outputs)
+RODS = _need(data=("forces", "energy", "rods"))
 
 METRICS: dict[str, Need] = {
     "penetration_rate_m_per_s": PENETRATION,
@@ -52,6 +55,11 @@ METRICS: dict[str, Need] = {
     "energy_transfer_efficiency": _need(("rock_plasticity",), ("forces", "energy")),
     "energy_balance_relative_error": ENERGY,
     "piston_rebound_energy_j": PISTON,
+    # rods (models.evaluation.rod_outputs): the largest stress at any rod's end in the window's blows (compression
+    # or tension), the rock's energy per blow int F_r v_bit dt and its share of the energy the blows put in
+    "rod_stress_max_pa": RODS,
+    "rock_energy_per_blow_j": RODS,
+    "rock_transfer_efficiency": RODS,
     # advance over the window / the blow energy of its blows (= penetration rate / hammer power E_blow f)
     "penetration_per_blow_energy_m_per_j": _need(("rock_plasticity",), ("piston",)),
     "window_start_s": PLAIN,
@@ -74,7 +82,13 @@ SERIES: dict[str, Need] = {
 
 # Outputs of one part, named "<part><suffix>". Metrics of any body of the drill string by name (a rod's
 # name: its last segment; a segment by its own name, ``rod[0]``): ``collar_velocity_peak_m_per_s`` above is one.
-BODY_METRICS: dict[str, Need] = {"_velocity_peak_m_per_s": PLAIN, "_velocity_rms_m_per_s": PLAIN}
+BODY_METRICS: dict[str, Need] = {"_velocity_peak_m_per_s": PLAIN, "_velocity_rms_m_per_s": PLAIN,
+                                  # a rod's (models.evaluation.rod_outputs): the largest stress at its ends in the
+                                  # window's blows, and the energy per blow through its top and bottom along +x
+                                  "_compressive_stress_max_pa": RODS, "_tensile_stress_max_pa": RODS,
+                                  "_energy_in_per_blow_j": RODS, "_energy_out_per_blow_j": RODS}
+# Histories of every rod's ends (stress, compression positive), besides the links' (always there).
+ROD_SERIES = ("_top_stress_pa", "_bottom_stress_pa")
 # Histories every link of the chain (the scene's connectors, a rod's inner links ``rod[0-1]``) always has, from
 # the bodies' positions and velocities (models.evaluation.parts): its force, positive in compression, and its compression
 # x_a - x_b (ground: x = 0); a coupling also the opening of its gap.

@@ -132,7 +132,8 @@ class Solver(Strict):
     the largest step for dopri5/ode23), ``spectral_radius``, ``relative_tolerance``,
     ``absolute_tolerance``; ode ``method``, ``relative_tolerance``, ``absolute_tolerance`` (SI units
     of the state), ``sample_interval_s`` (dense-output sampling); exact ``sample_interval_s``,
-    ``min_switch_interval_s``, ``max_switches_per_blow``. A preset fills the options not given;
+    ``min_switch_interval_s``, ``max_switches_per_blow``, ``wave_step_s`` (the step of the
+    characteristics of wave rods, models.waves; Exudyn's wave step is its ``step_s``). A preset fills the options not given;
     without a preset and without explicit accuracy options the ``standard`` preset applies
     (models.evaluation.solver_settings resolves them once per run). ``steady_state`` (every formulation):
     ``time`` (default) runs from the start to the end time and averages the blocks after the transient;
@@ -153,6 +154,7 @@ class Solver(Strict):
     sample_interval_s: Positive | None = None
     min_switch_interval_s: Positive | None = None
     max_switches_per_blow: Annotated[int, Field(ge=1, le=MAX_COUNT)] | None = None
+    wave_step_s: Positive | None = None
     steady_state: Literal[STEADY_STATES] = DEFAULT_STEADY_STATE  # type: ignore[valid-type]
 
     @model_validator(mode="after")
@@ -295,6 +297,11 @@ class Scene(Strict):
             raise ValueError(f"outputs {', '.join(pistonless)} need a piston (impact.piston)")
         bodies = {f"{name}[{i}]" if body.segments > 1 else name for name, body in self.drill_string.bodies.items()
                   for i in range(body.segments)} | set(self.drill_string.bodies)
+        rods = {name for name, body in self.drill_string.bodies.items() if body.is_rod}
+        rodless = [o for o in outputs.metrics if "rods" in _need(o).data and _need(o).bodies and not _need(o).bodies <= rods
+                   and _need(o).bodies <= bodies] + ([o for o in outputs.metrics if o == "rod_stress_max_pa"] if not rods else [])
+        if rodless:
+            raise ValueError(f"outputs {', '.join(rodless)} need a rod (a body with length_m and diameter_m)")
         missing = [o for o in outputs.metrics + outputs.timeseries if not _need(o).bodies <= bodies]
         if missing:
             absent = set().union(*(_need(o).bodies for o in missing)) - bodies
@@ -384,12 +391,17 @@ def built_effects(scene: Scene) -> BuiltEffects:
 
 def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
     """The scene's outputs, or without an outputs section every metric and history of the effects
-    built and the bodies present."""
+    built and the bodies present (a scene with rods: each rod's figures too, ``<rod>_compressive_stress_max_pa``
+    ...: models.definition.outputs.BODY_METRICS of the rods' data)."""
     if scene.outputs is not None:
         return scene.outputs
     built = {effect for effect, on in effects.as_dict().items() if on}
     bodies = set(scene.drill_string.bodies)
+    rods = any(body.is_rod for body in scene.drill_string.bodies.values())
     def available(need: Need) -> bool:
-        return need.effects <= built and need.bodies <= bodies and _has_piston_data(scene, need)
-    return Outputs(metrics=[m for m, n in METRICS.items() if available(n)],
+        return need.effects <= built and need.bodies <= bodies and _has_piston_data(scene, need) and \
+            (rods or "rods" not in need.data)
+    per_rod = [f"{name}{suffix}" for name, body in scene.drill_string.bodies.items() if body.is_rod
+               for suffix, need in BODY_METRICS.items() if "rods" in need.data]
+    return Outputs(metrics=[m for m, n in METRICS.items() if available(n)] + per_rod,
                    timeseries=[s for s, n in SERIES.items() if available(n)])

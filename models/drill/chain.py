@@ -5,12 +5,16 @@ Every formulation assembles from this one description (built from a scene's ``dr
 solver cannot disagree on the topology. The chain owns the first-order form of its linear part,
 :meth:`AxialChain.first_order_matrix`, which the ODE, the exact solver and the stability limits use. A rod of ``segments`` N becomes N lumped masses
 ``name[0]`` .. ``name[N-1]`` joined by springs E A N / L; connectors attach to a rod's first
-segment (``to``) and last segment (``from``).
+segment (``to``) and last segment (``from``). A rod with ``model: waves`` becomes its two end faces,
+massless nodes ``name[top]`` and ``name[bottom]``, and a wave element between them
+(``AxialChain.waves``, models.drill.wave_rod); a connector without a stiffness that joins only rigid faces
+(a wave rod's, a rigid body's) is rigid (stiffness infinite: :attr:`Link.rigid`).
 """
 
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +25,7 @@ from ..definition.drill_string import EVERY_BODY, GROUND, Body, Connector
 from ..definition.links import CLOSED as CLOSED_MODE
 from ..definition.links import LINK_TYPES, RATE, STRETCH, Link
 from ..definition.scene import Scene, Torsion
+from .wave_rod import WaveRod, wave_rod
 
 
 @dataclass(frozen=True)
@@ -39,10 +44,16 @@ class AxialChain:
     impact_body: int
     bit_body: int
     groups: dict[str, tuple[int, int]]  # drill-string body name -> (first, last) chain index
+    waves: tuple[WaveRod, ...] = ()  # the rods carried as waves, between their face nodes (massless)
 
     @property
     def size(self) -> int:
         return len(self.bodies)
+
+    @property
+    def massless(self) -> tuple[int, ...]:
+        """The nodes without mass: the faces of the wave rods."""
+        return tuple(i for i, body in enumerate(self.bodies) if body.mass_kg == 0.0)
 
     @property
     def is_linear(self) -> bool:
@@ -58,6 +69,11 @@ class AxialChain:
             if body.name == name:
                 return i
         raise KeyError(f"no body {name!r} in the drill string; bodies: {', '.join(b.name for b in self.bodies)}")
+
+    def rigid_pairs(self) -> list[tuple[int, int]]:
+        """The (a, b) nodes of every rigid link (rigid faces joined without a stiffness)."""
+        return [(link.body_a, link.body_b) for link in self.links
+                if link.linear and link.rigid and link.body_a is not None]
 
     def _assemble(self, attribute: str, links: tuple[Link, ...]) -> np.ndarray:
         """D^T diag(values) D: the links' stiffness or damping matrix, from their incidence D."""
@@ -126,10 +142,28 @@ class AxialChain:
         stretch, rate = incidence @ positions.T, incidence @ velocities.T
         elastic, damping = np.zeros(len(positions)), np.zeros(len(positions))
         for link, delta, delta_rate in zip(self.links, stretch, rate, strict=True):
+            if link.rigid:  # a constraint stores and dissipates nothing
+                continue
             spring = link.spring_force_n(delta)
             elastic += spring**2 * (0.5 / link.stiffness_n_per_m)
             damping += (link.force_n(delta, delta_rate) - spring) * delta_rate
         return elastic, damping
+
+
+def joined(size: int, pairs: list[tuple[int, int]], keep: frozenset[int] = frozenset()) -> list[int]:
+    """The representative node of each of ``size`` nodes joined through ``pairs`` (a node of ``keep``
+    represents its group when one is in it)."""
+    parent = list(range(size))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            i = parent[i]
+        return i
+    for a, b in pairs:
+        a, b = find(a), find(b)
+        if a != b:
+            parent[b if b not in keep else a] = a if b not in keep else b
+    return [find(i) for i in range(size)]
 
 
 def _derived_stiffness_n_per_m(ends: list[Body]) -> float:
@@ -147,9 +181,15 @@ def axial_chain(scene: Scene, joint_damping: bool = True) -> AxialChain:
     bodies: list[ChainBody] = []
     links: list[Link] = []
     groups: dict[str, tuple[int, int]] = {}
+    waves: list[WaveRod] = []
     for name, body in string.bodies.items():
         n, first = body.segments, len(bodies)
         force = feed.force_n if feed.acts_on in (EVERY_BODY, name) else 0.0
+        if body.is_wave:  # two massless faces; the feed on the top face (module doc of models.waves)
+            bodies += [ChainBody(f"{name}[top]", 0.0, force), ChainBody(f"{name}[bottom]", 0.0, 0.0)]
+            groups[name] = (first, first + 1)
+            waves.append(wave_rod(name, body, first, first + 1))
+            continue
         bodies += [ChainBody(name if n == 1 else f"{name}[{i}]", body.total_mass_kg / n, force / n) for i in range(n)]
         groups[name] = (first, first + n - 1)
         links += [Link(f"{name}[{i}-{i + 1}]", first + i, first + i + 1,
@@ -157,14 +197,16 @@ def axial_chain(scene: Scene, joint_damping: bool = True) -> AxialChain:
     for name, connector in string.connectors.items():
         links.append(_connector_link(scene, name, connector, groups, joint_damping))
     return AxialChain(tuple(bodies), tuple(links), impact_body=groups[string.impact_body][0],
-                      bit_body=groups[string.rock_body][1], groups=groups)
+                      bit_body=groups[string.rock_body][1], groups=groups, waves=tuple(waves))
 
 
 def _connector_link(scene: Scene, name: str, connector: Connector, groups: dict[str, tuple[int, int]],
                     damped: bool) -> Link:
     bodies = scene.drill_string.bodies
     ends = [bodies[b] for b in (connector.from_body, connector.to_body) if b != GROUND]
-    stiffness = connector.stiffness_n_per_m or _derived_stiffness_n_per_m(ends)
+    compliance = sum(body.half_segment_compliance_m_per_n() for body in ends)
+    rigid = math.inf if compliance == 0 else None  # rigid faces joined without a stiffness (module doc)
+    stiffness = connector.stiffness_n_per_m or rigid or _derived_stiffness_n_per_m(ends)
     body_a = None if connector.from_body == GROUND else groups[connector.from_body][1]
     extra = {key: getattr(connector, key) for key in LINK_TYPES[connector.type].parameters()
              if getattr(connector, key) is not None}

@@ -23,7 +23,10 @@ from .chain import AxialChain
 
 def rock_mode_frequency_hz(chain: AxialChain, rock: RockLaw) -> float:
     """Damped natural frequency omega_d / (2 pi) of the rock mode (module docstring) with the rock's
-    loading stiffness and damping; 0.0 when that mode is overdamped."""
+    loading stiffness and damping; 0.0 when that mode is overdamped, or when the chain has rods carried as
+    waves (their faces are massless: a rod's modes are not those of a mass matrix, and none is computed)."""
+    if chain.waves:
+        return 0.0
     rock_stiffness = rock.loading_stiffness_n_per_m
     size, bit = chain.size, chain.bit_body
     system = chain.first_order_matrix(chain.links, rock_stiffness, rock.damping_n_s_per_m)[:, :-1]

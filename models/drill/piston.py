@@ -49,6 +49,7 @@ from ..definition.drill_string import Body
 from ..definition.links import CLOSED, OPEN, STRETCH, Coupling, Link
 from ..definition.scene import Piston, Scene
 from .chain import AxialChain, ChainBody
+from .wave_rod import wave_rod
 
 PISTON = "piston"
 CONTACT = "piston_contact"
@@ -104,10 +105,14 @@ def contact_coupling_n_per_m(piston: Piston, struck: Body) -> float | None:
     stiffness k_c (``piston.contact_stiffness_n_per_m``; rigid faces when not given) in series with the
     half-segments behind the faces (a rod's lumped masses sit at its segments' centres, its faces are
     massless): 1/k = 1/k_c + L_p / (2 E_p A_p N_p) + L_s / (2 E_s A_s N_s) (a rigid body adds no
-    half-segment). None when nothing is compliant (a rigid piston on a rigid body, k_c not given)."""
+    half-segment, nor does a wave rod, whose faces are massless nodes: models.waves). Infinite (a
+    rigid contact, a constraint while closed) when nothing is compliant and a side is a wave rod; None
+    when nothing is compliant between two bodies with mass (a rigid piston on a rigid body, k_c not given)."""
     compliance = piston.half_segment_compliance_m_per_n() + struck.half_segment_compliance_m_per_n()
     if piston.contact_stiffness_n_per_m is not None:
         compliance += 1.0 / piston.contact_stiffness_n_per_m
+    if compliance == 0 and (piston.is_wave or struck.is_wave):
+        return math.inf
     return 1.0 / compliance if compliance > 0 else None
 
 
@@ -148,16 +153,22 @@ class PistonSetup:
 
     @property
     def segments(self) -> int:
-        return self.scene_piston.segments
+        """The piston's nodes: its lumped bodies, or a wave rod's two faces."""
+        return 2 if self.scene_piston.is_wave else self.scene_piston.segments
 
     @property
     def mass_kg(self) -> float:
-        return self.segment_mass_kg * self.segments
+        return self.scene_piston.total_mass_kg
 
     @property
     def blow_energy_j(self) -> float:
         """E_blow = m_p v_p^2 / 2."""
         return 0.5 * self.mass_kg * self.strike_velocity_m_per_s**2
+
+    @property
+    def momentum_n_s(self) -> float:
+        """m_p v_p, the most impulse a blow can give (the scale of a wave piston's rest: models.waves.stepping)."""
+        return self.mass_kg * self.strike_velocity_m_per_s
 
     @property
     def bodies(self) -> slice:
@@ -174,20 +185,30 @@ class PistonSetup:
                              piston_bodies=tuple(range(self.first, self.front + 1)))
 
     def internal_links(self) -> tuple[Link, ...]:
+        if self.scene_piston.is_wave:
+            return ()
         return tuple(Link(f"{PISTON}[{i}-{i + 1}]", self.first + i, self.first + i + 1,
                           self.segment_stiffness_n_per_m, 0.0) for i in range(self.segments - 1))
 
     def dynamic_chain(self, chain: AxialChain) -> AxialChain:
         """The drill string's chain with the piston's bodies appended (no feed on them), its springs and
         the contact: what the formulations integrate."""
+        groups = {**chain.groups, PISTON: (self.first, self.front)}
+        if self.scene_piston.is_wave:  # two massless faces and the rod's waves between them (models.waves)
+            faces = (ChainBody(f"{PISTON}[top]", 0.0, 0.0), ChainBody(f"{PISTON}[bottom]", 0.0, 0.0))
+            rod = wave_rod(PISTON, self.scene_piston, self.first, self.front)
+            return replace(chain, bodies=chain.bodies + faces, links=chain.links + (self.contact_link(),),
+                           groups=groups, waves=chain.waves + (rod,))
         names = [PISTON] if self.segments == 1 else [f"{PISTON}[{i}]" for i in range(self.segments)]
         bodies = chain.bodies + tuple(ChainBody(name, self.segment_mass_kg, 0.0) for name in names)
         return replace(chain, bodies=bodies, links=chain.links + self.internal_links() + (self.contact_link(),),
-                       groups={**chain.groups, PISTON: (self.first, self.front)})
+                       groups=groups)
 
     def contact_force_n(self, position_m: np.ndarray) -> np.ndarray:
         """F_c = k_c max(x_front - x_impact, 0) for (..., bodies) positions of the dynamic chain."""
         closure = position_m[..., self.front] - position_m[..., self.impact_body]
+        if math.isinf(self.contact_stiffness_n_per_m):  # a rigid contact: a constraint (models.waves gives it)
+            return np.zeros_like(closure)
         return self.contact_stiffness_n_per_m * np.maximum(closure, 0.0)
 
     def mean_velocity_m_per_s(self, velocity_m_per_s: np.ndarray) -> np.ndarray:
@@ -200,7 +221,7 @@ class PistonSetup:
         strain = 0.5 * self.segment_stiffness_n_per_m * np.sum(np.diff(position_m[..., self.bodies], axis=-1) ** 2,
                                                                 axis=-1)
         contact = self.contact_force_n(position_m) ** 2 / (2.0 * self.contact_stiffness_n_per_m)
-        return kinetic + strain + contact
+        return kinetic + strain + contact  # a wave piston's energy is in its waves (models.waves)
 
     def strike(self, position_m: np.ndarray, velocity_m_per_s: np.ndarray) -> None:
         """The strike (module doc), in place on a state of the dynamic chain."""
@@ -234,7 +255,7 @@ def piston_setup(scene: Scene, chain: AxialChain) -> PistonSetup | None:
         raise ValueError("a rigid piston striking a rigid impact body: give impact.piston.contact_stiffness_n_per_m "
                          "(without it the faces are rigid and only a rod's half-segments are compliant)")
     n = piston.segments
-    if piston.is_rod:
+    if piston.is_rod:  # a wave rod's segment values are unused
         duration = 2.0 * piston.length_m / piston.wave_speed_m_per_s
         segment_stiffness = piston.youngs_modulus_pa * piston.area_m2 * n / piston.length_m
     elif struck.is_rod:
@@ -257,13 +278,21 @@ class PistonJumps:
 
     setup: PistonSetup
     log: list[tuple[float, str, float, float]] = field(default_factory=list)
+    # what a strike puts in when it is not m_p v_p^2 / 2: a wave piston's, over its transit time as run
+    # (models.waves: a whole number of steps)
+    blow_energy_j: float | None = None
     rows: list[int] = field(default_factory=list)  # per log entry, the first sample after it (if known)
     caught: bool = True  # no blow before the first strike
 
     def _note(self, time_s: float, kind: str, position_m: np.ndarray, velocity_m_per_s: np.ndarray,
               row: int | None) -> None:
-        self.log.append((time_s, kind, float(self.setup.energy_j(position_m, velocity_m_per_s)),
-                         float(self.setup.mean_velocity_m_per_s(velocity_m_per_s))))
+        self.note(time_s, kind, float(self.setup.energy_j(position_m, velocity_m_per_s)),
+                  float(self.setup.mean_velocity_m_per_s(velocity_m_per_s)), row)
+
+    def note(self, time_s: float, kind: str, energy_j: float, velocity_m_per_s: float, row: int | None = None) -> None:
+        """Log a jump with the piston's energy and mean velocity just before it (a wave piston's from its
+        waves: models.waves)."""
+        self.log.append((time_s, kind, energy_j, velocity_m_per_s))
         if row is not None:
             self.rows.append(row)
 
@@ -291,7 +320,7 @@ class PistonJumps:
 
     @property
     def events(self) -> list[tuple[float, float]]:
-        blow = self.setup.blow_energy_j
+        blow = self.setup.blow_energy_j if self.blow_energy_j is None else self.blow_energy_j
         return [(t, blow - energy if kind == "strike" else -energy) for t, kind, energy, _ in self._ordered()]
 
     @property
@@ -306,7 +335,7 @@ class PistonJumps:
     def input_by_row(self, samples: int) -> np.ndarray:
         """The energy the jumps put in up to each of ``samples`` samples, from the first sample after each
         jump (every jump noted with its ``row``)."""
-        blow = self.setup.blow_energy_j
+        blow = self.setup.blow_energy_j if self.blow_energy_j is None else self.blow_energy_j
         put_in = np.zeros(samples + 1)
         for (_, kind, energy, _), row in zip(self.log, self.rows, strict=True):
             put_in[row] += blow - energy if kind == "strike" else -energy
@@ -337,6 +366,7 @@ class PistonHistory:
     contact_force_n: np.ndarray
     input_j: np.ndarray
     rebounds: np.ndarray
+    energy_j: np.ndarray | None = None  # E_p where the formulation gives it (a wave piston's, in its waves)
 
     @property
     def mean_velocity_m_per_s(self) -> np.ndarray:
@@ -356,6 +386,8 @@ def piston_history(setup: PistonSetup, jumps: PistonJumps, time_s: np.ndarray, p
 def piston_energy_j(history: PistonHistory, impact_position_m: np.ndarray) -> np.ndarray:
     """E_p at the samples of a history (module doc), from the piston's states and the impact body's
     position."""
+    if history.energy_j is not None:
+        return history.energy_j
     setup = history.setup
     positions = np.column_stack([np.zeros((len(impact_position_m), setup.first)), history.position_m])
     positions[:, setup.impact_body] = impact_position_m

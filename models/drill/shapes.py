@@ -1,6 +1,7 @@
 """The drill string as steel cylinders along the drilling axis: what Exudyn's graphics and the drawings show.
 
-A rod is drawn from its geometry (outer and bore diameter; each of its N segments L / N long). Any
+A rod is drawn from its geometry (outer and bore diameter; each of its N segments L / N long; a rod
+carried as waves as its two faces' halves, one cylinder per node of the chain as for segments). Any
 other body is a solid cylinder of its ``diameter_m`` (a rigid body may state one) or
 :data:`DEFAULT_DIAMETER_M`, as long as its ``length_m`` (a pipe) or, for a rigid ``mass_kg``, as long
 as that mass of its density (steel unless given) makes it: L = m / (rho pi D^2 / 4). The shapes do
@@ -25,7 +26,8 @@ DEFAULT_DIAMETER_M = 0.15  # a rigid body without a stated diameter: about a 6 i
 
 @dataclass(frozen=True)
 class Cylinder:
-    """One chain body (a rod segment ``rod[0]`` too) as a cylinder along the axis, at rest."""
+    """One chain body (a rod segment ``rod[0]``, a wave rod's face ``rod[top]`` too) as a cylinder along the
+    axis, at rest."""
 
     name: str
     group: str  # the scene's body name
@@ -93,11 +95,13 @@ def layout(scene: Scene) -> Layout:
     x = 0.0
     for name in axial_order(scene):
         length, diameter, bore = sizes[name]
-        n = bodies[name].segments
+        parts = [f"{name}[{i}]" for i in range(bodies[name].segments)] if bodies[name].segments > 1 else [name]
+        if bodies[name].is_wave:  # the chain's two face nodes (models.drill.chain): each drawn as half the rod
+            parts = [f"{name}[top]", f"{name}[bottom]"]
         placed[name] = []
-        for i in range(n):
-            placed[name].append(Cylinder(name if n == 1 else f"{name}[{i}]", name, x, length / n, diameter, bore))
-            x += length / n
+        for part in parts:
+            placed[name].append(Cylinder(part, name, x, length / len(parts), diameter, bore))
+            x += length / len(parts)
         x += gap
     cylinders = tuple(cylinder for name in bodies for cylinder in placed[name])  # the chain's order
     return Layout(cylinders, gap, placed[scene.drill_string.rock_body][-1].end_m)

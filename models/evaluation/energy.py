@@ -6,6 +6,7 @@ with W_impact = int F_d v_shank dt, W_feed = sum_i F_i (x_i - x_i(0)) (+ (M_x - 
 E_elastic including what the rock stores, F_spring^2 / (2 k_unload) (rocklaw.base.RockLaw),
 D_damping = int of every damper's power (joints, shock absorber, the rock damper, c_x), and
 W_crushing the rock law's plastic work int F_spring d(x_n) (Jenkins: F_th (x_n - x_n(0))).
+With wave rods (models.waves) E_elastic includes the energy of their waves in flight (kinetic and strain).
 With a piston (models.drill.piston) F_d is its contact force, and the balance takes the work in from the
 blows instead: W_piston = what the strikes and catches put in (blow energies less rebound energies)
 less the piston's energy E_piston held at the time, from its value at the start, in place of W_impact (the two agree
@@ -89,6 +90,8 @@ def energy_account(result: SimulationResult) -> EnergyAccount:
     spring_force = rock.spring_force(result.bit_position_m, result.rock_states())
     link_elastic, link_damping = chain.link_energy(x, v)
     elastic = link_elastic + 0.5 * spring_force**2 / rock.unloading_stiffness_n_per_m
+    if result.waves is not None:
+        elastic = elastic + result.waves.energy_j
     # what the rock force does beyond its spring-slider part is dissipated in the rock damper
     damping_power = link_damping + (result.rock_force_n - spring_force) * result.bit_velocity_m_per_s
     feed = (x - x[0]) @ chain.constant_forces()

@@ -20,6 +20,7 @@ import numpy as np
 from ..definition.outputs import body_metric
 from .energy import EnergyAccount, energy_account, impact_work_j
 from .results import SimulationResult
+from .rod_outputs import BOTTOM, TOP, blow_figures, rock_energy_per_blow_j, rods
 
 
 class _Window:
@@ -69,6 +70,31 @@ class _Window:
     def rms(self, values: np.ndarray) -> float:
         return float(math.sqrt(np.trapezoid(values[self.mask] ** 2, self.result.time_s[self.mask]) / self.duration))
 
+    def window_blows(self, per_blow: np.ndarray) -> np.ndarray:
+        """The window's blows of a per-blow array (blows that started in the run)."""
+        return per_blow[self.first:self.first + self.blows]
+
+    def rod_stress(self, rod: str, kind: str) -> float:
+        """The largest compression or tension (``kind``) at the rod's ends in the window's blows over its area."""
+        area = self.result.scene.drill_string.bodies[rod].area_m2
+        return max(float(np.max(self.window_blows(getattr(blow_figures(self.result, rod, end), kind)), initial=0.0))
+                   for end in (TOP, BOTTOM)) / area
+
+    def rod_energy(self, rod: str, end: str) -> float:
+        """The mean energy per blow through the rod's end along +x over the window's blows."""
+        return float(np.mean(self.window_blows(blow_figures(self.result, rod, end).energy_j)))
+
+    @cached_property
+    def rock_energy(self) -> np.ndarray:
+        return self.window_blows(rock_energy_per_blow_j(self.result))
+
+    def rock_transfer(self) -> float:
+        """The rock's energy over the energy the window's blows put in: the piston's blow energies, or the
+        pulse's impact work."""
+        piston = self.result.simulation.piston
+        put_in = self.blows * piston.blow_energy_j if piston is not None else self.impact_work
+        return float(np.sum(self.rock_energy) / put_in) if put_in > 0 else float("nan")
+
     def efficiency(self) -> float:
         """Crushing work / work put in by the impacts and the feed over the window."""
         put_in = self.impact_work + self.work(self.energy.feed_work_j)
@@ -105,6 +131,10 @@ METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
     "energy_transfer_efficiency": lambda w: w.efficiency(),
     "energy_balance_relative_error": lambda w: w.energy.relative_residual(),
     "piston_rebound_energy_j": _rebound_energy,
+    "rod_stress_max_pa": lambda w: max(w.rod_stress(rod, kind) for rod in rods(w.result.scene)
+                                       for kind in ("compression_n", "tension_n")),
+    "rock_energy_per_blow_j": lambda w: float(np.mean(w.rock_energy)),
+    "rock_transfer_efficiency": lambda w: w.rock_transfer(),
     "penetration_per_blow_energy_m_per_j": lambda w: float(
         w.per_blow.sum() / (w.blows * w.result.simulation.piston.blow_energy_j)),
     "window_start_s": lambda w: float(w.boundaries[0]),
@@ -118,6 +148,10 @@ METRIC_FUNCTIONS: dict[str, Callable[[_Window], float]] = {
 BODY_METRIC_FUNCTIONS: dict[str, Callable[[_Window, str], float]] = {
     "_velocity_peak_m_per_s": lambda w, body: w.peak(w.result.body_velocity_m_per_s(body)),
     "_velocity_rms_m_per_s": lambda w, body: w.rms(w.result.body_velocity_m_per_s(body)),
+    "_compressive_stress_max_pa": lambda w, rod: w.rod_stress(rod, "compression_n"),
+    "_tensile_stress_max_pa": lambda w, rod: w.rod_stress(rod, "tension_n"),
+    "_energy_in_per_blow_j": lambda w, rod: w.rod_energy(rod, TOP),
+    "_energy_out_per_blow_j": lambda w, rod: w.rod_energy(rod, BOTTOM),
 }
 
 

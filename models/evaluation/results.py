@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..definition.scene import Scene
 from ..drill.chain import AxialChain
 from .parts import link_series
+from .rod_outputs import stress_columns
 
 if TYPE_CHECKING:
     from ..drill.piston import PistonHistory
@@ -66,6 +67,9 @@ class SimulationResult:
     # an Exudyn model with items of one's own: their energy, and the user's sensors by name at the stored steps
     user_energy: UserEnergy | None = None
     user_series: dict[str, np.ndarray] = field(default_factory=dict)
+    # a scene with wave rods: the rods' ends at the samples, per-blow section figures, rigid joints' forces
+    # (models.waves.record.WaveRecord)
+    waves: Any = None
 
     @property
     def scene(self) -> Scene:
@@ -123,7 +127,9 @@ class SimulationResult:
         for i, body in enumerate(self.chain.bodies):
             out[f"{body.name}_position_m"] = self.position_m[:, i]
             out[f"{body.name}_velocity_m_per_s"] = self.velocity_m_per_s[:, i]
-        out.update(link_series(self.chain, self.position_m, self.velocity_m_per_s))
+        out.update(link_series(self.chain, self.position_m, self.velocity_m_per_s,
+                               None if self.waves is None else self.waves.joint_force_n))
+        out.update(stress_columns(self))
         optional = {
             "borehole_bottom_m": self.bottom_m,
             "rock_force_n": self.rock_force_n,

@@ -138,6 +138,7 @@ class ExactSettings:
     end_time_s: float
     output_interval_s: float
     preset: str | None
+    wave_step_s: float | None = None  # the characteristics' step of a scene with wave rods (models.waves.steps)
 
 
 Settings = ExudynSettings | OdeSettings | ExactSettings
@@ -164,8 +165,8 @@ def resolve_settings(solver: Solver, pulse_duration_s: float, scales: StepScales
         preset = _preset(solver, EXUDYN_ACCURACY_KEYS)
         tier = EXUDYN_PRESETS[preset or DEFAULT_PRESET]
         step = solver.step_s
-        if step is None:
-            step = tier.step(pulse_duration_s, scales)
+        if step is None:  # no scales: a scene with wave rods, whose step models.waves.steps sets
+            step = tier.step(pulse_duration_s, scales) if scales is not None else tier.step_s
         return ExudynSettings(type=solver.type or (tier.type if preset else UNPRESET_TYPE), step_s=step,
                               spectral_radius=_given(solver, "spectral_radius", 1.0),
                               relative_tolerance=_given(solver, "relative_tolerance", 1e-8),
@@ -181,4 +182,4 @@ def resolve_settings(solver: Solver, pulse_duration_s: float, scales: StepScales
     return ExactSettings(sample_interval_s=_given(solver, "sample_interval_s", solver.output_interval_s),
                          min_switch_interval_s=_given(solver, "min_switch_interval_s", 1e-12),
                          max_switches_per_blow=int(_given(solver, "max_switches_per_blow", 1000)),
-                         preset=solver.preset, **common)
+                         preset=solver.preset, wave_step_s=solver.wave_step_s, **common)

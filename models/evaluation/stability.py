@@ -127,13 +127,18 @@ def _mass_key(scene: Scene, body: str) -> tuple[str, float]:
 
 
 def fastest_element(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> FastestElement:
-    """The element of the highest rate (:class:`FastestElement`) of :func:`element_rates`."""
-    return max(element_rates(scene, chain, law, torsion), key=lambda element: element.rate_per_s)
+    """The element of the highest rate (:class:`FastestElement`) of :func:`element_rates` (a rate of 0 when
+    every element acts on a wave rod's massless face: those are integrated exactly, models.waves)."""
+    rates = element_rates(scene, chain, law, torsion)
+    if not rates:
+        return FastestElement(0.0, "drill_string", 0.0, "drill_string", 0.0)
+    return max(rates, key=lambda element: element.rate_per_s)
 
 
 def element_rates(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> list[FastestElement]:
     """The rate of every element (:class:`FastestElement`): the rock's spring and damper under the
-    bit, every link's spring and damper, the torsion line's when given."""
+    bit, every link's spring and damper, the torsion line's when given; not those that move a wave rod's
+    massless face (no rate of a mass; models.waves integrates them exactly) nor a rigid joint."""
     owner = {i: name for name, (first, last) in chain.groups.items() for i in range(first, last + 1)}
     masses = [body.mass_kg for body in chain.bodies]
     connectors = scene.drill_string.connectors
@@ -150,9 +155,11 @@ def element_rates(scene: Scene, chain: AxialChain, law: RockLaw, torsion: Torsio
                       else f"{path}.youngs_modulus_pa", moved, True),
                      (link.damping_n_s_per_m, f"{path}.damping_n_s_per_m", moved, False)]
     typical = {spring: median([e[0] for e in elements if e[3] == spring and e[0] > 0] or [1.0]) for spring in (True, False)}
-    typical_mass = median(masses)
+    typical_mass = median([m for m in masses if m > 0] or [1.0])
     candidates = []
     for value, key, moved, spring in elements:
+        if any(masses[i] == 0.0 for i in moved) or math.isinf(value):
+            continue
         inverse_mass = sum(1.0 / masses[i] for i in moved)
         rate = math.sqrt(value * inverse_mass) if spring else value * inverse_mass
         lightest = min(moved, key=lambda i: masses[i])

@@ -16,6 +16,9 @@ of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2
 * ode: T r ODE_STEPS_PER_RADIAN steps (measured), DOP853's dense output (ODE_STAGES
   states per step) and m values per sample.
 
+* a scene with wave rods (models.waves), either formulation: T / h steps of the characteristics, h the
+  wave step (models.waves.steps), at a measured cost per step and body; it stores its samples only.
+
 Histories resampled after the run (``rpdrill simulate``: every ``output_interval_s``) add 2 n + 8
 columns. Memory is 8 bytes per value times the copies held at the peak (MEMORY_COPIES,
 OUTPUT_COPIES); CPU time is steps x the measured cost of a step, a + b n^p seconds (p = 2 for the
@@ -31,9 +34,11 @@ import math
 from dataclasses import dataclass
 
 from ..definition.formulations import DEFAULT_PRESET
+from ..drill.piston import PISTON
 from ..drill.pulse import phase_pieces
 from ..evaluation.solver_settings import EXUDYN_PRESETS
 from ..evaluation.stability import element_rates
+from ..waves.steps import STEPS_PER_PULSE, STEPS_PER_TRANSIT
 from .exact_system import sub_step
 from .simulation import Simulation
 
@@ -41,7 +46,9 @@ from .simulation import Simulation
 # (a, b, p) of a + b n^p; the exact formulation with its energy works (an energy output asked for), and
 # without (a scan of the penetration rate)
 CPU_S_PER_STEP = {"exudyn": (3e-6, 6e-7, 1), "exact": (2.6e-7, 3.2e-9, 2), "exact without energy": (1e-7, 2.9e-9, 2),
-                  "ode": (4.5e-4, 0.0, 1)}
+                  "ode": (4.5e-4, 0.0, 1),
+                  # a step of the characteristics (benchmarks/bench_waves.py --strings: 14 and 12 bodies)
+                  "exact waves": (0.0, 2e-6, 1), "exudyn waves": (0.0, 1.7e-5, 1)}
 ODE_STEPS_PER_RADIAN = 2.0  # DOP853 steps per unit of r T
 ODE_STAGES = 10  # state vectors per step kept by DOP853's dense output
 OPERATOR_VALUES = 55  # values per state^2 of one exact propagator key (expm, anchors, read-outs, Taylor)
@@ -177,6 +184,28 @@ def _ode(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
         (fastest, steps * ODE_STAGES * m, settings.end_time_s / steps)]
 
 
+def _waves(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
+    """A scene with wave rods (models.waves.steps): T / h steps of the characteristics in either formulation,
+    h the scene's step or the shortest rod transit (or the pulse) over the preset's steps per transit;
+    its samples hold the state, two ends per rod and the rigid joints' forces."""
+    settings, scene, waves = simulation.settings, simulation.scene, simulation.dynamic_chain.waves
+    step = settings.wave_step_s if settings.formulation == "exact" else settings.step_s
+    given = "wave_step_s" if settings.formulation == "exact" else "step_s"
+    if getattr(scene.solver, given) is not None:
+        cause = Cause(f"solver.{given}", step)
+    else:
+        preset = settings.preset or DEFAULT_PRESET
+        shortest = min(waves, key=lambda rod: rod.transit_time_s)
+        where = "impact.piston" if shortest.name == PISTON else f"drill_string.bodies.{shortest.name}"
+        cause = Cause(f"{where}.length_m", shortest.length_m)
+        if simulation.pulse_duration_s / STEPS_PER_PULSE[preset] < shortest.transit_time_s / STEPS_PER_TRANSIT[preset]:
+            cause = _pulse(simulation)
+    sampled = _interval(simulation) if settings.formulation == "exact" else \
+        Cause("solver.output_interval_s", settings.output_interval_s)
+    values = _state_size(simulation) + 2 + 2 * len(waves) + len(simulation.dynamic_chain.links)
+    return step, cause, [(sampled, settings.end_time_s / sampled.value * values, sampled.value)]
+
+
 ESTIMATES = {"exudyn": _exudyn, "exact": _exact, "ode": _ode}
 
 
@@ -194,13 +223,14 @@ def run_cost(simulation: Simulation, resampled: Cause | None = None) -> RunCost:
     interval ``resampled`` names (``rpdrill simulate``: ``solver.output_interval_s``) or not (None)."""
     settings, n = simulation.settings, simulation.dynamic_chain.size
     end = settings.end_time_s
-    step, cause, parts = ESTIMATES[settings.formulation](simulation)
+    waves = bool(simulation.dynamic_chain.waves) and settings.formulation != "ode"
+    step, cause, parts = (_waves if waves else ESTIMATES[settings.formulation])(simulation)
     values = sum(part[1] for part in parts) * MEMORY_COPIES[settings.formulation]
     if resampled is not None:
         parts.append((resampled, end / resampled.value * (2 * n + 8), resampled.value))
         values += parts[-1][1] * OUTPUT_COPIES
     largest, _, interval = max(parts, key=lambda part: part[1])
-    a, b, power = CPU_S_PER_STEP[cost_key(simulation)]
+    a, b, power = CPU_S_PER_STEP[f"{settings.formulation} waves" if waves else cost_key(simulation)]
     return RunCost(steps=end / step, step_s=step, steps_cause=_named(cause, step, USUAL_STEP_S, end),
                    memory_bytes=values * BYTES_PER_VALUE, memory_cause=_named(largest, interval, USUAL_INTERVAL_S, end),
                    cpu_s=end / step * (a + b * n**power))

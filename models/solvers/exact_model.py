@@ -76,6 +76,7 @@ from ..drill.pulse import (
 )
 from ..evaluation.results import SimulationResult
 from ..evaluation.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
+from ..waves import exact_waves
 from .exact_kernels import (
     BLOW_START,
     DIVERGED,
@@ -409,6 +410,8 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     why = unsupported(simulation)
     if why:
         raise SceneError(("solver", "formulation"), "exact", why)
+    if simulation.dynamic_chain.waves:  # rods carried as waves: the characteristics (models.waves)
+        return exact_waves.simulate(simulation, progress)
     start = time.process_time()
     with BLAS.limit(limits=1, user_api="blas"):
         solver = ExactSolver(simulation)

@@ -17,11 +17,13 @@ solverType=model.solver_type)``: the model's per-step functions (the rock's stat
 ``add_pre_step``) are part of the built system. What a user adds is seen by the model's services
 (models.solvers.exudyn_user_items): the step rule and the stability bounds take the assembled system,
 the energy account its masses, spring-dampers and loads, the result's time series its sensors. A
-normal run is the same build and run (:func:`simulate`).
+normal run is the same build and run (:func:`simulate`). A scene with wave rods builds the string's bodies
+with mass only, the rods an element of their own updated before every step (models.waves.exudyn_waves).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 import warnings
@@ -37,9 +39,7 @@ from ...rocklaw.exudyn_module import exu  # first: it chooses Exudyn's compiled 
 # isort: split
 from exudyn.itemInterface import (
     LoadCoordinate,
-    MarkerBodyPosition,
     MarkerNodeCoordinate,
-    Node1D,
     NodePointGround,
     ObjectConnectorCoordinateSpringDamper,
     ObjectGround,
@@ -59,13 +59,14 @@ from ...rocklaw.exudyn_element import ExudynRockContact, attach_user_function
 from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
 from ..definition.scene import Scene
 from ..definition.validation import InputError, short
-from ..drill.chain import AxialChain, Link
+from ..drill.chain import AxialChain
 from ..drill.indexing import BlowStarts
 from ..drill.pulse import impact_force
 from ..drill.shapes import layout
 from ..evaluation.results import SimulationResult
 from ..evaluation.run_result import Result
 from ..evaluation.stability import StepLimitWarning, check_result, step_warning
+from ..waves.exudyn_waves import WaveExudyn
 from .exudyn_graphics import DrillGraphics, body_graphics, chain_cylinders, torsion_graphics
 from .exudyn_messages import (
     MinimumStepGuard,
@@ -78,43 +79,23 @@ from .exudyn_messages import (
     simulation_settings,
 )
 from .exudyn_piston import ExudynPiston
-from .exudyn_user_items import EnergyTerm, UserAccount, assembled_scales, item_counts, user_outcome
+from .exudyn_user_items import (
+    SOLVER_TYPES,
+    EnergyTerm,
+    ExudynBody,
+    ExudynConnector,
+    UserAccount,
+    add_body,
+    assembled_scales,
+    item_counts,
+    link_force_function,
+    user_outcome,
+)
 from .simulation import Simulation, as_simulation, prepare, solver_settings
 
-SOLVER_TYPES = {
-    "rk67": exu.DynamicSolverType.RK67,
-    "rk44": exu.DynamicSolverType.RK44,
-    "rk33": exu.DynamicSolverType.RK33,
-    "explicit_midpoint": exu.DynamicSolverType.ExplicitMidpoint,
-    "explicit_euler": exu.DynamicSolverType.ExplicitEuler,
-    "generalized_alpha": exu.DynamicSolverType.GeneralizedAlpha,
-    "trapezoidal_index2": exu.DynamicSolverType.TrapezoidalIndex2,
-    "dopri5": exu.DynamicSolverType.DOPRI5,
-    "ode23": exu.DynamicSolverType.ODE23,
-}
 COORDINATE = exu.OutputVariableType.Coordinates
 RATE = exu.OutputVariableType.Coordinates_t
 AXIS_X_FROM_Z = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]  # a rotational node's local z onto the drilling axis
-
-
-@dataclass(frozen=True)
-class ExudynBody:
-    """One axial body (a rod segment ``rod[0]`` too), or the torsion line, as Exudyn items."""
-
-    name: str
-    node: Any  # Node1D: the body's axial displacement (the torsion line: its angle)
-    object: Any  # ObjectMass1D (torsion: ObjectRotationalMass1D)
-    marker_coordinate: Any  # MarkerNodeCoordinate: for coordinate connectors and loads
-    marker_position: Any  # MarkerBodyPosition at the body's centre: a 3-D point for Exudyn's spatial connectors
-
-
-@dataclass(frozen=True)
-class ExudynConnector:
-    """One link of the chain (a scene connector, a rod's inner link ``rod[0-1]``) as its Exudyn object."""
-
-    name: str
-    object: Any  # ObjectConnectorCoordinateSpringDamper
-    link: Link
 
 
 @dataclass
@@ -154,6 +135,7 @@ class ExudynModel:
     _installed: Any = None  # the pre-step function the model set on mbs
     _foreign: Any = None  # a pre-step function of the user's, set on mbs, run after the model's
     solution_path: Path | None = None
+    waves: WaveExudyn | None = None  # wave rods: the element updated before every step (models.waves.exudyn_waves)
 
     def __post_init__(self) -> None:
         self._account = UserAccount(*(self._built_items[kind] for kind in ("objects", "loads", "sensors")))
@@ -229,6 +211,8 @@ class ExudynModel:
         self._prepared_items = item_counts(self.mbs)
 
     def _size_step(self) -> None:
+        if self.waves is not None:  # the step is the characteristics' (models.waves.steps)
+            return
         scales = assembled_scales(self)
         settings = solver_settings(self.simulation.scene, self.simulation.piston, scales)
         self.simulation = replace(self.simulation, step_scales=scales, settings=settings)
@@ -243,7 +227,8 @@ class ExudynModel:
 
     def _own_actions(self) -> list[Callable[[Any, float], bool]]:
         actions: list[Callable[[Any, float], bool]] = [self.piston] if self.piston is not None else []
-        return actions + ([self.rock.update_bottom] if self.rock.rock.crushes else [])
+        actions += [self.rock.update_bottom] if self.rock is not None and self.rock.rock.crushes else []
+        return actions + ([self.waves.pre_step] if self.waves is not None else [])
 
     def _replaced(self) -> dict[str, Any] | None:
         """The pre-step function on ``mbs`` when it is not the model's (a user's mbs.SetPreStepUserFunction)."""
@@ -275,10 +260,11 @@ class ExudynModel:
         if progress is not None:
             self._watch.append(progress_reporter(self.simulation.settings.end_time_s, progress))
         self._install()
-        warning = step_warning(self.simulation)
+        warning = step_warning(self.simulation) if self.waves is None else None
         if warning:
             warnings.warn(warning, StepLimitWarning, stacklevel=3)
-        with no_cyclic_gc(), exudyn_messages_as_warnings(self.simulation.name):
+        blas = self.waves.single_threaded() if self.waves is not None else contextlib.nullcontext()
+        with no_cyclic_gc(), exudyn_messages_as_warnings(self.simulation.name), blas:
             start = time.process_time()
             ok = self.mbs.SolveDynamic(settings, solverType=self.solver_type)
             cpu = time.process_time() - start
@@ -305,21 +291,6 @@ class ExudynModel:
                       {"source": "exu.SolveDynamic", **self.simulation.code_records()})
 
 
-def _add_body(mbs: Any, name: str, make_object: Callable[[Any], Any], initial: float = 0.0,
-              velocity: float = 0.0) -> ExudynBody:
-    node = mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[initial], initialVelocities=[velocity]))
-    body = make_object(node)
-    return ExudynBody(name, node, body, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0)),
-                      mbs.AddMarker(MarkerBodyPosition(bodyNumber=body, localPosition=[0.0, 0.0, 0.0])))
-
-
-def _link_force_function(link: Link, backend: Any) -> Callable[..., Any]:
-    """A connector's spring-force user function carrying the link's own law (:meth:`Link.force_n`)."""
-    def link_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        return link.force_n(displacement, velocity, backend)
-    return link_force
-
-
 def _exudyn_simulation(run: Scene | Simulation) -> tuple[Simulation, str]:
     """The prepared simulation to build, and the formulation the scene named: a scene of another
     formulation is run by Exudyn with its common solver keys (end time, preset, output interval)."""
@@ -341,6 +312,12 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
         raise InputError(f"rpdrill.build_exudyn: run: {short(run)}: give a rpdrill.Scene (rpdrill.load_scene) or a "
                          "prepared simulation")
     simulation, named = _exudyn_simulation(run)
+    if simulation.dynamic_chain.waves:  # the string's bodies with mass, the rods an element (models.waves)
+        model = WaveExudyn(simulation, symbolic).model(ExudynModel, ExudynBody, ExudynConnector,
+                                                       simulation_settings(simulation), named)
+        _apply_extensions(model)
+        model.prepare()
+        return model
     chain, impact, piston = simulation.dynamic_chain, simulation.impact, simulation.piston
     initial_positions = simulation.initial_positions_m if piston is None else piston.parked(simulation.initial_positions_m)
     shapes = layout(simulation.scene)
@@ -355,7 +332,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     for body, cylinder, initial, speed in zip(chain.bodies, chain_cylinders(shapes, chain), initial_positions, velocities,
                                               strict=True):
         shown = VObjectMass1D(graphicsData=body_graphics(cylinder, cylinder.group in rods))
-        bodies.append(_add_body(mbs, body.name, lambda n, m=body.mass_kg, x=cylinder.centre_m, v=shown: mbs.AddObject(
+        bodies.append(add_body(mbs, body.name, lambda n, m=body.mass_kg, x=cylinder.centre_m, v=shown: mbs.AddObject(
             ObjectMass1D(nodeNumber=n, mass=m, referencePosition=[x, 0.0, 0.0], visualization=v)), initial, speed))
         if body.constant_force_n:
             mbs.AddLoad(LoadCoordinate(markerNumber=bodies[-1].marker_coordinate, load=body.constant_force_n))
@@ -376,7 +353,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
         connectors[link.name] = ExudynConnector(link.name, connector, link)
         if not link.linear:
             user_functions.append(attach_user_function(
-                mbs, connector, "springForceUserFunction", _link_force_function(link, backend), symbolic))
+                mbs, connector, "springForceUserFunction", link_force_function(link, backend), symbolic))
 
     impact_load = mbs.AddLoad(LoadCoordinate(markerNumber=markers[chain.impact_body], load=0.0))
 
@@ -389,7 +366,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     if tor is not None:  # before the rock: the blow start reads its angle
         bit = shapes.cylinders[chain.bit_body]
         shown = VObjectRotationalMass1D(graphicsData=torsion_graphics(bit.diameter_m))
-        torsion = _add_body(mbs, "torsion", lambda n: mbs.AddObject(ObjectRotationalMass1D(
+        torsion = add_body(mbs, "torsion", lambda n: mbs.AddObject(ObjectRotationalMass1D(
             nodeNumber=n, inertia=tor.inertia_kg_m2, referencePosition=[bit.centre_m, 0.0, 0.0],
             referenceRotation=AXIS_X_FROM_Z, visualization=shown)), simulation.initial_torsion_angle_rad,
             simulation.initial_torsion_rate_rad_per_s)
@@ -439,14 +416,20 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     model = ExudynModel(simulation, chain, container, mbs, {body.name: body for body in bodies}, connectors, rock,
                         torsion, drawn, sensors, simulation_settings(simulation), [impact_function, *user_functions],
                         blows, hook, named, symbolic, _built_items=item_counts(mbs), _prepared_items=item_counts(mbs))
+    _apply_extensions(model)
+    model.prepare()
+    return model
+
+
+def _apply_extensions(model: ExudynModel) -> None:
+    """The scene's extensions (models.definition.extensions) applied to the built model."""
+    simulation = model.simulation
     for name, extension in (simulation.scene.extensions or {}).items():
         try:
             extension.apply(model)
         except Exception as error:
             raise ExtensionFailed(f"scene '{simulation.name}': extensions.{name} ({extension.function}) failed on the "
                                   f"built model: {type(error).__name__}: {error}") from error
-    model.prepare()
-    return model
 
 
 class ExtensionFailed(RuntimeError):
@@ -461,6 +444,11 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
 
 def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
     """The solved system's sensors read into a result (module doc), checked (models.evaluation.stability)."""
+    if model.waves is not None:
+        result = model.waves.finish(ok, cpu)
+        extra, result.user_energy, result.user_series = user_outcome(model, result.time_s)
+        result.info.update(extra)
+        return result
     simulation, mbs = model.simulation, model.mbs
     reached_s = mbs.systemData.GetTime()
     data = {name: mbs.GetSensorStoredData(sensor) for name, sensor in model.sensors.items()}

@@ -280,7 +280,14 @@ def _integrate_segment(system: _System, record: _Record, y: np.ndarray, modes: M
 
 
 def unsupported(simulation: Simulation) -> str | None:
-    """Why this formulation cannot run ``simulation`` (its switching comes from the laws' declared modes)."""
+    """Why this formulation cannot run ``simulation``: its switching comes from the laws' declared modes, and
+    it integrates bodies with mass only (a rod with model: waves has massless faces and delays: models.waves)."""
+    waves = [rod.name for rod in simulation.dynamic_chain.waves]
+    if waves:
+        keys = ", ".join("impact.piston.model" if name == "piston" else f"drill_string.bodies.{name}.model"
+                         for name in waves)
+        return (f"{keys} is waves: the ode formulation integrates lumped bodies only (a wave rod's faces are "
+                "massless and its waves arrive after a delay); use the exact or exudyn formulation, or model: lumped")
     return undeclared(simulation.chain, simulation.rock)
 
 

@@ -22,6 +22,7 @@ import numpy as np
 from ...rocklaw import RockLaw, State
 from ..definition.extensions import record, refusal
 from ..definition.extensions import records as extension_records
+from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
 from ..definition.outputs import needs
 from ..definition.scene import (
     BuiltEffects,
@@ -42,8 +43,11 @@ from ..drill.chain import (
 from ..drill.indexing import BlowStarts, Indexing
 from ..drill.piston import PistonSetup, piston_setup
 from ..drill.pulse import impulse_per_blow_n_s
+from ..drill.wave_rod import WaveRod
 from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_settings
 from ..evaluation.stability import FastestElement, StepScales, fastest_element, spring_spread, step_scales
+from ..waves.statics import wave_preload_m
+from ..waves.steps import wave_settings
 from .dispatch import implementation
 
 if TYPE_CHECKING:
@@ -189,11 +193,15 @@ def unsupported(name: str, simulation: Simulation) -> str | None:
     return check(simulation) if check else None
 
 
-def solver_settings(scene: Scene, piston: PistonSetup | None, scales: StepScales | None) -> Settings:
+def solver_settings(scene: Scene, piston: PistonSetup | None, scales: StepScales | None,
+                    waves: tuple[WaveRod, ...] = ()) -> Settings:
     """The settings of the scene's formulation for a drill of these step scales (an Exudyn preset's step
-    follows them; models.evaluation.solver_settings)."""
-    settings = resolve_settings(scene.solver, scene.impact.duration_s if piston is None else piston.pulse_duration_s,
-                                scales)
+    follows them; models.evaluation.solver_settings), and with wave rods the characteristics' step
+    (models.waves.steps: blows start on its grid)."""
+    pulse_s = scene.impact.duration_s if piston is None else piston.pulse_duration_s
+    settings = resolve_settings(scene.solver, pulse_s, scales)
+    if waves:
+        return wave_settings(settings, scene.solver, waves, scene.impact, pulse_s)
     if piston is not None and isinstance(settings, ExudynSettings) and scene.solver.step_s is None:
         # the strikes fall on step starts: a whole number of steps per period (a strike one step late
         # shifts the blow against the string's ringing; 2 % in the rate of the top-hammer scene)
@@ -215,16 +223,21 @@ def prepare(scene: Scene) -> Simulation:
         raise SceneError(("impact", "piston", "contact_stiffness_n_per_m"), None, str(err)) from None
     dynamic = chain if piston is None else piston.dynamic_chain(chain)
     fastest = fastest_element(scene, chain, rock, torsion)
-    scales = step_scales(dynamic, rock, torsion, scene.impact.period_s) if scene.solver.formulation == "exudyn" else None
+    waves = dynamic.waves
+    scales = step_scales(dynamic, rock, torsion, scene.impact.period_s) \
+        if scene.solver.formulation == "exudyn" and not waves else None
     if not math.isfinite(fastest.rate_per_s) or not math.isfinite(scales.spectral_radius_per_s if scales else 0.0):
         raise SceneError(tuple(fastest.key.split(".")), fastest.value,
                          f"with {fastest.other_key} {fastest.other_value:g} the model's fastest rate overflows "
                          f"(k/m or c/m beyond {sys.float_info.max:.3g}); give values of a physical drill")
-    settings = solver_settings(scene, piston, scales)
+    settings = solver_settings(scene, piston, scales, waves)
+    if waves and settings.formulation == "exudyn" and settings.type in AUTOMATIC_STEP_SOLVERS:
+        raise SceneError(("solver", "type"), settings.type, "wave rods step at the characteristics' fixed step "
+                         "(every step advances the waves once): use a fixed-step type such as rk44")
     positions, angle = np.zeros(chain.size), 0.0
     if scene.start == "preloaded":
         try:
-            positions = static_preload_m(chain, rock)
+            positions = static_preload_m(chain, rock) if not chain.waves else wave_preload_m(chain, rock)
         except ValueError as err:
             key, value, stiffest, softest = spring_spread(scene, chain, rock)
             if stiffest > STATIC_CONDITION_LIMIT * softest:  # the cause, rather than a body with no rest position

@@ -115,6 +115,10 @@ class RegimeFinder:
     """Finds the regime of one simulation (module doc)."""
 
     def __init__(self, simulation: Simulation) -> None:
+        if simulation.dynamic_chain.waves:
+            raise SteadyStateUnavailable(
+                f"scene '{simulation.name}': its wave rods carry their state in the waves in flight (a history "
+                "over each transit time), not in a state vector a period map could shoot on; the time run")
         problem = drift_problem(simulation)
         if problem:
             raise SteadyStateUnavailable(problem)

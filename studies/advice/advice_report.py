@@ -30,8 +30,13 @@ def best_point(advice: Advice) -> str:
     failed = f", {advice.failed_runs} failed" if advice.failed_runs else ""
     failed += f", {advice.replayed} replayed from an earlier session" if advice.replayed else ""
     beyond = f", {advice.beyond_limit} points beyond the thrust limit not run" if advice.beyond_limit else ""
+    stress = ""
+    if advice.max_rod_stress_pa is not None:
+        shown = metric("rod_stress_max_pa")
+        stress = (f", largest rod stress {shown.show_with_unit(advice.best_rod_stress_pa)} (bound "
+                  f"{shown.show_with_unit(advice.max_rod_stress_pa)}; {advice.beyond_stress} points above it)")
     return (f"{_rock(advice)}: best {y.name} {y.show_with_unit(advice.best_value)} at {at}, mean thrust "
-            f"{advice.best_thrust_ratio:.0%} of F_th ({advice.formulation}, {advice.runs} runs{failed}{beyond}, "
+            f"{advice.best_thrust_ratio:.0%} of F_th{stress} ({advice.formulation}, {advice.runs} runs{failed}{beyond}, "
             f"{advice.generations} generations{'' if advice.converged else ', not converged'}, "
             f"{advice.wall_time_s:.1f} s)")
 

@@ -59,14 +59,16 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
                  rocks: list[str] | None = None, power_kw: float | None = None, max_thrust_ratio: float = 1.0,
                  search: AdviceSearch | None = None, workers: int | None = None,
                  dask: str | None = None, out: str | Path | None = None, overwrite: bool = False,
-                 markdown: str | Path | None = None, quiet: bool = True, command: str | None = None) -> list[Advice]:
+                 markdown: str | Path | None = None, quiet: bool = True, command: str | None = None,
+                 max_rod_stress_pa: float | None = None) -> list[Advice]:
     """Maximise ``metric`` over ``bounds`` (``{"impact.frequency_hz": (45, 70), "feed.force_n": (35e3,
     60e3)}``, optionally ``"impact.amplitude_n"`` and an extension's ``"extensions.NAME.parameters.KEY"``; SI
     units) for the scene's rock, or for each Table 1
     rock of ``rocks``; ``power_kw``: a fixed hammer power (a piston scene, the blow energy P / f). One
     :class:`Advice` per rock (SI units). ``out``: the folder of the checkpoint and the report (module doc;
     new, empty or an earlier advice's, or any folder with ``overwrite``, which starts afresh there);
-    ``markdown``: a copy of advice.md; ``command``: the command the report names (default: this call).
+    ``markdown``: a copy of advice.md; ``command``: the command the report names (default: this call);
+    ``max_rod_stress_pa``: the best point whose rods stay below this stress (rod_stress_max_pa, a scene with rods).
     InputError before anything runs when an input cannot be used; ``quiet``: no progress bar."""
     where = "rpdrill.advise"
     check(where, "bounds", bounds, bounds_problem)
@@ -81,6 +83,7 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     check(where, "overwrite", overwrite, boolean_problem)
     check(where, "markdown", markdown, optional(file_problem))
     check(where, "quiet", quiet, boolean_problem)
+    check(where, "max_rod_stress_pa", max_rod_stress_pa, optional(positive_problem))
     folder = None if out is None else check_out(out, overwrite, CHECKPOINT)
     if markdown is not None:
         check_file_target("--markdown", markdown)
@@ -97,7 +100,7 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     ordered = {path: tuple(map(float, bounds[path])) for path in [*allowed, *sorted(set(bounds) - set(allowed))]
                if path in bounds}
     request = Request(metric, ordered, max_thrust_ratio, search or AdviceSearch(),
-                      power_w=power_kw * 1e3 if power_kw else None)
+                      power_w=power_kw * 1e3 if power_kw else None, max_rod_stress_pa=max_rod_stress_pa)
     scenes = [(rock, runnable_scene(data, rock, request, source)) for rock in rocks or [None]]
     identity = {"advice": data.name, "scene_file": source, "hash": advice_hash([s for _, s in scenes], request)}
     advices: list[Advice] = []
@@ -121,7 +124,8 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
             raise
         if log:
             log.add_session(_session(label, len(log.records) - earlier, advices, start, interrupted=False))
-    command = command or _call(source, ordered, metric, rocks, power_kw, max_thrust_ratio, request.search, out)
+    command = command or _call(source, ordered, metric, rocks, power_kw, max_thrust_ratio, request.search, out,
+                               max_rod_stress_pa)
     if folder is not None:
         with staged_directory(folder) as stage:
             write_json(stage / "advice.json", advice_record(advices, command))
@@ -144,10 +148,13 @@ def _session(runner: str, points_run: int, advices: list[Advice], start: float, 
 
 
 def _call(source: str, bounds: dict[str, tuple[float, ...]], metric: str, rocks: list[str] | None,
-          power_kw: float | None, max_thrust_ratio: float, search: AdviceSearch, out: str | Path | None) -> str:
+          power_kw: float | None, max_thrust_ratio: float, search: AdviceSearch, out: str | Path | None,
+          max_rod_stress_pa: float | None = None) -> str:
     """The library call as the report names it."""
+    stress = "" if max_rod_stress_pa is None else f", max_rod_stress_pa={max_rod_stress_pa!r}"
     return (f"rpdrill.advise({source!r}, {bounds!r}, metric={metric!r}, rocks={rocks!r}, power_kw={power_kw!r}, "
-            f"max_thrust_ratio={max_thrust_ratio!r}, search={search!r}, out={None if out is None else str(out)!r})")
+            f"max_thrust_ratio={max_thrust_ratio!r}, search={search!r}, out={None if out is None else str(out)!r}"
+            f"{stress})")
 
 
 def _extension_parameter(path: str, scene: Scene) -> bool:

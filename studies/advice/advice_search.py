@@ -66,6 +66,7 @@ from ..scan.curve_optima import band
 from ..scan.curves import Curve, run_curve
 
 FREQUENCY, FEED = "impact.frequency_hz", "feed.force_n"
+STRESS = "rod_stress_max_pa"  # the rods' largest stress (models.evaluation.rod_outputs), a --max-rod-stress-mpa bound's
 METRICS = ("penetration_rate_m_per_s", "penetration_per_impact_energy_m_per_j", "penetration_per_blow_energy_m_per_j")
 SLICE_POINTS = 15
 MAP_POINTS = 12
@@ -139,6 +140,12 @@ class Request:
     max_thrust_ratio: float = 1.0
     search: AdviceSearch = AdviceSearch()
     power_w: float | None = None  # a fixed hammer power: E_blow = P / f at every point (module doc)
+    max_rod_stress_pa: float | None = None  # a bound on the rods' stress (rod_stress_max_pa, module doc)
+
+    @property
+    def metrics(self) -> list[str]:
+        """What each run computes: the metric, and the rods' largest stress under a stress bound."""
+        return [self.metric] + ([STRESS] if self.max_rod_stress_pa is not None else [])
 
 
 @dataclass
@@ -169,6 +176,9 @@ class Advice:
     feed_map: dict[str, Any] = field(default_factory=dict)
     wall_time_s: float = 0.0
     power_w: float | None = None  # the fixed hammer power (module doc), or None
+    max_rod_stress_pa: float | None = None  # the rods' stress bound, or None
+    best_rod_stress_pa: float = math.nan  # the rods' largest stress at the best point (with a bound)
+    beyond_stress: int = 0  # points run whose rods' stress exceeded the bound
 
 
 def at_point(scene: Scene, point: Point, power_w: float | None = None, source: str = "advise") -> Scene:
@@ -191,7 +201,10 @@ def runnable_scene(scene: Scene, rock: str | None, request: Request, source: str
     if request.power_w is not None and scene.impact.piston is None:
         raise InputError(f"{source}: --power-kw needs a piston (impact.piston): the blow energy at a fixed power "
                          "is the piston's")
-    checked = scene.with_({**({"rock": {"name": rock}} if rock else {}), "outputs": {"metrics": [request.metric]}},
+    if request.max_rod_stress_pa is not None and not any(body.is_rod for body in scene.drill_string.bodies.values()):
+        raise InputError(f"{source}: --max-rod-stress-mpa needs rods (bodies with length_m and diameter_m): the bound "
+                         "is on the stress at the rods' ends")
+    checked = scene.with_({**({"rock": {"name": rock}} if rock else {}), "outputs": {"metrics": request.metrics}},
                           source)
     formulation = "exact" if unsupported("exact", prepare(checked.with_solver("exact"))) is None else "exudyn"
     blows = checked.metrics.transient_blows + checked.metrics.block_blows
@@ -238,12 +251,17 @@ class Evaluation:
     values: np.ndarray
     thrust_ratios: np.ndarray
     max_thrust_ratio: float
+    stress_excess: np.ndarray | None = None  # rods' stress / bound - 1 where a run exceeded the bound, else 0
 
     def objective(self) -> np.ndarray:
         """What the search minimises: -metric below the thrust limit (a failed run counts as 0), the
-        excess thrust ratio beyond it (worse than any point below)."""
+        excess thrust ratio beyond it (worse than any point below); a point whose rods' stress exceeds the
+        bound counts as its relative excess (worse than any point within it)."""
         excess = self.thrust_ratios - self.max_thrust_ratio
-        return np.where(excess < 0, -np.nan_to_num(self.values, nan=0.0), excess)
+        objective = np.where(excess < 0, -np.nan_to_num(self.values, nan=0.0), excess)
+        if self.stress_excess is not None:
+            objective = np.where((excess < 0) & (self.stress_excess > 0), self.stress_excess, objective)
+        return objective
 
 
 def advice_hash(scenes: list[Scene], request: Request) -> str:
@@ -271,7 +289,9 @@ class AdviceEvaluator:
         self.rock, self.log = rock, log
         self.recorded = {_point_key(r["rock"], r["point"]): r for r in (log.records if log else [])}
         self.earlier = set(self.recorded)  # recorded by an earlier session (the rest: this one's repeats)
-        self.runs = self.replayed = self.failed = self.beyond_limit = 0
+        self.runs = self.replayed = self.failed = self.beyond_limit = self.beyond_stress = 0
+        self.stress = np.empty(0)
+        self.stress_at: dict[tuple[Any, ...], float] = {}  # every point run under a stress bound -> its stress
         self.first_error = ""
         self.best_point: Point = {}
         self.best_value = -math.inf
@@ -280,22 +300,33 @@ class AdviceEvaluator:
         values[index] = math.nan if record["value"] is None else record["value"]
         self.failed += record["failed_runs"]
         self.first_error = self.first_error or record["error"]
+        bound, stress = self.request.max_rod_stress_pa, record.get(STRESS)
+        if bound is not None:
+            self.stress[index] = math.nan if stress is None else stress
+            self.stress_at[_point_key(record["rock"] or None, record["point"])] = self.stress[index]
+            if stress is not None and stress > bound:  # not allowed: no value on the curves and the map
+                values[index] = math.nan
+                self.beyond_stress += 1
 
     def __call__(self, points: list[Point]) -> Evaluation:
         scenes = [at_point(self.scene, p, self.request.power_w) for p in points]
         ratios = np.array([thrust_ratio(scene) for scene in scenes])
         run = [i for i in range(len(points)) if ratios[i] < self.request.max_thrust_ratio]
         values = np.full(len(points), np.nan)
+        self.stress = np.full(len(points), np.nan)
         replays = {i: self.recorded[key] for i in run if (key := _point_key(self.rock, points[i])) in self.recorded}
         for i, record in replays.items():
             self._take(values, i, record)
-        curves = [Curve(i, scenes[i], {}, (scenes[i].impact.frequency_hz,), (self.request.metric,))
+        curves = [Curve(i, scenes[i], {}, (scenes[i].impact.frequency_hz,), tuple(self.request.metrics))
                   for i in run if i not in replays]
         for point_run in (r for batch in self.runner(run_curve, curves) for r in batch) if curves else ():
             value = float(point_run.values(self.request.metric)[0])
             record = {"rock": self.rock or "", "point": {k: float(v) for k, v in points[point_run.key].items()},
                       "value": None if math.isnan(value) else value, "failed_runs": point_run.failed_runs,
                       "error": point_run.error}
+            if self.request.max_rod_stress_pa is not None:
+                stress = float(point_run.values(STRESS)[0])
+                record[STRESS] = None if math.isnan(stress) else stress
             self._take(values, point_run.key, record)
             if self.log is not None:
                 self.log.append(record)
@@ -308,7 +339,10 @@ class AdviceEvaluator:
         below = np.where(ratios < self.request.max_thrust_ratio, np.nan_to_num(values, nan=-math.inf), -math.inf)
         if len(points) and below.max() > self.best_value:
             self.best_value, self.best_point = float(below.max()), dict(points[int(np.argmax(below))])
-        return Evaluation(values, ratios, self.request.max_thrust_ratio)
+        excess = None
+        if self.request.max_rod_stress_pa is not None:
+            excess = np.maximum(np.nan_to_num(self.stress / self.request.max_rod_stress_pa - 1.0, nan=0.0), 0.0)
+        return Evaluation(values, ratios, self.request.max_thrust_ratio, excess)
 
 
 def planned_evaluations(request: Request) -> int:
@@ -397,6 +431,8 @@ def search_advice(data: Scene, rock: str | None, request: Request, runner: Runne
         advice.slices = slices(evaluate, request.bounds, advice.best, advice.best_value)
     advice.feed_map["response"] = feed_response(advice.feed_map)
     advice.runs, advice.failed_runs, advice.beyond_limit = evaluate.runs, evaluate.failed, evaluate.beyond_limit
+    advice.max_rod_stress_pa, advice.beyond_stress = request.max_rod_stress_pa, evaluate.beyond_stress
+    advice.best_rod_stress_pa = evaluate.stress_at.get(_point_key(rock, advice.best), math.nan)
     advice.replayed = evaluate.replayed
     advice.first_error = evaluate.first_error
     advice.wall_time_s = time.perf_counter() - start

@@ -63,6 +63,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="run only points whose mean thrust (feed + frequency x impulse per blow) is below this "
                              "fraction of the rock's threshold F_th (default 1: the static limit, beyond which the "
                              "rock yields under the mean load)")
+    parser.add_argument("--max-rod-stress-mpa", type=positive_number, metavar="S",
+                        help="the best point whose rods stay below this stress [MPa] at their ends (compression or "
+                             "tension, every blow of the window: rod_stress_max_pa); points above it are not allowed")
     parser.add_argument("--popsize", type=positive_count, default=AdviceSearch.popsize,
                         help=f"differential evolution: population per parameter (default {AdviceSearch.popsize})")
     parser.add_argument("--generations", type=positive_count, default=AdviceSearch.max_generations,
@@ -81,6 +84,7 @@ def command_line(args: argparse.Namespace) -> str:
     words += ["--power-kw", f"{args.power_kw:g}"] if args.power_kw else []
     words += ["--metric", args.metric] + (["--rock", *args.rock] if args.rock else [])
     words += ["--max-thrust-ratio", f"{args.max_thrust_ratio:g}"]
+    words += ["--max-rod-stress-mpa", f"{args.max_rod_stress_mpa:g}"] if args.max_rod_stress_mpa else []
     words += ["--popsize", str(args.popsize), "--generations", str(args.generations), "--seed", str(args.seed)]
     words += ["--out", args.out] + (["--markdown", str(args.markdown)] if args.markdown else [])
     return shlex.join(words)
@@ -94,7 +98,8 @@ def run(args: argparse.Namespace) -> int:
     advices = advise_scene(args.scene, bounds, args.metric, args.rock, args.power_kw, args.max_thrust_ratio,
                            AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed),
                            args.workers, args.dask, args.out, args.overwrite, args.markdown, args.quiet,
-                           command_line(args))
+                           command_line(args),
+                           max_rod_stress_pa=args.max_rod_stress_mpa * 1e6 if args.max_rod_stress_mpa else None)
     for advice in advices:
         print(advice_text(advice))
     print(best_table(advices))

@@ -89,6 +89,9 @@ METRICS: dict[str, Quantity] = {
     "energy_transfer_efficiency": _q("energy transfer efficiency", r"\eta", "%", 100.0, "1", merit=True),
     "energy_balance_relative_error": _q("energy balance error", r"\epsilon_E", "%", 100.0, "1"),
     "piston_rebound_energy_j": _q("piston rebound energy per blow", r"E_{reb}", "J"),
+    "rod_stress_max_pa": _q("largest rod stress", r"\hat{\sigma}", "MPa", 1e-6, "Pa"),
+    "rock_energy_per_blow_j": _q("rock energy per blow", r"W_r", "J"),
+    "rock_transfer_efficiency": _q("energy transfer to the rock", r"\eta_r", "%", 100.0, "1", merit=True),
     "penetration_per_blow_energy_m_per_j": _q("penetration per blow energy", r"v_p / (E_{blow} f)", "mm/kJ", 1e6,
                                               "m/J", merit=True),
     "window_start_s": _q("averaging window start", "t_0", "s"),
@@ -111,11 +114,17 @@ SERIES: dict[str, Quantity] = {
     "*_force_n": _q("{name} force (compression)", "F", "kN", 1e-3, "N"),
     "*_compression_m": _q("{name} compression", r"\delta", "mm", 1e3, "m"),
     "*_gap_opening_m": _q("{name} gap opening", "g", "mm", 1e3, "m"),
+    "*_top_stress_pa": _q("{name} stress at its top (compression)", r"\sigma", "MPa", 1e-6, "Pa"),
+    "*_bottom_stress_pa": _q("{name} stress at its bottom (compression)", r"\sigma", "MPa", 1e-6, "Pa"),
 }
 # a body's metrics by its name (models.definition.outputs.BODY_METRICS)
 BODY_METRICS: dict[str, Quantity] = {
     "*_velocity_peak_m_per_s": _q("peak {name} velocity", r"\hat{v}", "m/s", merit=True),
     "*_velocity_rms_m_per_s": _q("RMS {name} velocity", r"\tilde{v}", "m/s", merit=True),
+    "*_compressive_stress_max_pa": _q("largest compressive stress in {name}", r"\hat{\sigma}_c", "MPa", 1e-6, "Pa"),
+    "*_tensile_stress_max_pa": _q("largest tensile stress in {name}", r"\hat{\sigma}_t", "MPa", 1e-6, "Pa"),
+    "*_energy_in_per_blow_j": _q("energy into {name} per blow", r"E_{in}", "J"),
+    "*_energy_out_per_blow_j": _q("energy out of {name} per blow", r"E_{out}", "J"),
 }
 
 PARAMETERS: dict[str, Quantity] = {
@@ -129,6 +138,7 @@ PARAMETERS: dict[str, Quantity] = {
     "drill_string.bodies.*.youngs_modulus_pa": _q("{name} Young's modulus", "E", "GPa", 1e-9, "Pa"),
     "drill_string.bodies.*.density_kg_per_m3": _q("{name} density", r"\rho", "kg/m³"),
     "drill_string.bodies.*.segments": _q("{name} segments", "N", "segments"),
+    "drill_string.bodies.*.model": _category("{name} model"),
     "drill_string.connectors.*.type": _category("{name} type"),
     "drill_string.connectors.*.from": _category("{name} from"),
     "drill_string.connectors.*.to": _category("{name} to"),
@@ -156,6 +166,7 @@ PARAMETERS: dict[str, Quantity] = {
     "impact.piston.youngs_modulus_pa": _q("piston Young's modulus", "E_p", "GPa", 1e-9, "Pa"),
     "impact.piston.density_kg_per_m3": _q("piston density", r"\rho_p", "kg/m³"),
     "impact.piston.segments": _q("piston segments", "N_p", "segments"),
+    "impact.piston.model": _category("piston model"),
     "impact.piston.velocity_m_per_s": _q("strike speed", "v_p", "m/s"),
     "impact.piston.energy_j": _q("blow energy", r"E_{blow}", "J"),
     "impact.piston.contact_stiffness_n_per_m": _q("piston contact stiffness", "k_c", "MN/m", 1e-6, "N/m"),
@@ -190,6 +201,7 @@ PARAMETERS: dict[str, Quantity] = {
     "solver.sample_interval_s": _q("sample interval", r"\Delta t_s", "µs", 1e6, "s"),
     "solver.min_switch_interval_s": _q("shortest mode", r"\Delta t_{min}", "s"),
     "solver.max_switches_per_blow": _q("switches per blow allowed", "", "switches/blow"),
+    "solver.wave_step_s": _q("wave step", r"h_w", "µs", 1e6, "s"),
     "metrics.transient_blows": _q("transient blows", "", "blows"),
     "metrics.block_blows": _q("blows per block", "", "blows"),
     "effects.torsion": _category("torsion"),

@@ -7,7 +7,7 @@ length in its label (a body is shortened by a factor MIN_SHORTENING at least, or
 Labels go on the lowest level where they overlap no other label. Diameters are drawn to their own scale (the thickest body as tall as
 :data:`BODY_HEIGHT`), stated in the title. Connectors are drawn in the space between the bodies
 they join (schematic length): a spring above the axis, a dashpot below when damped, a coupling as
-two open flanges with its gap; a connector from ground ends on a hatched wall. The rock is a
+two open flanges with its gap, a rigid joint (wave rods' faces) as a solid bar; a connector from ground ends on a hatched wall. The rock is a
 hatched block at the rock face; the feed and the piston's impact are arrows on the bodies they act on.
 :func:`draw` writes the drawing (``.png`` or ``.svg`` by the suffix); :func:`drawn_layout` is where
 every body is drawn (the animation, studies.drawings.drill_animation, moves them from there). A built
@@ -160,7 +160,9 @@ def _connector(ax: Axes, drawing: DrawnLayout, link: Link, level: float) -> tupl
         top = 1.2 * BODY_HEIGHT
         ax.plot([x0, x0, x1, x1], [0, top, top, 0], color=SPRING_COLOUR, lw=0.8, ls=":")
         return 0.5 * (x0 + x1), level
-    if link.linear:
+    if link.rigid:  # the faces joined as one: a solid bar
+        ax.plot([x0, x1], [0, 0], color=COUPLING_COLOUR, lw=3)
+    elif link.linear:
         xs, ys = _zigzag(x0, x1, 0.35 * size if link.damping_n_s_per_m > 0 else 0.0, size)
         ax.plot(xs, ys, color=SPRING_COLOUR, lw=1)
         if link.damping_n_s_per_m > 0:
@@ -178,12 +180,16 @@ def _body_label(scene: Scene, group: str, drawing: DrawnLayout) -> str:
     body = scene.drill_string.bodies[group]
     length = sum(c.length_m for c in drawing.shapes.cylinders if c.group == group)
     text = f"{group}\n{_number(body.total_mass_kg)} kg, {_number(length)} m"
-    if body.segments > 1:
+    if body.is_wave:
+        text += "\nwaves"
+    elif body.segments > 1:
         text += f"\n{body.segments} segments"
     return text
 
 
 def _connector_label(link: Link, gap_m: float | None) -> str:
+    if link.rigid:  # a joint of rigid faces without a stiffness (models.drill.chain)
+        return f"{link.name}\nrigid"
     text = f"{link.name}\nk {_number(link.stiffness_n_per_m / 1e6)} MN/m"
     if link.damping_n_s_per_m > 0:
         text += f"\nc {_number(link.damping_n_s_per_m / 1e3)} kN s/m"

@@ -1,0 +1,223 @@
+"""Rods as waves (models.waves, issue #38): the closed-form checks in the exact and the Exudyn formulation
+with each blow's CPU time, and the wave and lumped models side by side on the shipped top-hammer scene
+and the four-rod string.
+
+    python benchmarks/bench_waves.py [--checks] [--strings] [--lumped-lundberg]
+
+``--checks`` (default when nothing is given): Lundberg's efficiency of a rectangular pulse into a bilinear
+rock, eta(alpha) = 2 (1 - exp(-alpha))^2 / alpha (rigid unloading: k_u = 1e4 k_l, against eta (1 - 1e-4);
+elastic: k_u = 10 k_l, against eta (1 - k_l / k_u); stiffer: k_u = 1e5 and 1e6 k_l at alpha 1.256); the rigid
+4.5 kg piston at 9 m/s on the 45 mm rod through a contact ten times a 240-segment rod's segment stiffness
+(against the contact-spring closed form) and with a rigid impact (against Z v_p exp(-Z t / m_p)); the
+equal-impedance rod piston's rectangular pulse; an impedance step 45 -> 55 mm. CPU: the run of the check's
+blow, after one warm-up run (numba's compiled kernels load from disk once per process).
+``--strings``: studies/scenes/top_hammer_waves.yaml (and its lumped twin top_hammer_piston.yaml at 4 and 16
+segments per rod, the piston at twice that) and four_rod_string.yaml with wave rods (and lumped at 4 and 16):
+penetration rate, largest rod stress, the rock's share of the blow energy, peak rock force, CPU (64 segments
+per rod would take Exudyn's standard preset about an hour per run on this machine).
+``--strings --fine [--segments 16,32,64] [--scenes top_hammer_piston,four_rod_string]``: the lumped rods of
+the scenes at these segments per rod in the exact formulation (the convergence of the lumped model towards
+the waves).
+``--lumped-lundberg``: Lundberg's check on lumped rods of 64 to 512 segments (Exudyn, reference preset),
+the dispersion the wave element removes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+import warnings
+from typing import Any
+
+import numpy as np
+
+from rpdrill.models.definition.scene import Scene
+from rpdrill.models.drill.piston import rigid_piston_pulse_n
+from rpdrill.models.drill.wave_rod import reflected_force_share, transmitted_force_share
+from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.solvers.simulation import prepare
+from rpdrill.studies.inputs.reading import read_yaml
+
+E_PA, RHO, D = 2.1e11, 7850.0, 0.045
+STEEL = {"diameter_m": D, "youngs_modulus_pa": E_PA, "density_kg_per_m3": RHO}
+AREA = math.pi * D**2 / 4
+Z = AREA * math.sqrt(E_PA * RHO)
+C = math.sqrt(E_PA / RHO)
+SPEED, PULSE_S = 9.0, 200e-6
+
+
+def one_blow(bodies: dict, impact: dict, rock: dict, end_time_s: float, formulation: str, connectors=None,
+             impact_body: str = "rod", rock_body: str = "rod", **solver: Any) -> Scene:
+    return Scene.model_validate({
+        "name": "wave_check", "drill_string": {"bodies": bodies, "connectors": connectors or {},
+                                               "impact_body": impact_body, "rock_body": rock_body},
+        "feed": {"force_n": 0.0}, "impact": {"frequency_hz": 1 / end_time_s, **impact}, "rock": rock,
+        "solver": {"formulation": formulation, "end_time_s": end_time_s, "output_interval_s": 1e-6, **solver},
+        "metrics": {"transient_blows": 0, "block_blows": 1}})
+
+
+def rod(length_m: float, **more: Any) -> dict:
+    return {"length_m": length_m, "model": "waves", **STEEL, **more}
+
+
+def timed(scene: Scene) -> tuple[Any, float]:
+    start = time.process_time()
+    result = prepare(scene).solve()
+    return result, time.process_time() - start
+
+
+def lundberg(alpha: float, ratio: float, formulation: str, model: str = "waves", segments: int = 1,
+             preset: str = "standard") -> tuple[float, float, float]:
+    """(efficiency, closed form, CPU s): tests/test_waves.py's check (a rod of 7.5 c T, run for 14 T)."""
+    loading = alpha * Z / PULSE_S
+    body = rod(7.5 * C * PULSE_S) if model == "waves" else {"length_m": 7.5 * C * PULSE_S, "segments": segments, **STEEL}
+    scene = one_blow({"rod": body}, {"amplitude_n": 1e5, "duration_s": PULSE_S, "shape": "rectangular"},
+                     {"law": "bilinear", "loading_stiffness_n_per_m": loading,
+                      "unloading_stiffness_n_per_m": ratio * loading}, 14 * PULSE_S, formulation, preset=preset)
+    result, cpu = timed(scene)
+    efficiency = summary_metrics(result)["rock_transfer_efficiency"]
+    return efficiency, 2 * (1 - math.exp(-alpha)) ** 2 / alpha * (1 - 1 / ratio), cpu
+
+
+def rigid_piston(contact: float | None, formulation: str, step_s: float | None = None) -> tuple[float, ...]:
+    """(peak / Z v_p - 1, largest excess over the closed form / Z v_p, peak / closed-form peak - 1, CPU s), the
+    peak the largest sample (every step: the preset's, 0.7 us, or ``step_s``)."""
+    piston = {"mass_kg": 4.5, "velocity_m_per_s": SPEED, **({"contact_stiffness_n_per_m": contact} if contact else {})}
+    step = {} if step_s is None else {"wave_step_s": step_s} if formulation == "exact" else {"step_s": step_s}
+    result, cpu = timed(one_blow({"rod": rod(0.5)}, {"piston": piston}, {"name": "sandstone"}, 1e-3, formulation,
+                                 output_interval_s=1e-7, **step))
+    t, force = result.time_s, result.piston.contact_force_n
+    before = t < 2 * 0.5 / C - 1e-6
+    before[0] = False  # the sample before the strike
+    closed = rigid_piston_pulse_n(t[before], 4.5, SPEED, Z, contact or math.inf)
+    peak = rigid_piston_pulse_n(np.linspace(0, 5e-6, 50001), 4.5, SPEED, Z, contact or math.inf).max()
+    return (force[before].max() / (Z * SPEED) - 1, float(np.max(force[before] - closed)) / (Z * SPEED),
+            force[before].max() / peak - 1, cpu)
+
+
+def rod_piston(formulation: str) -> tuple[float, float, float, float]:
+    """(plateau / (Z v_p / 2) - 1, length / (2 L_p / c) - 1, largest / plateau - 1, CPU s)."""
+    result, cpu = timed(one_blow({"rod": rod(4.0)}, {"piston": {**rod(0.5), "velocity_m_per_s": SPEED}},
+                                 {"name": "sandstone"}, 2e-3, formulation, output_interval_s=1e-7))
+    t, force = result.time_s, result.piston.contact_force_n
+    duration = 2 * 0.5 / C
+    plateau = float(np.mean(force[(t > 0.25 * duration) & (t < 0.75 * duration)]))
+    above = t[(force > 0.5 * plateau) & (t < 2 * duration)]
+    return plateau / (Z * SPEED / 2) - 1, (above.max() - above.min()) / duration - 1, force.max() / plateau - 1, cpu
+
+
+def impedance_step(formulation: str, upper: float = 0.045, lower: float = 0.055) -> tuple[float, float, float]:
+    """(transmitted force / 2 Z2 / (Z1 + Z2) - 1, crossing energy / (1 - R^2) - 1, CPU s)."""
+    length = 2 * C * 100e-6
+    z1, z2 = (math.pi * d**2 / 4 * math.sqrt(E_PA * RHO) for d in (upper, lower))
+    scene = one_blow({"upper": {**rod(length), "diameter_m": upper}, "lower": {**rod(length), "diameter_m": lower}},
+                     {"amplitude_n": 1e5, "duration_s": 100e-6, "shape": "rectangular"}, {"name": "sandstone"},
+                     3 * length / C - 10e-6, formulation, connectors={"joint": {"from": "upper", "to": "lower"}},
+                     impact_body="upper", rock_body="lower")
+    result, cpu = timed(scene)
+    waves = result.waves
+    arrived = (result.time_s > length / C + 25e-6) & (result.time_s < length / C + 75e-6)
+    transmitted = float(np.mean(waves.compression_n[arrived, waves.port("lower", "top")])) / 1e5
+    crossed = waves.blow_energy_j[0, waves.port("lower", "top")] / waves.blow_energy_j[0, waves.port("upper", "top")]
+    return (transmitted / transmitted_force_share(z1, z2) - 1, crossed / (1 - reflected_force_share(z1, z2) ** 2) - 1,
+            cpu)
+
+
+def checks() -> None:
+    for formulation in ("exact", "exudyn"):  # warm-up: the compiled kernels and Exudyn load once per process
+        lundberg(1.0, 10.0, formulation)
+    print("| check | formulation | figure | error | CPU s |")
+    print("|---|---|---|---|---|")
+    for formulation in ("exact", "exudyn"):
+        for ratio, label in ((1e4, "rigid (k_u = 1e4 k_l)"), (10.0, "k_u = 10 k_l")):
+            for alpha in (0.3, 1.256, 4.0):
+                efficiency, closed, cpu = lundberg(alpha, ratio, formulation)
+                print(f"| Lundberg, {label}, alpha {alpha:g} | {formulation} | eta {efficiency:.6f} "
+                      f"(closed form {closed:.6f}) | {efficiency - closed:+.1e} | {cpu:.2f} |")
+        for ratio in (1e5, 1e6):  # stiffer unloadings: the works' integral of a stiffer mode loses digits
+            efficiency, closed, cpu = lundberg(1.256, ratio, formulation)
+            print(f"| Lundberg, k_u = 1e{round(math.log10(ratio))} k_l, alpha 1.256 | {formulation} | eta {efficiency:.6f} "
+                  f"(closed form {closed:.6f}) | {efficiency - closed:+.1e} | {cpu:.2f} |")
+    for formulation in ("exact", "exudyn"):
+        for contact, label in ((10 * E_PA * AREA * 240 / 0.5, "contact 10 x a 240-segment rod's segment"),
+                               (None, "rigid impact")):
+            for step_s in (None, 1e-7):
+                peak, excess, against, cpu = rigid_piston(contact, formulation, step_s)
+                reference = "closed form" if contact else "Z v_p"
+                sampled = "preset step" if step_s is None else f"step {step_s * 1e6:g} us"
+                print(f"| rigid piston, {label}, {sampled} | {formulation} | peak - {reference} "
+                      f"{against if contact else peak:+.2e}, peak - Z v_p {peak:+.2%} | largest excess over the "
+                      f"closed form {excess:+.1e} Z v_p | {cpu:.2f} |")
+        plateau, length, largest, cpu = rod_piston(formulation)
+        print(f"| rod piston, equal impedance | {formulation} | plateau - Z v_p/2 {plateau:+.1e}, length - 2 L_p/c "
+              f"{length:+.2%} | largest force - plateau {largest:+.1e} | {cpu:.2f} |")
+        transmitted, crossed, cpu = impedance_step(formulation)
+        print(f"| impedance step 45 -> 55 mm | {formulation} | transmitted force - 2 Z2/(Z1+Z2) {transmitted:+.1e} | "
+              f"crossing energy - (1 - R^2) {crossed:+.1e} | {cpu:.2f} |")
+
+
+def strings(fine: bool = False, refined: tuple[int, ...] = (16, 32, 64),
+            scenes: tuple[str, ...] = ("top_hammer_piston", "four_rod_string")) -> None:
+    print("| scene | model | formulation | penetration rate mm/s | largest rod stress MPa | rock energy / blow energy "
+          "| peak rock force kN | CPU s |")
+    print("|---|---|---|---|---|---|---|---|")
+    cases = [("top_hammer_waves", "waves", "exact", None), ("top_hammer_waves", "waves", "exudyn", None),
+             ("top_hammer_piston", "lumped", "exact", 4)]
+    cases += [("top_hammer_piston", "lumped", "exudyn", n) for n in (4, 16)]
+    cases += [("four_rod_string", "waves", "exact", None), ("four_rod_string", "waves", "exudyn", None),
+              ("four_rod_string", "lumped", "exact", 4)]
+    cases += [("four_rod_string", "lumped", "exudyn", n) for n in (4, 16)]
+    if fine:  # the lumped rods refined in the exact formulation: do they go to the waves?
+        cases = [(name, "lumped", "exact", n) for name in scenes for n in refined]
+    for name, model, formulation, segments in cases:
+        data = read_yaml(f"studies/scenes/{name}.yaml")
+        bodies = data["drill_string"]["bodies"]
+        for body in bodies.values():
+            if "diameter_m" in body and "length_m" in body:
+                body.pop("segments", None)
+                body.update({"model": "waves"} if model == "waves" else {"segments": segments})
+        piston = data["impact"].get("piston")
+        if piston is not None and segments:
+            piston.update({"segments": 2 * segments})
+        data["solver"] = {**data["solver"], "formulation": formulation}
+        result, cpu = timed(Scene.model_validate(data))
+        m = summary_metrics(result)
+        share = m["rock_transfer_efficiency"]
+        print(f"| {name} | {model}{f' ({segments} per rod)' if segments else ''} | {formulation} | "
+              f"{1e3 * m['penetration_rate_m_per_s']:.4f} | {1e-6 * m['rod_stress_max_pa']:.1f} | {share:.4f} | "
+              f"{1e-3 * m['rock_force_max_n']:.1f} | {cpu:.1f} |", flush=True)
+
+
+def lumped_lundberg() -> None:
+    print("| segments | alpha | eta - closed form | CPU s |")
+    print("|---|---|---|---|")
+    for segments in (64, 128, 256, 512):
+        for alpha in (0.3, 1.256, 4.0):
+            efficiency, closed, cpu = lundberg(alpha, 1e4, "exudyn", "lumped", segments, "reference")
+            print(f"| {segments} | {alpha:g} | {efficiency - closed:+.4f} | {cpu:.1f} |", flush=True)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--checks", action="store_true")
+    parser.add_argument("--strings", action="store_true")
+    parser.add_argument("--lumped-lundberg", action="store_true")
+    parser.add_argument("--fine", action="store_true", help="--strings: lumped rods refined (--segments), exact")
+    parser.add_argument("--segments", type=lambda text: tuple(int(n) for n in text.split(",")), default=(16, 32, 64),
+                        help="--fine: segments per rod (default 16,32,64)")
+    parser.add_argument("--scenes", type=lambda text: tuple(text.split(",")),
+                        default=("top_hammer_piston", "four_rod_string"), help="--fine: these scenes only")
+    args = parser.parse_args(argv)
+    warnings.simplefilter("ignore")  # Exudyn's printed notes
+    if args.checks or not (args.strings or args.lumped_lundberg):
+        checks()
+    if args.strings:
+        strings(args.fine, args.segments, args.scenes)
+    if args.lumped_lundberg:
+        lumped_lundberg()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

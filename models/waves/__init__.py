@@ -1,0 +1,1 @@
+"""Rods as exact 1-D wave elements (d'Alembert): the physics once (rods), the waves in flight (history), the system between two wave steps (system), the characteristics (stepping, kernels, fast_path, works), and the exact and Exudyn formulations of a scene with wave rods."""

@@ -1,0 +1,125 @@
+"""The waves in flight: every rod end's outgoing wave, step by step, carried to the other end.
+
+On the grid t_k = k h of the characteristics a rod of transit time T is N = round(T / h) steps long
+(the transit times as run, N h, are stated: :func:`delays`). Over each step the outgoing wave at a port
+is the straight line through its values at the step's ends, (left, right): ``right`` the wave at the
+step's end, ``left`` chosen so that the line keeps the step's mean, which the exact integration of the
+node gives (left = 2 mean - right; the node's displacement over the step less the arriving wave's).
+A front that falls on a grid time is a jump between two steps and is carried exactly; one within a
+step (a fast contact's rise) keeps its area. A wave arrives N steps after it left:
+
+    incoming(port, k) = outgoing(other end of the rod, k - N).
+
+Before the start each rod carries the waves of its initial state: at rest under a compression P,
+d = P / (2 Z), u = -P / (2 Z).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..drill.wave_rod import WaveRod
+
+
+def delays(rods: Sequence[WaveRod], step_s: float) -> tuple[int, ...]:
+    """N = round(T / h) steps per rod (at least one)."""
+    return tuple(max(1, round(rod.transit_time_s / step_s)) for rod in rods)
+
+
+def transit_errors(rods: Sequence[WaveRod], step_s: float) -> dict[str, float]:
+    """(N h - T) / T of every rod: the transit time as run against the rod's own."""
+    return {rod.name: (n * step_s - rod.transit_time_s) / rod.transit_time_s
+            for rod, n in zip(rods, delays(rods, step_s), strict=True)}
+
+
+def wave_step_s(durations_s: Sequence[float], target_s: float, period_s: float, tolerance: float = 1e-3,
+                tries: int | None = None) -> float:
+    """The step of the characteristics: h = period / M (blows start on the grid) for the smallest
+    M >= period / target that makes every duration (the rods' transit times, a prescribed pulse's length)
+    a whole number of steps within ``tolerance`` (relative), among M up to 1.5 times the first (``tries``
+    candidates); the best of them when none is."""
+    first = max(1, math.ceil(period_s / target_s - 1e-9))
+    tries = tries or max(1, first // 2)
+    if not durations_s:
+        return period_s / first
+    transit = np.array(durations_s, dtype=float)
+    counts = np.arange(first, first + tries)
+    steps = period_s / counts
+    ratio = transit[None, :] / steps[:, None]
+    error = np.max(np.abs(np.maximum(np.round(ratio), 1) - ratio) / ratio, axis=1)
+    good = np.flatnonzero(error <= tolerance)
+    return float(steps[good[0]] if len(good) else steps[np.argmin(error)])
+
+
+class WaveLines:
+    """The outgoing waves of every port (2 per rod: top, bottom) over the last steps (module doc), with the
+    integrals over each step of the wave and of its square kept as running sums over the waves in flight
+    (a rod's energy and momentum at any step without summing its window)."""
+
+    def __init__(self, rods: Sequence[WaveRod], step_s: float, initial_outgoing: np.ndarray) -> None:
+        self.rods, self.step_s = tuple(rods), step_s
+        self.delays = np.array(delays(rods, step_s), dtype=int)
+        self.ring = int(self.delays.max(initial=1)) + 1
+        ports = len(initial_outgoing)
+        self.left = np.zeros((ports, self.ring))
+        self.right = np.zeros((ports, self.ring))
+        self.square = np.zeros((ports, self.ring))  # int over the step of the wave^2, / h
+        self.mean = np.zeros((ports, self.ring))  # int over the step of the wave, / h
+        self.square_sum = np.zeros(ports)  # over the N steps before the next one stored
+        self.mean_sum = np.zeros(ports)
+        self.port_delays = np.repeat(self.delays, 2)
+        self.impedances = np.array([rod.impedance_n_s_per_m for rod in self.rods])
+        self.sources = np.arange(ports) ^ 1  # the other end of the same rod
+        for rod in range(len(self.rods)):
+            for port in (2 * rod, 2 * rod + 1):
+                self._fill_port(port, rod, 0, float(initial_outgoing[port]))
+
+    def incoming(self, step: int) -> tuple[np.ndarray, np.ndarray]:
+        """(left, right) of the waves arriving at every port over step ``step``."""
+        k = (step - self.port_delays) % self.ring
+        return self.left[self.sources, k], self.right[self.sources, k]
+
+    def store(self, step: int, left: np.ndarray, right: np.ndarray, ports: np.ndarray | None = None,
+              again: bool = False) -> None:
+        """The outgoing waves of ``ports`` (default: every port; arrays over every port) over ``step``, steps
+        stored in order; ``again``: a step stored before, its values replaced."""
+        ports = np.arange(len(left)) if ports is None else ports
+        k = step % self.ring
+        old = k if again else (step - self.port_delays[ports]) % self.ring
+        left, right = left[ports], right[ports]
+        square, mean = (left * left + left * right + right * right) / 3.0, 0.5 * (left + right)
+        self.square_sum[ports] += square - self.square[ports, old]
+        self.mean_sum[ports] += mean - self.mean[ports, old]
+        self.left[ports, k], self.right[ports, k] = left, right
+        self.square[ports, k], self.mean[ports, k] = square, mean
+
+    def _fill_port(self, port: int, rod: int, step: int, value: float) -> None:
+        n = self.delays[rod]
+        for k in range(step - n, step + 1):
+            j = k % self.ring
+            self.left[port, j] = self.right[port, j] = self.mean[port, j] = value
+            self.square[port, j] = value * value
+        self.square_sum[port], self.mean_sum[port] = n * value * value, n * value
+
+    def fill(self, rod: int, step: int, value: float) -> None:
+        """Both ends of ``rod`` emitted ``value`` over the last N steps before ``step`` (a rod at a uniform
+        velocity 2 value, unstressed: a piston at its strike, 0 when it is caught)."""
+        for port in (2 * rod, 2 * rod + 1):
+            self._fill_port(port, rod, step, value)
+
+    def energy_j(self, rod: int) -> float:
+        """Z int (d^2 + u^2) over the waves in flight: the rod's kinetic and strain energy."""
+        return float(self.rods[rod].impedance_n_s_per_m * self.step_s * (self.square_sum[2 * rod]
+                                                                         + self.square_sum[2 * rod + 1]))
+
+    def energies_j(self) -> np.ndarray:
+        """:meth:`energy_j` of every rod."""
+        return self.impedances * self.step_s * (self.square_sum[::2] + self.square_sum[1::2])
+
+    def momentum_n_s(self, rod: int) -> float:
+        """Z int (d + u) over the waves in flight: the rod's momentum mu int v dx."""
+        return float(self.rods[rod].impedance_n_s_per_m * self.step_s * (self.mean_sum[2 * rod]
+                                                                         + self.mean_sum[2 * rod + 1]))

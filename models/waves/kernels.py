@@ -1,0 +1,180 @@
+"""The compiled fast path of the characteristics (models.waves.stepping): whole steps of one key in which
+no element switches, on plain float arrays (numba, cached on disk).
+
+A step is what :meth:`models.waves.stepping.Stepper.advance` does without events: the arriving waves
+set as (a, b) of every port, w <- expm(A h) w, the works w^T G w, the outgoing waves stored (end value
+and mean-keeping start) with the running sums of the waves in flight, the blow's section figures of the
+ports the element closes itself, and, for kinematic bodies, the impulse and end value of their loads.
+The kernel returns before committing a step in which an exit function crosses (or crosses and returns:
+the slopes), and after a step whose end a wave piston's catch condition holds; the stepper handles
+those in Python. Status: STEPS_DONE (reached ``stop``), SWITCH, CATCH.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+STEPS_DONE, SWITCH, CATCH = 0, 1, 2
+PISTON_NONE, PISTON_OPEN, PISTON_CLOSED = 0, 1, 2
+
+
+@njit(cache=True)
+def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_nodes, port_velocity, port_delays,
+              port_signs, port_impedances, port_down, own, left, right, square, mean, square_sum, mean_sum, ring,
+              works, rock_work, compression, tension, energy, integral, body_forces, loads,
+              piston_mode, piston_ports, impact_row, momentum_tolerance, force_tolerance, rod_impedance):
+    """Advance ``w`` from ``step`` up to ``stop`` (module doc); returns (status, the step reached)."""
+    m = w.shape[0]
+    ports = port_nodes.shape[0]
+    a0 = np.empty(ports)
+    x0 = np.empty(ports)
+    w1 = np.empty(m)
+    while step < stop:
+        for p in range(ports):
+            j = (step - port_delays[p]) % ring
+            source = p ^ 1
+            a = left[source, j]
+            a0[p] = a
+            w[inputs + 2 * p] = a
+            w[inputs + 2 * p + 1] = (right[source, j] - a) / h
+            x0[p] = w[port_nodes[p]]
+        for i in range(m):
+            total = 0.0
+            for j in range(m):
+                total += propagator[i, j] * w[j]
+            w1[i] = total
+        for e in range(exits.shape[0]):
+            g0 = 0.0
+            g1 = 0.0
+            s0 = 0.0
+            s1 = 0.0
+            for j in range(m):
+                g0 += exits[e, j] * w[j]
+                g1 += exits[e, j] * w1[j]
+                s0 += slopes[e, j] * w[j]
+                s1 += slopes[e, j] * w1[j]
+            if g1 > 0.0 or (g0 < 0.0 and s0 > 0.0 and s1 < 0.0):
+                return SWITCH, step
+        for q in range(3):
+            total = 0.0
+            for i in range(m):
+                row = 0.0
+                for j in range(m):
+                    row += grams[q, i, j] * w[j]
+                total += w[i] * row
+            if q < 2:
+                works[q] += total
+            else:
+                rock_work[0] += total
+        for b in range(body_forces.shape[0]):
+            impulse = 0.0
+            end = 0.0
+            for i in range(m):
+                moved = 0.0
+                for j in range(m):
+                    moved += integral[i, j] * w[j]
+                impulse += body_forces[b, i] * moved
+                end += body_forces[b, i] * w1[i]
+            loads[0, b] = 2.0 * impulse / h - end
+            loads[1, b] = end
+        for i in range(m):
+            w[i] = w1[i]
+        k = step % ring
+        for p in range(ports):
+            velocity = 0.0
+            for j in range(m):
+                velocity += port_velocity[p, j] * w[j]
+            a1 = w[inputs + 2 * p]
+            out_right = velocity - a1
+            out_left = 2.0 * ((w[port_nodes[p]] - x0[p]) / h - 0.5 * (a0[p] + a1)) - out_right
+            old = (step - port_delays[p]) % ring
+            sq = (out_left * out_left + out_left * out_right + out_right * out_right) / 3.0
+            mn = 0.5 * (out_left + out_right)
+            square_sum[p] += sq - square[p, old]
+            mean_sum[p] += mn - mean[p, old]
+            left[p, k] = out_left
+            right[p, k] = out_right
+            square[p, k] = sq
+            mean[p, k] = mn
+            if own[p]:
+                start_c = port_signs[p] * (out_left - a0[p])
+                end_c = port_signs[p] * (out_right - a1)
+                compression[p] = max(compression[p], max(start_c, end_c))
+                tension[p] = max(tension[p], -min(start_c, end_c))
+                incoming = a0[p] * a0[p] + a0[p] * a1 + a1 * a1
+                outgoing = out_left * out_left + out_left * out_right + out_right * out_right
+                energy[p] += port_down[p] * port_impedances[p] * h * (outgoing - incoming) / 3.0
+        step += 1
+        if piston_mode != PISTON_NONE:
+            momentum = rod_impedance * h * (mean_sum[piston_ports[0]] + mean_sum[piston_ports[1]])
+            if piston_mode == PISTON_OPEN and momentum <= 0.0:
+                return CATCH, step
+            if piston_mode == PISTON_CLOSED and abs(momentum) <= momentum_tolerance:
+                force = 0.0
+                for j in range(m):
+                    force += impact_row[j] * w[j]
+                if abs(force) <= force_tolerance:
+                    return CATCH, step
+    return STEPS_DONE, step
+
+
+@njit(cache=True)
+def _crossed(rows, w):
+    """The row with the largest positive value at w, -1 if none is positive."""
+    best, top = -1, 0.0
+    for e in range(rows.shape[0]):
+        g = 0.0
+        for j in range(w.shape[0]):
+            g += rows[e, j] * w[j]
+        if g > top:
+            best, top = e, g
+    return best
+
+
+@njit(cache=True)
+def first_crossing(steps, rows, slopes, w0, span, levels):
+    """(finest steps, exit) of the first crossing of rows . w > 0 within ``span`` finest steps from w0,
+    (0, -1) if none (models.waves.levels): bisection on the levels' grid, a step refused where an exit
+    crosses at its end or its slopes show a maximum inside (a crossing and its return); a maximum that
+    stays below zero restarts the search after it."""
+    w = steps[levels] @ w0
+    crossed = _crossed(rows, w)
+    if crossed >= 0:  # on its crossed side already at the start: a switch there
+        return 1, crossed
+    reached = 1
+    while reached < span:
+        limit = span
+        point = w.copy()
+        for j in range(1, levels + 1):
+            length = 1 << (levels - j)
+            while reached + length <= limit:
+                trial = steps[j] @ point
+                refused = _crossed(rows, trial) >= 0
+                for e in range(rows.shape[0]):
+                    if refused:
+                        break
+                    g = 0.0
+                    s0 = 0.0
+                    s1 = 0.0
+                    for i in range(point.shape[0]):
+                        g += rows[e, i] * point[i]
+                        s0 += slopes[e, i] * point[i]
+                        s1 += slopes[e, i] * trial[i]
+                    refused = s0 > 0.0 and s1 < 0.0 and g < 0.0
+                if refused:
+                    limit = reached + length
+                    break
+                point = trial
+                reached += length
+        crossed = _crossed(rows, steps[levels] @ point)
+        if crossed >= 0:
+            return reached + 1, crossed
+        if limit >= span:
+            return 0, -1
+        w = w0.copy()
+        for j in range(levels + 1):
+            if (limit >> (levels - j)) & 1:
+                w = steps[j] @ w
+        reached = limit
+    return 0, -1

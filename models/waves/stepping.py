@@ -1,0 +1,457 @@
+"""The method of characteristics at a stated step h, with the rest of the drill integrated exactly.
+
+Step k covers [t_k, t_k + h]: the waves arriving at every rod end are set from the waves that left
+the other end N steps before (models.waves.history), and the system of models.waves.system is
+propagated exactly, w(t + s) = expm(A s) w(t), piece by piece: a piece ends at a pulse phase change or
+at the first switch of a piecewise element, located to round-off (Brent's method on the exit function
+of the exact solution, a crossing and its return within a piece found from the slopes). At the step's
+end every port's outgoing wave is stored (its end value and the value that keeps the step's mean).
+
+What is exact and what is not: between two grid times every node, face, body and element follows
+the exact solution of the arriving waves as straight lines; the waves are carried without dispersion
+or delay error beyond the rounding of each transit time to whole steps (stated: history.transit_errors).
+The only approximation is the outgoing wave as a straight line over each step (second order in h where
+it is smooth; a front keeps its area).
+
+Blow starts fall on the grid (h divides the blow period): the indexing model's rock state and the
+piston's strike are applied there, as in the exact formulation. A rigid or lumped piston is caught by
+its contact's mode table; a wave piston when its contact is open and its momentum (in its waves) is
+negative at a step's end: at most a step late, its energy kept (models.drill.piston).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..definition.links import CLOSED, OPEN
+from ..drill.piston import CAUGHT, CONTACT, PARK_M, PistonJumps
+from ..drill.pulse import generator_states, phase_pieces, phase_row
+from ..drill.wave_rod import SIGMA, TOP
+from ..evaluation.stability import POSITION_LIMIT_M, SimulationFailed
+from .fast_path import SWITCH, run_fast
+from .history import WaveLines
+from .kernels import CATCH
+from .levels import key_levels
+from .system import Key, Modes, WaveSystem
+
+MAX_SWITCHES_PER_STEP = 64
+
+
+@dataclass
+class BlowStatistics:
+    """Per blow and per port (2 per rod: top, bottom): the largest compression and tension (N, tension as a
+    positive number), and the energy through the section int P v dt along +x (into the rock); per blow the
+    work the rock took, int F_r v_bit dt."""
+
+    compression_n: list[np.ndarray] = field(default_factory=list)
+    tension_n: list[np.ndarray] = field(default_factory=list)
+    energy_j: list[np.ndarray] = field(default_factory=list)
+    rock_work_j: list[float] = field(default_factory=list)
+
+    def open_blow(self, ports: int) -> None:
+        self.compression_n.append(np.zeros(ports))
+        self.tension_n.append(np.zeros(ports))
+        self.energy_j.append(np.zeros(ports))
+        self.rock_work_j.append(0.0)
+
+    def arrays(self, ports: int) -> dict[str, np.ndarray]:
+        shape = (len(self.energy_j), ports)
+        return {"compression_n": np.array(self.compression_n).reshape(shape),
+                "tension_n": np.array(self.tension_n).reshape(shape),
+                "energy_j": np.array(self.energy_j).reshape(shape), "rock_work_j": np.array(self.rock_work_j)}
+
+
+@dataclass
+class Samples:
+    time_s: list[float] = field(default_factory=list)
+    states: list[np.ndarray] = field(default_factory=list)
+    velocity: list[np.ndarray] = field(default_factory=list)
+    forces: list[np.ndarray] = field(default_factory=list)  # rock, impact, then each rigid joint's
+    works: list[np.ndarray] = field(default_factory=list)  # cumulative impact, internal (string) work
+    waves_j: list[float] = field(default_factory=list)  # energy of the string's rods' waves in flight
+    piston_j: list[float] = field(default_factory=list)  # a wave piston's energy
+    compression: list[np.ndarray] = field(default_factory=list)  # every port's compression
+    after: list[bool] = field(default_factory=list)  # recorded after a jump at its own time (a catch)
+
+
+class Stepper:
+    """One run on the grid of the characteristics (module doc). ``kinematic`` nodes move at their
+    velocity over each step (the Exudyn formulation's bodies, set before each step)."""
+
+    def __init__(self, simulation, step_s: float, sample_interval_s: float, kinematic: tuple[int, ...] = (),
+                 record_steps: bool = True) -> None:
+        self.simulation, self.step_s = simulation, step_s
+        chain = self.chain = simulation.dynamic_chain
+        self.string_size = simulation.chain.size
+        self.setup = simulation.piston
+        self.piston_rod = next((r for r, rod in enumerate(chain.waves) if self.setup is not None
+                                and rod.top >= self.string_size), None)
+        self.system = WaveSystem(chain, simulation.rock, simulation.torsion, simulation.impact, kinematic,
+                                 catch_by_row=self.piston_rod is None)
+        self.layout = self.system.layout
+        self.lines = WaveLines(chain.waves, step_s, initial_outgoing(simulation, chain))
+        end = simulation.settings.end_time_s
+        self.steps = max(1, round(end / step_s))
+        self.period_steps = round(simulation.impact.period_s / step_s)
+        times, phases = phase_pieces(simulation.impact, end)
+        self.phase_changes, self.phases = times[:, 0], phases
+        self.blows = simulation.blow_starts()
+        self.jumps = PistonJumps(self.setup) if self.setup is not None else None
+        self.contact = next((i for i, piece in enumerate(self.system.pieces) if piece.name == CONTACT), None)
+        if self.piston_rod is not None:  # the strike fills the rod as run: N h long
+            rod = chain.waves[self.piston_rod]
+            self.jumps.blow_energy_j = 0.5 * rod.impedance_n_s_per_m * self.lines.delays[self.piston_rod] * step_s \
+                * self.setup.strike_velocity_m_per_s**2
+        self.ports = self.system.ports
+        self.port_nodes = np.array([port.node for port in self.ports], dtype=int)
+        self.port_impedances = np.array([port.impedance_n_s_per_m for port in self.ports])
+        self.port_signs = np.array([SIGMA[port.end] for port in self.ports]) * self.port_impedances
+        self.port_down = np.array([1.0 if port.end == TOP else -1.0 for port in self.ports])  # flux along +x
+        self.own_ports = np.arange(len(self.ports))  # the Exudyn model closes the others (its bodies' ports)
+        self.string_ports = [p for p, port in enumerate(self.ports) if port.node < self.string_size]
+        self.rigid_names = [link.name for link in self.system.rigid_links]
+        self.sample_every = max(1, round(sample_interval_s / step_s))
+        self.w = self._initial_state()
+        self.modes = self.system.initial_modes(self.w)
+        self.phase_index = 0
+        self.samples, self.statistics = Samples(), BlowStatistics()
+        self.works = np.zeros(2)
+        self.switch_times: list[float] = []
+        self.switch_modes: list[Modes] = []
+        self.step_index = 0
+        self.kinematic = tuple(sorted(kinematic))
+        self.record_steps = record_steps  # False: the Exudyn model records at its step starts
+        self.record_inputs = False  # True: a sample after the arriving waves are set at every step start
+        self.caught_at_end = False  # the last step ended with a wave piston's catch
+        self._set_inputs(0)  # the waves arriving at the start (a preload's), for the first sample
+        self._step_flux = np.zeros(2)  # energy into the string's rods and a wave piston since the step's start
+        self.body_loads = np.zeros((2, len(self.kinematic)))  # (start, end) of the force on each over the step
+
+    # -- state ----------------------------------------------------------------------------------------
+
+    def _initial_state(self) -> np.ndarray:
+        layout, simulation = self.layout, self.simulation
+        w = np.zeros(layout.size)
+        positions = simulation.initial_positions_m
+        w[:layout.n] = positions if self.setup is None else self.setup.parked(positions)
+        w[layout.rock:layout.rock + layout.rock_states] = simulation.initial_rock_state
+        if layout.torsion:
+            w[layout.angle] = simulation.initial_torsion_angle_rad
+        w[layout.one] = 1.0
+        w[layout.one + 1:layout.one + 3] = generator_states(simulation.impact, np.zeros(1))[0]
+        return w
+
+    def key(self) -> Key:
+        return self.system.key(self.modes, self.phases[self.phase_index])
+
+    def _piece(self, key: Key, w0: np.ndarray, span_s: float) -> np.ndarray:
+        """w after a piece of ``span_s`` (<= h) from w0 on the key's levels, its works and the kinematic
+        bodies' impulse added (models.waves.levels)."""
+        w, works, moved = key_levels(self, key).advance(w0, span_s)
+        self.works += works[:2]
+        self.statistics.rock_work_j[-1] += works[2]
+        self._step_flux += works[3:]  # into the rods since the step's start (not in their waves in flight yet)
+        if moved is not None:
+            self._step_impulse += key.body_forces @ moved
+        return w
+
+    # -- one step -------------------------------------------------------------------------------------
+
+    def advance(self) -> None:
+        """Step ``step_index`` (module doc): in the compiled kernel when nothing happens in it (no blow
+        start, pulse phase change or switch), else here."""
+        if self._quiet(self.step_index):
+            if self.record_inputs:
+                self._set_inputs(self.step_index)
+                self._record(self.step_index * self.step_s, self.w, self.key(), after=True)
+            status, _ = run_fast(self, self.step_index + 1)
+            if status != SWITCH:
+                self._after(status == CATCH)
+                return
+        self._step()
+
+    def _quiet(self, k: int) -> bool:
+        """Whether step k has no blow start and no pulse phase change (the kernel's steps)."""
+        if k % self.period_steps == 0:
+            return False
+        t0, t1 = k * self.step_s, (k + 1) * self.step_s
+        later = self.phase_changes[self.phase_index + 1:self.phase_index + 2]
+        return not (len(later) and later[0] <= t1 + 1e-12 * self.step_s and later[0] > t0 - 1e-12 * self.step_s)
+
+    def _after(self, caught: bool) -> None:
+        """Once a step is done: the sample at its end when one is due (or a catch there)."""
+        self.caught_at_end = caught
+        k = self.step_index
+        if self.record_steps and (caught or k % self.sample_every == 0 or k == self.steps):
+            self._record(k * self.step_s, self.w, self.key(), after=caught)
+
+    def _step(self) -> None:
+        """Step ``step_index`` here (module doc)."""
+        k, h, layout = self.step_index, self.step_s, self.layout
+        t0 = k * h
+        w = self.w
+        if k % self.period_steps == 0:
+            self._start_blow(k, t0)
+            if self.setup is not None:  # the strike: a jump, recorded on both sides
+                self._set_inputs(k)
+                self._record(t0, w, self.key(), after=True)
+        self._set_inputs(k)
+        if self.record_inputs:  # the arriving waves jump at t0: a sample on this side too (an energy account)
+            self._record(t0, w, self.key(), after=True)
+        x0, a0 = w[:layout.n].copy(), w[layout.inputs::2].copy()
+        t, t1, switches = t0, t0 + h, 0
+        key = self.key()
+        self._step_impulse = np.zeros(len(self.kinematic))
+        while t < t1 - 1e-12 * h:
+            later = np.flatnonzero(self.phase_changes > t + 1e-12 * h)
+            boundary = min(t1, self.phase_changes[later[0]]) if len(later) else t1
+            key = self.key()
+            span = boundary - t
+            w1 = key_levels(self, key).propagate(w, span)
+            hit = self._first_switch(key, w, w1, span)
+            if hit is None:
+                w, t = self._piece(key, w, span), boundary
+                if len(later) and boundary >= self.phase_changes[later[0]] - 1e-12 * h:
+                    if self.record_inputs:  # the pulse may jump here: both sides (the trapezoidal account)
+                        self._record(t, w, key)
+                    self.phase_index = int(later[0])
+                    self._start_phase(w, t)
+                    if self.record_inputs:
+                        self._record(t, w, self.key())
+                continue
+            s, exit_ = hit
+            w_s = self._piece(key, w, s)
+            t += s
+            self._record(t, w_s, key)
+            w = self._switch(t, w_s, key, exit_)
+            self._record(t, w, self.key(), after=True)
+            switches += 1
+            if switches > MAX_SWITCHES_PER_STEP:
+                raise SimulationFailed(f"scene '{self.simulation.name}': more than {MAX_SWITCHES_PER_STEP} switches "
+                                       f"within one wave step at t = {t:.6g} s (a chattering contact)")
+        self.w = w
+        if not np.all(np.isfinite(w)) or np.max(np.abs(w[:layout.n])) > POSITION_LIMIT_M:
+            raise SimulationFailed(f"scene '{self.simulation.name}': the wave solution diverged at t = {t1:.6g} s")
+        caught = self._close_step(k, x0, a0, key)
+        if self.kinematic:  # the loads on the Exudyn bodies over the step: its end value and its mean
+            end = key.body_forces @ w
+            self.body_loads = np.array([2.0 * self._step_impulse / h - end, end])
+        self.step_index += 1
+        self._after(caught)
+
+    def _start_phase(self, w: np.ndarray, t: float) -> None:
+        """The pulse generator's states (u1, u2) at the start of the phase piece beginning at ``t``."""
+        period = self.simulation.impact.period_s
+        local = t - np.floor(t / period + 1e-9) * period
+        one = self.layout.one
+        w[one + 1:one + 3] = generator_states(self.simulation.impact, np.array([max(local, 0.0)]))[0]
+
+    def _set_inputs(self, k: int) -> None:
+        """The arriving waves of step k as (a, b) of every port."""
+        if not self.ports:
+            return
+        left, right = self.lines.incoming(k)
+        inputs = self.layout.inputs
+        self.w[inputs::2], self.w[inputs + 1::2] = left, (right - left) / self.step_s
+
+    def run(self) -> None:
+        """Every step, runs of quiet steps in the kernel up to the next blow start, phase change or sample."""
+        self._record(0.0, self.w, self.key())
+        while self.step_index < self.steps:
+            k = self.step_index
+            if not self._quiet(k) or self.record_inputs:
+                self.advance()
+                continue
+            stop = min(self.steps, (k // self.period_steps + 1) * self.period_steps,
+                       (k // self.sample_every + 1) * self.sample_every, self._phase_step(k))
+            status, _ = run_fast(self, stop)
+            if status == SWITCH:
+                self._step()
+            elif self.step_index == stop or status == CATCH:
+                self._after(status == CATCH)
+
+    def _phase_step(self, k: int) -> int:
+        """The first step from k on that holds the next pulse phase change (the kernel stops before it)."""
+        later = self.phase_changes[self.phase_index + 1:self.phase_index + 2]
+        if not len(later):
+            return self.steps
+        return max(k + 1, int(np.floor(later[0] / self.step_s - 1e-9)))
+
+    def _close_step(self, k: int, x0: np.ndarray, a0: np.ndarray, key: Key) -> bool:
+        """The outgoing waves of step k (at its end before any change there: ``key`` that of its last
+        piece), the blow's section statistics, a wave piston's catch (True then)."""
+        self._step_flux[:] = 0.0  # in the waves in flight from now on
+        if self.ports:
+            w, nodes = self.w, self.port_nodes
+            a1 = w[self.layout.inputs::2].copy()
+            self.last_inputs = (a0, a1)
+            self.close_ports(k, self.own_ports, w[nodes] - x0[nodes], key.velocity[nodes] @ w, a0, a1,
+                             provisional=True)
+        if self.piston_rod is not None and self._wave_piston_done(key):
+            self.catch_wave_piston(k + 1)
+            return True
+        return False
+
+    def close_ports(self, k: int, ports: np.ndarray, moved_m: np.ndarray, velocity: np.ndarray, a0: np.ndarray,
+                    a1: np.ndarray, again: bool = False, provisional: bool = False) -> None:
+        """Store the outgoing waves over step k from the ports' nodes' displacement over the step and velocity
+        at its end (arrays over every port) and add the step to the blow's section figures of ``ports``;
+        ``provisional``: store every port (the others are stored ``again`` later, from the Exudyn bodies)."""
+        h = self.step_s
+        right = velocity - a1
+        left = 2.0 * (moved_m / h - 0.5 * (a0 + a1)) - right
+        self.lines.store(k, left, right, None if provisional else ports, again)
+        left, right, a0, a1 = left[ports], right[ports], a0[ports], a1[ports]
+        stats, signs = self.statistics, self.port_signs[ports]
+        start, end = signs * (left - a0), signs * (right - a1)  # compression: sigma Z (outgoing - incoming)
+        stats.compression_n[-1][ports] = np.maximum(stats.compression_n[-1][ports], np.maximum(start, end))
+        stats.tension_n[-1][ports] = np.maximum(stats.tension_n[-1][ports], -np.minimum(start, end))
+        flux = self.port_impedances[ports] * h * ((left**2 + left * right + right**2) - (a0**2 + a0 * a1 + a1**2)) / 3
+        stats.energy_j[-1][ports] += self.port_down[ports] * flux
+
+    def _wave_piston_done(self, key: Key) -> bool:
+        """A wave piston is caught when its contact is open and its momentum not forward, or when it rests
+        against the struck face without pushing (its momentum and the contact force both nil to 1e-9)."""
+        mode, setup = self.modes[self.contact], self.setup
+        momentum = self.lines.momentum_n_s(self.piston_rod)
+        if mode == OPEN:
+            return momentum <= 0.0
+        if mode != CLOSED:
+            return False
+        rod = self.chain.waves[self.piston_rod]
+        scale = setup.strike_velocity_m_per_s
+        return abs(momentum) <= 1e-9 * setup.momentum_n_s and \
+            abs(self.impact_force(key, self.w)) <= 1e-9 * rod.impedance_n_s_per_m * scale
+
+    def impact_force(self, key: Key, w: np.ndarray) -> float:
+        """F_d on the impact body along +x: the pulse, or the piston's contact (-F of the link)."""
+        return float(self.impact_row(key) @ w)
+
+    def impact_row(self, key: Key) -> np.ndarray:
+        if self.contact is None:
+            row = np.zeros(self.layout.size)
+            row[self.layout.one:self.layout.one + 3] = phase_row(self.simulation.impact, key.phase)
+            return row
+        row = key.element_forces[self.contact]
+        return -(key.constraints[CONTACT] if row is None else row)
+
+    # -- switches -------------------------------------------------------------------------------------
+
+    def _first_switch(self, key: Key, w0: np.ndarray, w1: np.ndarray, span_s: float) -> tuple[float, int] | None:
+        """(time into the piece, exit) of the first switch in the piece, None without one: an exit function
+        on its crossed side at the piece's end, or one whose slopes show a maximum inside, located on the
+        key's levels (models.waves.levels)."""
+        if "exit_rows" not in key.cache:
+            rows = np.array([direction * row for row, direction, *_ in key.exits]).reshape(len(key.exits), len(w0))
+            key.cache["exit_rows"], key.cache["exit_slopes"] = rows, rows @ key.matrix
+        rows, slopes = key.cache["exit_rows"], key.cache["exit_slopes"]
+        start, end = rows @ w0, rows @ w1
+        returning = (start < 0.0) & (end <= 0.0) & (slopes @ w0 > 0.0) & (slopes @ w1 < 0.0)
+        candidates = (end > 0.0) | returning
+        if not np.any(candidates):
+            return None
+        return key_levels(self, key).first_switch(rows, slopes, w0, span_s, candidates)
+
+    def _switch(self, t: float, w: np.ndarray, key: Key, exit_: int) -> np.ndarray:
+        """Enter the exit's modes: its entry resets (the borehole bottom never decreases)."""
+        _, _, following, resets, element = key.exits[exit_]
+        if self.contact is not None and element == self.contact and following[self.contact] == CAUGHT \
+                and self.jumps is not None:  # the piston's energy before the reset
+            self.jumps.noted_catch(t, *self._piston_state(key, w))
+        w = w.copy()
+        monotone = self.system.pieces[0].monotone
+        values = {target: float(row @ w) for target, row in resets}
+        for target, value in values.items():
+            w[target] = max(w[target], value) if target == monotone else value
+        self.modes = following
+        self.switch_times.append(t)
+        self.switch_modes.append(following)
+        return w
+
+    def _piston_state(self, key: Key, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return w[:self.layout.n], key.velocity @ w
+
+    # -- blows ----------------------------------------------------------------------------------------
+
+    def _start_blow(self, k: int, t: float) -> None:
+        """The rock state the blow meets (indexing) and the piston's strike."""
+        self.statistics.open_blow(len(self.ports))
+        layout, w = self.layout, self.w
+        if self.blows:
+            states = slice(layout.rock, layout.rock + layout.rock_states)
+            angle = w[layout.angle] if layout.torsion else 0.0
+            _, w[states] = self.blows(w[self.chain.bit_body], tuple(w[states]), angle)
+            self.modes = (self.system.pieces[0].initial_mode(self._z(w)), *self.modes[1:])
+        if self.setup is None:
+            return
+        setup, velocity_index = self.setup, layout.velocity
+        if self.piston_rod is None:
+            velocities = self.key().velocity @ w
+            self.jumps.strike(t, w[:layout.n], velocities)
+            for node in range(setup.first, setup.front + 1):
+                w[node] = w[setup.impact_body]
+                if node in velocity_index:
+                    w[velocity_index[node]] = setup.strike_velocity_m_per_s
+        else:
+            rod = self.chain.waves[self.piston_rod]
+            self.jumps.note(t, "strike", self.lines.energy_j(self.piston_rod),
+                            self.lines.momentum_n_s(self.piston_rod) / rod.mass_kg)
+            w[rod.top] = w[rod.bottom] = w[setup.impact_body]
+            self.lines.fill(self.piston_rod, k, 0.5 * setup.strike_velocity_m_per_s)
+        self.modes = self.modes[:self.contact] + (CLOSED,) + self.modes[self.contact + 1:]
+
+    def catch_wave_piston(self, k: int) -> None:
+        rod = self.chain.waves[self.piston_rod]
+        t = k * self.step_s
+        self.jumps.note(t, "catch", self.lines.energy_j(self.piston_rod),
+                        self.lines.momentum_n_s(self.piston_rod) / rod.mass_kg)
+        self.lines.fill(self.piston_rod, k, 0.0)
+        self.w[rod.top] = self.w[rod.bottom] = self.w[self.setup.impact_body] - PARK_M
+        self.modes = self.modes[:self.contact] + (CAUGHT,) + self.modes[self.contact + 1:]
+        self.switch_times.append(t)
+        self.switch_modes.append(self.modes)
+
+    def _z(self, w: np.ndarray) -> np.ndarray:
+        return np.concatenate([w, self.key().velocity @ w])
+
+    # -- records --------------------------------------------------------------------------------------
+
+    def _record(self, t: float, w: np.ndarray, key: Key, after: bool = False) -> None:
+        """A sample: the state, every node's velocity, the forces (rock, impact, rigid joints), the works,
+        the energy in the string's rods and in a wave piston, every port's compression."""
+        samples, layout, n = self.samples, self.layout, self.layout.n
+        if "record" not in key.cache:  # velocities, forces and compressions as one matrix over w
+            ports = self.port_signs[:, None] * key.velocity[self.port_nodes]
+            ports[np.arange(len(self.ports)), layout.inputs + 2 * np.arange(len(self.ports))] -= 2.0 * self.port_signs
+            rows = [key.velocity, key.rock_force[None], self.impact_row(key)[None],
+                    np.array([key.constraints[name] for name in self.rigid_names]).reshape(-1, layout.size), ports]
+            key.cache["record"] = np.vstack(rows)
+        values = key.cache["record"] @ w
+        forces = 2 + len(self.rigid_names)
+        samples.time_s.append(t)
+        samples.after.append(after)
+        samples.states.append(w.copy())
+        samples.velocity.append(values[:n])
+        samples.forces.append(values[n:n + forces])
+        samples.compression.append(values[n + forces:])
+        samples.works.append(self.works.copy())
+        energies = self.lines.energies_j()
+        piston = 0.0 if self.piston_rod is None else energies[self.piston_rod]
+        samples.piston_j.append(piston + self._step_flux[1])
+        samples.waves_j.append(float(np.sum(energies)) - piston + self._step_flux[0])
+
+
+def initial_outgoing(simulation, chain) -> np.ndarray:
+    """Every port's outgoing wave before the start: at rest, P / (2 Z) at the top and -P / (2 Z) at the
+    bottom of a rod compressed by P (a preload: P = (E A / L) (x_top - x_bottom))."""
+    positions = simulation.initial_positions_m
+    out = np.zeros(2 * len(chain.waves))
+    for r, rod in enumerate(chain.waves):
+        if rod.top < len(positions):
+            compression = rod.stiffness_n_per_m * (positions[rod.top] - positions[rod.bottom])
+            out[2 * r], out[2 * r + 1] = compression / (2 * rod.impedance_n_s_per_m), \
+                -compression / (2 * rod.impedance_n_s_per_m)
+    return out
+
