@@ -66,6 +66,9 @@ class SimulationResult:
     # an Exudyn model with items of one's own: their energy, and the user's sensors by name at the stored steps
     user_energy: UserEnergy | None = None
     user_series: dict[str, np.ndarray] = field(default_factory=dict)
+    # the ODE2 coordinates an Exudyn model's extensions add, where a steady-state run follows them
+    # (Simulation.extension_coordinates): samples x (their positions, then their velocities)
+    extension_state: np.ndarray | None = None
 
     @property
     def scene(self) -> Scene:

@@ -68,6 +68,7 @@ from ..evaluation.run_result import Result
 from ..evaluation.stability import StepLimitWarning, check_result, step_warning
 from .exudyn_graphics import DrillGraphics, body_graphics, chain_cylinders, torsion_graphics
 from .exudyn_messages import (
+    SOLVER_TYPES,
     MinimumStepGuard,
     exudyn_messages_as_warnings,
     no_cyclic_gc,
@@ -78,20 +79,17 @@ from .exudyn_messages import (
     simulation_settings,
 )
 from .exudyn_piston import ExudynPiston
-from .exudyn_user_items import EnergyTerm, UserAccount, assembled_scales, item_counts, user_outcome
+from .exudyn_user_items import (
+    EnergyTerm,
+    UserAccount,
+    assembled_scales,
+    follow_extension_coordinates,
+    item_counts,
+    time_runs_only,
+    user_outcome,
+)
 from .simulation import Simulation, as_simulation, prepare, solver_settings
 
-SOLVER_TYPES = {
-    "rk67": exu.DynamicSolverType.RK67,
-    "rk44": exu.DynamicSolverType.RK44,
-    "rk33": exu.DynamicSolverType.RK33,
-    "explicit_midpoint": exu.DynamicSolverType.ExplicitMidpoint,
-    "explicit_euler": exu.DynamicSolverType.ExplicitEuler,
-    "generalized_alpha": exu.DynamicSolverType.GeneralizedAlpha,
-    "trapezoidal_index2": exu.DynamicSolverType.TrapezoidalIndex2,
-    "dopri5": exu.DynamicSolverType.DOPRI5,
-    "ode23": exu.DynamicSolverType.ODE23,
-}
 COORDINATE = exu.OutputVariableType.Coordinates
 RATE = exu.OutputVariableType.Coordinates_t
 AXIS_X_FROM_Z = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]  # a rotational node's local z onto the drilling axis
@@ -154,6 +152,7 @@ class ExudynModel:
     _installed: Any = None  # the pre-step function the model set on mbs
     _foreign: Any = None  # a pre-step function of the user's, set on mbs, run after the model's
     solution_path: Path | None = None
+    extension_sensors: list[Any] = field(default_factory=list)  # models.solvers.exudyn_user_items
 
     def __post_init__(self) -> None:
         self._account = UserAccount(*(self._built_items[kind] for kind in ("objects", "loads", "sensors")))
@@ -177,7 +176,8 @@ class ExudynModel:
     def settings(self) -> Any:
         """Exudyn's simulation settings of the run, its step sized for the system as assembled now
         (:meth:`prepare`): ``exu.SolveDynamic(model.mbs, model.settings, solverType=model.solver_type)``
-        runs what :meth:`run` runs."""
+        runs what :meth:`run` runs (InputError as :meth:`run`'s)."""
+        time_runs_only(self.simulation)
         self.prepare()
         return self._settings
 
@@ -251,7 +251,9 @@ class ExudynModel:
 
     def run(self, progress: Callable[[float], None] | None = None) -> Result:
         """Run the system (with any items added) by the scene's solver settings; ``progress(t)`` about
-        100 times. The result is ``rpdrill.Result``, as ``rpdrill.simulate`` returns; a model runs once."""
+        100 times. The result is ``rpdrill.Result``, as ``rpdrill.simulate`` returns; a model runs once.
+        InputError for a scene that asks for ``solver.steady_state: periodic``: a built model runs in time."""
+        time_runs_only(self.simulation)
         raw = self.solve(progress)  # the step may change with what was added: the simulation after the run
         return Result(self.simulation.scene, raw, {"source": "build_exudyn", **self.simulation.code_records()})
 
@@ -267,7 +269,8 @@ class ExudynModel:
                                  "state) with a symbolic one, which cannot run beside them; add it with "
                                  "model.add_pre_step(function) instead")
             self._foreign = replaced["function"]
-        settings = self.settings  # prepared for what was added
+        self.prepare()  # for what was added
+        settings = self._settings
         guard = None
         if self.simulation.settings.type in AUTOMATIC_STEP_SOLVERS:
             guard = MinimumStepGuard(settings.timeIntegration.minimumStepSize)
@@ -292,7 +295,8 @@ class ExudynModel:
         """The result of a run by Exudyn's own ``exu.SolveDynamic(model.mbs, model.settings, ...)`` (as
         :meth:`run` returns it). RuntimeError when the system has not run, or when a function set with
         ``mbs.SetPreStepUserFunction`` replaced the model's per-step functions (the rock's state never
-        moved): add such a function with ``model.add_pre_step`` instead."""
+        moved): add such a function with ``model.add_pre_step`` instead; InputError as :meth:`run`'s."""
+        time_runs_only(self.simulation)
         if self.mbs.systemData.GetTime() <= 0:
             raise RuntimeError("model.result(): the system has not run; call model.run() or "
                                "exu.SolveDynamic(model.mbs, model.settings, solverType=model.solver_type) first")
@@ -445,7 +449,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
         except Exception as error:
             raise ExtensionFailed(f"scene '{simulation.name}': extensions.{name} ({extension.function}) failed on the "
                                   f"built model: {type(error).__name__}: {error}") from error
-    model.prepare()
+    follow_extension_coordinates(model)  # model.prepare(), the coordinates a steady-state run follows with it
     return model
 
 
@@ -474,27 +478,18 @@ def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
     rock_state = model.rock.state_at(time_s)
     info: dict[str, Any] = {"solver_success": ok, "coordinates": model.coordinate_count,
                             **({"fresh_fractions": model.blows.fresh_fractions} if model.blows else {})}
-    extra, energy, series = user_outcome(model, time_s)
+    extra, energy, series, extension = user_outcome(model, time_s)
     info.update(extra)
     result = SimulationResult(
-        simulation=simulation,
-        formulation="exudyn",
-        time_s=time_s,
-        position_m=position,
-        velocity_m_per_s=velocity,
+        simulation=simulation, formulation="exudyn", time_s=time_s, position_m=position, velocity_m_per_s=velocity,
         bottom_m=rock_state[:, model.rock.rock.bottom_index],
         rock_force_n=data["rock"][:, 1] if "rock" in data else None,
         impact_force_n=(data["impact"][:, 1] if piston is None else piston.contact_force_n) if "impact" in data
         else None,
         torsion_angle_rad=data["phi"][:, 1] if "phi" in data else None,
         torsion_rate_rad_per_s=data["omega"][:, 1] if "omega" in data else None,
-        cpu_time_s=cpu,
-        info=info,
-        bottom_events=(history[:, 0], history[:, 1]),
-        rock_state_m=rock_state,
-        piston=piston,
-        user_energy=energy,
-        user_series=series,
+        cpu_time_s=cpu, info=info, bottom_events=(history[:, 0], history[:, 1]), rock_state_m=rock_state,
+        piston=piston, user_energy=energy, user_series=series, extension_state=extension,
     )
     check_result(result, solver_ok=ok, reached_s=reached_s)
     return result
