@@ -1,7 +1,8 @@
 """What a user of rpdrill writes for their rig (the tests name it by import path, ``user_rig:NAME``):
 extensions (the clamps of examples/clamp_extension.py: a mass on its own Node1D held on a body by a
 coordinate spring-damper, and one with a spring-force user function and its declared energy terms; sensors
-of one's own) and rock laws of one's own (the paper's law under another name; one without a mode table)."""
+of one's own; a loose mass, a step counter and an anchor to ground, which a steady state cannot follow) and
+rock laws of one's own (the paper's law under another name; one without a mode table)."""
 
 from __future__ import annotations
 
@@ -9,12 +10,20 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import exudyn
-from exudyn.itemInterface import SensorNode
+from exudyn.itemInterface import (
+    MarkerNodeCoordinate,
+    Node1D,
+    NodePointGround,
+    ObjectConnectorCoordinateSpringDamper,
+    ObjectMass1D,
+    SensorNode,
+)
 
 from examples.clamp_extension import add_clamp, add_friction_clamp  # the checkout's examples: a user's module
 from rpdrill.rocklaw import JenkinsRock
 
-__all__ = ["ForceOnlyRock", "RenamedJenkins", "add_clamp", "add_friction_clamp", "add_sensors"]
+__all__ = ["ForceOnlyRock", "RenamedJenkins", "add_anchor", "add_clamp", "add_friction_clamp", "add_loose_mass",
+           "add_sensors", "add_step_counter"]
 
 
 def add_sensors(model, body: str = "bit") -> None:
@@ -24,6 +33,26 @@ def add_sensors(model, body: str = "bit") -> None:
 
 
 add_sensors.changes_motion = False  # rpdrill: the exact and ODE formulations may run a scene with it
+
+
+def add_loose_mass(model, mass_kg: float = 50.0) -> None:
+    """A Mass1D on its own Node1D, ``loose_mass``, that no spring holds (a free coordinate of one's own)."""
+    node = model.mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[0.0], initialVelocities=[0.0]))
+    model.mbs.AddObject(ObjectMass1D(nodeNumber=node, mass=mass_kg, name="loose_mass"))
+
+
+def add_step_counter(model) -> None:
+    """A per-step function of one's own (``model.add_pre_step``) that counts the steps: a state outside Exudyn's."""
+    steps = []
+    model.add_pre_step(lambda mbs, t: steps.append(t) is None)
+
+
+def add_anchor(model, stiffness_n_per_m: float, body: str = "collar") -> None:
+    """A coordinate spring, ``anchor``, from ground to ``body`` (no coordinates of its own)."""
+    mbs = model.mbs
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
+    mbs.AddObject(ObjectConnectorCoordinateSpringDamper(markerNumbers=[ground, model.bodies[body].marker_coordinate],
+                                                        stiffness=stiffness_n_per_m, name="anchor"))
 
 
 @dataclass(frozen=True)
