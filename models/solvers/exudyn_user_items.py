@@ -166,6 +166,14 @@ def follow_extension_coordinates(model: Any) -> None:
             write(state, configuration=initial)
 
 
+def initial_coordinates(model: Any, indices: list[int]) -> np.ndarray:
+    """The ODE2 coordinates ``indices`` of a prepared model's start (Exudyn's initial configuration): their
+    positions, then their velocities."""
+    data, initial = model.mbs.systemData, exu.ConfigurationType.Initial
+    return np.concatenate([np.asarray(data.GetODE2Coordinates(configuration=initial))[indices],
+                           np.asarray(data.GetODE2Coordinates_t(configuration=initial))[indices]])
+
+
 def extension_history(model: Any, time_s: np.ndarray) -> np.ndarray | None:
     """The followed extension coordinates (:func:`follow_extension_coordinates`) at ``time_s``: samples x
     (positions, then velocities); None where none are followed."""

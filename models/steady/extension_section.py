@@ -16,8 +16,8 @@ assembled system: K e = 0, with K the stiffness of the system linearised by Exud
 and the chain's nonlinear links closed). The rows of the extension's coordinates give
 K_uu e_u = -K_uo e_o; e_u = 1 for a clamp held on a body by a spring (of any stiffness), 0 for a
 coordinate no spring ties to the string (a rotation with a spring to ground). Where the rows of the
-string's bodies then leave a force (K e != 0: a spring of the extension's to ground on a body that moves
-with the drill), the drill cannot repeat relative to the bottom, as with a link of the scene's own to
+string's bodies then leave a force (K e != 0 beyond GROUNDED, checked also where the extensions add no
+coordinates: a spring of theirs to ground on a body that moves with the drill), the drill cannot repeat relative to the bottom, as with a link of the scene's own to
 ground (models.steady.section.drift_problem). A coordinate that no spring holds (K_uu singular: a free
 mass, a freely turning shaft) has no shift that the forces decide, and its position may wander from
 blow to blow: the steady state is refused naming it. So are first-order (ODE1) and data coordinates and
@@ -30,9 +30,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...rocklaw.exudyn_module import exu
 from ..solvers.exudyn_model import ExudynModel, build_exudyn
-from ..solvers.exudyn_user_items import closed_chain, extension_nodes, linearised_system
+from ..solvers.exudyn_user_items import closed_chain, extension_nodes, initial_coordinates, linearised_system
 from ..solvers.simulation import ExtensionCoordinates, Simulation
 from .steady_state import SteadyStateUnavailable
 
@@ -58,9 +57,7 @@ def with_extension_coordinates(simulation: Simulation) -> Simulation:
     drift = _drift(model, indices, labels)  # also where they add no coordinates: a spring to ground
     if not nodes:
         return simulation
-    data, initial = model.mbs.systemData, exu.ConfigurationType.Initial
-    start = np.concatenate([np.asarray(data.GetODE2Coordinates(configuration=initial))[indices],
-                            np.asarray(data.GetODE2Coordinates_t(configuration=initial))[indices]])
+    start = initial_coordinates(model, indices)
     return replace(simulation, extension_coordinates=ExtensionCoordinates(
         tuple(labels), tuple(float(e) for e in drift), tuple(float(v) for v in start)))
 
