@@ -5,7 +5,7 @@ spring-damper) are in the Poincare section: every run of the blow map starts the
 it, so the orbit's rate is the extended drill's settled rate. Before, each run restarted the clamp at rest
 on the collar: the orbit of another machine, 7.4 % slower here, and nothing said so. What the section cannot
 hold (a coordinate no spring holds, a per-step function of one's own, a spring to ground) is refused by
-name, and the result is the scene's time run.
+name, and the result is the scene's time run; a coordinate held to ground only stays where its spring holds it.
 """
 
 from __future__ import annotations
@@ -69,6 +69,17 @@ def test_the_clamp_is_in_the_section_and_its_orbit_is_the_clamped_drills_settled
     restarted = rpdrill.simulate(clamped())
     assert restarted.info["regime"] == "period-1" and "clamp_position" not in restarted.info["orbit_state_labels"]
     assert abs(rate(restarted) / rate(time_run) - 1) > 100 * STATED
+
+
+def test_coordinates_that_do_not_move_with_the_drill_stay_where_their_forces_hold_them():
+    """An oscillator on ground drifts by 0 with the hole (K e = 0): the orbit holds it at rest where its spring
+    is relaxed, not riding with the bit; it changes no motion (and says so), so the rate is the plain drill's."""
+    oscillator = rpdrill.simulate(drill(extensions={"reference": {"function": "user_rig:add_ground_oscillator"}}))
+    info = oscillator.info
+    assert info["regime"] == "period-1" and info["orbit_state_labels"][-2:] == ["oscillator_position",
+                                                                                  "oscillator_velocity"]
+    np.testing.assert_allclose(info["orbit_state"][-2:], 0.0, atol=1e-9)  # it started at 1 mm: its orbit is rest
+    assert rate(oscillator) == pytest.approx(rate(rpdrill.simulate(drill())), rel=1e-9)
 
 
 @pytest.mark.parametrize(("function", "parameters", "why"), [

@@ -124,7 +124,10 @@ class RegimeFinder:
         simulation = with_extension_coordinates(simulation)  # an Exudyn scene's extensions' coordinates
         self.simulation, self.section = simulation, section_of(simulation)
         self.exact = simulation.settings.formulation == "exact"
-        self.guide = None if self.exact or not exact_available(simulation) else RegimeFinder(as_exact(simulation))
+        # the exact model guides where it runs the scene and the section is its own (not where an extension
+        # said to change no motion still adds coordinates: the exact model does not hold them)
+        self.guide = None if self.exact or not exact_available(simulation) or simulation.extension_coordinates \
+            else RegimeFinder(as_exact(simulation))
         self.maps: dict[int, PeriodMap] = {}
         self.runs = 0
         self.unstable: list[Orbit] = []
