@@ -10,17 +10,23 @@ The public API (every name documented with an example in ``docs/api.md``)::
     table = rpdrill.run_study(rpdrill.load_study("studies/paper/frequency_scan.yaml"), workers=2)
     rpdrill.crosscheck(scene).passed   # Exudyn against the paper's Eq. 4 as an ODE, first 20 blows
     rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (10e3, 30e3)})[0].best
+    rpdrill.calibrate("studies/paper/calibration.yaml", out="runs/calibration").best
+    rpdrill.sensitivity("studies/paper/sensitivity.yaml").summary
+    rpdrill.accuracy("studies/accuracy_studies/paper_base.yaml").pareto
+    rpdrill.reproduce(out="runs/reproduction").passed
+    rpdrill.rotation_report("runs/rotation").ridge
 
-The package's folders: ``rocklaw`` (the rock contact laws), ``models`` (the drill models and their
-three formulations), ``studies`` (YAML inputs, scans, analyses, reports and the command line);
-dependencies run one way, studies -> models -> rocklaw (``docs/architecture.md``).
+Every command of the ``rpdrill`` program is one of these calls. The package's folders: ``rocklaw`` (the
+rock contact laws), ``models`` (the drill models and their three formulations), ``studies`` (YAML
+inputs, scans, analyses, reports and the command line); dependencies run one way, studies -> models ->
+rocklaw (``docs/architecture.md``).
 """
 
 from typing import TYPE_CHECKING, Any
 
 # Every public name is imported when first used, not at ``import rpdrill``: the ``rpdrill`` program starts
-# (and takes its Ctrl-C handler, studies.cli.main.console) before NumPy, pydantic or Exudyn load; the command
-# line can still choose Exudyn's build (rocklaw.exudyn_build) and a user's ``import exudyn`` gets the regular one.
+# (and takes its Ctrl-C handler, studies.cli.main.console) before NumPy, pydantic or Exudyn load; the program
+# chooses Exudyn's build in its entry point, and a user's ``import exudyn`` gets the regular one.
 _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "InputError": ("models.definition.validation", "InputError"),
          "Result": ("models.evaluation.run_result", "Result"),
@@ -36,13 +42,24 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "table_frame": ("studies.api", "table_frame"),
          "Crosscheck": ("studies.crosscheck.crosscheck_run", "Crosscheck"),
          "crosscheck": ("studies.crosscheck.crosscheck_run", "crosscheck"),
+         "Budget": ("studies.runtime.budgets", "Budget"),
          "BudgetError": ("studies.runtime.budgets", "BudgetError"),
          "Study": ("studies.scan.study", "Study"),
          "build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
          "ExudynModel": ("models.solvers.exudyn_model", "ExudynModel"),
          "draw": ("studies.drawings.drill_drawing", "draw"),
          "write_animation": ("studies.drawings.drill_animation", "write_animation"),
-         "view_solution": ("studies.drawings.drill_animation", "view_solution")}
+         "view_solution": ("studies.drawings.drill_animation", "view_solution"),
+         "calibrate": ("studies.calibration.calibration_run", "calibrate"),
+         "CalibrationResult": ("studies.calibration.calibration_run", "CalibrationResult"),
+         "sensitivity": ("studies.sensitivity.sensitivity_run", "sensitivity"),
+         "SensitivityResult": ("studies.sensitivity.sensitivity_run", "SensitivityResult"),
+         "accuracy": ("studies.accuracy.accuracy_run", "accuracy"),
+         "AccuracyResult": ("studies.accuracy.accuracy_run", "AccuracyResult"),
+         "reproduce": ("studies.pages.reproduction_run", "reproduce"),
+         "ReproductionResult": ("studies.pages.reproduction_run", "ReproductionResult"),
+         "rotation_report": ("studies.pages.rotation_note", "rotation_report"),
+         "RotationReport": ("studies.pages.rotation_note", "RotationReport")}
 
 if TYPE_CHECKING:  # the names as type checkers and editors see them
     from .models.definition.scene import Scene
@@ -50,14 +67,19 @@ if TYPE_CHECKING:  # the names as type checkers and editors see them
     from .models.evaluation.run_result import Result
     from .models.evaluation.stability import SimulationFailed
     from .models.solvers.exudyn_model import ExudynModel, build_exudyn
+    from .studies.accuracy.accuracy_run import AccuracyResult, accuracy
     from .studies.advice.advice_run import Advice, AdviceSearch
     from .studies.advice.advice_run import advise_scene as advise
     from .studies.api import load_scene, load_study, run_study, save_result, simulate, table_frame
+    from .studies.calibration.calibration_run import CalibrationResult, calibrate
     from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
     from .studies.drawings.drill_animation import view_solution, write_animation
     from .studies.drawings.drill_drawing import draw
-    from .studies.runtime.budgets import BudgetError
+    from .studies.pages.reproduction_run import ReproductionResult, reproduce
+    from .studies.pages.rotation_note import RotationReport, rotation_report
+    from .studies.runtime.budgets import Budget, BudgetError
     from .studies.scan.study import Study
+    from .studies.sensitivity.sensitivity_run import SensitivityResult, sensitivity
 
 
 def __getattr__(name: str) -> Any:
@@ -75,6 +97,8 @@ def __dir__() -> list[str]:
     return sorted({*globals(), *_LAZY})
 
 
-__all__ = ["Advice", "AdviceSearch", "BudgetError", "Crosscheck", "ExudynModel", "InputError", "Result", "Scene", "SimulationFailed", "Study", "advise", "build_exudyn",
-           "crosscheck", "draw", "load_scene", "load_study", "run_study", "save_result", "simulate", "table_frame", "view_solution",
-           "write_animation"]
+__all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult", "Crosscheck",
+           "ExudynModel", "InputError", "ReproductionResult", "Result", "RotationReport", "Scene", "SensitivityResult",
+           "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck", "draw",
+           "load_scene", "load_study", "reproduce", "rotation_report", "run_study", "save_result", "sensitivity",
+           "simulate", "table_frame", "view_solution", "write_animation"]

@@ -12,6 +12,8 @@ family at each penetration-rate error ``--level``, on the study's window against
 from __future__ import annotations
 
 import argparse
+import itertools
+import math
 import statistics
 import warnings
 from dataclasses import replace
@@ -19,7 +21,7 @@ from pathlib import Path
 
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.evaluation.solver_settings import EXUDYN_PRESETS
-from rpdrill.models.evaluation.workprecision import cost_at_error, errors
+from rpdrill.models.evaluation.workprecision import errors, pareto_front
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.accuracy.accuracy_study import load_accuracy_study, reference_signature, run_setting
 
@@ -27,14 +29,26 @@ ROOT = Path(__file__).resolve().parents[1]
 MEASURE = "penetration_rate_error_rel"
 
 
-def preset_cost(base: dict, preset: str, seconds: float, repeats: int) -> tuple[float, float]:
+def cost_at_error(cost: list[float], error: list[float], level: float) -> float:
+    """CPU cost at which the Pareto front of (cost, error) reaches ``level``, log-log interpolated
+    between the neighbouring front points; NaN if the front does not bracket ``level``."""
+    front = pareto_front(cost, error)
+    points = [(math.log(error[i]), math.log(cost[i])) for i in front if error[i] > 0 and cost[i] > 0]
+    target = math.log(level)
+    for (e0, c0), (e1, c1) in itertools.pairwise(points):
+        if e1 <= target <= e0:
+            return math.exp(c0 + (c1 - c0) * (target - e0) / (e1 - e0)) if e0 != e1 else math.exp(c0)
+    return math.nan
+
+
+def preset_cost(base: Scene, preset: str, seconds: float, repeats: int) -> tuple[float, float]:
     """(CPU s per simulated s, step) of the base scene run with ``preset`` for ``seconds``."""
-    data = {**base, "solver": {"formulation": "exudyn", "preset": preset, "end_time_s": seconds}}
-    data["outputs"] = {"metrics": ["penetration_rate_m_per_s"], "timeseries": ["borehole_bottom_m"]}
-    simulation = prepare(Scene.model_validate(data))
+    simulation = prepare(base.with_({"solver": {"formulation": "exudyn", "preset": preset, "end_time_s": seconds},
+                                     "outputs": {"metrics": ["penetration_rate_m_per_s"],
+                                                 "timeseries": ["borehole_bottom_m"]}}))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        runs = [simulation.run().cpu_time_s for _ in range(repeats)]
+        runs = [simulation.solve().cpu_time_s for _ in range(repeats)]
     return statistics.median(runs) / seconds, simulation.settings.step_s
 
 
@@ -52,8 +66,8 @@ def main() -> None:
 
     print("\npreset     step [s]   CPU s / simulated s   penetration-rate error (window)")
     presets = [(p, r) for p, r in zip(study.points, study.runs) if r.solver.get("preset")]
-    for point, run in presets:
-        outcome = run_setting((point.index, study.scene, replace(run, repeats=args.repeats), study.spec.grid_interval_s,
+    for _, run in presets:
+        outcome = run_setting((study.scene, replace(run, repeats=args.repeats), study.spec.grid_interval_s,
                                study.spec.time_limit_s))
         error = errors(reference, outcome["signature"])[MEASURE] if outcome["status"] == "ok" else float("nan")
         per_second, step = preset_cost(study.base, run.solver["preset"], args.seconds, args.repeats)
@@ -63,15 +77,15 @@ def main() -> None:
         print(f"(presets not in the study: {', '.join(sorted(missing))})")
 
     groups = {"exudyn": [], "ode": []}
-    for point, run in zip(study.points, study.runs):
+    for run in study.runs:
         if run.solver.get("preset") or (run.formulation == "ode" and run.solver.get("method") != "DOP853"):
             continue
         if run.formulation not in groups:
             continue
-        outcome = run_setting((point.index, study.scene, replace(run, repeats=args.repeats), study.spec.grid_interval_s,
+        outcome = run_setting((study.scene, replace(run, repeats=args.repeats), study.spec.grid_interval_s,
                                study.spec.time_limit_s))
         if outcome["status"] == "ok":
-            groups[run.formulation].append((outcome["metrics"]["cpu_time_s"], errors(reference, outcome["signature"])[MEASURE]))
+            groups[run.formulation].append((outcome["cpu_time_s"], errors(reference, outcome["signature"])[MEASURE]))
     print("\nCPU time of the window at equal penetration-rate error (Pareto fronts, log-log interpolated):")
     print("error level   Exudyn model [s]   ODE DOP853 [s]   ratio Exudyn : ODE")
     for level in args.level:

@@ -33,8 +33,8 @@ from rpdrill.studies.advice.advice_search import (
     METRICS,
     AdviceEvaluator,
     Request,
-    advise,
     runnable_scene,
+    search_advice,
 )
 from rpdrill.studies.inputs.reading import load_scene
 from rpdrill.studies.runtime.pools import process_pool, sequential
@@ -75,7 +75,7 @@ def main() -> None:
     parser.add_argument("--frequency-hz", type=float, nargs=2, default=(20.0, 120.0))
     parser.add_argument("--feed-kn", type=float, nargs=2, default=(20.0, 100.0))
     args = parser.parse_args()
-    scene = load_scene(SCENE).model_dump(by_alias=True, exclude_none=True)
+    scene = load_scene(SCENE)
     request = Request(args.metric, {FREQUENCY: tuple(args.frequency_hz), FEED: tuple(v * 1e3 for v in args.feed_kn)})
     costs = {metric: seconds_per_run(scene, metric, request) for metric in METRICS}
     print("one run on the exact path [s]: " + ", ".join(f"{m} {t:.4f}" for m, t in costs.items())
@@ -89,7 +89,7 @@ def main() -> None:
             [{FREQUENCY: 65.0, FEED: 75e3}] * args.workers * 2)  # load the compiled kernels in each worker
         for rock in TABLE_1:
             start = time.perf_counter()
-            advice = advise(runnable_scene(scene, rock, request, str(SCENE)), rock, request, runner)
+            advice = search_advice(runnable_scene(scene, rock, request, str(SCENE)), rock, request, runner)
             wall = time.perf_counter() - start
             best, at = grid_best(scene, rock, request, runner, args.step_hz, args.step_kn * 1e3)
             print(f"{rock} | {advice.best_value:.5g} | {advice.best[FREQUENCY]:.4g}, {advice.best[FEED] / 1e3:.4g} | "

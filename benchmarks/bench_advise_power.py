@@ -25,8 +25,8 @@ from rpdrill.studies.advice.advice_search import (
     FREQUENCY,
     AdviceEvaluator,
     Request,
-    advise,
     runnable_scene,
+    search_advice,
 )
 from rpdrill.studies.inputs.reading import load_scene
 from rpdrill.studies.runtime.pools import process_pool
@@ -44,11 +44,11 @@ def main() -> None:
     args = parser.parse_args()
     bounds = {FREQUENCY: tuple(args.frequency_hz), FEED: tuple(1e3 * f for f in args.feed_kn)}
     request = Request("penetration_rate_m_per_s", bounds, power_w=1e3 * args.power_kw)
-    scene = load_scene(SCENE).model_dump(by_alias=True, exclude_none=True)
+    scene = load_scene(SCENE)
     data = runnable_scene(scene, None, request, str(SCENE))
     with process_pool(args.workers) as runner:
         start = time.perf_counter()
-        advice = advise(data, None, request, runner)
+        advice = search_advice(data, None, request, runner)
         advise_s = time.perf_counter() - start
         frequencies = np.arange(args.frequency_hz[0], args.frequency_hz[1] + 1e-9, args.step_hz)
         grid = AdviceEvaluator(data, request, runner)([{FREQUENCY: float(f), FEED: advice.best[FEED]}

@@ -21,7 +21,6 @@ for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
 import argparse
-import copy
 import json
 import statistics
 import subprocess
@@ -31,14 +30,16 @@ import tracemalloc
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.solvers.cost import CPU_S_PER_STEP, Cause, cost_key, run_cost
 from rpdrill.models.solvers.simulation import prepare, unsupported
 from rpdrill.studies.calibration.calibration_search import target_result
 from rpdrill.studies.calibration.calibration_spec import load_calibration
-from rpdrill.studies.inputs.reading import read_yaml
+from rpdrill.studies.inputs.reading import load_scene
 from rpdrill.studies.runtime.point_runs import prepare_point
+from rpdrill.studies.scan.curves import CurveRun
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "studies" / "scenes"
@@ -55,8 +56,8 @@ MEMORY_RUNS = [
 
 
 def simulation(scene: str, formulation: str, options: dict | None = None, outputs: dict | None = None):
-    data = read_yaml(SCENES / f"{scene}.yaml") | ({"outputs": outputs} if outputs else {})
-    return prepare(Scene.model_validate(data).with_solver(formulation, **(options or {})))
+    base = load_scene(SCENES / f"{scene}.yaml")
+    return prepare((base.with_({"outputs": outputs}) if outputs else base).with_solver(formulation, **(options or {})))
 
 
 def measured_steps(result) -> float:
@@ -83,13 +84,13 @@ def cpu_table(repeats: int) -> None:
             continue
         measured.add((scene, key))
         try:
-            first = run.run()  # warm-up: the exact kernels compile, Exudyn loads
+            first = run.solve()  # warm-up: the exact kernels compile, Exudyn loads
         except Exception as err:  # noqa: BLE001 - a formulation that fails on a scene is reported, not measured
             print(f"{scene:<17}{key:<22}{run.chain.size:<8}failed: {type(err).__name__}: {err}")
             continue
         steps = measured_steps(first)
         del first  # each result is dropped before the next run, as in a study
-        cpu = statistics.median(run.run().cpu_time_s for _ in range(repeats))
+        cpu = statistics.median(run.solve().cpu_time_s for _ in range(repeats))
         cost, n = run_cost(run), run.chain.size
         fits.setdefault(key, []).append((n, cpu / steps))
         if formulation == "ode":
@@ -118,7 +119,7 @@ def child(scene: str, formulation: str, options: dict) -> None:
     run = simulation(scene, formulation, options)
     estimate = run_cost(run, Cause("solver.output_interval_s", run.settings.output_interval_s)).memory_bytes
     before = peak_resident_bytes()
-    result = run.run()
+    result = run.solve()
     table = np.column_stack(list(result.resampled(run.settings.output_interval_s).values()))  # as rpdrill simulate
     grown = peak_resident_bytes() - before
     del table
@@ -153,12 +154,10 @@ def held(make, count: int) -> tuple[float, float]:
 def held_table(count: int = 200) -> None:
     print("\nheld by a command                             kB each   CPU ms to make")
     for name in ("paper_base", "four_rod_string"):
-        base = read_yaml(SCENES / f"{name}.yaml")
+        base = load_scene(SCENES / f"{name}.yaml")
 
-        def point(i: int, base: dict = base, name: str = name) -> object:
-            scene = copy.deepcopy(base)
-            scene["impact"]["frequency_hz"] = 40.0 + 0.01 * i
-            return prepare_point(name, scene, {"impact.frequency_hz": scene["impact"]["frequency_hz"]})
+        def point(i: int, base: Scene = base, name: str = name) -> object:
+            return prepare_point(base, {"impact.frequency_hz": 40.0 + 0.01 * i}, name)
 
         size, cpu = held(point, count)
         print(f"prepared study point of {name:<22}{size / 1e3:<10.3g}{cpu * 1e3:.3g}")
@@ -166,12 +165,15 @@ def held_table(count: int = 200) -> None:
     frequencies = list(calibration.frequencies_hz)
     curve = [float(np.exp(-((f - 60.0) / 15.0) ** 2)) for f in frequencies]
 
+    metrics = sorted({calibration.metric(t) for t in range(len(calibration.labels))})
+    table = pd.DataFrame({"impact.frequency_hz": frequencies, "status": "ok", "error": "", "wall_time_s": 0.0,
+                          **dict.fromkeys(metrics, curve)})
+    run = CurveRun(0, "impact.frequency_hz", table, 60.0, 0.0)
+
     def record(i: int) -> dict:
         unit = np.full(len(calibration.names), 0.5 + 1e-4 * i)
-        metrics = {calibration.metric(t) for t in range(len(calibration.labels))}
-        scan = {"values": dict.fromkeys(metrics, curve), "resonance_hz": 60.0, "failed_runs": 0, "error": ""}
         return {"unit": list(unit), "parameters": calibration.values(unit),
-                "targets": [target_result(calibration, t, frequencies, scan) for t in range(len(calibration.labels))]}
+                "targets": [target_result(calibration, t, run) for t in range(len(calibration.labels))]}
 
     size, _ = held(record, count)
     print(f"evaluation record of the shipped calibration  {size / 1e3:<10.3g}"

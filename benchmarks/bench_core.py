@@ -47,11 +47,11 @@ def main() -> None:
     print(f"ratio python / symbolic: {python / symbolic:.2f}")
 
     reference_step = step / 32
-    reference = prepare(with_solver(scene, end_time_s=0.3, step_s=reference_step)).run().bottom_m[-1]
+    reference = prepare(with_solver(scene, end_time_s=0.3, step_s=reference_step)).solve().bottom_m[-1]
     print(f"\nx_n(0.3 s) against rk44 at step {reference_step:g} s: {reference * 1e3:.6f} mm")
     print("step_s      x_n(0.3 s) [mm]   relative error   CPU s per simulated s")
     for factor in (4, 2, 1, 0.5, 0.25):
-        run = prepare(with_solver(scene, end_time_s=0.3, step_s=step * factor)).run()
+        run = prepare(with_solver(scene, end_time_s=0.3, step_s=step * factor)).solve()
         error = abs(run.bottom_m[-1] - reference) / abs(reference) if reference else float("nan")
         print(f"{step * factor:<10.3g}  {run.bottom_m[-1] * 1e3:<16.6f}  {error:<15.2e}  {run.cpu_time_s / 0.3:.3f}")
 

@@ -57,7 +57,7 @@ from bench_exact import scenes
 from rpdrill.models.solvers.simulation import prepare
 simulation = prepare(scenes(0.5)["paper_base"].with_solver("exact"))
 start = time.process_time()
-simulation.run()
+simulation.solve()
 print(time.process_time() - start)
 """
 
@@ -126,7 +126,7 @@ def main() -> None:
     print("scene                 formulation                  CPU s / sim s   x_n rel. error   abs. [m]   x_n(end) [mm]")
     lean = scenes(args.end_time_s, RATE_ONLY)
     for name, scene in scenes(args.end_time_s).items():
-        reference = prepare(scene.with_solver("exact", sample_interval_s=scene.solver.output_interval_s / 100)).run()
+        reference = prepare(scene.with_solver("exact", sample_interval_s=scene.solver.output_interval_s / 100)).solve()
         exudyn = prepare(scene)
         runs = {
             "exact (default)": prepare(scene.with_solver("exact")).run,

@@ -60,7 +60,7 @@ def joint() -> None:
     blow = 1 / 45.0
 
     def run(solver: dict):
-        return prepare(Scene.model_validate({**data, "solver": {"end_time_s": 0.045, **solver}})).run()
+        return prepare(Scene.model_validate({**data, "solver": {"end_time_s": 0.045, **solver}})).solve()
 
     ode = run({"formulation": "ode", "relative_tolerance": 1e-10, "absolute_tolerance": 1e-13})
     print("joint with play: Exudyn rk44 against the ODE (DOP853, rtol 1e-10)")
@@ -76,7 +76,7 @@ def joint() -> None:
 
 def rate(data: dict, solver: dict) -> float:
     scene = Scene.model_validate({**data, "solver": {**data["solver"], **solver}})
-    return summary_metrics(prepare(scene).run())["penetration_rate_m_per_s"] * 1e3
+    return summary_metrics(prepare(scene).solve())["penetration_rate_m_per_s"] * 1e3
 
 
 def string(couplings: bool) -> None:

@@ -26,7 +26,7 @@ RATE_ONLY = {"outputs": {"metrics": ["penetration_rate_m_per_s"]}}
 def measure(data: dict, repeats: int) -> tuple[float, float]:
     """(median CPU s, penetration rate) of ``repeats`` runs."""
     simulation = prepare(Scene.model_validate(data))
-    runs = [simulation.run() for _ in range(repeats)]
+    runs = [simulation.solve() for _ in range(repeats)]
     return statistics.median(r.cpu_time_s for r in runs), summary_metrics(runs[0])["penetration_rate_m_per_s"]
 
 

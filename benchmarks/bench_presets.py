@@ -61,10 +61,10 @@ def rate_error(metrics: dict[str, float], exact: dict[str, float]) -> float:
 
 def cost(scene: Scene, repeats: int) -> float:
     simulation = prepare(scene)
-    simulation.run()  # warm-up
+    simulation.solve()  # warm-up
     runs = []
     for _ in range(repeats):
-        runs.append(simulation.run().cpu_time_s)  # the result is dropped at once
+        runs.append(simulation.solve().cpu_time_s)  # the result is dropped at once
     return statistics.median(runs) / scene.solver.end_time_s
 
 
@@ -90,7 +90,7 @@ def measure(candidates: dict[str, Scene], exact: dict[str, dict[str, float]],
     per_second, errors, energy = float("nan"), {}, 0.0
     for name, candidate in candidates.items():
         try:
-            metrics = summary_metrics(prepare(candidate).run())
+            metrics = summary_metrics(prepare(candidate).solve())
         except Exception:  # noqa: BLE001 - a diverged or failed candidate is off the front
             errors[name] = energy = float("inf")
             continue
@@ -151,7 +151,7 @@ def paper_costs(presets: list[str], repeats: int) -> dict[str, tuple[float, floa
     """(CPU s per simulated s, penetration rate) of each preset on the paper scene, in this process."""
     paper = load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml")
     return {preset: (cost(paper.with_solver("exudyn", preset=preset), repeats), summary_metrics(
-        prepare(paper.with_solver("exudyn", preset=preset)).run())["penetration_rate_m_per_s"]) for preset in presets}
+        prepare(paper.with_solver("exudyn", preset=preset)).solve())["penetration_rate_m_per_s"]) for preset in presets}
 
 
 def modules(presets: list[str], repeats: int, rounds: int = 3) -> None:
@@ -193,7 +193,7 @@ def main() -> None:
         return
     scenes = {"paper_base": load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml")}
     scenes.update({name: hard_scene(overrides) for name, overrides in HARD_SCENES.items()})
-    exact = {name: summary_metrics(prepare(scene.with_solver("exact")).run()) for name, scene in scenes.items()}
+    exact = {name: summary_metrics(prepare(scene.with_solver("exact")).solve()) for name, scene in scenes.items()}
     if args.front:
         front(scenes, exact, args.repeats, args.sweeps.split(","))
         return
@@ -210,7 +210,7 @@ def main() -> None:
         worst = {"rate": 0.0, "energy": 0.0}
         for name, scene in scenes.items():
             simulation = prepare(scene.with_solver("exudyn", preset=preset))
-            result = simulation.run()
+            result = simulation.solve()
             metrics = summary_metrics(result)
             error, energy = rate_error(metrics, exact[name]), metrics["energy_balance_relative_error"]
             worst = {"rate": max(worst["rate"], error), "energy": max(worst["energy"], energy)}
@@ -221,7 +221,7 @@ def main() -> None:
     undamped = scenes[UNDAMPED]
     nudged = undamped.model_copy(update={"impact": undamped.impact.model_copy(
         update={"amplitude_n": undamped.impact.amplitude_n * (1 + 1e-9)})})
-    change = rate_error(summary_metrics(prepare(nudged.with_solver("exact")).run()), exact[UNDAMPED])
+    change = rate_error(summary_metrics(prepare(nudged.with_solver("exact")).solve()), exact[UNDAMPED])
     print(f"\n{UNDAMPED}: the exact penetration rate changes by {change:.1e} (relative) for a 1e-9 relative change "
           "of the impact amplitude (the scene is not sensitive: its preset errors are the solvers')")
 

@@ -64,7 +64,7 @@ def exact_run(scene: Scene) -> dict[str, float]:
 
 def exudyn_run(scene: Scene) -> dict[str, float]:
     simulation = prepare(scene)
-    result = simulation.run()
+    result = simulation.solve()
     return {"cpu_s": result.cpu_time_s, "step_s": simulation.settings.step_s,
             "steps": round(scene.solver.end_time_s / simulation.settings.step_s)}
 

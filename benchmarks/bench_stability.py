@@ -47,7 +47,7 @@ def attempt(name: str, solver: str, factor: float, radius: float) -> tuple[bool,
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # StepLimitWarning: the point is to go beyond the limit
-            result = prepare(scene).run()
+            result = prepare(scene).solve()
     except SimulationFailed as failure:
         # "diverged": non-finite or runaway states, or energy created; "stopped": end time not reached
         return False, "stopped" if "stopped at" in str(failure) else "diverged", float("nan")

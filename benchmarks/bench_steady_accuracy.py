@@ -39,7 +39,7 @@ def settled_advance(scene: rpdrill.Scene, settle: float) -> tuple[float, int]:
     blows = 400
     while True:
         run = prepare(scene.with_({"solver.end_time_s": blows / frequency, "solver.steady_state": "time",
-                                   "outputs": {"metrics": ["penetration_rate_m_per_s"]}})).run()
+                                   "outputs": {"metrics": ["penetration_rate_m_per_s"]}})).solve()
         advances = np.diff(run.bottom_at(np.arange(blows - 2, blows + 1) / frequency))
         if abs(advances[-1] - advances[-2]) <= settle * abs(advances[-1]) or blows >= 25600:
             return float(advances[-1]), blows
@@ -102,7 +102,7 @@ def exudyn_points(preset: str) -> None:
         difference = abs(exudyn - exact) / abs(exact)
         if difference > largest:
             largest, where = difference, str(point.parameters)
-        runs = [summary_metrics(prepare(s).run())["penetration_rate_m_per_s"] for s in (scene, scene.with_solver("exact"))]
+        runs = [summary_metrics(prepare(s).solve())["penetration_rate_m_per_s"] for s in (scene, scene.with_solver("exact"))]
         own = max(own, abs(runs[0] - runs[1]) / abs(runs[1]))
     print(f"Exudyn ({preset} preset) shooting against the exact orbit, frequency scan: largest relative difference "
           f"in the rate {largest:.3g} at {where}; its 1.5 s time runs against the exact ones: {own:.3g} (stated "

@@ -1,6 +1,6 @@
 """What the study machinery costs beside the simulations: the three paper scans, measured in one run.
 
-Usage: python benchmarks/bench_studies.py [--workers N] [--formulations exact,fast] [--repeats N]
+Usage: python benchmarks/bench_studies.py [--workers N] [--formulations exact,fast] [--repeats N] [--base REV]
 For each formulation (``exact``: the exact formulation; ``fast``/``standard``: Exudyn at that preset),
 the three paper scans (studies/paper/{frequency,impulse,stiffness}_scan.yaml, 207 points of 1.5 s)
 run through the study command's own loop (studies.study_runs.run_studies: resumable results, the
@@ -18,6 +18,11 @@ Then, as a user runs them (a new process each: imports, pool, plots): one ``rpdr
 of the three scans, and one of the frequency scan alone; their wall times (median of --repeats runs;
 each run starts afresh: the finished points are in a new folder), after the start and exit of a
 Python process with the libraries of a study loaded, with and without gc.freeze() before its exit.
+
+With ``--base REV`` the same measurements of rpdrill as it is at git revision REV (its tree exported by
+``git archive``, benchmarks/bench_same_results.py; its own bench_studies.py measures it) alternate with
+this checkout's, run by run, and the medians of both are printed with their ratio (this checkout / REV):
+the cost of a change measured side by side on the same machine at the same time.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ import contextlib
 import json
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -89,19 +95,20 @@ def three_scans(solver: str, workers: int, folder: Path) -> None:
     folders = [Path(tempfile.mkdtemp(prefix=f"{scan}_{solver}_", dir=folder)) for scan in SCANS]
     start = time.perf_counter()
     with pool(None, workers) as runner:
-        outcomes = run_studies(studies, folders, runner, plots_here=False, quiet=True)
-        plots_written = sum(len(written) for *_, written, _ in outcomes)
+        runs = run_studies(studies, folders, runner, plots_here=False, quiet=True)
+        plots_written = sum(len(run.plots) for run in runs)
         cpu = process_tree_cpu_s(os.getpid())
     wall = time.perf_counter() - start
-    run_once = {study.scene_keys[int(row["point"])]: float(row["cpu_time_s"]) if row["status"] == "ok" else 0.0
-                for study, _, rows, *_ in outcomes for row in rows}  # a point two scans share ran once
-    simulated_cpu = sum(run_once.values())
-    points = f"{sum(len(rows) for _, _, rows, *_ in outcomes)} ({len(run_once)})"
+    run_once = {run.study.scene_keys[point]: seconds if status == "ok" else 0.0
+                for run in runs for point, status, seconds in zip(run.table["point"], run.table["status"],
+                                                                   run.table["cpu_time_s"], strict=True)}
+    simulated_cpu = sum(run_once.values())  # a point two scans share ran once
+    points = f"{sum(len(run.table) for run in runs)} ({len(run_once)})"
     plots_cpu = []
     import rpdrill.studies.figures.scan_figures  # noqa: F401 - matplotlib loaded first, as in the pool's workers
-    for study, out, rows, optima, *_ in outcomes:  # each plot again, in this process, for its CPU time
-        (folder / "replotted" / out.name).mkdir(parents=True)
-        for task in plot_tasks(study, rows, optima, folder / "replotted" / out.name)[0]:
+    for run in runs:  # each plot again, in this process, for its CPU time
+        (folder / "replotted" / run.out.name).mkdir(parents=True)
+        for task in plot_tasks(run.study, run.table, run.optima, folder / "replotted" / run.out.name)[0]:
             start = time.process_time()
             draw_plot(task)
             plots_cpu.append(time.process_time() - start)
@@ -120,16 +127,81 @@ def one_command(solver: str, workers: int, folder: Path, scans: tuple[str, ...])
     return time.perf_counter() - start
 
 
+def versions_side_by_side(base: str, solvers: list[str], workers: int, repeats: int) -> None:
+    """The measurements of :func:`main` for rpdrill at ``base`` and for this checkout, alternated run by
+    run, each version's rpdrill on its own PYTHONPATH; medians and their ratio (module doc)."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    from bench_same_results import export
+
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = Path(scratch)
+        entries = {"base": export(base, folder / "base"), "here": folder / "here"}
+        (entries["here"] / "rpdrill").parent.mkdir(parents=True)
+        (entries["here"] / "rpdrill").symlink_to(ROOT)
+        for entry in entries.values():
+            compileall.compile_dir(entry / "rpdrill", quiet=1, rx=re.compile(r"[/\\](tests|docs|\.\w+)[/\\]"))
+        scripts = {label: entry / "rpdrill" / "benchmarks" / "bench_studies.py" for label, entry in entries.items()}
+
+        def environment(label: str) -> dict[str, str]:
+            return {**os.environ, "PYTHONPATH": str(entries[label])}
+
+        print(f"rpdrill at {base} (base) against this checkout (here), alternated, {repeats} runs each, "
+              f"{workers} workers; medians, and here / base")
+        for solver in solvers:
+            runs: dict[str, list[dict]] = {"base": [], "here": []}
+            for label in runs:  # a warm-up run of each, not counted (compiled kernels cached, files in the OS cache)
+                subprocess.run([sys.executable, str(scripts[label]), "--one", solver, "--folder", str(folder),
+                                "--workers", str(workers)], env=environment(label), check=True, capture_output=True,
+                               cwd=folder)
+            for _ in range(repeats):
+                for label, found in runs.items():
+                    start = time.perf_counter()
+                    child = subprocess.run([sys.executable, str(scripts[label]), "--one", solver, "--folder",
+                                            str(folder), "--workers", str(workers)], env=environment(label),
+                                           check=True, capture_output=True, text=True, cwd=folder)
+                    found.append({**json.loads(child.stdout.splitlines()[-1]), "process": time.perf_counter() - start})
+            for key, what in (("wall", "pool to last plot, wall s"), ("cpu", "all CPU s"),
+                              ("process", "whole process, wall s")):
+                medians = {label: statistics.median(r[key] for r in found) for label, found in runs.items()}
+                print(f"{solver:<8}{what:<28} base {medians['base']:<8.2f} here {medians['here']:<8.2f} "
+                      f"here / base {medians['here'] / medians['base']:.3f}   (base: "
+                      + " ".join(f"{r[key]:.2f}" for r in runs["base"]) + "; here: "
+                      + " ".join(f"{r[key]:.2f}" for r in runs["here"]) + ")", flush=True)
+        for solver in solvers:
+            commands: dict[str, list[tuple[float, float]]] = {"base": [], "here": []}  # (wall, CPU) of each run
+            for _ in range(repeats):
+                for label, measured in commands.items():
+                    files = [str(study_file(scan, solver, folder)) for scan in SCANS]
+                    out = tempfile.mkdtemp(prefix=f"command_{label}_", dir=folder)
+                    start, before = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
+                    subprocess.run([sys.executable, "-m", "rpdrill.studies.cli", "study", *files, "--out", out,
+                                    "--workers", str(workers), "--quiet"], env=environment(label), cwd=folder,
+                                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                    used = resource.getrusage(resource.RUSAGE_CHILDREN)  # the command and its waited-for workers
+                    measured.append((time.perf_counter() - start, used.ru_utime + used.ru_stime - before.ru_utime
+                                     - before.ru_stime))
+            for index, what in ((0, "one rpdrill study command, wall s"), (1, "one rpdrill study command, CPU s")):
+                medians = {label: statistics.median(m[index] for m in found) for label, found in commands.items()}
+                print(f"{solver:<8}{what:<28} base {medians['base']:<8.2f} here {medians['here']:<8.2f} here / base "
+                      f"{medians['here'] / medians['base']:.3f}   (base: "
+                      + " ".join(f"{m[index]:.2f}" for m in commands["base"]) + "; here: "
+                      + " ".join(f"{m[index]:.2f}" for m in commands["here"]) + ")", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--formulations", default="exact,fast")
     parser.add_argument("--repeats", type=int, default=3, help="runs of each measurement (the median shown)")
+    parser.add_argument("--base", help="also measure rpdrill at this git revision, alternating with this checkout")
     parser.add_argument("--one", help=argparse.SUPPRESS)  # a child: the three scans of one formulation
     parser.add_argument("--folder", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.one:
         three_scans(args.one, args.workers, Path(args.folder))
+        return
+    if args.base:
+        versions_side_by_side(args.base, args.formulations.split(","), args.workers, args.repeats)
         return
     solvers = args.formulations.split(",")
     # the project's modules byte-compiled, as a user's install has them after its first run (an

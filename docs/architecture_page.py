@@ -6,7 +6,9 @@ The import graph is read statically: every ``.py`` file of the package (the root
 ``rocklaw/``, ``models/``, ``studies/`` and their subpackages), every ``import`` and ``from ... import``
 at any depth (relative imports resolved as Python does; imports only for type checkers left out).
 The picture draws it between packages; the page lists each package with its modules, what it holds
-and what it imports. tests/test_architecture.py checks that the page matches the tree.
+and what it imports, and follows one value, the impact frequency, from a study file to the solver
+(:data:`FREQUENCY_PATH`: every function it names is looked up in the files, so the page cannot name
+one that is gone). tests/test_architecture.py checks that the page matches the tree.
 """
 
 from __future__ import annotations
@@ -48,17 +50,22 @@ ROLES = {
     "studies": "Everything around a model: reading YAML, scans and analyses, reports and the command line "
                "(the subpackages below, and two modules of their own).",
     "studies.api": "The library's functions that the root package re-exports (load a scene, simulate it into "
-                   "a Result, load and run a study into a pandas table); the command line is their client.",
+                   "a Result, load and run a study into a pandas table); the command line is their client, "
+                   "as it is of each analysis's own library call (`calibrate`, `sensitivity`, `accuracy`, "
+                   "`reproduce`, `rotation_report`, `advise`, `crosscheck`).",
     "studies.study_runs": "Running studies into their folders: the points of several studies as one run on "
                           "one pool, each study's results table, optima and plots.",
     "studies.inputs": "Reading YAML strictly (duplicate keys, YAML 1.2 numbers, sizes) into the models' "
                       "validated types; the spec base the study, calibration and other files share.",
     "studies.display": "How quantities are shown: the catalogue of every metric's and parameter's name, symbol "
                        "and display unit, and text/Markdown tables.",
-    "studies.runtime": "Running many points: process pools and Dask, resumable result tables, interrupts, "
-                       "progress, output folders, budgets checked before anything runs, one point's run.",
-    "studies.scan": "Studies: scans of a base scene expanded into points, run into their folders; the optima "
-                    "of scanned curves (main lobe, bands); labelled frequency scans the analyses share.",
+    "studies.runtime": "Running many points: one point (a typed scene made by `Scene.with_`, prepared, run "
+                       "into a row), process pools and Dask, resumable results tables (pandas DataFrames in "
+                       "memory, CSV on disk, one reader), interrupts, progress, output folders, budgets "
+                       "checked before anything runs.",
+    "studies.scan": "Scans: studies (a base scene's points over axes, run into their folders), the curves "
+                    "along one axis the analyses run (one worker a curve), and the one record of a curve's "
+                    "optimum (best point, main lobe, bands, why there is none) every analysis uses.",
     "studies.calibration": "Fitting scene parameters within argued bounds so that scans put their optima where "
                            "the paper does (differential evolution, checkpointed), and its report.",
     "studies.sensitivity": "The paper's section 3.3: one-at-a-time and SALib global sensitivity of the optima.",
@@ -77,6 +84,68 @@ ROLES = {
     "studies.cli": "The `rpdrill` command line: `main.py` (argparse, exit statuses, one-line warnings) and a "
                    "module per command; a command parses, calls the library and prints.",
 }
+
+
+# The impact frequency from a study file to the solver and back into the table: (module, name defined
+# there, what the value is at that step). A step whose name the module no longer defines fails the page.
+FREQUENCY_PATH = (
+    ("studies.inputs.reading", "read_yaml",
+     ("the study file read strictly: `scan: {impact.frequency_hz: {from: 10, to: 120, step: 5}}`, YAML 1.2 "
+     "numbers (a mapping of floats)")),
+    ("studies.scan.study", "load_study",
+     ("validated as the study's `scan: dict[str, Axis]` (pydantic), the key path checked against the scene's "
+     "fields (`studies.inputs.specs.check_scene_path`), `Axis.expand` giving the values as floats")),
+    ("studies.scan.study", "_combine",
+     "each point's axis values, `{\"impact.frequency_hz\": 65.0}`, crossed or zipped with the other axes"),
+    ("studies.runtime.point_runs", "point_scene",
+     ("the point's typed scene: `base.with_(values)` (`Scene.with_`, validated as a scene file is), "
+     "`scene.impact.frequency_hz` a positive float whose period is longer than the pulse; a bad value names "
+     "its axis")),
+    ("models.definition.scene", "Scene.with_", "the validated copy (models.definition.validation.with_changes)"),
+    ("studies.runtime.point_runs", "prepare_point",
+     ("prepared once (`models.solvers.simulation.prepare`): the `Simulation` holds the scene's `impact` and a "
+     "solver step fitted to its period `impact.period_s`; the prepared object goes to a worker as it is")),
+    ("studies.runtime.point_runs", "run_point",
+     ("in the worker: `Simulation.run`, the formulation (exact, Exudyn, ODE) placing the blows every "
+     "`impact.period_s` (`models.drill.pulse`); the row it returns holds floats")),
+    ("studies.runtime.resumable", "run_tables",
+     ("the row appended to `results.csv` (`studies.runtime.tables.append_rows`: text only in the file) and "
+     "the table read back typed (`studies.runtime.tables.read_table`, the one place a number is read from text)")),
+    ("studies.scan.study_optima", "study_optima",
+     ("the optimum along the frequency from the typed column (`studies.scan.curve_optima.curve_optimum`); "
+     "the analyses' curves take the same steps from `studies.scan.curves.run_curve`")),
+)
+
+
+def defines(path: Path, name: str) -> bool:
+    """Whether a module's file defines ``name`` at its top level (``Class.method`` inside the class)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    outer, _, inner = name.partition(".")
+    found = next((node for node in tree.body if isinstance(node, (ast.FunctionDef, ast.ClassDef))
+                  and node.name == outer), None)
+    if found is None or not inner:
+        return found is not None
+    return any(isinstance(node, ast.FunctionDef) and node.name == inner for node in getattr(found, "body", []))
+
+
+def frequency_path(root: Path = ROOT) -> list[str]:
+    """The page's section on :data:`FREQUENCY_PATH`; SystemExit naming a step the files no longer define."""
+    files = package_files(root)
+    gone = [f"{module}.{name}" for module, name, _ in FREQUENCY_PATH
+            if module not in files or not defines(files[module], name)]
+    if gone:
+        raise SystemExit(f"docs/architecture_page.py: FREQUENCY_PATH names {', '.join(gone)}, which the files "
+                         "do not define")
+    lines = ["## The impact frequency from a study file to the solver", "",
+             ("One value followed through the layers (`studies/paper/frequency_scan.yaml`): it is a typed "
+             "value at every step, never written into a raw mapping and never read back from text but by the "
+             "table's one reader."), ""]
+    lines += ["```mermaid", "flowchart TD"]
+    lines += [f'    step{i}["{i}. {module}.{name}"]' + (f" --> step{i + 1}" if i < len(FREQUENCY_PATH) else "")
+              for i, (module, name, _) in enumerate(FREQUENCY_PATH, 1)]
+    lines += ["```", ""]
+    lines += [f"{i}. `{module}.{name}`: {text}." for i, (module, name, text) in enumerate(FREQUENCY_PATH, 1)]
+    return [*lines, ""]
 
 
 def package_files(root: Path = ROOT) -> dict[str, Path]:
@@ -162,9 +231,7 @@ def label(package: str) -> str:
 def draw(graph: dict[str, set[str]], path: Path) -> None:
     """The package graph drawn bottom-up by layer (an arrow from importer to imported)."""
     import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     level = layers(graph)
     rows: dict[int, list[str]] = defaultdict(list)
@@ -175,7 +242,8 @@ def draw(graph: dict[str, set[str]], path: Path) -> None:
         for i, package in enumerate(packages):
             position[package] = ((i + 1) / (len(packages) + 1), y)
     colours = {"rocklaw": "#cfe2f3", "models": "#d9ead3", "studies": "#fff2cc", "": "#f4cccc"}
-    fig, ax = plt.subplots(figsize=(13, 1.3 * (max(rows) + 1)))
+    fig = Figure(figsize=(13, 1.3 * (max(rows) + 1)))
+    ax = fig.subplots()
     for source, targets in sorted(graph.items()):
         for target in sorted(targets):
             (x0, y0), (x1, y1) = position[source], position[target]
@@ -192,7 +260,6 @@ def draw(graph: dict[str, set[str]], path: Path) -> None:
     fig.tight_layout()
     with matplotlib.rc_context({"svg.hashsalt": "rpdrill"}):  # the same file for the same tree
         fig.savefig(path, metadata={"Date": None})
-    plt.close(fig)
 
 
 def page(root: Path = ROOT) -> str:
@@ -223,7 +290,7 @@ def page(root: Path = ROOT) -> str:
         held = ", ".join(f"`{m}`" for m in sorted(modules[package])) or "(only `__init__.py`)"
         lines += [f"## `{label(package)}` (layer {level[package]})", "", ROLES[package], "",
                   f"Modules: {held}.", "", f"Imports: {imports}.", ""]
-    return "\n".join(lines)
+    return "\n".join(lines + frequency_path(root))
 
 
 def main() -> None:

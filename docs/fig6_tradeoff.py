@@ -2,7 +2,9 @@
 
     python docs/fig6_tradeoff.py RUN_DIR [RUN_DIR ...]
 
-RUN_DIR: the --out of ``rpdrill calibrate studies/paper/calibration.yaml`` (its evaluations.jsonl). For
+RUN_DIR: the --out of ``rpdrill calibrate studies/paper/calibration.yaml`` (its evaluations.jsonl, each
+target's optimum as studies.scan.curve_optima.Optimum.record: a run of rpdrill before that record's
+layout 2 is refused by ``rpdrill calibrate`` and not read here). For
 every evaluation: "rest", the largest |relative miss| of 3.1 a), 3.1 b) and Fig. 5 (1 when the 3.1 b)
 optima do not rise with the impulse); "Fig. 6", the larger |miss| at the two stiffnesses the paper
 gives (80 Hz at 8.93e7, 90 Hz at 8.4e8 N/m; 1 unless all four Fig. 6 scans have a penetration
@@ -29,10 +31,10 @@ def misses(record: dict, labels: list[str]) -> tuple[float, float]:
     """(rest, Fig. 6) of one evaluation (module doc)."""
     target = dict(zip(labels, record["targets"], strict=True))
     rest = max(abs(target[label]["miss"]) for label in REST)
-    rising = [target[label]["main_hz"] for label in RISING]
+    rising = [target[label]["optimum"] for label in RISING]
     if None in rising or not rising[0] < rising[1] < rising[2]:
         rest = max(rest, 1.0)
-    inside = all(target[label]["main_hz"] is not None and not target[label]["main_at_scan_end"] for label in FIG6)
+    inside = all(target[label]["optimum"] is not None and not target[label]["peak_at_scan_end"] for label in FIG6)
     fig6 = max(abs(target[label]["miss"]) for label in ENDS) if inside else 1.0
     return rest, fig6
 
@@ -47,16 +49,16 @@ def report(run: Path) -> None:
     print("|---|---|---|---|---|")
     for i in front:
         target = dict(zip(labels, records[i]["targets"], strict=True))
-        hz = ", ".join("none" if target[label]["main_hz"] is None else f"{target[label]['main_hz']:.1f}"
+        hz = ", ".join("none" if target[label]["optimum"] is None else f"{target[label]['optimum']:.1f}"
                        for label in FIG6)
-        rates = ", ".join(f"{1e3 * (target[label]['main_value'] or 0.0):.3g}" for label in FIG6)
+        rates = ", ".join(f"{1e3 * (target[label]['optimum_value'] or 0.0):.3g}" for label in FIG6)
         print(f"| {i} | {points[i][0]:.3f} | {points[i][1]:.3f} | {hz} | {rates} |")
     ratios = []
     for record in records:
         target = dict(zip(labels, record["targets"], strict=True))
         soft, collar = target[FIG6[0]], target["3.2 k = 8.93e7"]
-        if soft["main_hz"] and collar["main_hz"] and not soft["main_at_scan_end"]:
-            ratios.append(soft["main_hz"] / collar["main_hz"])
+        if soft["optimum"] and collar["optimum"] and not soft["peak_at_scan_end"]:
+            ratios.append(soft["optimum"] / collar["optimum"])
     if ratios:
         near = sum(abs(r - 1.0) <= 0.15 for r in ratios) / len(ratios)
         print(f"softest rock, penetration optimum / collar-velocity optimum over {len(ratios)} evaluations with a "

@@ -71,15 +71,6 @@ def global_row(affine: Affine, rows: Mapping[str, np.ndarray]) -> np.ndarray:
                np.zeros_like(next(iter(rows.values()))))
 
 
-def linear_function(affine: Affine, rows: Mapping[str, np.ndarray]) -> Callable[[np.ndarray], float]:
-    """y -> affine . z(y) for a state y that has no constant entry (``rows`` without ``one``)."""
-    constant = affine.get(ONE, 0.0)
-    row = global_row({k: v for k, v in affine.items() if k != ONE}, rows)
-    nonzero = np.flatnonzero(row)
-    weights = row[nonzero]
-    return lambda y: float(weights @ y[nonzero]) + constant
-
-
 def check_mode_forces(law: Piecewise, samples: Sequence[Mapping[str, float]],
                       closed_form: Callable[[Mapping[str, float]], float]) -> list[str]:
     """Problems where a mode's force row disagrees with the closed form at a sample point that lies

@@ -24,21 +24,21 @@ from .inputs.arguments import (
     boolean_problem,
     callable_problem,
     check,
+    check_run_options,
     choice_problem,
-    dask_problem,
     either,
     file_problem,
     folder_problem,
     instance_problem,
     optional,
     rows_problem,
-    workers_problem,
 )
 from .inputs.reading import InputError, load_scene, prepare_scene, scene_and_source
 from .runtime.budgets import DEFAULT_BUDGET, Budget
 from .runtime.output_files import check_out, write_columns_csv, write_json, write_resolved
+from .runtime.tables import table_of
 from .scan.study import Study, load_study
-from .study_runs import Outcome, run_studies, run_study_files, study_folders
+from .study_runs import run_studies, run_study_files, study_folders
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -101,8 +101,10 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
     it starts; models.evaluation.stability.SimulationFailed when the run diverges. ``solution_file``:
     with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
-    (for its SolutionViewer: studies.drawings.drill_animation.view_solution)."""
-    from .drawings.drill_animation import run_with_solution
+    (for its SolutionViewer: studies.drawings.drill_animation.view_solution). Loads no figure module:
+    the caller's matplotlib is left as it is. A scene with ``solver.steady_state: periodic`` gives its
+    steady state (models.steady.steady_run.run_scene)."""
+    from ..models.steady.steady_run import run_scene
 
     check("rpdrill.simulate", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
     check("rpdrill.simulate", "progress", progress, callable_problem)
@@ -115,24 +117,17 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     if budget is not None:
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
-    raw = run_with_solution(simulation, progress, solution_file)
+    raw = run_scene(simulation, progress=progress, solution=None if solution_file is None else Path(solution_file))
     return Result(scene, raw, {"source": source, **simulation.code_records()})
 
 
 def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
-    """A results table (rows as read from ``results.csv``) as a DataFrame: numbers as numbers, text
-    (status, error, a rock's name) as text; one row a point, indexed by ``point``."""
-    import pandas as pd  # 0.3 s to import: only where a table is asked for
-
+    """A results table (rows as read from ``results.csv``: text cells) as the typed DataFrame
+    :func:`run_study` returns: numbers as numbers, text (status, error, a rock's name) as text; one row
+    a point, in point order, indexed by the point (studies.runtime.tables)."""
     check("rpdrill.table_frame", "rows", rows, rows_problem)
-    frame = pd.DataFrame(list(rows))
-    if frame.empty:
-        return frame
-    for column in frame.columns.difference(["status", "error"]):
-        numbers = pd.to_numeric(frame[column], errors="coerce")
-        if numbers.notna().sum() == frame[column].ne("").sum():  # every non-empty cell a number
-            frame[column] = numbers
-    return frame.set_index("point", drop=False)
+    rows = list(rows)
+    return table_of(list(rows[0]) if rows else [], [list(row.values()) for row in rows])
 
 
 def run_study(study: Study | str | Path, workers: int | None = None, out: str | Path | None = None,
@@ -145,10 +140,7 @@ def run_study(study: Study | str | Path, workers: int | None = None, out: str | 
 
     check("rpdrill.run_study", "study", study, either(file_problem, instance_problem(Study, "a rpdrill Study or a "
                                                                                     "study file's path")))
-    check("rpdrill.run_study", "workers", workers, optional(workers_problem))
-    check("rpdrill.run_study", "out", out, optional(folder_problem))
-    check("rpdrill.run_study", "dask", dask, dask_problem)
-    check("rpdrill.run_study", "quiet", quiet, boolean_problem)
+    check_run_options("rpdrill.run_study", workers, out, dask, quiet)
     if not isinstance(study, Study):
         study = load_study(study)
     with tempfile.TemporaryDirectory(prefix="rpdrill-study-") as scratch:
@@ -156,5 +148,4 @@ def run_study(study: Study | str | Path, workers: int | None = None, out: str | 
         if out is None:  # a scratch folder keeps no plots
             study = dataclasses.replace(study, spec=study.spec.model_copy(update={"plots": []}))
         with pool(dask, workers, "rpdrill.run_study: dask") as runner:
-            outcome: Outcome = run_studies([study], [folder], runner, dask is not None, quiet)[0]
-    return table_frame(outcome[2])
+            return run_studies([study], [folder], runner, dask is not None, quiet)[0].table

@@ -1,11 +1,12 @@
-"""Scenes for tests: the frozen test drill (tests/test_drill.yaml) with overrides by dotted key path."""
+"""Scenes for tests: the frozen test drill (tests/test_drill.yaml) with overrides by dotted key path, and the
+strict YAML reader (``read_yaml``: YAML 1.2 numbers) the tests read their files with."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
-from rpdrill.models.definition.scene import Scene
+from rpdrill import Scene
 from rpdrill.models.evaluation.results import SimulationResult
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
@@ -45,4 +46,4 @@ def crushing_scene(**overrides: Any) -> Scene:
 
 def simulate(scene: Scene, formulation: str | None = None, **options: Any) -> SimulationResult:
     """Run ``scene`` with ``formulation`` (default: the scene's) and solver ``options``."""
-    return prepare(scene.with_solver(formulation, **options)).run()
+    return prepare(scene.with_solver(formulation, **options)).solve()

@@ -9,8 +9,10 @@ import math
 import numpy as np
 import pytest
 import yaml
+from commands import main
 from scenes import crushing_scene, scene, scene_dict, simulate
 
+import rpdrill
 from rpdrill.models.drill.pulse import impulse_per_blow_n_s
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
@@ -21,22 +23,21 @@ from rpdrill.studies.advice.advice_search import (
     AdviceEvaluator,
     AdviseParameter,
     Request,
-    advise,
     at_point,
     feed_response,
     limit_feed_n,
     runnable_scene,
+    search_advice,
     thrust_ratio,
 )
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.runtime.pools import sequential
 
 RATE = "penetration_rate_m_per_s"
 SHORT = {"solver": {"end_time_s": 0.3}, "metrics": {"transient_blows": 4, "block_blows": 4}}
 
 
-def short_scene(**overrides) -> dict:
-    return scene(**SHORT, **overrides).model_dump(by_alias=True, exclude_none=True)
+def short_scene(**overrides) -> rpdrill.Scene:
+    return scene(**SHORT, **overrides)
 
 
 def test_advise_finds_the_best_of_a_fine_grid():
@@ -46,7 +47,7 @@ def test_advise_finds_the_best_of_a_fine_grid():
     grid = [{FREQUENCY: f, FEED: feed} for f in np.arange(45.0, 70.1, 1.0) for feed in np.arange(35e3, 60.1e3, 1e3)]
     data = runnable_scene(base, None, request, "test")
     brute = np.nanmax(AdviceEvaluator(data, request, sequential)(grid).values)
-    advice = advise(data, None, request, sequential)
+    advice = search_advice(data, None, request, sequential)
     assert brute > 0
     assert advice.best_value >= 0.99 * brute
     assert advice.formulation == "exact" and advice.runs < len(grid)
@@ -64,7 +65,7 @@ def test_mean_thrust_is_the_mean_rock_force_of_a_steady_run():
                                         outputs={"metrics": ["rock_force_max_n", RATE]}))
     expected = simulation.scene.feed.force_n + impulse_per_blow_n_s(simulation.impact) * simulation.impact.frequency_hz
     assert simulation.mean_thrust_n == pytest.approx(expected)
-    result = simulation.run()
+    result = simulation.solve()
     window = result.time_s >= 10 / simulation.impact.frequency_hz
     t, force = result.time_s[window], result.rock_force_n[window]
     assert np.trapezoid(force, t) / (t[-1] - t[0]) == pytest.approx(simulation.mean_thrust_n, rel=1e-3)
@@ -182,18 +183,28 @@ def test_advise_bad_bounds_exit_2(tmp_path, capsys, arguments, expected):
 
 
 def test_the_library_call_gives_the_commands_advice(tmp_path):
-    """rpdrill.advise with the bounds in SI units: the advice the command writes for the same inputs;
-    a bound the search does not take is an InputError naming it and what is allowed."""
-    import rpdrill
-
+    """rpdrill.advise with the bounds in SI units: the advice and the files the command writes for the same
+    inputs (``out``; a rerun there replays every point); a bound the search does not take is an InputError naming it and what is allowed."""
     scene = write_scene(tmp_path)
     out = tmp_path / "out"
     assert main(["advise", scene, "--frequency-hz", "45", "70", "--feed-kn", "35", "60", "--popsize", "3",
                  "--generations", "2", "--out", str(out), "--workers", "1", "--quiet"]) == 0
     (advice,) = rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (35e3, 60e3)},
-                               search=rpdrill.AdviceSearch(popsize=3, max_generations=2), workers=1)
-    written = json.loads((out / "advice.json").read_text())["results"][0]
-    assert advice.best == written["best"] and advice.best_value == written["best_value"]
+                               search=rpdrill.AdviceSearch(popsize=3, max_generations=2), workers=1,
+                               out=tmp_path / "library", markdown=tmp_path / "advice.md")
+    written = json.loads((out / "advice.json").read_text())
+    assert advice.best == written["results"][0]["best"] and advice.best_value == written["results"][0]["best_value"]
+    library = json.loads((tmp_path / "library" / "advice.json").read_text())
+    assert library["command"].startswith(f"rpdrill.advise({scene!r}, ")
+    same = {"wall_time_s": None}  # (the runs' wall time differs)
+    assert [r | same for r in library["results"]] == [r | same for r in written["results"]]
+    assert sorted(p.name for p in (tmp_path / "library").iterdir()) == sorted(p.name for p in out.iterdir())
+    markdown = (tmp_path / "advice.md").read_text()
+    assert markdown == (tmp_path / "library" / "advice.md").read_text() and "rpdrill.advise(" in markdown
+    (again,) = rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (35e3, 60e3)},
+                              search=rpdrill.AdviceSearch(popsize=3, max_generations=2), workers=1,
+                              out=tmp_path / "library")
+    assert again.replayed == again.runs == advice.runs and again.best == advice.best
     with pytest.raises(rpdrill.InputError, match="'rock.threshold_n': not a parameter advise searches; allowed: "
                                                  "impact.frequency_hz, feed.force_n, impact.amplitude_n"):
         rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (35e3, 60e3),

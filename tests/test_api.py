@@ -8,10 +8,10 @@ from pathlib import Path
 import pandas as pd
 import pytest
 import yaml
+from commands import main
 from scenes import PAPER_BASE, scene_dict
 
 import rpdrill
-from rpdrill.studies.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
 QUICK = {"solver.end_time_s": 0.2, "metrics.transient_blows": 2, "metrics.block_blows": 2}
@@ -95,3 +95,38 @@ def test_run_study_returns_typed_columns_and_keeps_files_when_asked(tmp_path):
     pd.testing.assert_series_equal(again["penetration_rate_m_per_s"], table["penetration_rate_m_per_s"])
     assert {"results.csv", "study.json", "optima.csv"} <= {p.name for p in out.iterdir()}
     assert any(p.suffix == ".png" for p in out.iterdir())
+
+
+NO_SIDE_EFFECTS = """
+import io, json, sys, tempfile
+from pathlib import Path
+import matplotlib
+matplotlib.use("svg")  # the user's own choice of backend
+out = sys.stdout
+import rpdrill
+scene = rpdrill.load_scene(sys.argv[1]).with_({"solver.end_time_s": 0.3})
+result = rpdrill.simulate(scene, formulation="exact")
+after_simulate = sorted(m for m in ("matplotlib.pyplot", "matplotlib.figure") if m in sys.modules)
+with tempfile.TemporaryDirectory() as folder:
+    rpdrill.save_result(result, folder)  # the figures of rpdrill simulate
+    rpdrill.run_study(sys.argv[2], workers=1, out=Path(folder) / "scan")  # a study's plots, drawn here
+print(json.dumps({"backend": matplotlib.get_backend(), "pyplot": "matplotlib.pyplot" in sys.modules,
+                  "after_simulate": after_simulate, "stdout_kept": sys.stdout is out}))
+"""
+
+
+def test_library_calls_leave_the_callers_process_as_it_was(tmp_path):
+    """``rpdrill.simulate`` loads no figure module; saving a result and running a study with plots draw
+    their figures without pyplot: the backend the user chose stays, no pyplot is loaded, standard
+    output is not replaced."""
+    study = tmp_path / "scan.yaml"
+    study.write_text(yaml.safe_dump({
+        "name": "scan", "base_scene": str(ROOT / "studies/scenes/paper_base.yaml"),
+        "base_overrides": {"solver.formulation": "exact", "solver.end_time_s": 0.3},
+        "scan": {"impact.frequency_hz": [50.0, 60.0, 65.0]}, "metrics": ["penetration_rate_m_per_s"],
+        "plots": [{"x": "impact.frequency_hz", "y": "penetration_rate_m_per_s"}]}))
+    done = subprocess.run([sys.executable, "-c", NO_SIDE_EFFECTS, str(ROOT / "studies/scenes/paper_base.yaml"),
+                           str(study)], cwd=tmp_path, capture_output=True, text=True, check=False, timeout=300)
+    assert done.returncode == 0, done.stderr
+    state = json.loads(done.stdout.splitlines()[-1])
+    assert state == {"backend": "svg", "pyplot": False, "after_simulate": [], "stdout_kept": True}, state

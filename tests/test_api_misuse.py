@@ -10,9 +10,9 @@ from typing import Any
 
 import pytest
 import yaml
+from commands import main
 
 import rpdrill
-from rpdrill.studies.cli.main import main
 
 CORPUS = Path(__file__).resolve().parent / "bad_inputs"
 CASES: dict[str, dict] = yaml.safe_load((CORPUS / "api_cases.yaml").read_text(encoding="utf-8"))
@@ -46,7 +46,7 @@ def resolved(value: Any, places: dict[str, Any]) -> Any:
 def places(tmp: Path) -> dict[str, Any]:
     return {"$scene": rpdrill.load_scene(SCENE_FILE), "$scene_file": str(SCENE_FILE), "$study_file": str(study_file(tmp)),
             "$out": str(tmp / "out"), "$result": short_result,
-            "$tiny_budget": rpdrill.studies.runtime.budgets.Budget(max_steps=10)}
+            "$tiny_budget": rpdrill.Budget(max_steps=10)}
 
 
 @pytest.mark.parametrize("name", sorted(CASES))

@@ -12,8 +12,8 @@ from pathlib import Path
 import pytest
 from scenes import simulate
 
+from rpdrill import load_scene
 from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.studies.inputs.reading import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("architecture_page", ROOT / "docs" / "architecture_page.py")

@@ -17,8 +17,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-
-from rpdrill.studies.cli.main import main
+from commands import main
 
 CORPUS = Path(__file__).resolve().parent / "bad_inputs"
 CASES: dict[str, dict] = yaml.safe_load((CORPUS / "cases.yaml").read_text(encoding="utf-8"))

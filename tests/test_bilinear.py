@@ -8,6 +8,7 @@ import functools
 import numpy as np
 import pytest
 import yaml
+from commands import main
 from scenes import scene, scene_dict, simulate
 
 from rpdrill.models.evaluation.compare import compare_runs, verdict
@@ -15,7 +16,6 @@ from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw import BilinearRock, force_and_state
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
 
 K_LOAD, K_UNLOAD = 2e8, 1e9

@@ -7,10 +7,10 @@ from __future__ import annotations
 import pytest
 from scenes import PAPER_BASE, scene
 
+from rpdrill import Budget, BudgetError, load_study
 from rpdrill.models.solvers.cost import Cause, run_cost
 from rpdrill.models.solvers.simulation import prepare
-from rpdrill.studies.runtime.budgets import MAX_CPU_HOURS, Budget, BudgetError
-from rpdrill.studies.scan.study import load_study
+from rpdrill.studies.runtime.budgets import MAX_CPU_HOURS
 
 PRESET = {"solver__step_s": None, "solver__type": None}  # the standard preset chooses the step
 

@@ -11,14 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from commands import main
 from scenes import PAPER_BASE
 
+import rpdrill
+from rpdrill import Budget
 from rpdrill.models.evaluation.workprecision import non_dominated
 from rpdrill.studies.calibration.calibration_search import objective, refined_frequencies_hz
 from rpdrill.studies.calibration.calibration_spec import Parameter, load_calibration
-from rpdrill.studies.cli.main import main
-from rpdrill.studies.runtime.budgets import Budget
-from rpdrill.studies.scan import frequency_scans as targets
+from rpdrill.studies.scan import curves
 
 ROOT = Path(__file__).resolve().parents[1]
 COLLAR = "drill_string.bodies.collar.mass_kg"
@@ -83,8 +84,8 @@ def test_objective_sums_weighted_squared_misses_and_the_rising_shortfall(tmp_pat
     calibration = load_calibration(write(tmp_path / "c.yaml", spec(targets=[
         {"label": "a", "optimum_hz": 60, "weight": 2.0}, {"label": "b", "optimum_hz": 70},
         {"label": "c", "optimum_hz": 80}], rising=[["a", "b", "c"]], rising_weight=0.5)))
-    results = [{"label": "a", "main_hz": 66.0, "miss": 0.1}, {"label": "b", "main_hz": 63.0, "miss": -0.1},
-               {"label": "c", "main_hz": None, "miss": 1.0}]  # a above b: 3 Hz short; c without optimum
+    results = [{"label": "a", "optimum": 66.0, "miss": 0.1}, {"label": "b", "optimum": 63.0, "miss": -0.1},
+               {"label": "c", "optimum": None, "miss": 1.0}]  # a above b: 3 Hz short; c without optimum
     total, penalty = objective(calibration, results)
     assert penalty == pytest.approx(3.0 / 70)
     assert total == pytest.approx(2 * 0.01 + 0.01 + 1.0 + 0.5 * 3.0 / 70)
@@ -130,6 +131,22 @@ def test_tiny_calibration_end_to_end(tiny):
     assert "| a | penetration_rate_m_per_s | 60 (55-65) |" in (out / "targets.md").read_text()
     cost = report["cost"]
     assert cost["simulations"] >= 10 * 12 and cost["wall_time_s"] > 0 and cost["evaluations"] == 10
+    target = best["targets"][0]  # each target's optimum: studies.scan.curve_optima.Optimum.record
+    assert target["label"] == "a" and target["along"] == "impact.frequency_hz" and target["points"] == 6
+    assert target["optimum"] is None or 40 <= target["optimum"] <= 90
+
+
+def test_calibrate_as_a_library_call_gives_the_command_s_result(tiny):
+    """``rpdrill.calibrate`` (no ``out``: a scratch checkpoint) finds the best set the command found, and
+    the calibrated scene is that set on the base scene."""
+    path, out = tiny
+    result = rpdrill.calibrate(path, workers=1)
+    report = json.loads((out / "calibration.json").read_text())
+    assert isinstance(result, rpdrill.CalibrationResult) and result.out is None and len(result.records) == 10
+    assert result.best["objective"] == report["best"]["objective"]
+    assert result.best["parameters"] == report["best"]["parameters"]
+    assert result.scene.drill_string.bodies["collar"].mass_kg == report["best"]["parameters"][COLLAR]
+    assert set(result.optima_hz) == {"a", "b", "a again"}
 
 
 def test_rerun_replays_every_evaluation_and_gives_the_same_result(tiny, tmp_path):
@@ -199,10 +216,9 @@ def test_nelder_mead_stays_within_its_budget(tmp_path):
 
 
 def test_every_simulation_failing_exits_1_without_a_scene(tmp_path, monkeypatch, capsys):
-    def failing(key, simulation, guess=None, cold_newton=True):
-        return {"point": key, "status": "failed", "error": "RuntimeError: diverged", "wall_time_s": 0.0,
-                "metrics": {}}, None
-    monkeypatch.setattr(targets, "run_prepared", failing)  # runs in this process (--workers 1)
+    def failing(branch, value, simulation):
+        return {"status": "failed", "error": "RuntimeError: diverged", "wall_time_s": 0.0}
+    monkeypatch.setattr(curves, "run_followed", failing)  # runs in this process (--workers 1)
     path = write(tmp_path / "c.yaml", spec(search={"popsize": 2, "max_generations": 0, "seed": 3}))
     assert calibrate(path, tmp_path / "out") == 1
     assert "RuntimeError: diverged" in capsys.readouterr().err
@@ -214,14 +230,14 @@ def test_shipped_calibration_is_valid():
     calibration = load_calibration(ROOT / "studies" / "paper" / "calibration.yaml", Budget(accept_long=True))
     spec_ = calibration.spec
     assert len(spec_.parameters) >= 8 and all(p.reason.strip() for p in spec_.parameters.values())
-    assert calibration.base["solver"]["formulation"] == "exact" and spec_.search.method == "differential-evolution"
+    assert calibration.base.solver.formulation == "exact" and spec_.search.method == "differential-evolution"
     assert [t.optimum_hz for t in spec_.targets] == [65, 60, 65, 80, 32, 69, 80, 83.7, 87.6, 90]
     assert spec_.rising == [["3.1 b) 160 kN", "3.1 b) 220 kN", "3.1 b) 280 kN"],
                             ["3.2 Fig. 6 k = 8.93e7", "3.2 Fig. 6 k = 2.1e8", "3.2 Fig. 6 k = 5.1e8",
                              "3.2 Fig. 6 k = 8.4e8"]]
     # section 3.2's one invariant impulse feeds all its scans, none of 3.1's
     amplitudes = [calibration.scene({**calibration.values(calibration.start_unit()), "$impulse_3_2_n": 123e3}, t)
-                  ["impact"]["amplitude_n"] for t in range(len(spec_.targets))]
+                  .impact.amplitude_n for t in range(len(spec_.targets))]
     assert amplitudes[4:] == [123e3] * 6 and 123e3 not in amplitudes[:4]
     assert calibration.frequencies_hz[0] == 10 and calibration.frequencies_hz[-1] == 120
 
@@ -236,10 +252,10 @@ def test_a_free_parameter_feeds_the_overrides_that_name_it_and_nothing_else(tmp_
                  {"label": "c", "optimum_hz": 62}])))
     values = calibration.values(np.array([0.5, 0.5, 0.25]))
     assert values["$impulse"] == pytest.approx(350e3)
-    assert calibration.scene(values, 0)["impact"]["amplitude_n"] == pytest.approx(350e3)
-    assert calibration.scene(values, 1)["rock"]["threshold_n"] == pytest.approx(350e3)
+    assert calibration.scene(values, 0).impact.amplitude_n == pytest.approx(350e3)
+    assert calibration.scene(values, 1).rock.threshold_n == pytest.approx(350e3)
     base = calibration.scene(values, 2)
-    assert base["impact"]["amplitude_n"] == calibration.base["impact"]["amplitude_n"] and "$impulse" not in base
+    assert base.impact.amplitude_n == calibration.base.impact.amplitude_n and "$impulse" not in calibration.changes(values, 2)
     assert calibration.start_unit()[2] == 0.5  # no base-scene value: the middle of its bounds
 
 

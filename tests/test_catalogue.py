@@ -12,8 +12,9 @@ from matplotlib.figure import Figure
 from matplotlib.text import Text
 from scenes import PAPER_BASE, scene
 
+import rpdrill
+from rpdrill import Scene
 from rpdrill.models.definition.outputs import METRICS, SERIES
-from rpdrill.models.definition.scene import Scene
 from rpdrill.models.definition.validation import allowed_keys
 from rpdrill.studies.display import catalogue
 
@@ -102,7 +103,6 @@ def plot_texts(monkeypatch) -> list[str]:
 
 def test_study_plots_show_no_raw_key_names(tmp_path, plot_texts):
     from rpdrill.studies.figures.plot_tasks import start_plots
-    from rpdrill.studies.scan.study import load_study
     from rpdrill.studies.scan.study_optima import study_optima
 
     study_file = tmp_path / "s.yaml"
@@ -113,12 +113,12 @@ def test_study_plots_show_no_raw_key_names(tmp_path, plot_texts):
         "plots": [{"x": "impact.frequency_hz", "y": ["penetration_rate_m_per_s", "advance_per_blow_m"]},
                   {"kind": "map", "x": "impact.frequency_hz", "y": "rock.stiffness_n_per_m",
                    "z": "penetration_rate_m_per_s"}]}))
-    study = load_study(study_file)
+    study = rpdrill.load_study(study_file)
     rng = np.random.default_rng(0)
-    rows = [{"point": str(p.index), **{a: str(v) for a, v in p.parameters.items()}, "status": "ok", "error": "",
-             "wall_time_s": "1", "penetration_rate_m_per_s": str(rng.uniform(0, 0.02)),
-             "advance_per_blow_m": str(rng.uniform(0, 3e-4))} for p in study.points]
-    written, _ = start_plots(study, rows, study_optima(study, rows), tmp_path)()
+    table = rpdrill.table_frame([{"point": str(p.index), **{a: str(v) for a, v in p.values.items()}, "status": "ok",
+                                  "error": "", "wall_time_s": "1", "penetration_rate_m_per_s": str(rng.uniform(0, 0.02)),
+                                  "advance_per_blow_m": str(rng.uniform(0, 3e-4))} for p in study.points])
+    written, _ = start_plots(study, table, study_optima(study, table), tmp_path)()
     assert {p.suffix for p in written} == {".png", ".svg"}
     text = "\n".join(plot_texts)
     assert "penetration rate" in text and "mm/s" in text and "rock stiffness" in text and "MN/m" in text
@@ -130,7 +130,6 @@ def test_a_map_keeps_axes_zipped_with_its_rows_in_one_panel(tmp_path, monkeypatc
     the damping named in the row label, not a panel per damping."""
     from rpdrill.studies.figures import plot_tasks as tasks
     from rpdrill.studies.figures import scan_figures as scans
-    from rpdrill.studies.scan.study import load_study
 
     study_file = tmp_path / "s.yaml"
     study_file.write_text(yaml.safe_dump({
@@ -141,14 +140,14 @@ def test_a_map_keeps_axes_zipped_with_its_rows_in_one_panel(tmp_path, monkeypatc
         "metrics": ["penetration_rate_m_per_s"],
         "plots": [{"kind": "map", "x": "impact.frequency_hz", "y": "rock.stiffness_n_per_m",
                    "z": "penetration_rate_m_per_s"}]}))
-    study = load_study(study_file)
+    study = rpdrill.load_study(study_file)
     assert study.zipped_with("rock.stiffness_n_per_m") == ["rock.stiffness_n_per_m", "rock.damping_n_s_per_m"]
-    rows = [{"point": str(p.index), **{a: str(v) for a, v in p.parameters.items()}, "status": "ok", "error": "",
-             "wall_time_s": "1", "penetration_rate_m_per_s": str(0.001 * (p.index + 1))} for p in study.points]
+    table = rpdrill.table_frame([{"point": str(p.index), **{a: str(v) for a, v in p.values.items()}, "status": "ok",
+                                  "error": "", "wall_time_s": "1", "penetration_rate_m_per_s": str(0.001 * (p.index + 1))}
+                                 for p in study.points])
     figures = []
     monkeypatch.setattr(scans, "save", lambda figure, path: figures.append(figure) or [path])
-    tasks.start_plots(study, rows, [], tmp_path)()
+    tasks.start_plots(study, table, [], tmp_path)()
     panels = [ax for ax in figures[0].axes if ax.collections and ax.get_ylabel().startswith("rock stiffness")]
     assert len(panels) == 1 and "rock damping" in panels[0].get_ylabel()
     assert panels[0].collections[0].get_array().size == 6  # 3 frequencies x 2 rocks
-    scans.plt.close(figures[0])

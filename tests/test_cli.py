@@ -12,9 +12,8 @@ from pathlib import Path
 
 import pytest
 import yaml
+from commands import COMMANDS, main
 from scenes import PAPER_BASE, scene_dict
-
-from rpdrill.studies.cli.main import COMMANDS, main
 
 ROOT = Path(__file__).resolve().parents[1]
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}

@@ -6,10 +6,10 @@ import sys
 
 import pytest
 import yaml
+from commands import main
 from scenes import scene_dict
 
 from rpdrill.models.evaluation.stability import StepLimitWarning
-from rpdrill.studies.cli.main import main
 
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}
 

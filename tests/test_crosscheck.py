@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from commands import main
 from scenes import PAPER_BASE, PER_BODY, scene_dict, simulate
 
-from rpdrill.models.definition.scene import Scene
+from rpdrill import Scene
 from rpdrill.models.evaluation.compare import compare_runs, verdict
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
 
 BLOWS = 15

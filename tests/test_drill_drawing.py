@@ -6,15 +6,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from commands import main
+from matplotlib.figure import Figure
 from PIL import Image
 from scenes import crushing_scene, scene_dict, simulate
 
+import rpdrill
 from rpdrill.models.drill.shapes import layout
-from rpdrill.studies.cli.main import main
-from rpdrill.studies.drawings.drill_animation import load_solution, nice_factor, write_animation
-from rpdrill.studies.drawings.drill_drawing import draw, draw_string, drawn_layout
-from rpdrill.studies.figures.figure_style import plt
-from rpdrill.studies.inputs.reading import load_scene
+from rpdrill.studies.drawings.drill_animation import load_solution, nice_factor
+from rpdrill.studies.drawings.drill_drawing import draw_string, drawn_layout
+
+load_scene, draw, write_animation = rpdrill.load_scene, rpdrill.draw, rpdrill.write_animation
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}
@@ -23,10 +25,9 @@ QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_
 @pytest.mark.parametrize("name", ["four_rod_string", "paper_base", "dth_drill", "wave_rod"])
 def test_every_body_and_connector_is_labelled_by_its_scene_name(name):
     s = load_scene(SCENES / f"{name}.yaml")
-    fig, ax = plt.subplots()
+    ax = Figure().subplots()
     draw_string(ax, s)
     labels = {text.get_text().splitlines()[0] for text in ax.texts}
-    plt.close(fig)
     assert set(s.drill_string.bodies) <= labels and set(s.drill_string.connectors) <= labels
     assert "rock" in labels and any(label.startswith("impact") for label in labels)
 

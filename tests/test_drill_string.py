@@ -9,19 +9,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from commands import main
 from pydantic import ValidationError
-from scenes import scene, scene_dict, simulate
+from scenes import read_yaml, scene, scene_dict, simulate
 
+from rpdrill import Scene, load_scene
 from rpdrill.models.definition.links import RATE, STRETCH, Coupling, Link
-from rpdrill.models.definition.scene import Scene
 from rpdrill.models.drill.chain import axial_chain, link_load_n
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.evaluation.waves import transmitted_pulse_n, travel_time_s
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw.modes import check_mode_forces
-from rpdrill.studies.cli.main import main
-from rpdrill.studies.inputs.reading import load_scene, read_yaml
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 ROD = {"length_m": 3.66, "diameter_m": 0.045, "bore_diameter_m": 0.012}

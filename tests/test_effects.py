@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 import yaml
+from commands import main
 from scenes import CRUSHING, scene, scene_dict, simulate
 
+from rpdrill import build_exudyn
 from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.models.solvers.exudyn_model import build_exudyn
 from rpdrill.models.solvers.simulation import prepare
-from rpdrill.studies.cli.main import main
 
 SHORT = {"solver__end_time_s": 0.25, "metrics__transient_blows": 3, "metrics__block_blows": 4}
 CRUSH = {k.replace(".", "__"): v for k, v in CRUSHING.items()}

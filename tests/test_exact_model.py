@@ -19,15 +19,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scenes import PAPER_BASE, PER_BODY, crushing_scene, scene, simulate
+from scenes import PAPER_BASE, PER_BODY, crushing_scene, read_yaml, scene, simulate
 
 import rpdrill.models.evaluation.stability
 import rpdrill.models.solvers.exact_model
-from rpdrill.models.definition.scene import Scene
+from rpdrill import Scene, SimulationFailed
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.evaluation.results import SimulationResult
-from rpdrill.models.evaluation.stability import SimulationFailed
 from rpdrill.models.solvers.exact_kernels import (
     BRENT_RTOL,
     BRENT_XTOL,
@@ -37,7 +36,6 @@ from rpdrill.models.solvers.exact_kernels import (
     run_events,
 )
 from rpdrill.models.solvers.simulation import prepare
-from rpdrill.studies.inputs.reading import read_yaml
 
 BLOWS = 12
 SHORT_METRICS = {"metrics__transient_blows": 2, "metrics__block_blows": 2}

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from scenes import scene_dict, simulate
 
+from rpdrill import Scene
 from rpdrill.models.definition.links import LINK_TYPES, RATE, STRETCH, Link
-from rpdrill.models.definition.scene import Scene
 from rpdrill.models.evaluation.compare import compare_bottom_at, compare_histories
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.rocklaw.modes import check_mode_forces

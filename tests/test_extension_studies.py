@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 import yaml
+from commands import main
 from scenes import PAPER_BASE
 
 import rpdrill
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.sensitivity.sensitivity_study import scene_values
 
 MASS = "extensions.clamp.parameters.mass_kg"
@@ -83,7 +83,7 @@ def test_an_extension_parameter_is_a_calibration_axis(tmp_path):
 
 def test_an_extension_parameter_is_a_sensitivity_parameter(tmp_path):
     base = rpdrill.load_scene(PAPER_BASE).with_({**SHORT, "extensions": CLAMP})
-    values = scene_values(base.model_dump(by_alias=True, exclude_none=True))
+    values = scene_values(base)
     assert values[MASS] == 300.0 and values["extensions.clamp.parameters.stiffness_n_per_m"] == 1e8
     sensitivity = {"name": "clamp_sensitivity", "base_scene": str(PAPER_BASE),
                    "base_overrides": {**SHORT, "extensions": CLAMP}, "frequency_hz": {"from": 40, "to": 60, "step": 10},

@@ -143,7 +143,7 @@ def test_an_extension_named_by_the_scene_is_applied_in_every_run_and_recorded(tm
     by_hand = clamped(stiffness_n_per_m=1e9).run()
     assert rate(result) == rate(by_hand) and result.info["exudyn_model"]["extensions"] == ["clamp"]
     simulation = pickle.loads(pickle.dumps(prepare(scene)))  # data: a worker rebuilds the model by name
-    assert rate(rpdrill.Result(scene, simulation.run())) == rate(by_hand)
+    assert rate(rpdrill.Result(scene, simulation.solve())) == rate(by_hand)
     rpdrill.save_result(result, tmp_path)
     recorded = rpdrill.load_scene(tmp_path / "scene.resolved.yaml").extensions["clamp"]
     assert recorded.recorded["import_path"] == "user_rig:add_clamp" and recorded.recorded["file"].endswith("user_rig.py")

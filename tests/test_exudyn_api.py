@@ -15,10 +15,9 @@ from exudyn.itemInterface import (
 )
 from scenes import crushing_scene, scene
 
+from rpdrill import build_exudyn, load_scene, simulate
 from rpdrill.models.definition.drill_string import STEEL_DENSITY_KG_PER_M3
 from rpdrill.models.drill.shapes import DEFAULT_DIAMETER_M, layout
-from rpdrill.models.solvers.exudyn_model import build_exudyn, simulate
-from rpdrill.studies.inputs.reading import load_scene
 
 SHORT = {"solver__end_time_s": 0.4, "metrics__transient_blows": 8, "metrics__block_blows": 6}
 FOUR_RODS = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "four_rod_string.yaml"

@@ -4,9 +4,9 @@ optima.csv (no silent flat lines)."""
 import csv
 
 import yaml
+from commands import main
 from scenes import PAPER_BASE
 
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.figures import scan_figures
 from rpdrill.studies.scan.flat_curves import NO_CRUSHING, NO_RESULT, ZERO, why_no_optimum
 

@@ -12,16 +12,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from scenes import CRUSHING, crushing_scene, scene_dict, simulate
+from commands import main
+from scenes import CRUSHING, crushing_scene, read_yaml, scene_dict, simulate
 
-from rpdrill.models.definition.scene import Bit, Scene
+import rpdrill
+from rpdrill import InputError, Scene, load_study
+from rpdrill.models.definition.scene import Bit
 from rpdrill.models.drill.indexing import CRATER, FRESH, MIN_FRESH_FRACTION, RIDGES, Indexing
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
-from rpdrill.studies.inputs.reading import InputError, prepare_scene, read_yaml
-from rpdrill.studies.scan.study import load_study
+from rpdrill.studies.inputs.reading import prepare_scene
 
 BIT = {"diameter_m": 0.216, "gauge_button_diameter_m": 0.019, "gauge_buttons": 12}  # the DTH bit
 DIAMETER, BUTTON = BIT["diameter_m"], BIT["gauge_button_diameter_m"]
@@ -241,3 +242,11 @@ def test_rotation_report_from_two_small_studies(tmp_path):
     manual = 1600 * 0.019 / (math.pi * 0.216)
     assert f"**{manual:.1f} rpm**" in text and f"**{60 * 36 * 0.019 / (math.pi * 0.216):.1f} rpm**" in text
     assert "| conglomerate | 60 |" in text and (out / "rotation_map_conglomerate.png").stat().st_size > 0
+    # the library call behind the command: the same note (but for the command line it records), no files kept
+    note = rpdrill.rotation_report(tmp_path / "runs", rock="conglomerate")
+    assert note.files == [] and note.out is None
+    assert [line for line in note.text.splitlines() if "rpdrill rotation-report" not in line] == \
+        [line for line in text.splitlines() if "rpdrill rotation-report" not in line]
+    assert set(note.ridge["rock"]) == {"conglomerate"} and note.ridge["best_speed_rpm"].notna().all()
+    with pytest.raises(rpdrill.InputError, match="rock.*granite.*not on the map.*conglomerate"):
+        rpdrill.rotation_report(tmp_path / "runs", rock="granite")

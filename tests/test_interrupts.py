@@ -130,6 +130,42 @@ def test_a_worker_killed_alone_stops_the_run_keeping_its_finished_points(tmp_pat
     assert len(csv_rows(out / "results.csv")) >= stopped.kept_at_signal
 
 
+def slow_points(tmp_path: Path) -> Path:
+    """4 points of several CPU seconds each (30 s of the test drill on Exudyn), only the rate recorded."""
+    return write(tmp_path / "slow.yaml", {
+        "name": "slow", "base_scene": str(PAPER_BASE), "base_overrides": {"solver.end_time_s": 30.0},
+        "scan": {"impact.frequency_hz": [40, 45, 50, 55]}, "metrics": ["penetration_rate_m_per_s"]})
+
+
+def after(seconds: float) -> Callable[[], int]:
+    """1 once ``seconds`` have passed (the command's workers are then in the middle of their first points)."""
+    start = time.monotonic()
+    return lambda: int(time.monotonic() - start >= seconds)
+
+
+def test_a_killed_command_leaves_no_worker_in_the_middle_of_a_point(tmp_path):
+    """Why a pool worker asks the kernel to end it with its command (PR_SET_PDEATHSIG,
+    studies.runtime.interrupts.worker_ends_with_its_command): the command killed (SIGKILL: none of its
+    own code runs) while its workers are seconds from the end of their points; 2 s later no worker is
+    left. Without it each worker runs its point to the end before it finds its command gone (seen, with the
+    call commented out: the workers still running 2 s after the kill)."""
+    stopped = stop(command("study", str(slow_points(tmp_path)), "--out", str(tmp_path / "out"), "--workers", "2",
+                           "--quiet"), after(4.0), signal.SIGKILL, group=False, at_least=1)
+    assert stopped.status == -signal.SIGKILL and not stopped.left, stopped
+
+
+def test_a_stop_does_not_wait_for_the_points_under_way(tmp_path):
+    """Why the command ends its workers on a stop (studies.runtime.pools._terminate_workers: Python 3.14's
+    ``terminate_workers``, before it the executor's own processes): Ctrl-C while both workers are seconds
+    from the end of their points (they ignore it: the command stops the run) exits within 2 s. Without it
+    the pool's shutdown waits for the points under way (seen, with the call commented out: no exit within
+    the 60 s this test waits, on the shared 2-core machine)."""
+    stopped = stop(command("study", str(slow_points(tmp_path)), "--out", str(tmp_path / "out"), "--workers", "2",
+                           "--quiet"), after(4.0), signal.SIGINT, group=True, at_least=1)
+    assert stopped.status == 130 and stopped.exit_after_s < EXIT_WITHIN_S and not stopped.left, stopped
+    assert "Traceback" not in stopped.err
+
+
 @pytest.mark.slow
 def test_an_interrupted_study_resumes_to_the_rows_of_an_uninterrupted_run(tmp_path):
     study, out, whole = study_file(tmp_path), tmp_path / "out", tmp_path / "whole"

@@ -7,7 +7,8 @@ import time
 
 import pytest
 
-from rpdrill.studies.inputs.reading import InputError, parse_yaml, read_yaml
+from rpdrill import InputError
+from rpdrill.studies.inputs.reading import parse_yaml, read_yaml
 
 
 def test_yaml_12_floats_are_numbers():

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 import yaml
+from commands import main
 from scenes import PAPER_BASE
 
 from rpdrill import InputError
-from rpdrill.studies.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
 CORPUS = Path(__file__).resolve().parent / "bad_inputs"
@@ -74,7 +74,7 @@ def test_a_stale_lock_is_taken_over_and_said_once(tmp_path, capsys):
 def test_a_resumed_table_with_edited_rows_runs_them_again(tmp_path, capsys):
     study = write_study(tmp_path / "edited.yaml", [40, 50, 60])
     out = tmp_path / "out"
-    # both runs by the rpdrill program (its Exudyn build: rocklaw.exudyn_build), so that rows compare exactly
+    # both runs by the rpdrill program (its Exudyn build: studies.cli.main.choose_exudyn_build), so that rows compare exactly
     first = subprocess.run(command("study", str(study), "--out", str(out), "--workers", "1", "--quiet"), cwd=ROOT,
                            capture_output=True, text=True, timeout=300, check=False)
     assert first.returncode == 0, first.stderr

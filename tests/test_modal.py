@@ -5,8 +5,8 @@ import math
 import pytest
 from scenes import scene, scene_dict
 
+from rpdrill import Scene
 from rpdrill.models.definition.links import Link
-from rpdrill.models.definition.scene import Scene
 from rpdrill.models.drill.chain import AxialChain, ChainBody
 from rpdrill.models.drill.modal import rock_mode_frequency_hz
 from rpdrill.models.solvers.simulation import prepare

@@ -8,13 +8,11 @@ import sys
 
 import numpy as np
 import pytest
-from scenes import PAPER_BASE, simulate
+from scenes import PAPER_BASE, read_yaml, simulate
 
-from rpdrill.models.definition.scene import Scene
+from rpdrill import Scene, SimulationFailed
 from rpdrill.models.evaluation.energy import energy_account
-from rpdrill.models.evaluation.stability import SimulationFailed
 from rpdrill.models.solvers import ode_model
-from rpdrill.studies.inputs.reading import read_yaml
 
 
 def scene_from_base(blows: float = 15, **changes: object) -> Scene:

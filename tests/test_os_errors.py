@@ -21,8 +21,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-
-from rpdrill.studies.cli.main import main
+from commands import main
 
 ROOT = Path(__file__).resolve().parents[1]
 DRILL = Path(__file__).resolve().parent / "bad_inputs" / "valid" / "drill.yaml"

@@ -10,25 +10,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rpdrill.models.definition.scene import Scene
+import rpdrill
 from rpdrill.models.drill.modal import rock_mode_frequency_hz
 from rpdrill.models.evaluation.compare import compare_runs, verdict
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
-from rpdrill.studies.inputs.reading import read_yaml
-from rpdrill.studies.inputs.specs import set_path
 from rpdrill.studies.scan.curve_optima import curve_optimum
 
 PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"
 SOFT_ROCK = {"rock.stiffness_n_per_m": 8.93e7, "rock.damping_n_s_per_m": 683.0, "rock.threshold_n": 123e3}
 
 
-def pipe_drill(**overrides: object) -> Scene:
-    data = read_yaml(PIPE_DRILL)
-    for path, value in overrides.items():
-        set_path(data, path, value)
-    return Scene.model_validate(data)
+def pipe_drill(**overrides: object) -> rpdrill.Scene:
+    return rpdrill.load_scene(PIPE_DRILL).with_(overrides)
 
 
 def main_lobe_optimum_hz(frequencies_hz: np.ndarray, metric: str, **overrides: object) -> float:
@@ -38,8 +33,8 @@ def main_lobe_optimum_hz(frequencies_hz: np.ndarray, metric: str, **overrides: o
         simulation = prepare(pipe_drill(**overrides, **{"impact.frequency_hz": float(frequency),
                                                          "outputs": {"metrics": [metric]}}))
         resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock)
-        values.append(summary_metrics(simulation.run())[metric])
-    found = curve_optimum(frequencies_hz, values, resonance).main_hz
+        values.append(summary_metrics(simulation.solve())[metric])
+    found = curve_optimum(frequencies_hz, values, resonance, metric=metric).optimum
     assert found is not None, f"no optimum of {metric} with {overrides}"
     return found
 
@@ -62,7 +57,7 @@ def test_the_optimum_rises_with_the_rock_stiffness():
     assert soft == pytest.approx(32.0, rel=0.15) and stiff == pytest.approx(69.0, rel=0.15)
 
 
-def crushing_window() -> Scene:
+def crushing_window() -> rpdrill.Scene:
     """Ten blows of the pipe drill crushing at 65 Hz (every output: energies too)."""
     return pipe_drill(**{"solver.end_time_s": 10 / 65.0, "metrics": {"transient_blows": 4, "block_blows": 3}})
 
@@ -71,7 +66,7 @@ def crushing_window() -> Scene:
 def runs():
     """The crushing window by the exact formulation (the reference, to round-off) and the Exudyn model."""
     scene = crushing_window()
-    return {"exact": prepare(scene).run(), "exudyn": prepare(scene.with_solver("exudyn", type="rk44", step_s=5e-6)).run()}
+    return {"exact": prepare(scene).solve(), "exudyn": prepare(scene.with_solver("exudyn", type="rk44", step_s=5e-6)).solve()}
 
 
 def test_the_arrangement_crushes_and_balances_its_energy(runs):
@@ -90,7 +85,7 @@ def test_the_ode_crushes_balances_its_energy_and_agrees_with_exact_and_exudyn(ru
     """The independent formulation on the arrangement (tight tolerance): it drills, closes its energy
     balance, ends with the exact solution's bottom to 1e-9 and agrees with the Exudyn model within the
     cross-check's tolerances."""
-    ode = prepare(crushing_window().with_solver("ode", relative_tolerance=1e-11, absolute_tolerance=1e-14)).run()
+    ode = prepare(crushing_window().with_solver("ode", relative_tolerance=1e-11, absolute_tolerance=1e-14)).solve()
     assert ode.bottom_m[-1] > 1e-4 and energy_account(ode).relative_residual() < 1e-3
     assert abs(runs["exact"].bottom_m[-1] - ode.bottom_m[-1]) <= 1e-9 * runs["exact"].bottom_m[-1]
     report = compare_runs(ode, runs["exudyn"], ode.scene.solver.end_time_s)

@@ -7,8 +7,8 @@ import pytest
 from pydantic import ValidationError
 from scenes import crushing_scene, scene, simulate
 
+from rpdrill import load_scene
 from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.studies.inputs.reading import load_scene
 
 SHORT = {"solver__end_time_s": 0.1, "metrics__transient_blows": 1, "metrics__block_blows": 2}
 LINKS = ("shock_absorber", "shank_collar_joint", "collar_bit_joint")

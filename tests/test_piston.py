@@ -11,10 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from commands import main
 from pydantic import ValidationError
 from scenes import PAPER_BASE, scene_dict
 
-from rpdrill.models.definition.scene import Scene
+import rpdrill
+from rpdrill import Scene
 from rpdrill.models.drill.piston import rigid_piston_pulse_n
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.solvers.simulation import SceneError, prepare
@@ -24,14 +26,13 @@ from rpdrill.studies.advice.advice_search import (
     AdviceEvaluator,
     AdviceSearch,
     Request,
-    advise,
     at_point,
     runnable_scene,
+    search_advice,
 )
-from rpdrill.studies.cli.main import main
-from rpdrill.studies.inputs.reading import load_scene
 from rpdrill.studies.runtime.pools import sequential
-from rpdrill.studies.scan.study import load_study
+
+load_scene, load_study = rpdrill.load_scene, rpdrill.load_study
 
 E_PA, RHO, SPEED = 2.1e11, 7850.0, 9.0
 STEEL = {"diameter_m": 0.045, "youngs_modulus_pa": E_PA, "density_kg_per_m3": RHO}
@@ -60,7 +61,7 @@ def rod_piston(segments: int) -> dict:
 
 
 def run(data: dict):
-    return prepare(Scene.model_validate(data)).run()
+    return prepare(Scene.model_validate(data)).solve()
 
 
 def plateau_and_length(result) -> tuple[float, float]:
@@ -226,8 +227,7 @@ def test_advise_at_a_fixed_power_needs_a_piston(tmp_path, capsys):
 
 
 def test_at_a_fixed_power_the_blow_energy_follows_the_frequency():
-    data = load_scene(TOP_HAMMER).model_dump(by_alias=True, exclude_none=True)
-    scene = Scene.model_validate(at_point(data, {FREQUENCY: 60.0}, 15e3))
+    scene = at_point(load_scene(TOP_HAMMER), {FREQUENCY: 60.0}, 15e3)
     assert scene.impact.piston.blow_energy_j * scene.impact.frequency_hz == pytest.approx(15e3)
 
 
@@ -236,9 +236,8 @@ def test_advise_at_a_fixed_power_is_not_beaten_by_a_frequency_grid():
     """The issue's criterion on the shipped top hammer (a narrower box than benchmarks/bench_advise_power.py)."""
     bounds = {FREQUENCY: (60.0, 80.0), FEED: (5e3, 15e3)}
     request = Request("penetration_rate_m_per_s", bounds, power_w=15e3, search=AdviceSearch(popsize=6, max_generations=8))
-    data = runnable_scene(load_scene(TOP_HAMMER).model_dump(by_alias=True, exclude_none=True), None, request,
-                          str(TOP_HAMMER))
-    advice = advise(data, None, request, sequential)
+    data = runnable_scene(load_scene(TOP_HAMMER), None, request, str(TOP_HAMMER))
+    advice = search_advice(data, None, request, sequential)
     grid = AdviceEvaluator(data, request, sequential)([{FREQUENCY: f, FEED: advice.best[FEED]}
                                                        for f in np.arange(60.0, 80.01, 1.0)]).values
     assert np.nanmax(grid) <= 1.01 * advice.best_value

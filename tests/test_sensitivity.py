@@ -10,9 +10,10 @@ from pathlib import Path
 
 import pytest
 import yaml
+from commands import main
 from scenes import PAPER_BASE
 
-from rpdrill.studies.cli.main import main
+import rpdrill
 from rpdrill.studies.sensitivity.sensitivity_study import load_sensitivity, scene_values
 
 COLLAR, ROCK = "drill_string.bodies.collar.mass_kg", "rock.stiffness_n_per_m"
@@ -76,6 +77,21 @@ def test_trends_and_summary(run):
     assert set(rate["parameters_by_peak_change"]) == {COLLAR, ROCK}
     assert summary["variations"] == 4 and summary["nominal_keeps_every_trend"]
     assert len(list(out.glob("tornado_*.svg"))) == 4
+
+
+def test_sensitivity_as_a_library_call_gives_the_command_s_tables(run):
+    """``rpdrill.sensitivity`` (no ``out``: a scratch table, nothing drawn) gives the command's results as
+    typed tables: the same optima, one-at-a-time changes and trends as the files hold."""
+    study, out, _ = run
+    result = rpdrill.sensitivity(study, workers=1)
+    assert isinstance(result, rpdrill.SensitivityResult) and result.out is None and not result.figures
+    files = rpdrill.table_frame(table(out / "results.csv"))
+    columns = [c for c in files.columns if c != "wall_time_s"]
+    assert result.table[columns].equals(files[columns])
+    assert result.one_at_a_time["optimum_change"].dtype == float and len(result.one_at_a_time) == 16
+    assert [str(c) for c in result.trends["change"]] == [row["change"] for row in table(out / "trends.csv")]
+    assert result.summary == json.loads((out / "summary.json").read_text())
+    assert result.global_indices.empty
 
 
 def test_rerun_runs_nothing(run, capsys):

@@ -47,7 +47,7 @@ def settled_advance(scene_: rpdrill.Scene, settle_to: float = 1e-9) -> tuple[flo
     blows = 400
     while True:
         run = prepare(scene_.with_({"solver.end_time_s": blows / frequency, "solver.steady_state": "time",
-                                    "outputs": {"metrics": ["penetration_rate_m_per_s"]}})).run()
+                                    "outputs": {"metrics": ["penetration_rate_m_per_s"]}})).solve()
         advances = np.diff(run.bottom_at(np.arange(blows + 1) / frequency))
         if abs(advances[-1] - advances[-2]) <= settle_to * abs(advances[-1]) or blows >= 6400:
             return float(advances[-1]), advances
@@ -128,7 +128,7 @@ def test_a_periodic_run_gives_every_metric_of_the_orbit():
     assert abs(metrics["energy_balance_relative_error"]) < 1e-9  # the exact works over the orbit
     # the same figures as the last blows of a long time run (peaks and efficiency included)
     long_run = prepare(scene_.with_({"solver.steady_state": "time", "solver.end_time_s": 800 * period_s,
-                                     "metrics": {"transient_blows": 795, "block_blows": 5}})).run()
+                                     "metrics": {"transient_blows": 795, "block_blows": 5}})).solve()
     settled = summary_metrics(long_run)
     for name in ("penetration_rate_m_per_s", "collar_velocity_rms_m_per_s", "energy_transfer_efficiency",
                  "rock_force_max_n"):

@@ -18,18 +18,15 @@ from typing import Any
 
 import pytest
 import yaml
-from scenes import PAPER_BASE, simulate
+from commands import main
+from scenes import PAPER_BASE, scene_dict
 
+import rpdrill
 from rpdrill.models.definition.outputs import METRICS
-from rpdrill.models.definition.scene import Scene
-from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.evaluation.stability import StepLimitWarning
-from rpdrill.studies.cli.main import main
-from rpdrill.studies.inputs.reading import read_yaml
-from rpdrill.studies.inputs.specs import METRIC_NAMES
-from rpdrill.studies.runtime.point_runs import run_point
 from rpdrill.studies.runtime.pools import BATCHES_PER_WORKER, ONE_THREAD, batches, process_pool
-from rpdrill.studies.scan.study import load_study
+
+load_study = rpdrill.load_study
 
 ROOT = Path(__file__).resolve().parents[1]
 SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}
@@ -75,8 +72,7 @@ def test_axes_expand_and_combine(tmp_path):
     assert study.axes["impact.frequency_hz"] == [40.0, 45.0, 50.0]
     assert study.axes["rock.stiffness_n_per_m"] == pytest.approx([1e8, 1e8 * 10**0.5, 1e9])
     assert len(study.points) == 9
-    assert {(p.simulation.scene.rock.stiffness_n_per_m, p.simulation.scene.rock.damping_n_s_per_m)
-            for p in study.points} \
+    assert {(p.scene.rock.stiffness_n_per_m, p.scene.rock.damping_n_s_per_m) for p in study.points} \
         == set(zip(study.axes["rock.stiffness_n_per_m"], [1e3, 2e3, 3e3]))
 
 
@@ -85,29 +81,29 @@ def test_axes_expand_and_combine(tmp_path):
 def test_paper_studies_expand(name, count):
     study = load_study(ROOT / "studies" / "paper" / f"{name}.yaml")
     assert len(study.points) == count
-    assert study.points[0].simulation.scene.impact.frequency_hz == 10.0
+    assert study.points[0].scene.impact.frequency_hz == 10.0
 
 
 def test_rock_name_axis_supplies_rock_values():
     study = load_study(ROOT / "studies" / "paper" / "rock_table.yaml")
-    rocks = {p.simulation.scene.rock.name: p.simulation.resolved_scene()["rock"]["stiffness_n_per_m"]
-             for p in study.points}
+    rocks = {p.scene.rock.name: p.simulation.resolved_scene()["rock"]["stiffness_n_per_m"] for p in study.points}
     assert rocks == {"conglomerate": 8.4e8, "sandstone": 5.1e8, "soft_limestone": 2.1e8}
 
 
 def test_points_run_on_a_base_scene_with_default_solver(tmp_path):
-    base = {key: value for key, value in read_yaml(PAPER_BASE).items() if key != "solver"}
+    base = {key: value for key, value in scene_dict().items() if key != "solver"}
     study = load_study(write_study(tmp_path / "s.yaml", base_scene=base, scan={"impact.frequency_hz": [40]},
                                    base_overrides=SHORT, plots=[]))
-    outcome = run_point((0, study.points[0].simulation))
-    assert outcome["status"] == "ok", outcome["error"]
+    table = rpdrill.run_study(study, workers=1)
+    assert list(table["status"]) == ["ok"], list(table["error"])
 
 
-def test_metric_names_are_those_of_summary_metrics():
-    scene = Scene.model_validate({**read_yaml(PAPER_BASE), "metrics": SHORT["metrics"],
-                                  "solver": {"end_time_s": 0.1}})
+def test_a_study_collects_every_metric_a_run_gives():
+    """Without ``metrics`` a study collects every metric (models.definition.outputs.METRICS), the same a
+    run of its scene gives (those of a piston scene left out)."""
+    scene = rpdrill.Scene.model_validate({**scene_dict(), "metrics": SHORT["metrics"], "solver": {"end_time_s": 0.1}})
     piston_only = {name for name, need in METRICS.items() if "piston" in need.data}  # a piston scene's
-    assert piston_only and set(summary_metrics(simulate(scene))) == set(METRIC_NAMES) - piston_only
+    assert piston_only and set(rpdrill.simulate(scene).metrics) == set(METRICS) - piston_only
 
 
 def test_study_hash_is_the_json_of_its_scenes_and_metrics(tmp_path):

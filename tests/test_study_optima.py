@@ -9,14 +9,16 @@ import json
 import numpy as np
 import pytest
 import yaml
+from commands import main
 from scenes import PAPER_BASE
 
+import rpdrill
 from rpdrill.models.drill.modal import rock_mode_frequency_hz
 from rpdrill.models.evaluation.stability import StepLimitWarning
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.scan.curve_optima import curve_optimum
-from rpdrill.studies.scan.study import load_study
 from rpdrill.studies.scan.study_optima import csv_rows, curve_axis, optima_table, study_optima
+
+load_study = rpdrill.load_study
 
 SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}
 
@@ -31,17 +33,18 @@ def bump(frequency_hz: float, centre_hz: float) -> float:
     return 0.02 * np.exp(-0.5 * ((frequency_hz - centre_hz) / 6.0) ** 2)
 
 
-def synthetic_rows(study, centres_hz, fail=()):
-    """Rows whose penetration rate is a bump around the centre of its amplitude's curve."""
+def synthetic_table(study, centres_hz, fail=()):
+    """A results table (as results.csv holds it) whose penetration rate is a bump around the centre of its
+    amplitude's curve."""
     rows = []
     for point in study.points:
-        f, amplitude = point.parameters["impact.frequency_hz"], point.parameters["impact.amplitude_n"]
+        f, amplitude = point.values["impact.frequency_hz"], point.values["impact.amplitude_n"]
         failed = (f, amplitude) in fail
         rows.append({"point": str(point.index), "impact.frequency_hz": str(f), "impact.amplitude_n": str(amplitude),
                      "status": "failed" if failed else "ok", "error": "x" if failed else "", "wall_time_s": "1",
                      "penetration_rate_m_per_s": "" if failed else str(bump(f, centres_hz[amplitude])),
                      "cpu_time_s": "" if failed else "0.5"})
-    return rows
+    return rpdrill.table_frame(rows)
 
 
 def test_curve_axis_is_the_frequency_when_scanned_else_the_first_numeric_axis(tmp_path):
@@ -52,29 +55,32 @@ def test_curve_axis_is_the_frequency_when_scanned_else_the_first_numeric_axis(tm
                                                   "feed.force_n": [1e4, 2e4, 3e4]}, base_overrides={**SHORT, "rock": {"name": "sandstone"}}))
     assert curve_axis(feed) == "feed.force_n"
     two = load_study(write(tmp_path / "c.yaml", {"impact.frequency_hz": [40.0, 50.0]}))
-    assert curve_axis(two) is None and study_optima(two, []) == []
+    assert curve_axis(two) is None and study_optima(two, rpdrill.table_frame([])) == []
 
 
 def test_optima_of_every_curve_and_figure_of_merit(tmp_path):
     study = load_study(write(tmp_path / "s.yaml", {"impact.frequency_hz": {"from": 30, "to": 90, "step": 5},
                                                   "impact.amplitude_n": [160e3, 220e3]}))
     centres = {160e3: 52.0, 220e3: 63.0}
-    rows = synthetic_rows(study, centres, fail={(90.0, 160e3)})
-    records = study_optima(study, rows)
-    assert [r["metric"] for r in records] == ["penetration_rate_m_per_s"] * 2  # cpu_time_s is no figure of merit
+    table = synthetic_table(study, centres, fail={(90.0, 160e3)})
+    optima = study_optima(study, table)
+    assert [o.metric for o in optima] == ["penetration_rate_m_per_s"] * 2  # cpu_time_s is no figure of merit
     resonance = rock_mode_frequency_hz(study.points[0].simulation.chain, study.points[0].simulation.rock)
-    for record in records:
-        amplitude = float(record["curve"]["impact.amplitude_n"])
+    for optimum in optima:
+        amplitude = optimum.curve["impact.amplitude_n"]
         frequencies = np.arange(30.0, 91.0, 5.0)
         values = [bump(f, centres[amplitude]) for f in frequencies]
         expected = curve_optimum(frequencies, values, resonance).main_lobe
-        assert record["optimum"] == pytest.approx(expected.peak_hz)
+        record = optimum.record
+        assert record["optimum"] == pytest.approx(expected.peak)
         assert record["optimum"] == pytest.approx(centres[amplitude], abs=0.5)  # the parabola finds the bump
-        assert record["band_80"] == pytest.approx(list(expected.band_80_hz))
+        assert record["band_80"] == pytest.approx(list(expected.band_80))
         assert record["band_50"][0] < record["band_80"][0] < record["optimum"] < record["band_80"][1]
         assert record["best"] == frequencies[int(np.argmax(values))] and record["best_value"] == max(values)
         assert record["resonance_hz"] == pytest.approx(resonance)
         assert record["failed"] == (1 if amplitude == 160e3 else 0) and record["points"] == len(frequencies)
+        assert record["curve"] == {"impact.amplitude_n": amplitude}  # typed: a number, not its text
+    records = optima
     header = list(csv_rows(records)[0])
     assert {"impact.amplitude_n", "optimum_impact.frequency_hz", "band_80_low_impact.frequency_hz",
             "value_unit"} <= set(header)

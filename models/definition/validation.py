@@ -27,7 +27,11 @@ LONG_QUOTED = re.compile(r"(?<!\w)(['\"])([^'\"\n]{78})[^'\"\n]{3,}\1(?!\w)")  #
 
 class InputError(ValueError):
     """Bad user input; the message is complete and meant for the user (a quoted value in it beyond 80
-    characters is shortened, :func:`shortened`)."""
+    characters is shortened, :func:`shortened`). ``problems``: when a validation found it (:func:`parse`),
+    each problem as (key path, what is wrong), so that a caller can tie it to the change that caused it
+    (a scan axis: studies.runtime.point_runs)."""
+
+    problems: tuple[tuple[str, str], ...] = ()
 
     def __str__(self) -> str:
         return shortened(super().__str__())
@@ -159,7 +163,10 @@ def parse(model: type[ModelT], data: Any, source: str, prefix: tuple[Any, ...] =
     try:
         return model.model_validate(data)
     except ValidationError as error:
-        raise InputError(describe_validation_error(source, error, model, prefix)) from None
+        failure = InputError(describe_validation_error(source, error, model, prefix))
+        failure.problems = tuple((".".join(str(p) for p in item["loc"] if p != "function-after"), problem(item))
+                                 for item in error.errors())
+        raise failure from None
 
 
 def set_path(data: dict[str, Any], path: str, value: Any) -> None:

@@ -59,9 +59,6 @@ class AxialChain:
                 return i
         raise KeyError(f"no body {name!r} in the drill string; bodies: {', '.join(b.name for b in self.bodies)}")
 
-    def mass_matrix(self) -> np.ndarray:
-        return np.diag([b.mass_kg for b in self.bodies])
-
     def _assemble(self, attribute: str, links: tuple[Link, ...]) -> np.ndarray:
         """D^T diag(values) D: the links' stiffness or damping matrix, from their incidence D."""
         incidence = self.incidence(links)
@@ -84,9 +81,6 @@ class AxialChain:
         """K of every link at its full stiffness (couplings closed: the stiffest state), or of the
         linear links only."""
         return self._assemble("stiffness_n_per_m", self.linear_links() if linear_only else self.links)
-
-    def damping_matrix(self, linear_only: bool = False) -> np.ndarray:
-        return self._assemble("damping_n_s_per_m", self.linear_links() if linear_only else self.links)
 
     def constant_forces(self) -> np.ndarray:
         return np.array([b.constant_force_n for b in self.bodies])

@@ -160,11 +160,6 @@ class PistonSetup:
         return 0.5 * self.mass_kg * self.strike_velocity_m_per_s**2
 
     @property
-    def momentum_n_s(self) -> float:
-        """m_p v_p, the most impulse a blow can give."""
-        return self.mass_kg * self.strike_velocity_m_per_s
-
-    @property
     def bodies(self) -> slice:
         """The piston's bodies in the dynamic chain's state vectors."""
         return slice(self.first, self.first + self.segments)

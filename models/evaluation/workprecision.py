@@ -1,4 +1,4 @@
-"""Work-precision numerics: error measures against a reference, Pareto fronts, convergence orders.
+"""Work-precision numerics: error measures against a reference, Pareto fronts.
 
 Formulation independent: a run is reduced to a :class:`Signature` (what the errors are measured
 on) by :func:`signature`, and two signatures give the errors of :func:`errors`:
@@ -16,7 +16,6 @@ Knows nothing of YAML or of how a run was made.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -104,21 +103,3 @@ def pareto_front(cost: Sequence[float], error: Sequence[float]) -> list[int]:
     front = [finite[j] for j in non_dominated([(cost[i], error[i]) for i in finite])]
     unique = {(cost[i], error[i]): i for i in reversed(front)}  # of equal points the first
     return sorted(unique.values(), key=lambda i: (cost[i], error[i]))
-
-
-def cost_at_error(cost: Sequence[float], error: Sequence[float], level: float) -> float:
-    """CPU cost at which the Pareto front of (cost, error) reaches ``level``, log-log interpolated
-    between the neighbouring front points; NaN if the front does not bracket ``level``."""
-    front = pareto_front(cost, error)
-    points = [(math.log(error[i]), math.log(cost[i])) for i in front if error[i] > 0 and cost[i] > 0]
-    target = math.log(level)
-    for (e0, c0), (e1, c1) in itertools.pairwise(points):
-        if e1 <= target <= e0:
-            return math.exp(c0 + (c1 - c0) * (target - e0) / (e1 - e0)) if e0 != e1 else math.exp(c0)
-    return math.nan
-
-
-def convergence_order(steps_s: Sequence[float], errors_: Sequence[float]) -> float:
-    """Slope of the least-squares line through (log step, log error): the measured order p of e ~ h^p."""
-    slope, _ = np.polyfit(np.log(np.asarray(steps_s, float)), np.log(np.asarray(errors_, float)), 1)
-    return float(slope)

@@ -152,10 +152,12 @@ class Simulation:
         """What must be recorded for the requested outputs: ``forces``, ``energy``."""
         return needs(self.outputs.metrics, self.outputs.timeseries).data
 
-    def run(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
+    def solve(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
         """Simulate with the scene's formulation (models.solvers.dispatch); ``progress(t)`` as simulated
-        time advances. SceneError naming the extension when the formulation builds no Exudyn model and
-        the scene has an extension that changes the motion (models.definition.extensions)."""
+        time advances. The formulation's own result (``solve``, as ``ExudynModel.solve``); ``rpdrill.simulate``
+        and ``ExudynModel.run`` wrap it into ``rpdrill.Result``. SceneError naming the extension when the
+        formulation builds no Exudyn model and the scene has an extension that changes the motion
+        (models.definition.extensions)."""
         refused = refusal(self.scene.extensions, self.settings.formulation)
         if refused:
             raise SceneError(("extensions", refused[0]), self.scene.extensions[refused[0]].function, refused[1])

@@ -24,10 +24,10 @@ class FormulationMap:
 
     def __call__(self, y0: np.ndarray, jacobian: bool = False) -> MapRun:
         """Y(y0) (no Jacobian, no switches: this formulation does not report its events)."""
-        result = started_at(self.simulation, y0, self.periods, outputs=False).run()
+        result = started_at(self.simulation, y0, self.periods, outputs=False).solve()
         return MapRun(end_state(result), None, ())
 
     def blow_states(self, y0: np.ndarray, blows: int) -> list[np.ndarray]:
         """y at every blow start of a run of ``blows`` periods from y0 (the last one its end)."""
-        result = started_at(self.simulation, y0, blows, outputs=False).run()
+        result = started_at(self.simulation, y0, blows, outputs=False).solve()
         return [end_state(result, k * self.period_s) for k in range(1, blows + 1)]

@@ -258,7 +258,7 @@ class RegimeFinder:
             if ran.monodromy is not None:
                 orbit = orbit.with_jacobian(self.section.jacobian(ran.monodromy), "exact")
             return result, orbit, ran.end_state
-        result = started_at(self.simulation, orbit.state, orbit.periods).run()
+        result = started_at(self.simulation, orbit.state, orbit.periods).solve()
         return result, orbit, end_state(result)
 
     def _why_none(self) -> str:
@@ -279,4 +279,4 @@ def steady_state(simulation: Simulation, guess: np.ndarray | None = None, period
     bottom."""
     finder = RegimeFinder(simulation)
     found = finder.find(guess, periods)
-    return found if found.orbit is not None else finder.settled(simulation.run(), found)
+    return found if found.orbit is not None else finder.settled(simulation.solve(), found)

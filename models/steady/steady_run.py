@@ -23,12 +23,14 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..evaluation.results import SimulationResult
 from ..solvers.simulation import Simulation
+from ..solvers.solution_file import solve_with_solution
 from .section import section_of
 from .shooting import Orbit, scales
 from .steady_state import NONE_FOUND, SteadyState
@@ -63,13 +65,15 @@ def orbit_info(state: SteadyState) -> dict[str, Any]:
 
 
 def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
-              progress: Callable[[float], None] | None = None, cold_newton: bool = True) -> SimulationResult:
+              progress: Callable[[float], None] | None = None, cold_newton: bool = True,
+              solution: Path | None = None) -> SimulationResult:
     """The run ``simulation``'s scene asks for (module doc). ``guess``: the section state and period of
     an orbit to start Newton from (a neighbour's, predicted: models.steady.continuation); without one,
     ``cold_newton`` False goes straight to the time run and the period it repeats (a neighbour had no
-    periodic orbit: models.steady.regimes, step 2)."""
+    periodic orbit: models.steady.regimes, step 2). ``solution``: a time run of the Exudyn formulation
+    writes Exudyn's coordinates solution file there (models.solvers.solution_file)."""
     if simulation.scene.solver.steady_state != "periodic":
-        result = simulation.run(progress)
+        result = solve_with_solution(simulation, progress, solution)
         result.info.update(steady_state="time", regime=TIME_RUN, period_blows=None, floquet_max_abs=math.nan)
         return result
     from ..solvers.exact_model import BLAS  # numba's kernels: loaded for a periodic run only
@@ -84,7 +88,7 @@ def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
             state = finder.find(*(guess or (None, 1))) if guess is not None or cold_newton else \
                 SteadyState(NONE_FOUND, None)
             if state.orbit is None:  # step 2: the period its time run repeats (models.steady.regimes)
-                time_run = finder.simulation.run(progress)  # (an extension's coordinates recorded)
+                time_run = finder.simulation.solve(progress)  # (an extension's coordinates recorded)
                 state = finder.settled(time_run, state)
     except SteadyStateUnavailable as why:
         state = SteadyState(NONE_FOUND, None, note=str(why))
@@ -98,7 +102,7 @@ def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
         if progress is not None:
             progress(simulation.settings.end_time_s)
     if state.orbit is None:
-        result = time_run or simulation.run(progress)
+        result = time_run or simulation.solve(progress)
     result.cpu_time_s = time.process_time() - start
     result.info.update(steady_state="periodic", **orbit_info(state))
     if state.orbit is not None:

@@ -44,7 +44,7 @@ import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from pydantic import Field
 
@@ -59,11 +59,15 @@ from ...models.evaluation.workprecision import (
     uniform_grid_s,
 )
 from ...models.solvers.cost import Cause
+from ...models.solvers.simulation import prepare
 from ..inputs.reading import InputError, parse, prepare_scene, read_yaml
 from ..inputs.specs import Axis, SceneSpec, StrictSpec
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, check_size
-from ..runtime.resumable import STATUS_COLUMNS, result_row
-from ..scan.study import StudyPoint
+from ..runtime.point_runs import STATUS_COLUMNS
+from ..runtime.resumable import point_row
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 # Exudyn runs store every step (a write period below any step): the error of a run includes the
 # linear interpolation of its own steps onto the grid, not that of a coarser storage interval.
@@ -118,48 +122,55 @@ class Setting:
 
 
 @dataclass(frozen=True)
+class AccuracyPoint:
+    """A setting of the study as a point of its table: its index, the ``values`` its row starts with
+    (PARAMETERS: family, formulation, solver as resolved, setting, value) and its estimated CPU seconds."""
+
+    index: int
+    values: dict[str, Any]
+    cpu_s: float
+
+
+@dataclass(frozen=True)
 class AccuracyStudy:
     """A validated study (duck-typed like studies.scan.study.Study for the shared provenance and resume code)."""
 
     source: Path
     spec: AccuracySpec
-    base: dict[str, Any]
-    scene: dict[str, Any]  # the windowed scene every setting runs
-    points: list[StudyPoint]
+    base: Scene
+    scene: Scene  # the windowed scene every setting runs
+    points: list[AccuracyPoint]
     runs: list[Setting]  # runs[i] belongs to points[i]
     reference: Setting
     reference_check: Setting | None
 
     def resolved(self) -> dict[str, Any]:
         data = self.spec.model_dump(mode="json", by_alias=True)
-        data.update(base_scene=Scene.model_validate(self.scene).model_dump(mode="json", by_alias=True),
-                    settings=[{**p.parameters, **r.solver} for p, r in zip(self.points, self.runs)])
+        data.update(base_scene=self.scene.model_dump(mode="json", by_alias=True),
+                    settings=[{**p.values, **r.solver} for p, r in zip(self.points, self.runs)])
         return data
 
     @property
     def hash(self) -> str:
-        content = {"scene": self.scene, "grid_interval_s": self.spec.grid_interval_s,
+        content = {"scene": self.scene.model_dump(mode="json", by_alias=True, exclude_none=True),
+                   "grid_interval_s": self.spec.grid_interval_s,
                    "runs": [[r.solver, r.repeats] for r in self.runs], "reference": self.reference.solver}
         return hashlib.sha256(json.dumps(content, sort_keys=True, default=str).encode()).hexdigest()
 
 
-def windowed_scene(base: dict[str, Any], blows: int) -> dict[str, Any]:
-    """The base scene over ``blows`` periods, computing only the penetration rate and x_n (not validated)."""
-    scene = json.loads(json.dumps(base))
-    period = 1.0 / Scene.model_validate(base).impact.frequency_hz
-    scene["solver"] = {"end_time_s": blows * period}
-    scene["outputs"] = OUTPUTS
-    return scene
+def windowed_scene(base: Scene, blows: int, source: str) -> Scene:
+    """The base scene over ``blows`` periods (its solver's defaults), computing only the penetration rate and
+    x_n; InputError naming ``source`` when that is no valid scene."""
+    return base.with_({"solver": {"end_time_s": blows * base.impact.period_s}, "outputs": OUTPUTS}, source)
 
 
-def scene_for(study: AccuracyStudy | dict[str, Any], setting: Setting, grid_interval_s: float) -> dict[str, Any]:
+def scene_for(scene: Scene, setting: Setting, grid_interval_s: float, source: str = "accuracy") -> Scene:
     """The windowed scene with the setting's solver: Exudyn storing every step, the exact solver
     sampling the comparison grid, the ODE's dense output at ODE_SAMPLE_INTERVAL_S unless given."""
-    data = json.loads(json.dumps(study))
     storage = {"exact": grid_interval_s, "ode": grid_interval_s}.get(setting.formulation, EVERY_STEP_S)
     defaults = {"sample_interval_s": ODE_SAMPLE_INTERVAL_S} if setting.formulation == "ode" else {}
-    data["solver"] = {**data["solver"], "output_interval_s": storage, **defaults, **setting.solver}
-    return data
+    solver = {"end_time_s": scene.solver.end_time_s, "output_interval_s": storage, **defaults, **setting.solver}
+    return scene.with_({"solver": solver}, source)
 
 
 def _setting(fixed: dict[str, Any], key: str | None, value: Any, atol_ratio: float, repeats: int) -> Setting:
@@ -169,14 +180,14 @@ def _setting(fixed: dict[str, Any], key: str | None, value: Any, atol_ratio: flo
     return Setting(solver, repeats)
 
 
-def _checked(setting: Setting, scene: dict[str, Any], spec: AccuracySpec, source: str, key: str,
+def _checked(setting: Setting, scene: Scene, spec: AccuracySpec, source: str, key: str,
              budget: Budget) -> tuple[float, str]:
     """(The estimated CPU seconds of the setting's runs (each at most ``time_limit_s``), its solver as
     resolved: the Exudyn solver type, a preset's included, the ODE method, or the formulation);
     InputError naming ``source`` and ``key`` unless its windowed scene validates and prepares,
     BudgetError beyond the run budget."""
     grid, where = spec.grid_interval_s, f"{source}: {key}"
-    simulation = prepare_scene(parse(Scene, scene_for(scene, setting, grid), where, ()), where)
+    simulation = prepare_scene(scene_for(scene, setting, grid, where), where)
     cost = budget.check_run(simulation, source, f"{key}, over blows: {spec.blows}: ",
                             resampled=Cause("grid_interval_s", grid))
     solver = getattr(simulation.settings, "type", None) or getattr(simulation.settings, "method", setting.formulation)
@@ -189,9 +200,9 @@ def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Ac
     path = Path(path)
     source = str(path)
     spec = parse(AccuracySpec, read_yaml(path), source)
-    base = spec.base_scene_dict(path)
-    scene = windowed_scene(base, spec.blows)
-    pulse_s = parse(Scene, scene, f"{path} (base scene over blows: {spec.blows})").impact.duration_s
+    base = spec.base(path)
+    scene = windowed_scene(base, spec.blows, f"{path} (base scene over blows: {spec.blows})")
+    pulse_s = scene.impact.duration_s
     if spec.grid_interval_s > pulse_s / GRID_POINTS_PER_PULSE:
         raise InputError(f"{source}: grid_interval_s: {spec.grid_interval_s:g}: the comparison grid must resolve "
                          f"the pulse: at most impact.duration_s / {GRID_POINTS_PER_PULSE} = "
@@ -205,8 +216,8 @@ def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Ac
         for value in axis.expand():
             setting = _setting(family.solver, key, value, family.atol_ratio, family.repeats or spec.repeats)
             cpu, solver = _checked(setting, scene, spec, source, f"families.{i}.sweep.{key}: {value!r}", budget)
-            points.append(StudyPoint(len(points), {"family": family.label, "formulation": setting.formulation,
-                                              "solver": solver, "setting": key, "value": value}, None, cpu))
+            points.append(AccuracyPoint(len(points), {"family": family.label, "formulation": setting.formulation,
+                                                      "solver": solver, "setting": key, "value": value}, cpu))
             runs.append(setting)
     references = [None if run is None else _setting(run.solver, None, None, run.atol_ratio, 1)
                   for run in (spec.reference, spec.reference_check)]
@@ -216,14 +227,12 @@ def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Ac
     return AccuracyStudy(path, spec, base, scene, points, runs, *references)
 
 
-def simulate_setting(scene: dict[str, Any], setting: Setting, grid_interval_s: float) -> SimulationResult:
+def simulate_setting(scene: Scene, setting: Setting, grid_interval_s: float) -> SimulationResult:
     """One run of the windowed ``scene`` with ``setting`` (StepLimitWarnings silenced: a diverged
     run is reported as SimulationFailed by the formulation)."""
-    from ...models.solvers.simulation import prepare
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return prepare(Scene.model_validate(scene_for(scene, setting, grid_interval_s))).run()
+        return prepare(scene_for(scene, setting, grid_interval_s)).solve()
 
 
 class TimeLimitExceeded(RuntimeError):
@@ -250,11 +259,11 @@ def cpu_time_limit(seconds: float) -> Iterator[None]:
         signal.signal(signal.SIGPROF, previous)
 
 
-def run_setting(task: tuple[int, dict[str, Any], Setting, float, float]) -> dict[str, Any]:
-    """Worker: ``(index, windowed scene, setting, grid interval, CPU time limit per run)`` run
-    ``repeats`` times; the outcome carries the :class:`Signature` of the first run and every CPU
-    time. A failure (SimulationFailed, the time limit or any exception) is returned, not raised."""
-    index, scene, setting, grid_interval_s, limit_s = task
+def run_setting(task: tuple[Scene, Setting, float, float]) -> dict[str, Any]:
+    """Worker: ``(windowed scene, setting, grid interval, CPU time limit per run)`` run ``repeats`` times;
+    the outcome carries the :class:`Signature` of the first run and every CPU time. A failure
+    (SimulationFailed, the time limit or any exception) is returned, not raised."""
+    scene, setting, grid_interval_s, limit_s = task
     start = time.perf_counter()
     cpu, sig = [], None
     try:
@@ -268,11 +277,9 @@ def run_setting(task: tuple[int, dict[str, Any], Setting, float, float]) -> dict
         message = f"{type(err).__name__}: {err}"
         if "TimeLimitExceeded" in message:  # raised inside an Exudyn user function: wrapped
             message = f"TimeLimitExceeded: run exceeded the study's CPU time limit of {limit_s:g} s (time_limit_s)"
-        return {"point": index, "status": "failed", "error": message,
-                "wall_time_s": time.perf_counter() - start, "metrics": {}, "signature": None}
-    return {"point": index, "status": "ok", "error": "", "wall_time_s": time.perf_counter() - start,
-            "metrics": {"cpu_time_s": statistics.median(cpu), "cpu_time_s_runs": ";".join(f"{c:.4g}" for c in cpu)},
-            "signature": sig}
+        return {"status": "failed", "error": message, "wall_time_s": time.perf_counter() - start, "signature": None}
+    return {"status": "ok", "error": "", "wall_time_s": time.perf_counter() - start,
+            "cpu_time_s": statistics.median(cpu), "cpu_time_s_runs": ";".join(f"{c:.4g}" for c in cpu), "signature": sig}
 
 
 def reference_signature(study: AccuracyStudy, setting: Setting) -> Signature:
@@ -284,66 +291,61 @@ def reference_signature(study: AccuracyStudy, setting: Setting) -> Signature:
 PARAMETERS = ("family", "formulation", "solver", "setting", "value")
 VALUES = ("cpu_time_s", "cpu_time_s_runs", "bottom_end_error_m", *ERROR_MEASURES, "penetration_rate_m_per_s")
 COLUMNS = ["point", *PARAMETERS, *STATUS_COLUMNS, *VALUES]
+TEXT = ("family", "formulation", "solver", "setting", "value", "cpu_time_s_runs")  # text even where they read as numbers
+# how the table writes its numbers: 6 digits, the penetration rate 10
+FORMATS = {"cpu_time_s": ".6g", "bottom_end_error_m": ".6g", **dict.fromkeys(ERROR_MEASURES, ".6g"),
+           "penetration_rate_m_per_s": ".10g"}
 PARETO_COLUMNS = ("measure", "point", *PARAMETERS, "cpu_time_s", "error")
-Row = dict[str, str]
 
 
-def outcome_row(study: AccuracyStudy, reference: Signature, outcome: dict[str, Any]) -> dict[str, Any]:
-    """The CSV row of a finished setting, its errors measured against ``reference``."""
+def outcome_row(study: AccuracyStudy, reference: Signature, point: AccuracyPoint, outcome: dict[str, Any]) -> dict[str, Any]:
+    """The table row of a finished setting, its errors measured against ``reference``."""
+    values = {key: value for key, value in outcome.items() if key != "signature"}
     if outcome["status"] == "ok":
         sig: Signature = outcome["signature"]
-        outcome["metrics"].update({k: f"{v:.6g}" for k, v in errors(reference, sig).items()},
-                                  penetration_rate_m_per_s=f"{sig.penetration_rate_m_per_s:.10g}")
-        outcome["metrics"]["cpu_time_s"] = f"{outcome['metrics']['cpu_time_s']:.6g}"
-    return result_row(study.points[outcome["point"]], outcome)
+        values.update(errors(reference, sig), penetration_rate_m_per_s=sig.penetration_rate_m_per_s)
+    return point_row(point, values)
 
 
-def number(text: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        return math.nan
+def pareto_rows(table: pd.DataFrame) -> pd.DataFrame:
+    """The Pareto front of every error measure over the settings that ran (PARETO_COLUMNS)."""
+    import pandas as pd
 
-
-def pareto_rows(rows: list[Row]) -> list[dict[str, Any]]:
-    """The Pareto front of every error measure over the settings that ran."""
-    ok = [r for r in rows if r["status"] == "ok"]
+    ok = table[table["status"] == "ok"]
     out = []
     for measure in ERROR_MEASURES:
-        cost, error = [number(r["cpu_time_s"]) for r in ok], [number(r[measure]) for r in ok]
-        for i in pareto_front(cost, error):
-            out.append({"measure": measure, **{k: ok[i][k] for k in ("point", *PARAMETERS)},
-                        "cpu_time_s": ok[i]["cpu_time_s"], "error": ok[i][measure]})
-    return out
+        for i in pareto_front(ok["cpu_time_s"].to_numpy(dtype=float), ok[measure].to_numpy(dtype=float)):
+            row = ok.iloc[i]
+            out.append({"measure": measure, **{k: row[k] for k in ("point", *PARAMETERS)},
+                        "cpu_time_s": row["cpu_time_s"], "error": row[measure]})
+    return pd.DataFrame(out, columns=list(PARETO_COLUMNS))
 
 
-def smallest_errors(rows: list[Row]) -> dict[str, float]:
+def smallest_errors(table: pd.DataFrame) -> dict[str, float]:
     """The smallest positive error of each measure over the settings that ran (what the plot shows)."""
+    ok = table[table["status"] == "ok"]
     out = {}
     for measure in ERROR_MEASURES:
-        values = [v for v in (number(r[measure]) for r in rows if r["status"] == "ok") if v > 0 and math.isfinite(v)]
+        values = [v for v in ok[measure].to_numpy(dtype=float) if v > 0 and math.isfinite(v)]
         out[measure] = min(values, default=math.nan)
     return out
 
 
 def reference_report(study: AccuracyStudy, reference: Signature, check: Signature | None,
-                     rows: list[Row]) -> dict[str, Any]:
+                     table: pd.DataFrame) -> dict[str, Any]:
     """Both references, their agreement per measure and whether it is below the smallest plotted error."""
     report: dict[str, Any] = {
         "reference": {**study.reference.solver,
                       "cpu_time_s": reference.cpu_time_s, "bottom_end_m": reference.bottom_end_m,
                       "penetration_rate_m_per_s": reference.penetration_rate_m_per_s},
-        "smallest_plotted_error": smallest_errors(rows),
+        "smallest_plotted_error": smallest_errors(table),
     }
     if check is None or study.reference_check is None:
         return report
     agreement = errors(reference, check)
-    report["reference_check"] = {
-                                 **study.reference_check.solver, "cpu_time_s": check.cpu_time_s}
+    report["reference_check"] = {**study.reference_check.solver, "cpu_time_s": check.cpu_time_s}
     report["agreement"] = agreement
     report["agreement_below_smallest_error"] = {
         m: bool(not math.isfinite(report["smallest_plotted_error"][m])
                 or agreement[m] < report["smallest_plotted_error"][m]) for m in ERROR_MEASURES}
     return report
-
-

@@ -1,18 +1,33 @@
 """The best operating point as a library call: :func:`advise_scene` is ``rpdrill advise`` without its
-files and printing (studies.advice.advice_search: the search, the curves around the optimum, the feed x
-frequency map), with the bounds in SI units by key path."""
+printing (studies.advice.advice_search: the search, the curves around the optimum, the feed x frequency
+map), with the bounds in SI units by key path. With ``out`` every point run is recorded there as it
+returns (evaluations.jsonl, studies.runtime.evaluation_log: a rerun into the same folder replays them and
+runs the rest) and the report is written at the end (advice.json, advice.md, the figures of each rock:
+studies.advice.advice_report, studies.advice.advice_figures)."""
 
 from __future__ import annotations
 
+import contextlib
+import sys
+import time
+from datetime import datetime, timezone
 from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
 
 from ...models.definition.scene import Scene
 from ...rocklaw.catalog import TABLE_1
+from ..display.catalogue import metric as metric_entry
+from ..display.catalogue import parameter
 from ..inputs.arguments import (
+    boolean_problem,
     bounds_problem,
     check,
     choice_problem,
     dask_problem,
+    file_problem,
+    folder_problem,
     instance_problem,
     names_problem,
     optional,
@@ -20,7 +35,11 @@ from ..inputs.arguments import (
     workers_problem,
 )
 from ..inputs.reading import InputError, scene_and_source
+from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog
+from ..runtime.output_files import check_file_target, check_out, staged_directory, write_atomic, write_json
 from ..runtime.pools import pool
+from .advice_figures import plot_curves, plot_feed_map
+from .advice_report import advice_markdown, advice_record
 from .advice_search import (
     FEED,
     FREQUENCY,
@@ -29,20 +48,26 @@ from .advice_search import (
     Advice,
     AdviceSearch,
     Request,
-    advise,
+    advice_hash,
+    planned_evaluations,
     runnable_scene,
+    search_advice,
 )
 
 
 def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float]], metric: str = METRICS[0],
                  rocks: list[str] | None = None, power_kw: float | None = None, max_thrust_ratio: float = 1.0,
                  search: AdviceSearch | None = None, workers: int | None = None,
-                 dask: str | None = None) -> list[Advice]:
+                 dask: str | None = None, out: str | Path | None = None, overwrite: bool = False,
+                 markdown: str | Path | None = None, quiet: bool = True, command: str | None = None) -> list[Advice]:
     """Maximise ``metric`` over ``bounds`` (``{"impact.frequency_hz": (45, 70), "feed.force_n": (35e3,
     60e3)}``, optionally ``"impact.amplitude_n"`` and an extension's ``"extensions.NAME.parameters.KEY"``; SI
     units) for the scene's rock, or for each Table 1
     rock of ``rocks``; ``power_kw``: a fixed hammer power (a piston scene, the blow energy P / f). One
-    :class:`Advice` per rock (SI units). InputError before anything runs when an input cannot be used."""
+    :class:`Advice` per rock (SI units). ``out``: the folder of the checkpoint and the report (module doc;
+    new, empty or an earlier advice's, or any folder with ``overwrite``, which starts afresh there);
+    ``markdown``: a copy of advice.md; ``command``: the command the report names (default: this call).
+    InputError before anything runs when an input cannot be used; ``quiet``: no progress bar."""
     where = "rpdrill.advise"
     check(where, "bounds", bounds, bounds_problem)
     check(where, "metric", metric, choice_problem(METRICS, "metric"))
@@ -52,12 +77,18 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     check(where, "search", search, instance_problem(AdviceSearch, "a rpdrill.AdviceSearch or None", optional=True))
     check(where, "workers", workers, optional(workers_problem))
     check(where, "dask", dask, dask_problem)
-    validated, source = scene_and_source(scene, where)
-    data = validated.model_dump(by_alias=True, exclude_none=True)
+    check(where, "out", out, optional(folder_problem))
+    check(where, "overwrite", overwrite, boolean_problem)
+    check(where, "markdown", markdown, optional(file_problem))
+    check(where, "quiet", quiet, boolean_problem)
+    folder = None if out is None else check_out(out, overwrite, CHECKPOINT)
+    if markdown is not None:
+        check_file_target("--markdown", markdown)
+    data, source = scene_and_source(scene, where)
     allowed = [entry.path for entry in PARAMETERS]
-    own = [f"extensions.{name}.parameters.KEY" for name in validated.extensions or {}]  # an extension's parameter
+    own = [f"extensions.{name}.parameters.KEY" for name in data.extensions or {}]  # an extension's parameter
     for path in bounds:
-        if path not in allowed and not _extension_parameter(path, validated):
+        if path not in allowed and not _extension_parameter(path, data):
             raise InputError(f"{source}: bounds: {path!r}: not a parameter advise searches; allowed: "
                              f"{', '.join(allowed + own)}")
     missing = [path for path in (FREQUENCY, FEED) if path not in bounds]
@@ -68,8 +99,55 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     request = Request(metric, ordered, max_thrust_ratio, search or AdviceSearch(),
                       power_w=power_kw * 1e3 if power_kw else None)
     scenes = [(rock, runnable_scene(data, rock, request, source)) for rock in rocks or [None]]
-    with pool(dask, workers, f"{where}: dask") as (_, runner):
-        return [advise(prepared, rock, request, runner) for rock, prepared in scenes]
+    identity = {"advice": data.name, "scene_file": source, "hash": advice_hash([s for _, s in scenes], request)}
+    advices: list[Advice] = []
+    with contextlib.ExitStack() as stack:
+        log = None if folder is None else stack.enter_context(
+            contextlib.closing(EvaluationLog(folder, identity, Path(source), overwrite)))
+        label, runner = stack.enter_context(pool(dask, workers, f"{where}: dask"))
+        bar = stack.enter_context(tqdm(total=planned_evaluations(request) * len(scenes), desc="advise", unit="point",
+                                       disable=quiet))
+        earlier = len(log.records) if log else 0
+        print(f"advise: maximising {metric_entry(metric).name} over {', '.join(parameter(p).name for p in ordered)} "
+              f"for {len(scenes)} rock(s) on {label}" + (f"; {earlier} points recorded earlier in {folder}"
+                                                         if earlier else ""), file=sys.stderr)
+        start = time.perf_counter()
+        try:
+            for rock, prepared in scenes:
+                advices.append(search_advice(prepared, rock, request, runner, bar.update, log))
+        except KeyboardInterrupt:  # the points run are kept (evaluations.jsonl); the session says where it stopped
+            if log:
+                log.add_session(_session(label, len(log.records) - earlier, advices, start, interrupted=True))
+            raise
+        if log:
+            log.add_session(_session(label, len(log.records) - earlier, advices, start, interrupted=False))
+    command = command or _call(source, ordered, metric, rocks, power_kw, max_thrust_ratio, request.search, out)
+    if folder is not None:
+        with staged_directory(folder) as stage:
+            write_json(stage / "advice.json", advice_record(advices, command))
+            (stage / "advice.md").write_text(advice_markdown(advices, command), encoding="utf-8")
+            for advice in advices:
+                name = advice.rock or advice.scene
+                plot_curves(advice, stage / f"{name}_curves.png")
+                plot_feed_map(advice, stage / f"{name}_feed_frequency_map.png")
+    if markdown is not None:
+        write_atomic(Path(markdown), advice_markdown(advices, command))
+    return advices
+
+
+def _session(runner: str, points_run: int, advices: list[Advice], start: float, interrupted: bool) -> dict[str, Any]:
+    """One session of an advice, for its checkpoint (as a calibration records its sessions)."""
+    return {"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"), "runner": runner,
+            "interrupted": interrupted, "points_run": points_run,
+            "points_replayed": sum(advice.replayed for advice in advices), "rocks_done": len(advices),
+            "wall_time_s": round(time.perf_counter() - start, 3)}
+
+
+def _call(source: str, bounds: dict[str, tuple[float, ...]], metric: str, rocks: list[str] | None,
+          power_kw: float | None, max_thrust_ratio: float, search: AdviceSearch, out: str | Path | None) -> str:
+    """The library call as the report names it."""
+    return (f"rpdrill.advise({source!r}, {bounds!r}, metric={metric!r}, rocks={rocks!r}, power_kw={power_kw!r}, "
+            f"max_thrust_ratio={max_thrust_ratio!r}, search={search!r}, out={None if out is None else str(out)!r})")
 
 
 def _extension_parameter(path: str, scene: Scene) -> bool:

@@ -25,10 +25,11 @@ scene: the penetration rate per unit hammer power; models.evaluation.metrics).
 * **AdviceSearch**: SciPy's differential evolution over the box of the bounds (best1bin, a population
   of ``popsize`` x parameters, at most ``max_generations`` generations, seeded; no gradient
   polish: the metric has steps where crushing starts). Each generation's population is one batch
-  on the runner (studies.runtime.pools), every run a one-point scan (studies.scan.frequency_scans.scan_target).
+  on the runner (studies.runtime.pools), every run a one-point curve (studies.scan.curves: the point is the
+  scene with the operating parameters, ``Scene.with_``).
 * **Around the optimum**: the metric along each parameter across its bounds with the others at
   the optimum (``SLICE_POINTS`` points and the optimum itself) and the interval where it stays at
-  or above 80 % of the optimum (studies.scan.curve_optima.band_hz).
+  or above 80 % of the optimum (studies.scan.curve_optima.band).
 * **Feed x frequency map**: the metric on a ``MAP_POINTS`` x ``MAP_POINTS`` grid of feed force and
   impact frequency (others at the optimum). Percussive drilling has an optimum feed force in
   experiments (the rate rises, then falls, as the feed grows); :func:`feed_response` reads from the
@@ -40,7 +41,6 @@ scene: the penetration rate per unit hammer power; models.evaluation.metrics).
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import hashlib
 import itertools
@@ -52,20 +52,18 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from pydantic import ValidationError
 from scipy import optimize
 
 from ...models.definition.scene import Scene
-from ...models.definition.validation import InputError, describe_validation_error
+from ...models.definition.validation import InputError
 from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
 from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter
 from ..inputs.arguments import check, count_problem, positive_problem, seed_problem
-from ..inputs.specs import set_path
 from ..runtime.evaluation_log import EvaluationLog
 from ..runtime.pools import Runner
-from ..scan.curve_optima import band_hz
-from ..scan.frequency_scans import scan_target
+from ..scan.curve_optima import band
+from ..scan.curves import Curve, run_curve
 
 FREQUENCY, FEED = "impact.frequency_hz", "feed.force_n"
 METRICS = ("penetration_rate_m_per_s", "penetration_per_impact_energy_m_per_j", "penetration_per_blow_energy_m_per_j")
@@ -173,43 +171,40 @@ class Advice:
     power_w: float | None = None  # the fixed hammer power (module doc), or None
 
 
-def at_point(scene: dict[str, Any], point: Point, power_w: float | None = None) -> dict[str, Any]:
-    """The scene with the operating parameters of ``point`` set, and at a fixed hammer power ``power_w``
-    the piston's blow energy P / f (in place of its strike speed)."""
-    data = copy.deepcopy(scene)
-    for path, value in point.items():
-        set_path(data, path, float(value))
+def at_point(scene: Scene, point: Point, power_w: float | None = None, source: str = "advise") -> Scene:
+    """The scene with the operating parameters of ``point`` (``Scene.with_``), and at a fixed hammer power
+    ``power_w`` the piston's blow energy P / f (in place of its strike speed); InputError naming ``source``
+    when that is no valid scene."""
+    changes: dict[str, Any] = {path: float(value) for path, value in point.items()}
     if power_w is not None:
-        piston = data["impact"]["piston"]
-        piston.pop("velocity_m_per_s", None)
-        piston["energy_j"] = power_w / data["impact"]["frequency_hz"]
-    return data
+        frequency_hz = changes.get(FREQUENCY, scene.impact.frequency_hz)
+        changes.update({"impact.piston.velocity_m_per_s": None, "impact.piston.energy_j": power_w / frequency_hz})
+    return scene.with_(changes, source)
 
 
-def runnable_scene(scene: dict[str, Any], rock: str | None, request: Request, source: str) -> dict[str, Any]:
+def runnable_scene(scene: Scene, rock: str | None, request: Request, source: str) -> Scene:
     """The scene as advise runs it: the Table 1 ``rock`` in place of its rock (None: its own), the exact
     formulation if it can run it, else Exudyn, the end time raised to fit the metrics' blows at the
     lowest frequency, only the metric computed. InputError (naming ``source`` and the options) when a
     corner of the bounds gives a scene that cannot run, or a fixed power is asked of a scene without a
     piston."""
-    if request.power_w is not None and "piston" not in scene.get("impact", {}):
+    if request.power_w is not None and scene.impact.piston is None:
         raise InputError(f"{source}: --power-kw needs a piston (impact.piston): the blow energy at a fixed power "
                          "is the piston's")
-    checked = Scene.model_validate({**scene, **({"rock": {"name": rock}} if rock else {}),
-                                    "outputs": {"metrics": [request.metric]}})
+    checked = scene.with_({**({"rock": {"name": rock}} if rock else {}), "outputs": {"metrics": [request.metric]}},
+                          source)
     formulation = "exact" if unsupported("exact", prepare(checked.with_solver("exact"))) is None else "exudyn"
-    data = checked.with_solver(formulation).model_dump(by_alias=True, exclude_none=True)
     blows = checked.metrics.transient_blows + checked.metrics.block_blows
-    data["solver"]["end_time_s"] = max(checked.solver.end_time_s, blows / request.bounds[FREQUENCY][0])
+    data = checked.with_solver(formulation).with_(
+        {"solver.end_time_s": max(checked.solver.end_time_s, blows / request.bounds[FREQUENCY][0])}, source)
     options = {path: path for path in request.bounds} | {p.path: p.option for p in PARAMETERS}
     for corner in itertools.product(*request.bounds.values()):
         point = dict(zip(request.bounds, corner, strict=True))
         try:
-            prepare(Scene.model_validate(at_point(data, point, request.power_w)))
-        except (ValidationError, SceneError) as error:
+            prepare(at_point(data, point, request.power_w, source))
+        except (InputError, SceneError) as error:
             where = " ".join(f"{options[path]} {parameter(path).show(value)}" for path, value in point.items())
-            problem = describe_validation_error(source, error, Scene) if isinstance(error, ValidationError) else \
-                f"{source}: {'.'.join(error.location)}: {error}"
+            problem = str(error) if isinstance(error, InputError) else f"{source}: {'.'.join(error.location)}: {error}"
             raise InputError(f"{source}: the scene cannot run at the corner {where} of the bounds:\n{problem}") from None
     lowest = {path: low for path, (low, _) in request.bounds.items()}
     ratio = thrust_ratio(at_point(data, lowest))
@@ -221,20 +216,16 @@ def runnable_scene(scene: dict[str, Any], rock: str | None, request: Request, so
     return data
 
 
-def _prepared(scene: dict[str, Any]) -> Simulation:
-    return prepare(Scene.model_validate(scene))
-
-
-def thrust_ratio(scene: dict[str, Any]) -> float:
+def thrust_ratio(scene: Scene) -> float:
     """Mean thrust / the rock's threshold F_th (module doc: the static limit is 1)."""
-    simulation = _prepared(scene)
+    simulation: Simulation = prepare(scene)
     return simulation.mean_thrust_n / simulation.rock.threshold_n
 
 
-def limit_feed_n(scene: dict[str, Any], frequency_hz: float, ratio: float, power_w: float | None = None) -> float:
+def limit_feed_n(scene: Scene, frequency_hz: float, ratio: float, power_w: float | None = None) -> float:
     """The feed force at which the mean thrust reaches ``ratio`` x F_th at ``frequency_hz`` (inf for a
     rock without a threshold, negative when the blows alone exceed it)."""
-    simulation = _prepared(at_point(scene, {FREQUENCY: frequency_hz}, power_w))
+    simulation = prepare(at_point(scene, {FREQUENCY: frequency_hz}, power_w))
     share = simulation.feed_total_n / simulation.scene.feed.force_n  # 1, or the bodies the feed acts on
     return (ratio * simulation.rock.threshold_n - (simulation.mean_thrust_n - simulation.feed_total_n)) / share
 
@@ -255,10 +246,11 @@ class Evaluation:
         return np.where(excess < 0, -np.nan_to_num(self.values, nan=0.0), excess)
 
 
-def advice_hash(scenes: list[dict[str, Any]], request: Request) -> str:
+def advice_hash(scenes: list[Scene], request: Request) -> str:
     """SHA-256 of what determines an advice's points and their values: the scene of each rock and the
     request (its checkpoint's hash, studies.runtime.evaluation_log)."""
-    content = json.dumps({"scenes": scenes, "request": dataclasses.asdict(request)}, sort_keys=True)
+    content = json.dumps({"scenes": [scene.model_dump(by_alias=True, exclude_none=True) for scene in scenes],
+                          "request": dataclasses.asdict(request)}, sort_keys=True)
     return hashlib.sha256(content.encode()).hexdigest()
 
 
@@ -272,7 +264,7 @@ class AdviceEvaluator:
     recorded replayed, new ones recorded as they return); counts runs, replays, failures and points
     beyond the thrust limit."""
 
-    def __init__(self, scene: dict[str, Any], request: Request, runner: Runner,
+    def __init__(self, scene: Scene, request: Request, runner: Runner,
                  progress: Callable[[int], None] | None = None, rock: str | None = None,
                  log: EvaluationLog | None = None) -> None:
         self.scene, self.request, self.runner, self.progress = scene, request, runner, progress
@@ -297,14 +289,14 @@ class AdviceEvaluator:
         replays = {i: self.recorded[key] for i in run if (key := _point_key(self.rock, points[i])) in self.recorded}
         for i, record in replays.items():
             self._take(values, i, record)
-        tasks = [(i, scenes[i], [self.request.metric], [scenes[i]["impact"]["frequency_hz"]])
-                 for i in run if i not in replays]
-        for scan in (scan for batch in self.runner(scan_target, tasks) for scan in batch) if tasks else ():
-            value = float(scan["values"][self.request.metric][0])
-            record = {"rock": self.rock or "", "point": {k: float(v) for k, v in points[scan["key"]].items()},
-                      "value": None if math.isnan(value) else value, "failed_runs": scan["failed_runs"],
-                      "error": scan["error"]}
-            self._take(values, scan["key"], record)
+        curves = [Curve(i, scenes[i], {}, (scenes[i].impact.frequency_hz,), (self.request.metric,))
+                  for i in run if i not in replays]
+        for point_run in (r for batch in self.runner(run_curve, curves) for r in batch) if curves else ():
+            value = float(point_run.values(self.request.metric)[0])
+            record = {"rock": self.rock or "", "point": {k: float(v) for k, v in points[point_run.key].items()},
+                      "value": None if math.isnan(value) else value, "failed_runs": point_run.failed_runs,
+                      "error": point_run.error}
+            self._take(values, point_run.key, record)
             if self.log is not None:
                 self.log.append(record)
                 self.recorded[_point_key(self.rock, record["point"])] = record
@@ -347,12 +339,12 @@ def slices(evaluate: AdviceEvaluator, bounds: Bounds, best: Point, best_value: f
         metric = [float(next(results)) for _ in values]
         at = values.index(best[path])
         metric[at] = best_value  # the same point as the search's best
-        band = band_hz(np.array(values), np.nan_to_num(metric, nan=0.0), at, 0.8 * best_value)
-        curves[path] = {"values": values, "metric": metric, "band_80": list(band)}
+        band_80 = band(np.array(values), np.nan_to_num(metric, nan=0.0), at, 0.8 * best_value)
+        curves[path] = {"values": values, "metric": metric, "band_80": list(band_80)}
     return curves
 
 
-def feed_map(evaluate: AdviceEvaluator, request: Request, best: Point, scene: dict[str, Any]) -> dict[str, Any]:
+def feed_map(evaluate: AdviceEvaluator, request: Request, best: Point, scene: Scene) -> dict[str, Any]:
     """The metric on the feed x frequency grid, the other parameters at the optimum (NaN: not run or
     failed), and the feed force of the thrust limit at each frequency."""
     frequencies = [float(f) for f in np.linspace(*request.bounds[FREQUENCY], MAP_POINTS)]
@@ -384,18 +376,17 @@ def feed_response(feed_map_: dict[str, Any]) -> dict[str, Any]:
     return {"best_feed_at": kinds, "frequencies_by_kind": by_kind}
 
 
-def advise(data: dict[str, Any], rock: str | None, request: Request, runner: Runner,
-           progress: Callable[[int], None] | None = None, log: EvaluationLog | None = None) -> Advice:
+def search_advice(data: Scene, rock: str | None, request: Request, runner: Runner,
+                  progress: Callable[[int], None] | None = None, log: EvaluationLog | None = None) -> Advice:
     """The best operating point (module doc) of the scene ``data`` (:func:`runnable_scene`, on ``rock``),
     with the curves around it and the feed x frequency map; ``progress(points)`` after each batch;
     ``log``: the points recorded and replayed (module doc)."""
     start = time.perf_counter()
     evaluate = AdviceEvaluator(data, request, runner, progress, rock, log)
-    scene = Scene.model_validate(data)
-    advice = Advice(scene=data["name"], description=describe_scene(scene, request.bounds),
-                    scene_description=describe_scene(scene, [*request.bounds, "rock.name"]), rock=rock, metric=request.metric, formulation=data["solver"]["formulation"],
-                    end_time_s=data["solver"]["end_time_s"], bounds=request.bounds,
-                    max_thrust_ratio=request.max_thrust_ratio, power_w=request.power_w)
+    advice = Advice(scene=data.name, description=describe_scene(data, request.bounds),
+                    scene_description=describe_scene(data, [*request.bounds, "rock.name"]), rock=rock,
+                    metric=request.metric, formulation=data.solver.formulation, end_time_s=data.solver.end_time_s,
+                    bounds=request.bounds, max_thrust_ratio=request.max_thrust_ratio, power_w=request.power_w)
     advice.best, advice.best_value, advice.generations, advice.converged = search_best(evaluate, request)
     advice.best_thrust_ratio = thrust_ratio(at_point(data, advice.best, request.power_w))
     advice.slices = slices(evaluate, request.bounds, advice.best, advice.best_value)

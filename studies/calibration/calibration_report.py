@@ -14,15 +14,19 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ...models.evaluation.workprecision import non_dominated
 from ..runtime.evaluation_log import Record
 from ..runtime.output_files import write_json, write_resolved, write_rows_csv
-from .calibration_search import CalibrationResult
+from ..runtime.tables import write_table
+from .calibration_search import SearchResult
 from .calibration_spec import Calibration
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 TARGET_COLUMNS = ("label", "metric", "paper_optimum_hz", "paper_band_low_hz", "paper_band_high_hz",
                   "resonance_estimate_hz", "main_lobe_optimum_hz", "main_lobe_band_80_low_hz",
@@ -34,45 +38,51 @@ HEADER = ("| target | metric | paper [Hz] | reached, main lobe [Hz] (80 % band) 
           "| miss | within tolerance | peak value |")
 
 
-def _number(value: float | None, digits: int = 4) -> str:
-    return "" if value is None else f"{value:.{digits}g}"
+# targets.csv writes its numbers to 4 significant digits, the miss and tolerance to 3
+TARGET_FORMATS = {**dict.fromkeys(TARGET_COLUMNS, ".4g"), "relative_miss": ".3g", "tolerance": ".3g"}
 
 
-def target_rows(calibration: Calibration, results: list[Record]) -> list[dict[str, str]]:
-    """One row per target (TARGET_COLUMNS); miss and tolerance are relative to the paper's optimum."""
+def target_table(calibration: Calibration, results: list[Record]) -> pd.DataFrame:
+    """One row per target (TARGET_COLUMNS, typed; None where there is no value); miss and tolerance are
+    relative to the paper's optimum."""
+    import pandas as pd
+
     rows = []
     for index, (target, result) in enumerate(zip(calibration.spec.targets, results, strict=True)):
         band = target.band_hz or (None, None)
-        reached = result["band_80_hz"] or (None, None)
+        reached = result["band_80"] or (None, None)
         rows.append({
             "label": result["label"], "metric": calibration.metric(index),
-            "paper_optimum_hz": _number(target.optimum_hz), "paper_band_low_hz": _number(band[0]),
-            "paper_band_high_hz": _number(band[1]), "resonance_estimate_hz": _number(result["resonance_hz"]),
-            "main_lobe_optimum_hz": _number(result["main_hz"]), "main_lobe_band_80_low_hz": _number(reached[0]),
-            "main_lobe_band_80_high_hz": _number(reached[1]), "global_max_optimum_hz": _number(result["global_hz"]),
-            "relative_miss": _number(result["miss"], 3), "tolerance": _number(target.tolerance, 3),
-            "within_tolerance": "yes" if abs(result["miss"]) <= target.tolerance else "no",
-            "main_lobe_peak_value": _number(result["main_value"]), "global_max_peak_value": _number(result["global_value"]),
-            "failed_runs": str(result["failed_runs"]),
+            "paper_optimum_hz": target.optimum_hz, "paper_band_low_hz": band[0], "paper_band_high_hz": band[1],
+            "resonance_estimate_hz": result["resonance_hz"], "main_lobe_optimum_hz": result["optimum"],
+            "main_lobe_band_80_low_hz": reached[0], "main_lobe_band_80_high_hz": reached[1],
+            "global_max_optimum_hz": result["global_optimum"], "relative_miss": result["miss"],
+            "tolerance": target.tolerance, "within_tolerance": "yes" if abs(result["miss"]) <= target.tolerance else "no",
+            "main_lobe_peak_value": result["optimum_value"] or 0.0, "global_max_peak_value": result["best_value"] or 0.0,
+            "failed_runs": result["failed"],
         })
-    return rows
+    return pd.DataFrame(rows, columns=list(TARGET_COLUMNS), dtype=object)
 
 
-def targets_markdown(calibration: Calibration, rows: list[dict[str, str]], refine_note: str) -> str:
+def _shown(value: float | None) -> str:
+    return "" if value is None else format(value, ".4g")
+
+
+def targets_markdown(calibration: Calibration, table: pd.DataFrame, refine_note: str) -> str:
     """The per-target table in Markdown."""
     lines = [f"# Calibration `{calibration.spec.name}`: reached optima", "",
              f"Main lobe: the lobe whose peak is nearest (log frequency) to the rock-mode estimate; {refine_note}.",
              "", HEADER, "|---|---|---|---|---|---|---|---|"]
-    for row in rows:
-        paper = row["paper_optimum_hz"] + (f" ({row['paper_band_low_hz']}-{row['paper_band_high_hz']})"
-                                           if row["paper_band_low_hz"] else "")
-        main = row["main_lobe_optimum_hz"] or "none"
-        if row["main_lobe_band_80_low_hz"]:
-            main += f" ({row['main_lobe_band_80_low_hz']}-{row['main_lobe_band_80_high_hz']})"
-        miss = f"{float(row['relative_miss']):+.1%}"
-        lines.append(f"| {row['label']} | {row['metric']} | {paper} | {main} | {row['global_max_optimum_hz'] or 'none'} "
-                     f"| {miss} | {row['within_tolerance']} (±{float(row['tolerance']):.0%}) "
-                     f"| {row['main_lobe_peak_value'] or '0'} |")
+    for row in table.to_dict("records"):
+        paper = _shown(row["paper_optimum_hz"]) + (f" ({_shown(row['paper_band_low_hz'])}-"
+                                                   f"{_shown(row['paper_band_high_hz'])})"
+                                                   if row["paper_band_low_hz"] is not None else "")
+        main = _shown(row["main_lobe_optimum_hz"]) or "none"
+        if row["main_lobe_band_80_low_hz"] is not None:
+            main += f" ({_shown(row['main_lobe_band_80_low_hz'])}-{_shown(row['main_lobe_band_80_high_hz'])})"
+        lines.append(f"| {row['label']} | {row['metric']} | {paper} | {main} | "
+                     f"{_shown(row['global_max_optimum_hz']) or 'none'} | {row['relative_miss']:+.1%} | "
+                     f"{row['within_tolerance']} (±{row['tolerance']:.0%}) | {_shown(row['main_lobe_peak_value']) or '0'} |")
     return "\n".join(lines) + "\n"
 
 
@@ -87,18 +97,18 @@ def pareto_rows(calibration: Calibration, records: list[Record]) -> list[dict[st
             for i in front]
 
 
-def write_report(directory: Path, calibration: Calibration, result: CalibrationResult,
+def write_report(directory: Path, calibration: Calibration, result: SearchResult,
                  sessions: list[dict[str, Any]]) -> None:
     """Every output file of a calibration with a best evaluation (module docstring)."""
     best, final = result.best, result.final
-    scene = calibration.scene(best["parameters"])
+    scene = calibration.scene(best["parameters"]).model_dump(mode="json", by_alias=True, exclude_none=True)
     write_resolved(directory / "calibrated_scene.yaml", scene)
-    rows = target_rows(calibration, final.results)
-    write_rows_csv(directory / "targets.csv", rows, list(TARGET_COLUMNS))
+    table = target_table(calibration, final.results)
+    write_table(directory / "targets.csv", table, TARGET_FORMATS)
     step = calibration.spec.refine_hz
     note = (f"optima of the best parameter set scanned again with points every {step:g} Hz around its optima"
             if step else "optima on the calibration's frequency axis")
-    (directory / "targets.md").write_text(targets_markdown(calibration, rows, note), encoding="utf-8")
+    (directory / "targets.md").write_text(targets_markdown(calibration, table, note), encoding="utf-8")
     pareto = pareto_rows(calibration, result.records)
     write_rows_csv(directory / "pareto.csv", pareto, list(pareto[0]))
     curves = [{"target": label, "frequency_hz": f, "metric": calibration.metric(t), "value": v}

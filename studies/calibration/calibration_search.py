@@ -1,8 +1,9 @@
 """Calibration: fit scene parameters within bounds so that scans put their main-lobe optima where
 the paper does.
 
-An evaluation of a parameter set runs every target's frequency scan (studies.calibration.calibration_spec)
-and finds each scan's main-lobe optimum (studies.scan.frequency_scans). Its objective is
+An evaluation of a parameter set runs every target's frequency scan (studies.calibration.calibration_spec;
+a studies.scan.curves.Curve each) and finds each scan's main-lobe optimum (studies.scan.curve_optima.Optimum).
+Its objective is
 
     J = sum_t w_t m_t^2 + rising_weight sum_(a before b) max(0, f_a - f_b) / f_b*,
 
@@ -30,26 +31,27 @@ from scipy import optimize
 from ..runtime.evaluation_log import EvaluationLog, Record, unit_key
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.pools import Runner
-from ..scan.frequency_scans import ScanTask, rising_shortfalls, run_scans, scan_all, scan_cost, scan_optimum
+from ..scan.curves import Curve, CurveRun, rising_shortfalls, run_all, run_curves, runs_cost
 from .calibration_spec import Calibration
 
 Progress = Callable[[Record, bool], None]  # (record, replayed)
 
 
-def target_result(calibration: Calibration, index: int, frequencies_hz: list[float], scan: dict[str, Any]) -> Record:
-    """Optima of one target's scan (studies.scan.frequency_scans.scan_optimum) and the relative miss of its
-    main-lobe optimum."""
+def target_result(calibration: Calibration, index: int, run: CurveRun) -> Record:
+    """The optimum of one target's scan (studies.scan.curve_optima.Optimum.record), its label, the first
+    failed run's error and the relative miss of its main-lobe optimum."""
     target = calibration.spec.targets[index]
-    result = scan_optimum(calibration.labels[index], frequencies_hz, scan, calibration.metric(index))
-    main = result["main_hz"]
-    return {**result, "miss": 1.0 if main is None else (main - target.optimum_hz) / target.optimum_hz}
+    optimum = run.optimum(calibration.metric(index))
+    main = optimum.optimum
+    return {"label": calibration.labels[index], **optimum.record, "error": run.error,
+            "miss": 1.0 if main is None else (main - target.optimum_hz) / target.optimum_hz}
 
 
 def rising_penalty(calibration: Calibration, results: list[Record]) -> float:
     """sum over neighbours (a, b) of each rising list of max(0, f_a - f_b) / f_b* (pairs where a
     target has no optimum are left out: their misses already count 1)."""
     paper = {label: t.optimum_hz for label, t in zip(calibration.labels, calibration.spec.targets, strict=True)}
-    shortfalls = rising_shortfalls(calibration.spec.rising, {r["label"]: r["main_hz"] for r in results})
+    shortfalls = rising_shortfalls(calibration.spec.rising, {r["label"]: r["optimum"] for r in results})
     return sum(max(0.0, shortfall) / paper[b] for _, b, shortfall in shortfalls)
 
 
@@ -60,11 +62,12 @@ def objective(calibration: Calibration, results: list[Record]) -> tuple[float, f
     return misses + calibration.spec.rising_weight * penalty, penalty
 
 
-def scan_tasks(calibration: Calibration, key: Any, values: dict[str, float],
-               frequencies_hz: Callable[[int], list[float]]) -> list[ScanTask]:
-    """One task per target: the scene at these parameter values, the target's frequencies."""
-    return [((key, t), calibration.scene(values, t), [calibration.metric(t)], frequencies_hz(t))
-            for t in range(len(calibration.spec.targets))]
+def target_curves(calibration: Calibration, key: Any, values: dict[str, float],
+                  frequencies_hz: Callable[[int], list[float]]) -> list[Curve]:
+    """One curve per target: the base scene changed to these parameter values and the target's overrides,
+    along the target's frequencies."""
+    return [Curve((key, t), calibration.base, calibration.changes(values, t), tuple(frequencies_hz(t)),
+                  (calibration.metric(t),)) for t in range(len(calibration.spec.targets))]
 
 
 class CalibrationEvaluator:
@@ -94,20 +97,19 @@ class CalibrationEvaluator:
         count = len(calibration.spec.targets)
         frequencies = list(calibration.frequencies_hz)
         values = {k: calibration.values(np.array(k)) for k in keys}
-        tasks = [task for k in keys for task in scan_tasks(calibration, k, values[k], lambda _: frequencies)]
-        scans: dict[tuple[float, ...], dict[int, dict[str, Any]]] = {k: {} for k in keys}
-        ran: dict[tuple[float, ...], list[dict[str, Any]]] = {k: [] for k in keys}  # distinct scans
-        for served, scan in run_scans(self.runner, tasks):
+        curves = [curve for k in keys for curve in target_curves(calibration, k, values[k], lambda _: frequencies)]
+        scans: dict[tuple[float, ...], dict[int, CurveRun]] = {k: {} for k in keys}
+        ran: dict[tuple[float, ...], list[CurveRun]] = {k: [] for k in keys}  # distinct scans
+        for served, run in run_curves(self.runner, curves):
             key = served[0][0]
-            ran[key].append(scan)
-            scans[key].update({target: scan for _, target in served})
+            ran[key].append(run)
+            scans[key].update({target: run for _, target in served})
             if len(scans[key]) == count:
-                self._record(key, values[key], [scans[key][t] for t in range(count)], scan_cost(ran[key]))
+                self._record(key, values[key], [scans[key][t] for t in range(count)], runs_cost(ran[key]))
 
-    def _record(self, key: tuple[float, ...], values: dict[str, float], scans: list[dict[str, Any]],
+    def _record(self, key: tuple[float, ...], values: dict[str, float], runs: list[CurveRun],
                 cost: dict[str, Any]) -> None:
-        results = [target_result(self.calibration, t, list(self.calibration.frequencies_hz), scan)
-                   for t, scan in enumerate(scans)]
+        results = [target_result(self.calibration, t, run) for t, run in enumerate(runs)]
         raise_if_stopped()  # scans cut by an interrupt are not an evaluation
         total, penalty = objective(self.calibration, results)
         record = {"unit": list(key), "parameters": values, "targets": results, "rising_penalty": penalty,
@@ -162,22 +164,22 @@ class FinalScan:
 
     results: list[Record]
     curves: list[tuple[list[float], list[float]]]  # (frequencies, metric values) per target
-    cost: dict[str, Any]  # scan_cost
+    cost: dict[str, Any]  # studies.scan.curves.runs_cost
 
 
 def final_scan(calibration: Calibration, best: Record, runner: Runner) -> FinalScan:
     """Scan every target of the best evaluation again, refined around its main and global optima."""
-    axes = [refined_frequencies_hz(calibration.frequencies_hz, (r["main_hz"], r["global_hz"]),
+    axes = [refined_frequencies_hz(calibration.frequencies_hz, (r["optimum"], r["global_optimum"]),
                                    calibration.spec.refine_hz) for r in best["targets"]]
-    tasks = scan_tasks(calibration, "best", best["parameters"], lambda t: axes[t])
-    scans, cost = scan_all(runner, tasks)
-    results = [target_result(calibration, t, axes[t], scans[("best", t)]) for t in range(len(tasks))]
-    curves = [(axes[t], scans[("best", t)]["values"][calibration.metric(t)]) for t in range(len(tasks))]
-    return FinalScan(results, curves, cost)
+    curves = target_curves(calibration, "best", best["parameters"], lambda t: axes[t])
+    runs, cost = run_all(runner, curves)
+    results = [target_result(calibration, t, runs[("best", t)]) for t in range(len(curves))]
+    values = [(axes[t], runs[("best", t)].values(calibration.metric(t))) for t in range(len(curves))]
+    return FinalScan(results, values, cost)
 
 
 @dataclass(frozen=True)
-class CalibrationResult:
+class SearchResult:
     """Every recorded evaluation, the best one (None if every simulation of every evaluation failed,
     or every run of a target did: ``failed_targets``), its final scan, and what this session cost."""
 
@@ -192,7 +194,7 @@ def failed_targets(calibration: Calibration, records: list[Record]) -> list[str]
     """The labels of the targets whose every run failed in every evaluation."""
     count = len(calibration.frequencies_hz)
     return [label for t, label in enumerate(calibration.labels)
-            if all(record["targets"][t]["failed_runs"] >= count for record in records)]
+            if all(record["targets"][t]["failed"] >= count for record in records)]
 
 
 def _session(evaluator: CalibrationEvaluator, final: FinalScan | None, runner_label: str, start_wall: float,
@@ -205,8 +207,8 @@ def _session(evaluator: CalibrationEvaluator, final: FinalScan | None, runner_la
             "wall_time_s": time.perf_counter() - start_wall}
 
 
-def calibrate(calibration: Calibration, runner: Runner, log: EvaluationLog,
-              progress: Progress | None = None, runner_label: str = "") -> CalibrationResult:
+def search_calibration(calibration: Calibration, runner: Runner, log: EvaluationLog,
+                       progress: Progress | None = None, runner_label: str = "") -> SearchResult:
     """Search (replaying what ``log`` holds), then scan the best parameter set for the report. An
     interrupted search (Ctrl-C, SIGTERM) records its session before it stops."""
     start_wall = time.perf_counter()
@@ -222,4 +224,4 @@ def calibrate(calibration: Calibration, runner: Runner, log: EvaluationLog,
         raise
     session = _session(evaluator, final, runner_label, start_wall, interrupted=False)
     log.add_session(session)
-    return CalibrationResult(list(log.records), best, final, session, failed)
+    return SearchResult(list(log.records), best, final, session, failed)

@@ -24,7 +24,6 @@ a log scale. Example: ``studies/paper/calibration.yaml``.
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import hashlib
 import itertools
@@ -40,7 +39,7 @@ from pydantic import Field, ValidationInfo, field_validator, model_validator
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, field_at, parse
 from ..inputs.reading import read_yaml
-from ..inputs.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
+from ..inputs.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, scene_value
 from ..runtime.budgets import (
     AXIS_VALUE_BYTES,
     DEFAULT_BUDGET,
@@ -49,12 +48,16 @@ from ..runtime.budgets import (
     base_estimate_s,
 )
 from ..runtime.point_runs import prepare_point
-from ..scan.frequency_scans import FREQUENCY, Scan, scan_scene
+from ..scan.curve_optima import FREQUENCY
+from ..scan.curves import Scan
 
 PositiveFloat = Annotated[float, Field(gt=0)]
 FREE = "$"  # the first character of a free parameter's name (module docstring)
 # keys that do not change what an evaluation gives: a rerun may change them and continue
 BUDGET_KEYS = ("max_generations", "max_evaluations")
+# the layout of an evaluation's record (studies.calibration.calibration_search): part of the hash, so that
+# a checkpoint of another layout is refused, not misread
+RECORD_LAYOUT = 2
 
 
 class Parameter(StrictSpec):
@@ -91,7 +94,7 @@ class Parameter(StrictSpec):
 
 
 class Target(Scan):
-    """A scan (studies.scan.frequency_scans) and where the paper puts its optimum."""
+    """A scan (studies.scan.curves) and where the paper puts its optimum."""
 
     optimum_hz: PositiveFloat
     band_hz: tuple[PositiveFloat, PositiveFloat] | None = Field(None, strict=False)  # as Parameter.bounds
@@ -156,7 +159,7 @@ class Calibration:
 
     source: Path
     spec: CalibrationSpec
-    base: dict[str, Any]
+    base: Scene
     frequencies_hz: tuple[float, ...]
     labels: tuple[str, ...]
     cpu_s: float = 0.0  # estimated for the whole calibration (models.solvers.cost)
@@ -178,21 +181,21 @@ class Calibration:
         return {name: parameter.value(float(u))
                 for (name, parameter), u in zip(self.spec.parameters.items(), unit, strict=True)}
 
-    def scene(self, values: dict[str, float], target: int | None = None, frequency_hz: float | None = None) -> dict:
-        """The base scene with parameter values, then a target's overrides (a free parameter's name
-        given as a value replaced by its value) and a frequency, set."""
-        scene = copy.deepcopy(self.base)
-        overrides = self.spec.targets[target].overrides if target is not None else {}
-        scene_values = {path: value for path, value in values.items() if not is_free(path)}
-        for path, value in {**scene_values, **resolve_free(overrides, values)}.items():
-            set_path(scene, path, value)
-        if frequency_hz is not None:
-            set_path(scene, FREQUENCY, frequency_hz)
-        return scene
+    def changes(self, values: dict[str, float], target: int | None = None) -> dict[str, Any]:
+        """The scene changes of parameter values, then of a target's overrides (a free parameter's name
+        given as a value replaced by its value), in that order."""
+        overrides = resolve_free(self.spec.targets[target].overrides, values) if target is not None else {}
+        scene_values = {path: value for path, value in values.items() if not is_free(path) and path not in overrides}
+        return {**scene_values, **overrides}
+
+    def scene(self, values: dict[str, float], target: int | None = None) -> Scene:
+        """The base scene with parameter values and a target's overrides (:meth:`changes`)."""
+        return self.base.with_(self.changes(values, target), f"{self.source} (parameters {values})")
 
     def start_unit(self) -> np.ndarray:
-        """The base scene's values in unit coordinates (0.5 where the base scene gives none)."""
-        values = {name: _get(self.base, name) for name in self.spec.parameters}
+        """The base scene's values in unit coordinates (0.5 where the base scene has none: a free
+        parameter, an optional key left out)."""
+        values = {name: None if is_free(name) else scene_value(self.base, name) for name in self.spec.parameters}
         return np.array([0.5 if values[name] is None else parameter.unit(values[name])
                          for name, parameter in self.spec.parameters.items()])
 
@@ -209,8 +212,9 @@ class Calibration:
                                     exclude={"name", "description", "refine_hz", "base_scene", "base_overrides"})
         for key in BUDGET_KEYS:
             spec["search"].pop(key)
-        content = {"spec": spec, "base_scene": Scene.model_validate(self.base).model_dump(mode="json", by_alias=True),
-                   "frequencies_hz": list(self.frequencies_hz), "labels": list(self.labels)}
+        content = {"spec": spec, "base_scene": self.base.model_dump(mode="json", by_alias=True),
+                   "frequencies_hz": list(self.frequencies_hz), "labels": list(self.labels),
+                   "record_layout": RECORD_LAYOUT}
         return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
 
 
@@ -241,12 +245,6 @@ def resolve_free(value: Any, values: dict[str, float]) -> Any:
     return value
 
 
-def _get(data: Any, path: str) -> Any:
-    for key in path.split("."):
-        data = data.get(key) if isinstance(data, dict) else None
-    return data
-
-
 def _takes_numbers(annotation: Any) -> bool:
     """Whether a scene field's annotation is a real number (``float``, perhaps constrained or optional)."""
     if get_origin(annotation) is Annotated:
@@ -273,11 +271,16 @@ def _labels(spec: CalibrationSpec, source: str) -> tuple[str, ...]:
     return labels
 
 
-def _check_scene(source: str, key: str, scene: dict[str, Any], where: str, budget: Budget) -> float:
-    """The estimated CPU seconds of a run of ``scene``; InputError unless it validates and prepares (its
-    formulation able to run it), BudgetError beyond the budget of a run."""
+def _check_scene(calibration: Calibration, key: str, values: dict[str, float], target: int, frequency_hz: float,
+                 where: str, budget: Budget) -> float:
+    """The estimated CPU seconds of a run of a target's scene at parameter ``values`` and a frequency;
+    InputError unless it validates and prepares (its formulation able to run it), BudgetError beyond the
+    budget of a run."""
+    source = str(calibration.source)
+    changes = {**calibration.changes(values, target), FREQUENCY: frequency_hz,
+               "outputs": {"metrics": [calibration.metric(target)]}}
     try:
-        simulation = prepare_point(source, scene, {})
+        simulation = prepare_point(calibration.base, {}, source, changes)
     except InputError as error:
         first = str(error).splitlines()[0].removeprefix(f"{source}: ")
         raise InputError(f"{source}: {key}: {where} is not a valid scene: {first}") from None
@@ -288,20 +291,19 @@ def _check_scenes(calibration: Calibration, budget: Budget) -> float:
     """Every target at both ends of the scan must be a valid scene within the run budget at the start
     values and with each parameter at each bound (the others at their start values); the mean
     estimated CPU seconds of a run at the start values."""
-    source, spec = str(calibration.source), calibration.spec
+    spec = calibration.spec
     start = calibration.values(calibration.start_unit())
     ends = (calibration.frequencies_hz[0], calibration.frequencies_hz[-1])
     cases = [("targets.{i}.overrides", start, "")] + [
         (f"parameters.{name}.bounds", start | {name: bound}, f" with {name} = {bound:g} ({side} bound)")
         for name, parameter in spec.parameters.items() for side, bound in zip(("lower", "upper"), parameter.bounds)]
-    cpu = [[_check_scene(source, key.format(i=i), scan_scene(calibration.scene(values, i), frequency,
-                                                             [calibration.metric(i)]),
-                         f"target {label!r} at {frequency:g} Hz{note}", budget)
+    cpu = [[_check_scene(calibration, key.format(i=i), values, i, frequency, f"target {label!r} at {frequency:g} Hz{note}",
+                         budget)
             for i, label in enumerate(calibration.labels) for frequency in ends] for key, values, note in cases]
     return float(np.mean(cpu[0]))
 
 
-def _check_parameters(spec: CalibrationSpec, base: dict[str, Any], source: str) -> None:
+def _check_parameters(spec: CalibrationSpec, base: Scene, source: str) -> None:
     """A parameter names a scene key that takes a number, or is a free parameter that some target's
     overrides use; a target's overrides name scene keys and only declared free parameters."""
     used = {name for target in spec.targets for name in _free_references(target.overrides)}
@@ -317,9 +319,10 @@ def _check_parameters(spec: CalibrationSpec, base: dict[str, Any], source: str) 
             continue
         check_scene_path(source, "parameters", name, base)
         field = field_at(Scene, tuple(name.split(".")))  # None: a parameter of one's own (an extension's)
-        numeric = isinstance(_get(base, name), (int, float)) and not isinstance(_get(base, name), bool)
+        value = scene_value(base, name)
+        numeric = isinstance(value, (int, float)) and not isinstance(value, bool)
         if not (numeric if field is None else _takes_numbers(field.annotation)):
-            raise InputError(f"{source}: parameters.{name}: {_get(base, name)!r} in the base scene: a scene key "
+            raise InputError(f"{source}: parameters.{name}: {value!r} in the base scene: a scene key "
                              "that does not take a real number; a fitted parameter is a key that does")
         if name == FREQUENCY or all(name in target.overrides for target in spec.targets):
             raise InputError(f"{source}: parameters.{name}: every target sets it (the scanned frequency or "
@@ -356,7 +359,7 @@ def load_calibration(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Calib
     path = Path(path)
     source = str(path)
     spec = parse(CalibrationSpec, read_yaml(path), source)
-    base = spec.base_scene_dict(path)
+    base = spec.base(path)
     _check_parameters(spec, base, source)
     evaluations = spec.search.evaluations(len(spec.parameters))
     scans, count = scans_per_evaluation(spec), spec.frequency_hz.count
@@ -364,7 +367,7 @@ def load_calibration(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Calib
             f"x {scans} scans x frequency_hz: {count:.6g} frequencies")
     runs = evaluations * scans * count
     metrics = {target.metric or spec.metric for target in spec.targets}
-    budget.check_total(source, what, runs, runs * base_estimate_s(source, {**base, "outputs": {"metrics": sorted(metrics)}}),
+    budget.check_total(source, what, runs, runs * base_estimate_s(source, base, {"outputs": {"metrics": sorted(metrics)}}),
                        evaluations * EVALUATION_BYTES + count * AXIS_VALUE_BYTES)
     frequencies = spec.frequency_hz.expand()
     _check_frequencies(spec, frequencies, source)

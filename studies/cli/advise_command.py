@@ -1,5 +1,5 @@
 """``rpdrill advise SCENE.yaml --frequency-hz LOW HIGH --feed-kn LOW HIGH --out DIR``: the operating point
-that maximises a metric within the bounds given (studies.advice.advice_search), for the scene's rock or for each
+that maximises a metric within the bounds given (the library's ``rpdrill.advise``: studies.advice.advice_run; the search studies.advice.advice_search), for the scene's rock or for each
 ``--rock``. Bounds are in the units of the option names. Prints the best point and the metric
 around it, one parameter at a time; exit status 1 when every run failed.
 """
@@ -7,36 +7,18 @@ around it, one parameter at a time; exit status 1 when every run failed.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import shlex
 import sys
-import time
-from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any
-
-from tqdm import tqdm
 
 from ...rocklaw.catalog import TABLE_1
-from ..advice.advice_report import advice_markdown, advice_record, advice_text, best_table
-from ..advice.advice_search import (
-    METRICS,
-    PARAMETERS,
-    AdviceSearch,
-    AdviseParameter,
-    Request,
-    advice_hash,
-    advise,
-    planned_evaluations,
-    runnable_scene,
-)
-from ..display.catalogue import metric, parameter
-from ..figures.advice_figures import plot_curves, plot_feed_map
+from ..advice.advice_report import advice_text, best_table
+from ..advice.advice_run import advise_scene
+from ..advice.advice_search import METRICS, PARAMETERS, AdviceSearch, AdviseParameter
+from ..display.catalogue import parameter
 from ..inputs.arguments import choice_problem, cli_type
-from ..inputs.reading import load_scene
-from ..runtime.evaluation_log import CHECKPOINT, EVALUATIONS, EvaluationLog
-from ..runtime.output_files import check_file_target, check_out, staged_directory, write_atomic, write_json
-from ..runtime.pools import pool
+from ..runtime.evaluation_log import CHECKPOINT, EVALUATIONS
+from ..runtime.output_files import check_file_target, check_out
 from .options import add_runner_arguments, positive_count, positive_number, seed
 
 FILES = f"""files written to DIR (an interrupted advice keeps its points there: the same command again
@@ -104,52 +86,17 @@ def command_line(args: argparse.Namespace) -> str:
     return shlex.join(words)
 
 
-def session(runner: str, points_run: int, advices: list[Any], start: float, interrupted: bool) -> dict[str, Any]:
-    """One session of an advice, for its checkpoint (as a calibration records its sessions)."""
-    return {"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"), "runner": runner,
-            "interrupted": interrupted, "points_run": points_run,
-            "points_replayed": sum(advice.replayed for advice in advices), "rocks_done": len(advices),
-            "wall_time_s": round(time.perf_counter() - start, 3)}
-
-
 def run(args: argparse.Namespace) -> int:
-    out = check_out(args.out, args.overwrite, CHECKPOINT)
+    check_out(args.out, args.overwrite, CHECKPOINT)  # (the library checks again: the options' order of messages)
     if args.markdown:
         check_file_target("--markdown", args.markdown)
-    scene = load_scene(args.scene).model_dump(by_alias=True, exclude_none=True)
     bounds = {e.path: e.si_bounds(_given(args, e)) for e in PARAMETERS if _given(args, e) is not None}
-    request = Request(args.metric, bounds, args.max_thrust_ratio,
-                      AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed),
-                      power_w=args.power_kw * 1e3 if args.power_kw else None)
-    rocks = args.rock or [None]
-    scenes = [runnable_scene(scene, rock, request, args.scene) for rock in rocks]
-    advices = []
-    identity = {"advice": scene["name"], "scene_file": args.scene, "hash": advice_hash(scenes, request)}
-    with contextlib.closing(EvaluationLog(out, identity, Path(args.scene), args.overwrite)) as log, \
-            pool(args.dask, args.workers) as (label, runner), \
-            tqdm(total=planned_evaluations(request) * len(rocks), desc="advise", unit="point", disable=args.quiet) as bar:
-        print(f"advise: maximising {metric(args.metric).name} over {', '.join(parameter(p).name for p in bounds)} "
-              f"for {len(rocks)} rock(s) on {label}" + (f"; {len(log.records)} points recorded earlier in {out}"
-                                                         if log.records else ""), file=sys.stderr)
-        earlier, start = len(log.records), time.perf_counter()
-        try:
-            for rock, data in zip(rocks, scenes, strict=True):
-                advices.append(advise(data, rock, request, runner, bar.update, log))
-                tqdm.write(advice_text(advices[-1]), file=sys.stdout)
-        except KeyboardInterrupt:  # the points run are kept (evaluations.jsonl); the session says where it stopped
-            log.add_session(session(label, len(log.records) - earlier, advices, start, interrupted=True))
-            raise
-        log.add_session(session(label, len(log.records) - earlier, advices, start, interrupted=False))
-    command = command_line(args)
-    with staged_directory(args.out) as stage:
-        write_json(stage / "advice.json", advice_record(advices, command))
-        (stage / "advice.md").write_text(advice_markdown(advices, command), encoding="utf-8")
-        for advice in advices:
-            name = advice.rock or advice.scene
-            plot_curves(advice, stage / f"{name}_curves.png")
-            plot_feed_map(advice, stage / f"{name}_feed_frequency_map.png")
-    if args.markdown:
-        write_atomic(args.markdown, advice_markdown(advices, command))
+    advices = advise_scene(args.scene, bounds, args.metric, args.rock, args.power_kw, args.max_thrust_ratio,
+                           AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed),
+                           args.workers, args.dask, args.out, args.overwrite, args.markdown, args.quiet,
+                           command_line(args))
+    for advice in advices:
+        print(advice_text(advice))
     print(best_table(advices))
     print(f"wrote {args.out}" + (f", {args.markdown}" if args.markdown else ""), file=sys.stderr)
     failed = [a for a in advices if a.failed_runs == a.runs]

@@ -15,15 +15,13 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from ...models.definition.formulations import FORMULATIONS
 from ...models.evaluation.run_status import STATUSES, USABLE
 from ..api import run_study_files
 from ..inputs.arguments import choice_problem, cli_type
-from ..runtime.resumable import Row
-from ..scan.study import Study
-from ..scan.study_optima import Record, optima_table
+from ..scan.study_optima import optima_table
+from ..study_runs import StudyRun
 from .options import add_resumable_arguments, budget
 
 FILES = """files written to DIR (to DIR/<file name without .yaml> for each of several studies):
@@ -45,33 +43,33 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="run every point with this formulation (default: the scene's solver.formulation)")
 
 
-def report(study: Study, out: Path, rows: list[Row], optima: list[Record], written: list[Path],
-           skipped: list[str]) -> None:
+def report(run: StudyRun) -> None:
     """What a study wrote and its failed points (stderr), its optima table (stdout)."""
-    failed = [row for row in rows if row["status"] == "failed"]
-    flagged = [row for row in rows if row["status"] not in ("ok", "failed")]
-    kinds = ", ".join(f"{sum(r['status'] == kind for r in flagged)} {kind}" for kind in STATUSES[1:]
-                      if any(r["status"] == kind for r in flagged))
-    print(f"{study.spec.name}: {len(rows) - len(failed) - len(flagged)} points ok, {kinds + ', ' if kinds else ''}"
-          f"{len(failed)} failed; wrote "
-          f"{out / 'results.csv'}, {out / 'study.json'}, {out / 'optima.csv'}" + "".join(f", {p}" for p in written),
+    status, out = run.table["status"], run.out
+    counts = status.value_counts()
+    kinds = ", ".join(f"{counts[kind]} {kind}" for kind in STATUSES[1:] if kind in counts)
+    print(f"{run.study.spec.name}: {counts.get('ok', 0)} points ok, {kinds + ', ' if kinds else ''}"
+          f"{counts.get('failed', 0)} failed; wrote "
+          f"{out / 'results.csv'}, {out / 'study.json'}, {out / 'optima.csv'}" + "".join(f", {p}" for p in run.plots),
           file=sys.stderr)
-    if skipped:
-        print(f"  no plot {', '.join(skipped)}: no point has a result for its metrics", file=sys.stderr)
-    for row in (failed + flagged)[:5]:
-        print(f"  point {row['point']} ({row['status']}): {row['error']}", file=sys.stderr)
-    table = optima_table(optima)
-    print(table or f"{study.spec.name}: no optima (no figure of merit collected, or no numeric axis with "
+    if run.skipped_plots:
+        print(f"  no plot {', '.join(run.skipped_plots)}: no point has a result for its metrics", file=sys.stderr)
+    failed_first = [run.table[status == "failed"], run.table[~status.isin(("ok", "failed"))]]
+    shown = [(p, k, e) for part in failed_first for p, k, e in zip(part["point"], part["status"], part["error"])][:5]
+    for point, kind, error in shown:
+        print(f"  point {point} ({kind}): {error}", file=sys.stderr)
+    table = optima_table(run.optima)
+    print(table or f"{run.study.spec.name}: no optima (no figure of merit collected, or no numeric axis with "
                     "three or more values)")
 
 
 def run(args: argparse.Namespace) -> int:
-    outcomes = run_study_files(args.study, args.out, formulation=args.formulation, budget=budget(args),
-                               workers=args.workers, dask=args.dask, quiet=args.quiet)
-    for outcome in outcomes:
-        report(*outcome)
-    useless = [outcome[0].source for outcome in outcomes if not any(r["status"] in USABLE for r in outcome[2])]
+    runs = run_study_files(args.study, args.out, formulation=args.formulation, budget=budget(args),
+                           workers=args.workers, dask=args.dask, quiet=args.quiet)
+    for study_run in runs:
+        report(study_run)
+    useless = [study_run.study.source for study_run in runs if not study_run.table["status"].isin(USABLE).any()]
     for source in useless:
         print(f"{source}: no point gave figures that stand (status {' or '.join(USABLE)}); nothing to compare: "
               "see the errors in results.csv", file=sys.stderr)
-    return 1 if useless or any(row["status"] == "failed" for outcome in outcomes for row in outcome[2]) else 0
+    return 1 if useless or any((study_run.table["status"] == "failed").any() for study_run in runs) else 0

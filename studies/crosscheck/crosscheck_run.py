@@ -58,7 +58,7 @@ def crosscheck(scene: Scene | str | Path, blows: int = 20, step_s: float = DEFAU
     if budget is not None:
         for simulation in simulations:
             budget.check_run(simulation, source, f"{simulation.settings.formulation} window: ")
-    exudyn, ode = (Result(window, simulation.run(), {"source": source})
+    exudyn, ode = (Result(window, simulation.solve(), {"source": source})
                    for window, simulation in zip(windows, simulations, strict=True))
     report = compare_runs(ode.raw, exudyn.raw, windows[0].solver.end_time_s)
     return Crosscheck(exudyn, ode, blows, step_s, report, verdict(report))

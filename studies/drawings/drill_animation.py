@@ -32,9 +32,7 @@ from matplotlib.figure import Figure
 
 from ...models.evaluation.results import SimulationResult
 from ...models.evaluation.run_result import Result
-from ...models.solvers.simulation import Simulation
-from ...models.steady.steady_run import run_scene
-from ..figures.figure_style import plt
+from ..figures.figure_style import figure
 from ..inputs.arguments import (
     built_model_problem,
     check,
@@ -111,7 +109,8 @@ def write_animation(result: SimulationResult | Result | ExudynModel, path: str |
     # metres of displacement -> drawn x units: lengths are drawn to scale but for shortened bodies
     reach = max(float(np.max(np.abs(moved))), float(np.max(np.abs(rock))), 1e-12)
     factor = magnification or nice_factor(0.5 * drawing.gap / reach)
-    fig, ax = plt.subplots(figsize=(14, 3.6), layout="constrained")
+    fig = figure(figsize=(14, 3.6), layout="constrained")
+    ax = fig.subplots()
     title = figure_title(scene, drawing).splitlines()[0].split(";")[0]
 
     def frame(k: int) -> None:
@@ -127,25 +126,7 @@ def write_animation(result: SimulationResult | Result | ExudynModel, path: str |
                      f"borehole bottom {1e3 * (bottom[k] - bottom[0]):+.3f} mm since the window's start", fontsize=9)
 
     save_frames(fig, frame, len(times), path, writer)
-    plt.close(fig)
     return factor
-
-
-def run_with_solution(simulation: Simulation, progress: Callable[[float], None] | None = None,
-                      solution: Path | None = None) -> SimulationResult:
-    """Run ``simulation`` as its scene asks (models.steady.steady_run.run_scene: a time run, or its steady
-    state); with ``solution``, a time run and the Exudyn formulation, write Exudyn's coordinates solution
-    file there during the run (every output interval). The other formulations write none."""
-    if solution is None or simulation.settings.formulation != "exudyn" \
-            or simulation.scene.solver.steady_state != "time":
-        return run_scene(simulation, progress=progress)
-    from ...models.solvers.exudyn_model import build_exudyn
-
-    model = build_exudyn(simulation)
-    model.write_solution(solution)
-    result = model.solve(progress)
-    result.info["solution_file"] = str(solution)
-    return result
 
 
 def load_solution(run: str | Path | ExudynModel) -> tuple[ExudynModel, dict]:
@@ -212,7 +193,8 @@ def model_animation(model: ExudynModel, path: str | Path, blows: int = 3, magnif
     moved = coordinates - coordinates[0]
     own = model.built_items["objects"]
     names = {int(body.object): name for name, body in model.bodies.items()}
-    fig, ax = plt.subplots(figsize=(14, 3.6), layout="constrained")
+    fig = figure(figsize=(14, 3.6), layout="constrained")
+    ax = fig.subplots()
     picture = SystemPicture(ax, model.mbs, own, names)
     points, _ = picture.show(coordinates[0])
     shapes = model.graphics.layout
@@ -236,5 +218,4 @@ def model_animation(model: ExudynModel, path: str | Path, blows: int = 3, magnif
     fig.canvas.draw()
     fig.set_layout_engine("none")  # laid out once: every frame is drawn as the first (a layout per frame costs)
     save_frames(fig, frame, len(rows), path, writer)
-    plt.close(fig)
     return factor

@@ -29,7 +29,7 @@ from ...models.definition.drill_string import EVERY_BODY, GROUND
 from ...models.definition.links import Link
 from ...models.definition.scene import Scene
 from ...models.drill.shapes import DEFAULT_DIAMETER_M, Layout, axial_order, layout
-from ..figures.figure_style import OKABE_ITO, plt
+from ..figures.figure_style import OKABE_ITO, figure
 from ..inputs.arguments import built_model_problem, check, either, file_problem, instance_problem
 from .system_drawing import draw_model
 
@@ -330,7 +330,8 @@ def draw(scene: Scene | ExudynModel, path: str | Path) -> Path:
         return draw_model(build_exudyn(scene) if isinstance(scene, Scene) else scene, path)
     drawing = drawn_layout(scene)
     width = drawing.rock_face + 2.5 * drawing.gap - drawing.start
-    fig, ax = plt.subplots(figsize=(14, 4.6), layout="constrained")
+    fig = figure(figsize=(14, 4.6), layout="constrained")
+    ax = fig.subplots()
     ax.set_ylim(*draw_string(ax, scene, drawing))
     ax.set_xlim(drawing.start - 1.6 * drawing.gap, drawing.rock_face + 2.7 * drawing.gap)
     ax.set_yticks([])
@@ -339,7 +340,6 @@ def draw(scene: Scene | ExudynModel, path: str | Path) -> Path:
         ax.spines[side].set_visible(False)
     ax.set_title(figure_title(scene, drawing), fontsize=9)
     fig.savefig(path, dpi=130)
-    plt.close(fig)
     return path
 
 

@@ -24,8 +24,9 @@ from typing import Any
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.collections import PolyCollection
+from matplotlib.patches import Circle
 
-from ..figures.figure_style import OKABE_ITO, plt
+from ..figures.figure_style import OKABE_ITO, figure
 
 USER_COLOUR = OKABE_ITO[6]  # items of one's own
 CONNECTOR_KINDS = ("Connector", "Contact")  # objectType prefixes of items joining two markers
@@ -217,12 +218,12 @@ class SystemPicture:
             return [points]
         if kind in ("Circle", "Text"):
             point = rotation @ np.asarray(shape["position"], dtype=float) + position
-            self.drawn.append(ax.add_patch(plt.Circle(point[:2], shape["radius"], fill=False, color="0.2", zorder=3))
+            self.drawn.append(ax.add_patch(Circle(point[:2], shape["radius"], fill=False, color="0.2", zorder=3))
                               if kind == "Circle" else ax.text(point[0], point[1], shape["text"], fontsize=7, zorder=5))
             return [point[None, :]]
         if kind == "Spheres":
             points = np.reshape(shape["points"], (-1, 3)) @ rotation.T + position
-            self.drawn += [ax.add_patch(plt.Circle(point[:2], radius, color="0.5", zorder=3))
+            self.drawn += [ax.add_patch(Circle(point[:2], radius, color="0.5", zorder=3))
                            for point, radius in zip(points, np.ravel(shape["radii"]), strict=False)]
             return [points]
         return []
@@ -279,13 +280,11 @@ def draw_model(model: Any, path: str | Path, coordinates: Sequence[float] | None
     own = model.built_items["objects"]
     names = {int(body.object): name for name, body in model.bodies.items()}
     names.update({int(c.object): name for name, c in model.connectors.items()})
-    probe = plt.figure()
-    points, _ = draw_system(probe.add_subplot(), model.mbs, coordinates, own, names)
-    plt.close(probe)
+    points, _ = draw_system(figure().add_subplot(), model.mbs, coordinates, own, names)
     low, high, half = _window(model, points)
     whole_too = np.ptp(points[:, 0]) > 3 * (high - low)  # else the part near the rock is most of the system
-    fig, axes = plt.subplots(2 if whole_too else 1, 1, figsize=(14, 7.5 if whole_too else 4.4), layout="constrained",
-                             squeeze=False)
+    fig = figure(figsize=(14, 7.5 if whole_too else 4.4), layout="constrained")
+    axes = fig.subplots(2 if whole_too else 1, 1, squeeze=False)
     told = ", ".join(f"{count} {kind}" for kind, count in model.user_items().items()) or "none"
     heading = (title or f"{model.simulation.name}: the Exudyn system from its graphics, seen from the side") + \
         f"\nitems of one's own (labelled in this colour): {told}"
@@ -307,5 +306,4 @@ def draw_model(model: Any, path: str | Path, coordinates: Sequence[float] | None
         ax.set_xlabel("x along the drilling axis (m)")
         ax.set_ylabel("y (m)")
     fig.savefig(path, dpi=130)
-    plt.close(fig)
     return path

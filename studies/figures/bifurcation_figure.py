@@ -12,7 +12,7 @@ import numpy as np
 
 from ..display.catalogue import parameter
 from ..scan.bifurcation_diagram import BlowFigures, Diagram
-from .figure_style import OKABE_ITO, plt, save
+from .figure_style import OKABE_ITO, figure, save
 
 PANELS = (("advance_m", 1e6, "advance per blow [um]"), ("peak_rock_force_n", 1e-3, "peak rock force per blow [kN]"))
 
@@ -23,7 +23,8 @@ def _period(figure: BlowFigures) -> int | None:
 
 def plot_bifurcation(diagram: Diagram, path: Path, title: str) -> list[Path]:
     """The diagram's figure (module doc) into ``path`` (and an SVG beside it); the files written."""
-    fig, axes = plt.subplots(2, 1, figsize=(9, 7.5), sharex=True, layout="constrained")
+    fig = figure(figsize=(9, 7.5), layout="constrained")
+    axes = fig.subplots(2, 1, sharex=True)
     axis = parameter(diagram.axis)
     for ax, (name, factor, label) in zip(axes, PANELS, strict=True):
         dots = [(axis.display(f.value), v * factor) for f in diagram.brute_force for v in getattr(f, name)]
@@ -40,19 +41,19 @@ def plot_bifurcation(diagram: Diagram, path: Path, title: str) -> list[Path]:
                         label="period-1 orbit, unstable (not the rate)")
         shown: set[str] = set()
         for direction, marker, figures in (("up", "o", diagram.up), ("down", "s", diagram.down)):
-            for figure in figures:
-                n = _period(figure)
+            for blow in figures:
+                n = _period(blow)
                 if n is None:
                     key = f"no periodic orbit found ({direction})"
-                    ax.plot([axis.display(figure.value)] * len(getattr(figure, name)), np.array(getattr(figure, name)) * factor,
+                    ax.plot([axis.display(blow.value)] * len(getattr(blow, name)), np.array(getattr(blow, name)) * factor,
                             "x", color=OKABE_ITO[5], ms=4, label=None if key in shown else key)
                 elif n > 1:
                     key = f"period-{n} orbit ({direction})"
-                    ax.plot([axis.display(figure.value)] * n, np.array(getattr(figure, name)) * factor, marker,
+                    ax.plot([axis.display(blow.value)] * n, np.array(getattr(blow, name)) * factor, marker,
                             color=OKABE_ITO[(n % 5) + 1], mfc="none", ms=5, label=None if key in shown else key)
                 else:
                     key = f"period-1 orbit ({direction})"
-                    ax.plot([axis.display(figure.value)], [getattr(figure, name)[0] * factor], marker,
+                    ax.plot([axis.display(blow.value)], [getattr(blow, name)[0] * factor], marker,
                             color=OKABE_ITO[4], mfc="none", ms=3, label=None if key in shown else key)
                 shown.add(key)
         ax.set_ylabel(label)

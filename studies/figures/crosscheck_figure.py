@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ...models.evaluation.results import SimulationResult
 from ..display.catalogue import series
-from .figure_style import OKABE_ITO, plt, save
+from .figure_style import OKABE_ITO, figure, save
 
 # result attribute -> time-history column (studies.display.catalogue)
 PANELS = {"bottom_m": "borehole_bottom_m", "bit_velocity_m_per_s": "bit_velocity_m_per_s", "rock_force_n": "rock_force_n"}
@@ -14,7 +14,8 @@ PANELS = {"bottom_m": "borehole_bottom_m", "bit_velocity_m_per_s": "bit_velocity
 
 def plot_overlay(ode: SimulationResult, exudyn: SimulationResult, title: str, path: Path) -> list[Path]:
     """x_n, bit velocity and rock force of both formulations against time; the files written."""
-    fig, axes = plt.subplots(len(PANELS), 1, sharex=True, figsize=(9, 8))
+    fig = figure(figsize=(9, 8))
+    axes = fig.subplots(len(PANELS), 1, sharex=True)
     time = series("time_s")
     for ax, (name, column) in zip(axes, PANELS.items()):
         quantity = series(column)

@@ -7,13 +7,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-
 from ..reproduction.paper_reproduction import CaseResult, Figure, Reproduction
 from ..scan.flat_curves import why_no_optimum
+from .figure_style import figure as new_figure
 
 # Okabe-Ito: distinct for colour-blind readers
 PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
@@ -31,8 +27,8 @@ def draw_figure(reproduction: Reproduction, results: list[CaseResult], figure: F
     """Draw one of the paper's figures into ``stem``.<format>; the paths written."""
     by_label = {r.case.label: r for r in results}
     frequencies = reproduction.frequencies_hz
-    fig, axes = plt.subplots(len(figure.metrics), 1, sharex=True, figsize=(8, 2.8 * len(figure.metrics) + 0.8),
-                             squeeze=False)
+    fig = new_figure(figsize=(8, 2.8 * len(figure.metrics) + 0.8))
+    axes = fig.subplots(len(figure.metrics), 1, sharex=True, squeeze=False)
     for ax, metric in zip(axes[:, 0], figure.metrics, strict=True):
         scale, label = DISPLAY[metric]
         reasons = []
@@ -44,9 +40,9 @@ def draw_figure(reproduction: Reproduction, results: list[CaseResult], figure: F
                     label=case + (f" ({reasons[-1].split(':')[0]})" if reasons[-1] else ""))
             if metric == result.metric:
                 optimum = result.optimum
-                marks = [(optimum["main_hz"], optimum["main_value"], colour)]
-                if optimum["global_hz"] != optimum["main_hz"]:
-                    marks.append((optimum["global_hz"], optimum["global_value"], "none"))
+                marks = [(optimum.optimum, optimum.optimum_value, colour)]
+                if optimum.global_optimum != optimum.optimum:
+                    marks.append((optimum.global_optimum, optimum.best_value, "none"))
                 for frequency, value, fill in marks:
                     if frequency is not None:
                         ax.plot(frequency, value * scale, marker="*", ms=13, color=colour, mfc=fill, ls="none")
@@ -64,5 +60,4 @@ def draw_figure(reproduction: Reproduction, results: list[CaseResult], figure: F
         path = stem.with_suffix(f".{fmt}")
         fig.savefig(path, dpi=110)
         written.append(path)
-    plt.close(fig)
     return written

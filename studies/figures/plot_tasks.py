@@ -6,14 +6,19 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..runtime.pools import Runner, sequential
+from ..scan.curve_optima import Optimum
 from ..scan.study import Plot, Study
-from ..scan.study_optima import Record, Row, metric_value
+from ..scan.study_optima import metric_values
 
-PlotTask = tuple[Plot, Study, list[Row], list[Record], Path]
+if TYPE_CHECKING:
+    import pandas as pd
+
+PlotTask = tuple[Plot, Study, "pd.DataFrame", list[Optimum], Path]
 
 
 def plot_name(plot: Plot) -> str:
@@ -30,25 +35,25 @@ def draw_plot(task: PlotTask) -> list[Path]:
     return draw(*task)
 
 
-def plot_tasks(study: Study, rows: list[Row], optima: list[Record], out: Path) -> tuple[list[PlotTask], list[str]]:
+def plot_tasks(study: Study, table: pd.DataFrame, optima: list[Optimum], out: Path) -> tuple[list[PlotTask], list[str]]:
     """(A :func:`draw_plot` task per plot of the study that has a result, into ``out``; the names of the
     plots left out because none of their metrics has a finite value)."""
     tasks, skipped = [], []
     for i, plot in enumerate(study.spec.plots):
         name = f"{i:02d}_{plot_name(plot)}"
-        if any(np.isfinite(metric_value(row, m)) for row in rows for m in plot.metrics):
-            tasks.append((plot, study, rows, optima, out / f"{name}.{study.spec.format}"))
+        if any(np.isfinite(metric_values(table, m)).any() for m in plot.metrics):
+            tasks.append((plot, study, table, optima, out / f"{name}.{study.spec.format}"))
         else:
             skipped.append(name)
     return tasks, skipped
 
 
-def start_plots(study: Study, rows: list[Row], optima: list[Record], out: Path,
+def start_plots(study: Study, table: pd.DataFrame, optima: list[Optimum], out: Path,
                 runner: Runner = sequential) -> Callable[[], tuple[list[Path], list[str]]]:
     """Hand every plot of the study that has a result to ``runner`` now, one plot per task (a pool's
     workers start drawing them at once, side by side, while this process goes on), and return the call
     that waits for them: (the files written, the names of the plots left out because none of their
     metrics has a finite value). With the sequential runner the plots are drawn by that call."""
-    tasks, skipped = plot_tasks(study, rows, optima, out)
+    tasks, skipped = plot_tasks(study, table, optima, out)
     pending = runner(draw_plot, tasks) if tasks else iter(())
     return lambda: (sorted(path for batch in pending for paths in batch for path in paths), skipped)

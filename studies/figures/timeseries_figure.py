@@ -10,7 +10,7 @@ import numpy as np
 
 from ...models.definition.scene import Scene
 from ..display.catalogue import describe_scene, series
-from .figure_style import OKABE_ITO, plt, save
+from .figure_style import OKABE_ITO, figure, save
 
 PANELS = ("bit_velocity_m_per_s", "borehole_bottom_m", "rock_force_n", "impact_force_n")
 ZOOM_BLOWS = 3
@@ -26,8 +26,8 @@ def plot_timeseries(columns: dict[str, np.ndarray], scene: Scene, path: Path) ->
     panels = list(dict.fromkeys(panels)) or [next(name for name in columns if name != "time_s")]
     zoom = t >= t[-1] - ZOOM_BLOWS * scene.impact.period_s
     time = series("time_s")
-    fig, axes = plt.subplots(len(panels), 2, sharex="col", figsize=(11, 2 * len(panels) + 0.8), squeeze=False,
-                             width_ratios=(3, 2), layout="constrained")
+    fig = figure(figsize=(11, 2 * len(panels) + 0.8), layout="constrained")
+    axes = fig.subplots(len(panels), 2, sharex="col", squeeze=False, width_ratios=(3, 2))
     for row, name in zip(axes, panels):
         quantity = series(name)
         for ax, part in zip(row, (slice(None), zoom)):

@@ -6,20 +6,21 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
-import matplotlib
+from .figure_style import figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
+if TYPE_CHECKING:
+    import pandas as pd
 
 # colour-blind-safe pair (Okabe-Ito blue and vermillion) for -step and +step
 COLOURS = {-1: "#0072B2", 1: "#D55E00"}
 
 
-def draw_tornados(changes: list[dict[str, Any]], title: str, out: Path, formats: tuple[str, ...]) -> list[Path]:
-    """One figure per (scan, metric) with two panels (optimum shift, peak change) in percent."""
-    written = []
+def draw_tornados(table: pd.DataFrame, title: str, out: Path, formats: tuple[str, ...]) -> list[Path]:
+    """One figure per (scan, metric) of the one-at-a-time ``table``
+    (studies.sensitivity.sensitivity_study.one_at_a_time) with two panels (optimum shift, peak change) in percent."""
+    changes, written = table.to_dict("records"), []
     for scan, metric in dict.fromkeys((c["scan"], c["metric"]) for c in changes):
         mine = [c for c in changes if c["scan"] == scan and c["metric"] == metric]
         effect: dict[str, float] = {}
@@ -28,7 +29,8 @@ def draw_tornados(changes: list[dict[str, Any]], title: str, out: Path, formats:
                 if any(math.isfinite(v) for v in (c["optimum_change"], c["peak_change"])) else 0.0
             effect[c["parameter"]] = max(effect.get(c["parameter"], 0.0), size)
         order = sorted(effect, key=lambda p: effect[p])
-        fig, axes = plt.subplots(1, 2, figsize=(11, 0.32 * len(order) + 1.6), sharey=True)
+        fig = figure(figsize=(11, 0.32 * len(order) + 1.6))
+        axes = fig.subplots(1, 2, sharey=True)
         for ax, key, label in zip(axes, ("optimum_change", "peak_change"),
                                   ("optimum frequency change [%]", "peak value change [%]"), strict=True):
             for c in mine:
@@ -48,5 +50,4 @@ def draw_tornados(changes: list[dict[str, Any]], title: str, out: Path, formats:
             path = out / f"{stem}.{fmt}"
             fig.savefig(path, dpi=110)
             written.append(path)
-        plt.close(fig)
     return written

@@ -4,35 +4,38 @@ error measure, one line per solver family, the Pareto front and the references' 
 from __future__ import annotations
 
 import math
-from collections import defaultdict
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ...models.evaluation.workprecision import ERROR_LABELS, ERROR_MEASURES
-from ..accuracy.accuracy_study import AccuracyStudy, Row, number
-from .figure_style import line_styles, plt, save
+from .figure_style import figure, line_styles, save
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
-def plot_workprecision(study: AccuracyStudy, rows: list[Row], front: list[dict[str, Any]],
-                       report: dict[str, Any], path: Path) -> list[Path]:
-    """Error against median CPU time, log-log, one panel per measure, one line per family
-    (colour-blind-safe styles, studies.figures.figure_style); the files written."""
-    fig, axes = plt.subplots(1, len(ERROR_MEASURES), figsize=(6 * len(ERROR_MEASURES), 5.5))
-    families: dict[str, list[Row]] = defaultdict(list)
-    for row in sorted(rows, key=lambda r: int(r["point"])):
-        families[row["family"]].append(row)
+def plot_workprecision(title: str, table: pd.DataFrame, front: pd.DataFrame, report: dict[str, Any],
+                       path: Path) -> list[Path]:
+    """Error against median CPU time (the study's ``table``: studies.accuracy.accuracy_study), log-log, one panel
+    per measure, one line per family (colour-blind-safe styles, studies.figures.figure_style), the Pareto
+    ``front`` and the references' agreement of the ``report``; the files written."""
+    fig = figure(figsize=(6 * len(ERROR_MEASURES), 5.5))
+    axes = fig.subplots(1, len(ERROR_MEASURES))
+    families = list(table.groupby("family", sort=False))
     styles = line_styles(len(families))
     for ax, measure in zip(axes, ERROR_MEASURES):
         positive = False  # log axes need a positive value to show (settings equal to the reference have none)
-        for style, (label, members) in zip(styles, families.items()):
-            pairs = [(number(r["cpu_time_s"]), number(r[measure])) for r in members if r["status"] == "ok"]
-            pairs = [(c, e) for c, e in pairs if c > 0 and e > 0 and math.isfinite(e)]
-            failed = sum(r["status"] != "ok" for r in members)
+        for style, (label, members) in zip(styles, families):
+            ok = members[members["status"] == "ok"]
+            pairs = [(c, e) for c, e in zip(ok["cpu_time_s"].astype(float), ok[measure].astype(float))
+                     if c > 0 and e > 0 and math.isfinite(e)]
+            failed = int((members["status"] != "ok").sum())
             name = label + (f" ({failed} failed)" if failed else "")
             positive |= bool(pairs)
             ax.plot(*(zip(*pairs) if pairs else ([], [])), ms=4, lw=1, label=name, **style.kwargs())
-        points = [(number(p["cpu_time_s"]), number(p["error"])) for p in front if p["measure"] == measure]
-        points = [(c, e) for c, e in points if c > 0 and e > 0]
+        mine = front[front["measure"] == measure]
+        points = [(c, e) for c, e in zip(mine["cpu_time_s"].astype(float), mine["error"].astype(float))
+                  if c > 0 and e > 0]
         if points:
             ax.step(*zip(*points), where="post", color="k", ls="--", lw=1, label="Pareto front")
             ax.plot(*zip(*points), "o", mfc="none", mec="k", ms=9)
@@ -48,7 +51,7 @@ def plot_workprecision(study: AccuracyStudy, rows: list[Row], front: list[dict[s
         ax.set_ylabel(f"{ERROR_LABELS[measure]} [-]")
         ax.grid(alpha=0.3, which="both")
     axes[0].legend(fontsize=7, loc="lower left")
-    fig.suptitle(f"{study.spec.name}: {study.spec.blows} blows, reference {study.reference.solver}")
+    fig.suptitle(title)
     fig.tight_layout()
     return save(fig, path, dpi=110)
 

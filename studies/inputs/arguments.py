@@ -258,3 +258,13 @@ def either(*problems: Problem) -> Problem:
 def optional(problem: Problem) -> Problem:
     """None, or a value that passes ``problem``."""
     return lambda value: None if value is None else problem(value)
+
+
+def check_run_options(function: str, workers: Any, out: Any, dask: Any, quiet: Any) -> None:
+    """The options every run of many points shares (run_study, calibrate, sensitivity, accuracy, advise):
+    ``workers`` (None or a whole number >= 1), ``out`` (None or a folder), ``dask`` (None, "" or an
+    address) and ``quiet`` (a boolean), each refused as :func:`check` says."""
+    check(function, "workers", workers, optional(workers_problem))
+    check(function, "out", out, optional(folder_problem))
+    check(function, "dask", dask, dask_problem)
+    check(function, "quiet", quiet, boolean_problem)

@@ -1,14 +1,13 @@
 """What the study, accuracy and calibration files share: a strict spec base naming a base scene
-with overrides, scan axes, and edits of scene dicts by dotted key path.
+with overrides, scan axes, and the check of a scene key path they name.
 
 ``base_scene`` is a scene file (relative to the spec file) or an inline mapping; ``base_overrides``
 maps dotted scene paths to values, each replacing what is at that path (``solver.end_time_s: 1.5``,
-``rock: {name: sandstone}``).
+``rock: {name: sandstone}``): the base scene is the typed scene with them (``Scene.with_``).
 """
 
 from __future__ import annotations
 
-import copy
 import math
 from pathlib import Path
 from typing import Any, Literal
@@ -17,7 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ...models.definition.outputs import METRICS
 from ...models.definition.scene import Scene
-from ...models.definition.validation import InputError, check_path, parse, set_path
+from ...models.definition.validation import InputError, check_path, parse
 from .reading import read_yaml
 
 METRIC_NAMES = tuple(METRICS)
@@ -41,24 +40,20 @@ class SceneSpec(StrictSpec):
     base_scene: str | dict[str, Any]
     base_overrides: dict[str, Any] = Field(default_factory=dict)
 
-    def base_scene_dict(self, source: Path) -> dict[str, Any]:
-        """The base scene as written, with the overrides set (not filled in: a scanned ``rock.name``
-        must still supply the rock values); InputError naming ``source`` otherwise."""
+    def base(self, source: Path) -> Scene:
+        """The base scene, validated, with the overrides (``Scene.with_``: the scene keeps what its file
+        gives, so that a scanned ``rock.name`` still supplies the rock's values); InputError naming
+        ``source`` (and the scene file, or ``base_overrides``) otherwise."""
         if isinstance(self.base_scene, str):
             path = source.parent / self.base_scene
             try:
                 data = read_yaml(path)
             except InputError as error:
                 raise InputError(f"{source}: base_scene: {self.base_scene!r}: {error}") from None
-            parse(Scene, data, str(path))
+            scene = parse(Scene, data, str(path))
         else:
-            data = copy.deepcopy(self.base_scene)
-            parse(Scene, data, str(source), ("base_scene",))
-        for path, value in self.base_overrides.items():
-            check_scene_path(str(source), "base_overrides", path, data)
-            set_path(data, path, value)
-        parse(Scene, data, f"{source} (base_scene with base_overrides)")
-        return data
+            scene = parse(Scene, self.base_scene, str(source), ("base_scene",))
+        return scene.with_(dict(self.base_overrides), f"{source}: base_overrides") if self.base_overrides else scene
 
 
 class Axis(StrictSpec):
@@ -115,9 +110,17 @@ class Axis(StrictSpec):
         return [float(f"{v:.12g}") for v in raw]
 
 
-def check_scene_path(source: str, key: str, path: str, base: dict[str, Any] | None = None,
-                     value_only: bool = False) -> None:
+def check_scene_path(source: str, key: str, path: str, base: Scene | None = None, value_only: bool = False) -> None:
     """A scan or override path must name a scene key; a name in a mapping (``drill_string.bodies.X``)
     must exist in the ``base`` scene; ``value_only`` (a scan axis): a value, not a whole section
     (models.definition.validation.check_path)."""
-    check_path(Scene, source, key, path, base, value_only=value_only)
+    data = None if base is None else base.model_dump(by_alias=True, exclude_none=True)
+    check_path(Scene, source, key, path, data, value_only=value_only)
+
+
+def scene_value(scene: Scene, path: str) -> Any:
+    """The value at a scene key path (None where the scene has none: an optional key left out)."""
+    node: Any = scene.model_dump(by_alias=True, exclude_none=True)
+    for key in path.split("."):
+        node = node.get(key) if isinstance(node, dict) else None
+    return node

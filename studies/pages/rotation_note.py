@@ -12,11 +12,14 @@ scenes.
 
 from __future__ import annotations
 
-import csv
 import json
 import math
-from collections import defaultdict
+import shlex
+import shutil
+import tempfile
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,8 +27,13 @@ from ...models.definition.scene import Bit
 from ...models.drill.indexing import Indexing
 from ..display.catalogue import metric
 from ..figures.rotation_map import draw_rotation_map
+from ..inputs.arguments import boolean_problem, check, folder_problem, instance_problem, optional
 from ..inputs.reading import InputError
-from ..runtime.output_files import write_atomic
+from ..runtime.output_files import check_out, staged_directory, write_atomic
+from ..runtime.tables import read_table
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 RATE, ADVANCE = "penetration_rate_m_per_s", "advance_per_blow_m"
 SPEED, FREQUENCY, ROCK = "rotation.speed_rpm", "impact.frequency_hz", "rock.name"
@@ -43,10 +51,11 @@ def manual_speed_rpm(bit: Bit, frequency_hz: float) -> float:
     return MANUAL_INDEX_PER_BUTTON * bit.gauge_button_diameter_m * 60.0 * frequency_hz / (math.pi * bit.diameter_m)
 
 
-def _rows(results: Path) -> list[dict[str, str]]:
-    with results.open(newline="") as handle:
-        # (unsettled rows have their values; a metric that is not a finite number is empty: models.evaluation.run_status)
-        return [row for row in csv.DictReader(handle) if row["status"] != "failed" and row[RATE] != ""]
+def _rows(results: Path) -> pd.DataFrame:
+    """A study's results table without its failed points and those without a rate (unsettled ones kept: their
+    values stand; a metric that is not a finite number is empty: models.evaluation.run_status)."""
+    table = read_table(results)
+    return table[(table["status"] != "failed") & table[RATE].notna()]
 
 
 def _study(run: Path) -> dict:
@@ -57,11 +66,9 @@ def _bit(run: Path) -> Bit:
     return Bit.model_validate(_study(run)["resolved_study"]["base_scene"]["bit"])
 
 
-def _by_rock(rows: list[dict[str, str]]) -> dict[str, list[dict[str, str]]]:
-    groups: dict[str, list[dict[str, str]]] = defaultdict(list)
-    for row in rows:
-        groups[row[ROCK]].append(row)
-    return groups
+def _by_rock(table: pd.DataFrame) -> dict[str, pd.DataFrame]:
+    """The rows of each rock, sorted by rotation speed."""
+    return {rock: members.sort_values(SPEED, kind="stable") for rock, members in table.groupby(ROCK, sort=False)}
 
 
 def dth_rows(run: Path) -> tuple[list[str], float, float]:
@@ -71,9 +78,7 @@ def dth_rows(run: Path) -> tuple[list[str], float, float]:
     manual, best = manual_speed_rpm(bit, frequency), Indexing(bit, None, frequency).best_speed_rpm()
     lines = []
     for rock, members in _by_rock(rows).items():
-        members = sorted(members, key=lambda r: float(r[SPEED]))
-        speeds = np.array([float(r[SPEED]) for r in members])
-        rates = np.array([float(r[RATE]) for r in members])
+        speeds, rates = members[SPEED].to_numpy(dtype=float), members[RATE].to_numpy(dtype=float)
         top = int(np.argmax(rates >= rates.max() - TIE * abs(rates.max())))  # the slowest of equal rates
         if rates[top] <= 0:
             lines.append(f"| {rock} | no penetration at any speed | 0 | 0 | - |")
@@ -85,17 +90,17 @@ def dth_rows(run: Path) -> tuple[list[str], float, float]:
     return lines, frequency, best
 
 
-def ridge(run: Path) -> list[tuple[str, float, float, float, float]]:
+def ridge_points(run: Path) -> list[tuple[str, float, float, float, float]]:
     """(rock, frequency, best scanned speed, rate there, the model's best speed 60 f w / (pi D)) at every
     frequency where the rock is drilled (the best rate at least DRILLED of the rock's best on the map)."""
     bit, found = _bit(run), []
     for rock, members in _by_rock(_rows(run / "results.csv")).items():
         best: dict[float, tuple[float, float]] = {}
-        for row in sorted(members, key=lambda r: float(r[SPEED])):
-            frequency, rate = float(row[FREQUENCY]), float(row[RATE])
+        for speed, frequency, rate in zip(*(members[c].to_numpy(dtype=float) for c in (SPEED, FREQUENCY, RATE)),
+                                          strict=True):
             # the slowest of equal rates: speeds whose index per blow differ by a button pitch are aliases
             if frequency not in best or rate > best[frequency][1] + TIE * abs(best[frequency][1]):
-                best[frequency] = (float(row[SPEED]), rate)
+                best[frequency] = (float(speed), float(rate))
         peak = max(rate for _, rate in best.values())
         found += [(rock, frequency, speed, rate, Indexing(bit, None, frequency).best_speed_rpm())
                   for frequency, (speed, rate) in sorted(best.items()) if rate > 0 and rate >= DRILLED * peak]
@@ -110,11 +115,11 @@ def render(runs: Path, figure: Path, rock: str, made_by: str) -> str:
     speeds = _study(map_run)["resolved_study"]["scan"][SPEED]
     step = speeds[1] - speeds[0]
     crater_mm, pitch_mm = 1e3 * bit.crater_m, 1e3 * math.pi * bit.diameter_m / bit.gauge_buttons
-    ridge_points = ridge(map_run)
+    ridge_points_ = ridge_points(map_run)
     table = "\n".join(f"| {rock} | {f:g} | {speed:g} | {rate * 1e3:.3g} | {model:.1f} | {speed / model - 1:+.0%} |"
-                      for rock, f, speed, rate, model in ridge_points)
+                      for rock, f, speed, rate, model in ridge_points_)
     table = table or "| no rock drilled on the map | - | - | - | - | - |"
-    far = max(ridge_points, key=lambda p: abs(p[2] / p[4] - 1), default=None)
+    far = max(ridge_points_, key=lambda p: abs(p[2] / p[4] - 1), default=None)
     furthest = (f" (the furthest here: {far[0]} at {far[1]:g} Hz, {far[2]:g} rpm against {far[4]:.1f} rpm)"
                 if far else "")
     spiral_rate = [mm * manual / 60.0 for mm in CHALK_SPIRAL_MM]
@@ -202,10 +207,56 @@ def write_report(runs: Path, out: Path, rock: str, made_by: str) -> list[Path]:
     """rotation.md and the map of ``rock`` (PNG and SVG) into ``out``; the files written."""
     figure = out / f"rotation_map_{rock}.png"
     run = runs / STUDIES[0]
-    rows = [r for r in _rows(run / "results.csv") if r[ROCK] == rock]
+    table = _rows(run / "results.csv")
     bit = _bit(run)
-    draw_rotation_map(rows, figure, f"{rock}: {metric(RATE).label()}",
+    draw_rotation_map(table[table[ROCK] == rock], figure, f"{rock}: {metric(RATE).label()}",
                       lambda f: Indexing(bit, None, f).best_speed_rpm(), lambda f: manual_speed_rpm(bit, f), DRILLED)
     note = out / "rotation.md"
     write_atomic(note, render(runs, figure, rock, made_by))
     return [note, figure, figure.with_suffix(".svg")]
+
+
+@dataclass(frozen=True)
+class RotationReport:
+    """The rotation-speed note: its Markdown ``text``, the files written into ``out`` (the note and the
+    map, PNG and SVG; none without ``out``), and the ``ridge`` of the map: per rock and drilled frequency the
+    best scanned speed, the rate there and the model's best speed 60 f w / (pi D)."""
+
+    text: str
+    files: list[Path]
+    ridge: pd.DataFrame
+    out: Path | None
+
+
+def rotation_report(runs: str | Path, out: str | Path | None = None, rock: str = "sandstone",
+                    docs: str | Path | None = None, overwrite: bool = False) -> RotationReport:
+    """``rpdrill rotation-report`` as a library call: the note (module doc) from the two rotation studies'
+    results in ``runs``, written into ``out`` (new, empty or an earlier report's; ``overwrite``: any
+    folder) and copied into ``docs``; without ``out``, into a scratch folder removed after. InputError
+    before anything is written when a study's results or the rock are missing."""
+    import pandas as pd
+
+    where = "rpdrill.rotation_report"
+    check(where, "runs", runs, folder_problem)
+    check(where, "out", out, optional(folder_problem))
+    check(where, "rock", rock, instance_problem(str, "a rock's name (text)"))
+    check(where, "docs", docs, optional(folder_problem))
+    check(where, "overwrite", overwrite, boolean_problem)
+    runs = Path(runs)
+    folder = None if out is None else check_out(out, overwrite, "rotation.md")
+    docs_folder = None if docs is None else check_out(docs, True, option="--docs")
+    check_runs(runs, rock)
+    words = ["rpdrill", "rotation-report", str(runs), *(["--out", str(out)] if out is not None else [])]
+    words += (["--rock", rock] if rock != "sandstone" else []) + (["--docs", str(docs)] if docs is not None else [])
+    with tempfile.TemporaryDirectory(prefix="rpdrill-rotation-") as scratch:
+        target = folder or Path(scratch) / "rotation"
+        with staged_directory(target) as stage:
+            written = [target / p.name for p in write_report(runs, stage, rock, f"`{shlex.join(words)}`")]
+        text = written[0].read_text(encoding="utf-8")
+    if folder is not None and docs_folder is not None:
+        docs_folder.mkdir(parents=True, exist_ok=True)
+        for path in written:
+            shutil.copy(path, docs_folder / path.name)
+    ridge = pd.DataFrame(ridge_points(runs / STUDIES[0]), columns=["rock", "frequency_hz", "best_speed_rpm",
+                                                                     "penetration_rate_m_per_s", "model_speed_rpm"])
+    return RotationReport(text, written if folder is not None else [], ridge, folder)

@@ -2,7 +2,7 @@
 paper's, its trends checked, the lobes below the main resonance listed.
 
 A reproduction file (``studies/paper/reproduction.yaml``) names the base scene with overrides
-(studies.inputs.specs), the ``frequency_hz`` axis, the ``metrics`` recorded, the ``cases`` (studies.scan.frequency_scans
+(studies.inputs.specs), the ``frequency_hz`` axis, the ``metrics`` recorded, the ``cases`` (studies.scan.curves
 scans, each with what the ``paper`` says: ``optimum_hz``, ``band_hz`` and the words), the ``rising``
 trends, the case whose lobes explain the sawtooth below the resonance (``sub_harmonics``) and the
 ``figures`` to redraw (cases and metrics of each). Every case's optimum is the maximum of its main
@@ -15,7 +15,6 @@ the result depends on.
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,11 +22,12 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
+from ...models.definition.scene import Scene
 from ..inputs.reading import InputError, parse, read_yaml
-from ..inputs.specs import Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, set_path
+from ..inputs.specs import Axis, MetricName, SceneSpec, StrictSpec, check_scene_path
 from ..runtime.pools import Runner
-from ..scan.curve_optima import CurveOptimum, curve_optimum
-from ..scan.frequency_scans import Scan, rising_shortfalls, scan_all, scan_optimum
+from ..scan.curve_optima import Optimum
+from ..scan.curves import Curve, Scan, rising_shortfalls, run_all
 
 PositiveFloat = Field(gt=0, allow_inf_nan=False)
 
@@ -41,7 +41,7 @@ class PaperResult(StrictSpec):
 
 
 class Case(Scan):
-    """A scan of the paper (studies.scan.frequency_scans.Scan) and what the paper says about it."""
+    """A scan of the paper (studies.scan.curves.Scan) and what the paper says about it."""
 
     paper: PaperResult
 
@@ -103,7 +103,7 @@ class Reproduction:
 
     source: Path
     spec: ReproductionSpec
-    base: dict[str, Any]
+    base: Scene
     frequencies_hz: list[float]
 
     @property
@@ -113,30 +113,42 @@ class Reproduction:
     def metric(self, case: Case) -> str:
         return case.metric or self.spec.metric
 
-    def scene(self, case: Case, variant: Variant | None = None) -> dict[str, Any]:
-        """The base scene (with a variant's additions and overrides) with the case's overrides."""
-        scene = copy.deepcopy(self.base)
-        if variant is not None:
-            for part, named in variant.add.items():
-                scene["drill_string"][part].update(copy.deepcopy(named))
-            for path, value in variant.overrides.items():
-                set_path(scene, path, value)
+    def changes(self, case: Case, variant: Variant | None = None) -> dict[str, Any]:
+        """The scene changes of a case (on a variant): the variant's bodies and connectors added, its
+        overrides, then the case's overrides (a path of both: the case's), in that order."""
+        changes = variant_changes(self.base, variant)
         for path, value in case.overrides.items():
-            set_path(scene, path, value)
-        return scene
+            changes.pop(path, None)
+            changes[path] = value
+        return changes
+
+    def scene(self, case: Case, variant: Variant | None = None) -> Scene:
+        """The case's scene at the base scene's frequency (:meth:`changes`)."""
+        return self.base.with_(self.changes(case, variant), f"{self.source} (case {case.label!r})")
+
+
+def variant_changes(base: Scene, variant: Variant | None) -> dict[str, Any]:
+    """A variant's scene changes: the drill string's bodies and connectors with its own added, then its
+    overrides."""
+    if variant is None:
+        return {}
+    string = base.model_dump(by_alias=True, exclude_none=True)["drill_string"]
+    added = {f"drill_string.{part}": {**string[part], **named} for part, named in variant.add.items()}
+    return {**added, **variant.overrides}
 
 
 @dataclass(frozen=True)
 class CaseResult:
-    """A case on the shipped scene: the curves of every metric, its optima (studies.scan.frequency_scans.scan_optimum),
-    the lobes of its metric, and from which frequency on nothing is crushed (None if it crushes to the
-    scan's end; only for a penetration metric)."""
+    """A case on the shipped scene: the curves of every metric, the optimum of its metric
+    (studies.scan.curve_optima.Optimum: main lobe, global maximum, every lobe), its first failed run's error,
+    and from which frequency on nothing is crushed (None if it crushes to the scan's end; only for a
+    penetration metric)."""
 
     case: Case
     metric: str
     curves: dict[str, list[float]]
-    optimum: dict[str, Any]
-    lobes: CurveOptimum
+    optimum: Optimum
+    error: str
     silent_from_hz: float | None
 
 
@@ -144,19 +156,19 @@ def load_reproduction(path: str | Path) -> Reproduction:
     """Read and validate a reproduction file; InputError naming the file and key otherwise."""
     path = Path(path)
     spec = parse(ReproductionSpec, read_yaml(path), str(path))
-    base = spec.base_scene_dict(path)
+    base = spec.base(path)
     for i, case in enumerate(spec.cases):
         for key in case.overrides:
             check_scene_path(str(path), f"cases.{i}.overrides", key, base)
+    string = base.model_dump(by_alias=True, exclude_none=True)["drill_string"]
     for i, variant in enumerate(spec.variants):
         for part, named in variant.add.items():
-            taken = sorted(set(named) & set(base["drill_string"][part]))
+            taken = sorted(set(named) & set(string[part]))
             if taken:
                 raise InputError(f"{path}: variants.{i}.add.{part}: {', '.join(taken)}: already in the base scene; "
                                  "change it with overrides")
-        extended = copy.deepcopy(base)
-        for part, named in variant.add.items():
-            extended["drill_string"][part].update(named)
+        added = {key: value for key, value in variant_changes(base, variant).items() if key not in variant.overrides}
+        extended = base.with_(added, f"{path}: variants.{i}.add")
         for key in variant.overrides:
             check_scene_path(str(path), f"variants.{i}.overrides", key, extended)
     return Reproduction(path, spec, base, spec.frequency_hz.expand())
@@ -174,29 +186,29 @@ def _silent_from_hz(frequencies_hz: list[float], values: list[float], main_hz: f
     return silent
 
 
-def reproduce(reproduction: Reproduction, runner: Runner) -> tuple[dict[str | None, list[CaseResult]], dict[str, Any]]:
+def scan_cases(reproduction: Reproduction, runner: Runner) -> tuple[dict[str | None, list[CaseResult]], dict[str, Any]]:
     """Scan every case of the shipped scene (key None) and of every variant (key: its label), all on the
     runner at once: the results, and what the scans cost."""
     spec, frequencies = reproduction.spec, reproduction.frequencies_hz
     variants: list[Variant | None] = [None, *spec.variants]
-    tasks = [((v, i), reproduction.scene(case, variant), list(spec.metrics), frequencies)
-             for v, variant in enumerate(variants) for i, case in enumerate(spec.cases)]
-    scans, cost = scan_all(runner, tasks)
-    return {None if variant is None else variant.label: _case_results(reproduction, [scans[(v, i)] for i in
-                                                                                     range(len(spec.cases))])
+    curves = [Curve((v, i), reproduction.base, reproduction.changes(case, variant), tuple(frequencies),
+                    tuple(spec.metrics)) for v, variant in enumerate(variants) for i, case in enumerate(spec.cases)]
+    runs, cost = run_all(runner, curves)
+    return {None if variant is None else variant.label: _case_results(reproduction, [runs[(v, i)] for i in
+                                                                                    range(len(spec.cases))])
             for v, variant in enumerate(variants)}, cost
 
 
-def _case_results(reproduction: Reproduction, scans: list[dict[str, Any]]) -> list[CaseResult]:
+def _case_results(reproduction: Reproduction, runs: list[Any]) -> list[CaseResult]:
     frequencies = reproduction.frequencies_hz
     results = []
-    for case, scan in zip(reproduction.spec.cases, scans, strict=True):
+    for case, run in zip(reproduction.spec.cases, runs, strict=True):
         metric = reproduction.metric(case)
-        optimum = scan_optimum(case.label, frequencies, scan, metric)
-        lobes = curve_optimum(frequencies, scan["values"][metric], scan["resonance_hz"])
-        silent = _silent_from_hz(frequencies, scan["values"][metric], optimum["main_hz"]) \
+        optimum = run.optimum(metric)
+        curves = {name: run.values(name) for name in reproduction.spec.metrics}
+        silent = _silent_from_hz(frequencies, curves[metric], optimum.optimum) \
             if metric in ("penetration_rate_m_per_s", "advance_per_blow_m") else None
-        results.append(CaseResult(case, metric, scan["values"], optimum, lobes, silent))
+        results.append(CaseResult(case, metric, curves, optimum, run.error, silent))
     return results
 
 
@@ -209,7 +221,7 @@ def within(value_hz: float | None, paper: PaperResult, tolerance: float) -> bool
 
 def trend_checks(reproduction: Reproduction, results: list[CaseResult]) -> list[dict[str, Any]]:
     """Per rising list: the main-lobe optima in order and whether they rise (the shortfalls if not)."""
-    optima = {r.case.label: r.optimum["main_hz"] for r in results}
+    optima = {r.case.label: r.optimum.optimum for r in results}
     return [{"cases": chain, "optima_hz": [optima[label] for label in chain],
              "shortfalls": rising_shortfalls([chain], optima),
              "rises": all(optima[label] is not None for label in chain) and not rising_shortfalls([chain], optima)}
@@ -220,11 +232,11 @@ def sub_harmonic_lobes(reproduction: Reproduction, results: list[CaseResult]) ->
     """The lobes of the ``sub_harmonics`` case, each with the rock-mode resonance f_r over its peak and the
     nearest whole number n: a lobe near f_r / n is driven in phase by every n-th blow."""
     result = next(r for r in results if r.case.label == reproduction.spec.sub_harmonics)
-    resonance = result.optimum["resonance_hz"]
+    resonance = result.optimum.resonance_hz
     lobes = []
-    for lobe in result.lobes.lobes:
-        ratio = resonance / lobe.peak_hz if resonance else math.nan
-        lobes.append({"peak_hz": lobe.peak_hz, "peak_value": lobe.peak_value, "band_50_hz": lobe.band_50_hz,
+    for lobe in result.optimum.lobes:
+        ratio = resonance / lobe.peak if resonance else math.nan
+        lobes.append({"peak_hz": lobe.peak, "peak_value": lobe.peak_value, "band_50_hz": lobe.band_50,
                       "resonance_over_peak": ratio, "nearest_n": round(ratio) if math.isfinite(ratio) else None,
-                      "main": lobe is result.lobes.main_lobe})
+                      "main": lobe is result.optimum.main_lobe})
     return lobes

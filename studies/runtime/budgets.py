@@ -15,9 +15,11 @@ that causes the cost, its value, the estimate and the option that allows it (``-
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from ...models.definition.scene import Scene
 from ...models.solvers.cost import Cause, RunCost, run_cost
 from ...models.solvers.simulation import Simulation
 from ..inputs.reading import InputError
@@ -89,10 +91,11 @@ class Budget:
 DEFAULT_BUDGET = Budget()
 
 
-def base_estimate_s(source: str, scene: dict[str, Any]) -> float:
-    """Estimated CPU seconds of a run of ``scene`` (0 when it does not prepare: its points will say why)."""
+def base_estimate_s(source: str, base: Scene, changes: Mapping[str, Any] | None = None) -> float:
+    """Estimated CPU seconds of a run of ``base`` with ``changes`` (0 when it does not prepare: its points
+    will say why)."""
     try:
-        return run_cost(prepare_point(source, scene, {})).cpu_s
+        return run_cost(prepare_point(base, {}, source, changes)).cpu_s
     except InputError:
         return 0.0
 

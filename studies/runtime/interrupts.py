@@ -60,7 +60,9 @@ def raise_if_stopped() -> None:
 def worker_ends_with_its_command() -> None:
     """In a pool worker: Ctrl-C is ignored (the command's process stops the run and ends its workers),
     SIGTERM ends it at once, and so does the end of the command's process however it ends (Linux:
-    PR_SET_PDEATHSIG), so that no worker outlives its run."""
+    PR_SET_PDEATHSIG, asked of the kernel through libc: no Python call sets it), so that no worker
+    outlives its run: tests/test_interrupts.py::test_a_killed_command_leaves_no_worker_in_the_middle_of_a_point
+    (without it the workers ran on after the kill)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if sys.platform.startswith("linux"):

@@ -1,82 +1,116 @@
-"""One scene of a study, an accuracy study or a calibration: prepared once, run by a worker.
+"""One point of an analysis: a typed scene made from a base scene and axis values, prepared, run.
 
-Every point is validated and prepared where it is made (models.solvers.simulation.prepare: the chain, the
-rock law, the solver settings, the initial state); workers receive the prepared simulation and
-build the formulation's model themselves (Exudyn systems cannot be pickled). A point's problems
-are tied to the scan axis that caused them when there is one.
+A point's scene is ``base.with_(values)`` (models.definition.scene.Scene.with_: validated, so that any
+scene key path the scene accepts is an axis), its problems tied to the axis that caused them when
+there is one (:func:`point_scene`). It is prepared once where it is made (models.solvers.simulation.prepare:
+the chain, the rock law, the solver settings, the initial state; studies.inputs.reading.prepare_scene);
+a worker receives the prepared simulation and builds the formulation's model itself (Exudyn systems
+cannot be pickled). :func:`run_point` runs it as its scene asks (models.steady.steady_run.run_scene: a time
+run, or its steady state) into one row of a results table: the columns :func:`point_columns` names, what
+the run returns (its status, the steady state's columns, the metrics). Points along an axis run in order
+(a curve, a continuation study's chain: :func:`run_followed`) start each periodic orbit's Newton from
+their neighbours' (models.steady.continuation).
 """
 
 from __future__ import annotations
 
+import math
 import time
+from collections.abc import Mapping, Sequence
 from typing import Any
 
-from pydantic import ValidationError
-
 from ...models.definition.scene import Scene
-from ...models.definition.validation import problem, short
+from ...models.definition.validation import short
 from ...models.evaluation.metrics import summary_metrics
 from ...models.evaluation.results import SimulationResult
-from ...models.evaluation.run_status import run_status
+from ...models.evaluation.run_status import STATUSES, run_status
 from ...models.solvers.simulation import Simulation
+from ...models.steady.continuation import Continuation, branch_point
 from ...models.steady.steady_run import OrbitGuess, regime_columns, run_scene
 from ..inputs.reading import InputError, prepare_scene
 
+# what a run returns besides its metrics, in the order of a results table's columns (the steady state's:
+# models.steady.steady_run.regime_columns)
+STATUS_COLUMNS = ("status", "error", "steady_state", "regime", "wall_time_s", "period_blows", "floquet_max_abs")
+# a finished point's status: ok; failed (its error says why); unstable, unsettled, not_finite or
+# unbalanced (metrics written, but the run's figures do not stand as they are: models.evaluation.run_status)
+FINISHED = ("failed", *STATUSES)
 
-def _point_error(source: str, error: ValidationError, parameters: dict[str, Any]) -> list[str]:
-    """Problems of one point, each tied to the scan axis that caused it when there is one."""
+
+def _point_errors(source: str, problems: Sequence[tuple[str, str]], values: Mapping[str, Any]) -> list[str]:
+    """Problems of one point, each tied to the axis that caused it when there is one."""
     lines = []
-    for item in error.errors():
-        loc = ".".join(str(p) for p in item["loc"] if p != "function-after")
-        related = [a for a in parameters if a == loc or a.startswith(loc + ".") or loc.startswith(a + ".")]
-        parent = loc.rpartition(".")[0]
+    for location, message in problems:
+        related = [a for a in values if a == location or a.startswith(location + ".") or location.startswith(a + ".")]
+        parent = location.rpartition(".")[0]
         if not related and parent:  # a check across keys (a pulse longer than the period): its sibling axes
-            related = [a for a in parameters if a.startswith(parent + ".")]
-        message = problem(item)
+            related = [a for a in values if a.startswith(parent + ".")]
         if len(related) == 1:
-            lines.append(f"{source}: scan.{related[0]}: {short(parameters[related[0]])}: {message}")
+            lines.append(f"{source}: scan.{related[0]}: {short(values[related[0]])}: {message}")
         else:
-            lines.append(f"{source}: {_point(parameters)}{loc or 'scene'}: {message}")
+            lines.append(f"{source}: {where(values)}{location or 'scene'}: {message}")
     return lines
 
 
-def _point(parameters: dict[str, Any]) -> str:
-    return f"scan point {parameters}: " if parameters else ""
+def where(values: Mapping[str, Any]) -> str:
+    """'scan point {...}: ' naming a point by its axis values in a message ('' without any)."""
+    return f"scan point {dict(values)}: " if values else ""
 
 
-def prepare_point(source: str, scene: dict[str, Any], parameters: dict[str, Any]) -> Simulation:
-    """Validate and prepare one point's scene; InputError naming the scan axis that made it invalid
-    (or the point), and when its formulation cannot run it (studies.inputs.reading.prepare_scene)."""
+def point_scene(base: Scene, values: Mapping[str, Any], source: str, fixed: Mapping[str, Any] | None = None) -> Scene:
+    """The point's scene: ``base.with_`` the ``fixed`` changes every point shares (its outputs, a
+    calibration's parameters), then its axis ``values`` (key path -> value); InputError naming ``source``
+    and the axis that made it invalid (or the point)."""
     try:
-        validated = Scene.model_validate(scene)
-    except ValidationError as error:
-        raise InputError("\n".join(_point_error(source, error, parameters))) from None
-    return prepare_scene(validated, source, _point(parameters))
+        return base.with_({**(fixed or {}), **values}, source)
+    except InputError as error:
+        if not error.problems or not values:
+            raise
+        raise InputError("\n".join(_point_errors(source, error.problems, values))) from None
 
 
-def run_prepared(key: Any, simulation: Simulation, guess: OrbitGuess | None = None, cold_newton: bool = True
+def prepare_point(base: Scene, values: Mapping[str, Any], source: str,
+                  fixed: Mapping[str, Any] | None = None) -> Simulation:
+    """:func:`point_scene`, prepared; InputError also when its formulation cannot run it."""
+    return prepare_scene(point_scene(base, values, source, fixed), source, where(values))
+
+
+def point_columns(metrics: Sequence[str]) -> list[str]:
+    """The columns of a point's row (:func:`run_point`) when ``metrics`` are asked for."""
+    return [*STATUS_COLUMNS, *metrics]
+
+
+def run_prepared(simulation: Simulation, guess: OrbitGuess | None = None, cold_newton: bool = True
                  ) -> tuple[dict[str, Any], SimulationResult | None]:
     """Run one prepared point as its scene asks (models.steady.steady_run.run_scene: a time run, or its
-    steady state from ``guess``, a neighbour's orbit) and collect its outputs' metrics, its status
-    (models.evaluation.run_status: ok, unstable, unsettled, not_finite or unbalanced, the reason in
-    ``error``) and its steady-state
-    columns (regime, period_blows, floquet_max_abs); a failure is returned, not raised. The outcome and
-    the run (None if it failed). ``cold_newton``: models.steady.steady_run.run_scene."""
+    steady state from ``guess``, a neighbour's orbit; ``cold_newton``: as there) into its row
+    (:func:`point_columns`): status (models.evaluation.run_status: ok, unstable, unsettled, not_finite or
+    unbalanced, the reason in ``error``; a steady state's note where the run is ok), the steady state's
+    columns, wall time and every metric of its outputs; a failure is returned (status ``failed``, the
+    exception in ``error``, no metrics), not raised. The row and the run (None if it failed)."""
     start = time.perf_counter()
     try:
         result = run_scene(simulation, guess, cold_newton=cold_newton)
         metrics = summary_metrics(result)
         status, why = run_status(result, metrics)
-    except Exception as err:  # noqa: BLE001 - one bad point is recorded and the study goes on
-        return {"point": key, "status": "failed", "error": f"{type(err).__name__}: {err}",
-                "wall_time_s": time.perf_counter() - start, "metrics": {}, **regime_columns(None),
-                "steady_state": simulation.scene.solver.steady_state}, None
+    except Exception as err:  # noqa: BLE001 - one bad point is recorded and the analysis goes on
+        return {"status": "failed", "error": f"{type(err).__name__}: {err}", **regime_columns(None),
+                "steady_state": simulation.scene.solver.steady_state, "wall_time_s": time.perf_counter() - start}, None
     if result.info.get("steady_state_note") and status == "ok":
         why = result.info["steady_state_note"]
-    return {"point": key, "status": status, "error": why, "wall_time_s": time.perf_counter() - start,
-            "metrics": metrics, **regime_columns(result)}, result
+    return {"status": status, "error": why, **regime_columns(result), "wall_time_s": time.perf_counter() - start,
+            **metrics}, result
 
 
-def run_point(task: tuple[Any, Simulation]) -> dict[str, Any]:
-    """Worker: run one prepared point ``(key, simulation)`` (:func:`run_prepared`)."""
-    return run_prepared(*task)[0]
+def run_point(simulation: Simulation) -> dict[str, Any]:
+    """Worker: one prepared point's row (:func:`run_prepared`)."""
+    return run_prepared(simulation)[0]
+
+
+def run_followed(branch: Continuation, value: float, simulation: Simulation) -> dict[str, Any]:
+    """One point of a sequence along an axis at ``value``, run after the points before it (module doc):
+    Newton from ``branch``'s prediction, which then takes this point's orbit (every point's, a failed
+    one's too, so that the passes of a chain align: models.steady.continuation). Its row."""
+    row, result = run_prepared(simulation, branch.guess(value), branch.cold_newton)
+    branch.add(branch_point(value, {} if result is None else result.info, row.get("advance_per_blow_m", math.nan)))
+    return row

@@ -40,8 +40,8 @@ from ..inputs.reading import InputError
 from .interrupts import WorkerLost, raise_if_stopped, worker_ends_with_its_command
 
 Arg = TypeVar("Arg")
-Result = TypeVar("Result")
-Runner = Callable[[Callable[[Arg], Result], Sequence[Arg]], Iterator[list[Result]]]
+Output = TypeVar("Output")
+Runner = Callable[[Callable[[Arg], Output], Sequence[Arg]], Iterator[list[Output]]]
 Caught = list[tuple[str, type[Warning], str, int]]
 
 # Child processes a Dask LocalCluster starts: one BLAS thread each (set before they load NumPy).
@@ -61,7 +61,7 @@ def batches(arguments: Sequence[Arg], workers: int) -> list[list[Arg]]:
     return [list(arguments[a:b]) for a, b in itertools.pairwise(bounds)]
 
 
-def run_batch(task: tuple[Callable[[Arg], Result], list[Arg]]) -> tuple[list[Result], Caught]:
+def run_batch(task: tuple[Callable[[Arg], Output], list[Arg]]) -> tuple[list[Output], Caught]:
     """Worker: ``function`` over one batch of arguments, and the warnings it issued (text, category,
     file, line)."""
     function, arguments = task
@@ -78,7 +78,7 @@ def start_process_worker() -> None:
     threadpool_limits(1)
 
 
-def sequential(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
+def sequential(function: Callable[[Arg], Output], arguments: Sequence[Arg]) -> Iterator[list[Output]]:
     """In this process, one after the other (each result its own batch)."""
     return ([function(argument)] for argument in arguments)
 
@@ -144,7 +144,7 @@ def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
     executors: list[ProcessPoolExecutor] = []
     registry: dict[Any, Any] = {}
 
-    def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
+    def run(function: Callable[[Arg], Output], arguments: Sequence[Arg]) -> Iterator[list[Output]]:
         if not executors:
             executors.append(ProcessPoolExecutor(max_workers=workers, initializer=start_process_worker))
         futures = [executors[0].submit(run_batch, (function, [argument])) for argument in arguments]
@@ -167,7 +167,9 @@ def _cancelled_futures_quiet() -> Iterator[None]:
     """While a pool lives: when a stop ends its workers (a Ctrl-C reaches the whole process group), the
     executor's management thread may set an exception on a future the stop already cancelled
     (InvalidStateError, a race inside concurrent.futures); that is the stop itself, not a failure, and
-    no traceback is printed for it. Any other exception of a thread reaches the previous hook."""
+    no traceback is printed for it. Any other exception of a thread reaches the previous hook (what it
+    prevents, and that it lets the others through: tests/test_interrupts.py::
+    test_the_cancelled_futures_race_of_a_stop_prints_no_traceback; nothing public silences that race)."""
     previous = threading.excepthook
 
     def hook(args: threading.ExceptHookArgs) -> None:
@@ -182,7 +184,10 @@ def _cancelled_futures_quiet() -> Iterator[None]:
 
 
 def _terminate_workers(executor: ProcessPoolExecutor) -> None:
-    """End the executor's worker processes now (SIGTERM), whatever they run."""
+    """End the executor's worker processes now (SIGTERM), whatever they run: Python 3.14's
+    ``terminate_workers``, before it the executor's own record of its processes (no public way to reach
+    them). Without it a stop waits for the points under way: tests/test_interrupts.py::
+    test_a_stop_does_not_wait_for_the_points_under_way."""
     terminate = getattr(executor, "terminate_workers", None)  # Python 3.14
     if terminate is not None:
         terminate()
@@ -226,7 +231,7 @@ def dask_pool(address: str | None = None, workers: int | None = None, option: st
         slots = sum(client.nthreads().values()) or 1
         registry: dict[Any, Any] = {}
 
-        def run(function: Callable[[Arg], Result], arguments: Sequence[Arg]) -> Iterator[list[Result]]:
+        def run(function: Callable[[Arg], Output], arguments: Sequence[Arg]) -> Iterator[list[Output]]:
             futures = client.map(run_batch, [(function, batch) for batch in batches(arguments, slots)], pure=False)
             return Completed(futures, dask_completed, client.cancel, registry, False)
 

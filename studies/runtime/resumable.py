@@ -3,54 +3,54 @@ and the provenance beside it.
 
 ``DIR/study.json`` records what produced the results (the study's hash, versions, the resolved
 study, every session); ``DIR/<table>.csv`` gets the rows of each batch of points as it finishes
-(studies.runtime.pools). A rerun
+(studies.runtime.pools; the file format and its reader: studies.runtime.tables). A rerun
 into the same directory keeps the complete rows (a row cut by a kill is dropped), runs only the
 points without one, and refuses a study whose hash differs. Failed points count as finished
 (their errors are in the table; delete their rows to retry them). Several tables run as one: their
 points go to the workers together, and a point whose scene equals another's (by resolved scene,
 studies.scan.study.Study.scene_keys: the formulations are deterministic; the paper's impulse scan repeats
-the frequency scan's 23 points at 220 kN) runs once, its outcome written to both.
+the frequency scan's 23 points at 220 kN) runs once, its outcome written to both. Each table comes
+back as a typed pandas DataFrame (studies.runtime.tables.read_table: what its file holds), one row a
+point in point order.
 
-A study is anything with ``spec.name``, ``source``, ``hash``, ``points`` (each with ``index`` and
-``parameters``) and ``resolved()``: studies.scan.study.Study and studies.accuracy.accuracy_study.AccuracyStudy.
+A study is anything with ``spec.name``, ``source``, ``hash``, ``points`` (each with ``index``, the
+``values`` its row starts with, and ``cpu_s``) and ``resolved()``: studies.scan.study.Study,
+studies.accuracy.accuracy_study.AccuracyStudy, studies.sensitivity.sensitivity_study.SensitivityStudy.
 """
 
 from __future__ import annotations
 
-import csv
 import importlib.metadata
-import io
 import json
-import math
 import sys
 import time
 import warnings
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from tqdm import tqdm
 
-from ...models.evaluation.run_status import STATUSES
 from ..inputs.reading import InputError, short
 from .budgets import duration
 from .interrupts import raise_if_stopped
 from .output_files import atomic_file, write_json
+from .point_runs import FINISHED
 from .pools import Runner
+from .tables import append_rows, cell_text, is_finite, read_table, read_text, write_rows
 
-STATUS_COLUMNS = ("status", "error", "steady_state", "regime", "wall_time_s", "period_blows", "floquet_max_abs")
-# a finished point's status: ok; failed (its error says why); unstable, unsettled, not_finite or
-# unbalanced (metrics written, but the run's figures do not stand as they are: models.evaluation.run_status)
-FINISHED = ("failed", *STATUSES)
+if TYPE_CHECKING:
+    import pandas as pd
+
 RECORD = "study.json"
-Row = dict[str, str]
+WALL_TIME_FORMAT = ".4g"
 
 
 class TablePoint(Protocol):
     index: int
-    parameters: dict[str, Any]
+    values: Mapping[str, Any]  # the cells its row starts with (a scan point's axis values)
     cpu_s: float  # estimated (models.solvers.cost)
 
 
@@ -126,90 +126,65 @@ def code_records(points: Sequence[Any]) -> dict[str, Any]:
     return records
 
 
-def _is_finite(text: str) -> bool:
-    try:
-        return math.isfinite(float(text))
-    except ValueError:
-        return False
-
-
-def damage(row: Row, columns: list[str], points: Sequence[TablePoint]) -> str | None:
+def damage(cells: list[str], header: list[str], columns: list[str], points: Sequence[TablePoint],
+           text: Sequence[str] = (), formats: Mapping[str, str] | None = None) -> str | None:
     """Why a finished row of a table is not one rpdrill wrote for its point (None: it is): its columns,
-    status and point index; its parameters those of the point; its wall time and every column after it
-    (the metrics) a finite number, or empty (rpdrill writes a metric that is not a finite number as empty:
-    an edited 'inf' is damage)."""
-    if list(row) != columns or None in row.values():
+    status and point index; its starting values those of the point (in the column's ``formats``); its
+    wall time and every column after it (the metrics) but the ``text`` ones a finite number, or empty
+    (rpdrill writes a value that is not a finite number as empty: an edited 'inf' is damage)."""
+    if header != columns or len(cells) != len(columns):
         return "not the table's columns"
+    row = dict(zip(columns, cells, strict=True))
     if not row["point"].isdigit() or int(row["point"]) >= len(points):
         return f"point {short(row['point'])}: not a point of the study"
     if row["status"] not in FINISHED:
         return f"status {short(row['status'])}: not one of {', '.join(FINISHED)}"
     point = points[int(row["point"])]
     for name in columns:
-        if name in point.parameters and row[name] != str(point.parameters[name]):
-            return f"{name} {short(row[name])}: the point's is {short(point.parameters[name])}"
-    numeric = columns[columns.index("wall_time_s"):] if "wall_time_s" in columns else []
-    bad = next((name for name in numeric if row[name] != "" and not _is_finite(row[name])), None)
+        if name in point.values and row[name] != cell_text(point.values[name], (formats or {}).get(name)):
+            return f"{name} {short(row[name])}: the point's is {short(point.values[name])}"
+    numeric = [name for name in columns[columns.index("wall_time_s"):] if name not in text] \
+        if "wall_time_s" in columns else []
+    bad = next((name for name in numeric if row[name] != "" and not is_finite(row[name])), None)
     return None if bad is None else f"{bad} {short(row[bad])}: not a finite number"
 
 
-def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint]) -> dict[int, Row]:
-    """Complete rows of earlier runs by point index; the file is rewritten with just those. A row cut
-    by a kill is dropped; a damaged or edited row (:func:`damage`) too, said once in a warning (its
-    point runs again)."""
-    rows: dict[int, Row] = {}
+def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint], text: Sequence[str] = (),
+                  formats: Mapping[str, str] | None = None) -> set[int]:
+    """The points of earlier runs with a complete row; the file is rewritten with just those rows, in
+    point order. A row cut by a kill is dropped; a damaged or edited row (:func:`damage`) too, said once
+    in a warning (its point runs again)."""
+    header, lines = read_text(path)
+    rows: dict[int, list[str]] = {}
     damaged: list[str] = []
-    try:
-        text = path.read_text(encoding="utf-8") if path.exists() else ""
-        for line, row in enumerate(csv.DictReader(io.StringIO(text[: text.rfind("\n") + 1], newline="")), 2):
-            why = damage(row, columns, points)
-            if why is None:
-                rows.setdefault(int(row["point"]), row)
-            else:
-                damaged.append(f"line {line}: {why}")
-    except (UnicodeDecodeError, csv.Error, OSError) as error:
-        why = error.strerror if isinstance(error, OSError) and error.strerror else error
-        raise InputError(f"--out: {path}: not a results table rpdrill wrote ({why}); use a new --out directory") \
-            from None
+    for line, cells in lines:
+        why = damage(cells, header, columns, points, text, formats)
+        if why is None:
+            rows.setdefault(int(cells[0]), cells)
+        else:
+            damaged.append(f"line {line}: {why}")
     if damaged:
         more = f" and {len(damaged) - 3} more" if len(damaged) > 3 else ""
         warnings.warn(f"{path}: {len(damaged)} row(s) damaged or edited, dropped and their points run again "
                       f"({'; '.join(damaged[:3])}{more})", stacklevel=2)
     with atomic_file(path) as handle:
-        writer = csv.DictWriter(handle, columns)
-        writer.writeheader()
-        writer.writerows(rows[i] for i in sorted(rows))
-    return rows
+        write_rows(handle, columns, [dict(zip(columns, rows[i], strict=True)) for i in sorted(rows)], {}, header=True)
+    return set(rows)
 
 
-def read_rows(path: Path) -> list[Row]:
-    with path.open(newline="", encoding="utf-8") as handle:
-        return list(csv.DictReader(handle))
-
-
-def result_row(point: TablePoint, outcome: dict[str, Any]) -> dict[str, Any]:
-    """A table row: the point, its parameters, status, error, wall time and the outcome's metrics (empty
-    where not a finite number: its status says so, models.evaluation.run_status)."""
-    return {"point": point.index, **point.parameters, "status": outcome["status"], "error": outcome["error"],
-            "steady_state": outcome.get("steady_state", ""), "regime": outcome.get("regime", ""),
-            "wall_time_s": f"{outcome['wall_time_s']:.4g}", "period_blows": cell(outcome.get("period_blows")),
-            "floquet_max_abs": cell(outcome.get("floquet_max_abs")), **{k: cell(v) for k, v in outcome["metrics"].items()}}
-
-
-def cell(value: Any) -> Any:
-    """A table's cell of a value: empty where it is not a finite number (NaN, infinite; also as text)."""
-    try:
-        return value if math.isfinite(float(value)) else ""
-    except (TypeError, ValueError):
-        return value
+def point_row(point: TablePoint, outcome: Mapping[str, Any]) -> dict[str, Any]:
+    """A table row: the point's index, its values, then what its run returned."""
+    return {"point": point.index, **point.values, **outcome}
 
 
 @dataclass
 class Table:
     """One study's points and where their results go: ``out/table`` with ``columns``; ``task(point)`` is
-    what ``worker`` receives, ``row(outcome)`` the table row of its outcome (default :func:`result_row`,
-    the outcome's ``point`` its index). ``scene_keys``: each point's scene, when points of equal keys
-    give equal results (module doc; the worker's outcome then names its point by index)."""
+    what ``worker`` receives, its outcome (column -> value: status, error, wall time, metrics) completed
+    into the point's row by ``row(point, outcome)`` (default :func:`point_row`). ``formats``: number
+    formats of columns in the file (wall time: 4 digits); ``text``: columns that hold text even where
+    they read as numbers or are empty (studies.runtime.tables.typed). ``scene_keys``: each point's scene,
+    when points of equal keys give equal results (module doc)."""
 
     study: ResumableStudy
     out: Path
@@ -217,11 +192,13 @@ class Table:
     columns: list[str]
     task: Callable[[TablePoint], Any]
     worker: Callable[[Any], dict[str, Any]]
-    row: Callable[[dict[str, Any]], dict[str, Any]] | None = None
+    row: Callable[[TablePoint, dict[str, Any]], dict[str, Any]] = point_row
+    formats: dict[str, str] = field(default_factory=dict)
+    text: Sequence[str] = ()
     scene_keys: Sequence[str] | None = None
 
-    def to_row(self, outcome: dict[str, Any]) -> dict[str, Any]:
-        return self.row(outcome) if self.row else result_row(self.study.points[outcome["point"]], outcome)
+    def number_formats(self) -> dict[str, str]:
+        return {"wall_time_s": WALL_TIME_FORMAT, **self.formats}
 
 
 def run_tagged(item: tuple[Callable[[Any], Any], int, Any]) -> tuple[int, Any]:
@@ -231,13 +208,15 @@ def run_tagged(item: tuple[Callable[[Any], Any], int, Any]) -> tuple[int, Any]:
 
 
 def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
-               finished: Callable[[int, list[Row]], None] = lambda index, rows: None) -> list[list[Row]]:
+               finished: Callable[[int, pd.DataFrame], None] = lambda index, table: None) -> list[pd.DataFrame]:
     """Run the points of every table without a finished row (module doc) in one call of ``runner``, so
     that the workers go from one study's points to the next without waiting; each batch's rows are
     appended to their tables as it completes; a point whose scene key equals another's runs once and
-    its outcome goes to both. ``finished(i, rows)`` is called as soon as table ``i`` is complete (in
-    this process, while the workers go on), with its rows in point order. Prints what it runs, shows
-    progress, records each table's session; returns every table's rows."""
+    its outcome goes to both. ``finished(i, table)`` is called as soon as table ``i`` is complete (in
+    this process, while the workers go on), with the table in point order. Prints what it runs, shows
+    progress, records each table's session; returns every table (typed DataFrames)."""
+    import pandas  # noqa: F401 - before the pool's workers start: forked, they have it for the tables they get
+
     label, run = runner
     records, remaining = [], []
     tasks: list[tuple[Callable[[Any], Any], int, Any]] = []
@@ -247,7 +226,7 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
         job.out.mkdir(parents=True, exist_ok=True)
         records.append(provenance(job.study, job.out, job.table))
         write_json(job.out / RECORD, records[-1])
-        done = finished_rows(job.out / job.table, job.columns, job.study.points)
+        done = finished_rows(job.out / job.table, job.columns, job.study.points, job.text, job.number_formats())
         todo = [p for p in job.study.points if p.index not in done]
         runs = []
         for point in todo:
@@ -262,15 +241,14 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
         same = f"{len(todo) - len(runs)} the same as another point (run once), " if len(runs) < len(todo) else ""
         print(f"{job.study.spec.name}: {len(job.study.points)} points, {len(done)} finished earlier, {same}running "
               f"{len(runs)} on {label} (estimated {duration(sum(p.cpu_s for p in runs))} of CPU)", file=sys.stderr)
-    rows: list[list[Row] | None] = [None] * len(tables)
+    frames: list[pd.DataFrame | None] = [None] * len(tables)
     ran, copied = [0] * len(tables), [0] * len(tables)  # points written: run for the table, or copied to it
     start = time.perf_counter()
 
     def complete(i: int, interrupted: bool = False) -> None:
-        rows[i] = _record_session(records[i], tables[i].out, tables[i].out / tables[i].table, label, ran[i],
-                                  copied[i], start, interrupted)
+        frames[i] = _record_session(records[i], tables[i], label, ran[i], copied[i], start, interrupted)
         if not interrupted:
-            finished(i, rows[i])
+            finished(i, frames[i])
 
     try:
         for i in range(len(tables)):
@@ -284,16 +262,16 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
                 first: dict[int, int] = {}  # per table: the outcomes of points run for it (the others copied)
                 for tag, outcome in batch:
                     for n, (i, index) in enumerate(targets[tag]):
-                        by_table.setdefault(i, []).append({**outcome, "point": index} if tables[i].scene_keys
-                                                          is not None else outcome)
+                        job = tables[i]
+                        by_table.setdefault(i, []).append(job.row(job.study.points[index], outcome))
                         first[i] = first.get(i, 0) + (n == 0)
-                for i, outcomes in by_table.items():  # a batch's rows, then one flush per table
-                    with (tables[i].out / tables[i].table).open("a", newline="", encoding="utf-8") as handle:
-                        csv.DictWriter(handle, tables[i].columns).writerows(map(tables[i].to_row, outcomes))
+                for i, rows in by_table.items():  # a batch's rows, then one flush per table
+                    job = tables[i]
+                    append_rows(job.out / job.table, job.columns, rows, job.number_formats())
                     ran[i] += first.get(i, 0)
-                    copied[i] += len(outcomes) - first.get(i, 0)
-                    remaining[i] -= len(outcomes)
-                    bar.update(len(outcomes))
+                    copied[i] += len(rows) - first.get(i, 0)
+                    remaining[i] -= len(rows)
+                    bar.update(len(rows))
                     if remaining[i] == 0:
                         complete(i)
 
@@ -308,27 +286,26 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
                 raise
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (studies.cli.main): the finished rows stay, the sessions are recorded
         for i in range(len(tables)):
-            if rows[i] is None:
+            if frames[i] is None:
                 complete(i, interrupted=True)
         raise
-    return [r for r in rows if r is not None]
+    return [frame for frame in frames if frame is not None]
 
 
-def run_points(study: ResumableStudy, out: Path, table: str, columns: list[str], task: Callable[[TablePoint], Any],
-               worker: Callable[[Any], dict[str, Any]], runner: tuple[str, Runner], quiet: bool,
-               row: Callable[[dict[str, Any]], dict[str, Any]] | None = None) -> list[Row]:
-    """:func:`run_tables` of one study: its rows."""
-    return run_tables([Table(study, out, table, columns, task, worker, row)], runner, quiet)[0]
+def run_points(table: Table, runner: tuple[str, Runner], quiet: bool) -> pd.DataFrame:
+    """:func:`run_tables` of one table: the typed table."""
+    return run_tables([table], runner, quiet)[0]
 
 
-def _record_session(record: dict[str, Any], out: Path, path: Path, label: str, ran: int, copied: int,
-                    start: float, interrupted: bool) -> list[Row]:
-    """Add this session (and every point's wall time) to the record in out/study.json; the rows in point
-    order (the table holds them in the order they finished)."""
-    rows = sorted(read_rows(path), key=lambda r: int(r["point"]))
+def _record_session(record: dict[str, Any], table: Table, label: str, ran: int, copied: int, start: float,
+                    interrupted: bool) -> pd.DataFrame:
+    """Add this session (and every point's wall time) to the record in out/study.json; the table as its
+    file holds it, in point order (the file holds the rows in the order they finished)."""
+    frame, out = read_table(table.out / table.table, table.text), table.out
     record["sessions"].append({"finished": datetime.now(timezone.utc).isoformat(timespec="seconds"),
                                "runner": label, "points_run": ran, "points_copied": copied,
                                "interrupted": interrupted, "wall_time_s": round(time.perf_counter() - start, 3)})
-    record["point_wall_time_s"] = {r["point"]: float(r["wall_time_s"]) for r in rows}
+    record["point_wall_time_s"] = {str(point): float(wall) for point, wall in zip(frame["point"], frame["wall_time_s"],
+                                                                                   strict=True)}
     write_json(out / RECORD, record)
-    return rows
+    return frame

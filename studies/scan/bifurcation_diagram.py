@@ -120,7 +120,7 @@ def bifurcation_data(base: Scene, axis: str, values: Sequence[float], settle_blo
     for value in values:
         frequency_hz = float(value) if axis == "impact.frequency_hz" else base.impact.frequency_hz
         scene = _scene(base, axis, value, end_time_s=settle_blows / frequency_hz, steady_state="time")
-        diagram.brute_force.append(blow_figures(prepare(scene).run(), last_blows, value))
+        diagram.brute_force.append(blow_figures(prepare(scene).solve(), last_blows, value))
     diagram.up = _followed(base, axis, values)
     diagram.down = _followed(base, axis, values[::-1])[::-1]
     diagram.period_one = _period_one(base, axis, values, next((f for f in diagram.up if f.regime == "period-1"), None))

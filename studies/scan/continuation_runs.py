@@ -17,13 +17,13 @@ from pathlib import Path
 from typing import Any
 
 from ...models.solvers.simulation import Simulation
-from ...models.steady.continuation import BranchPoint, Continuation, branch_point, changes, hysteresis
+from ...models.steady.continuation import BranchPoint, Continuation, changes, hysteresis
 from ..runtime.output_files import write_rows_csv
-from ..runtime.point_runs import run_prepared
+from ..runtime.point_runs import run_followed
 from ..runtime.pools import Runner
 from .study import Study, StudyPoint
 
-ChainTask = tuple[str, list[tuple[int, float, Simulation]], str]  # (axis, [(index, value, simulation)], metric)
+ChainTask = tuple[list[tuple[int, float, Simulation]], str]  # ([(index, value, simulation)], metric)
 
 
 def chains(study: Study) -> list[list[StudyPoint]]:
@@ -33,40 +33,32 @@ def chains(study: Study) -> list[list[StudyPoint]]:
     moving = set(study.zipped_with(axis))
     groups: dict[str, list[StudyPoint]] = {}
     for point in study.points:
-        key = repr(sorted((name, value) for name, value in point.parameters.items() if name not in moving))
+        key = repr(sorted((name, value) for name, value in point.values.items() if name not in moving))
         groups.setdefault(key, []).append(point)
-    return [sorted(group, key=lambda p: p.parameters[axis]) for group in groups.values()]
+    return [sorted(group, key=lambda p: p.values[axis]) for group in groups.values()]
 
 
-def _pass(axis: str, points: list[tuple[int, float, Simulation]], metric: str
-          ) -> tuple[list[dict[str, Any]], list[BranchPoint]]:
-    """One pass along the chain: each point's outcome (studies.runtime.point_runs.run_prepared) and orbit."""
-    branch, outcomes = Continuation(), []
-    for index, value, simulation in points:
-        outcome, result = run_prepared(index, simulation, branch.guess(value), branch.cold_newton)
-        outcomes.append(outcome)
-        advance = math.nan
-        if result is not None:
-            advance = outcome["metrics"].get("advance_per_blow_m", math.nan)
-        branch.add(branch_point(value, {} if result is None else result.info, advance))
-    return outcomes, branch.points
+def _pass(points: list[tuple[int, float, Simulation]]) -> tuple[list[dict[str, Any]], list[BranchPoint]]:
+    """One pass along the chain: each point's row (studies.runtime.point_runs.run_followed) and orbit."""
+    branch = Continuation()
+    return [run_followed(branch, value, simulation) for _, value, simulation in points], branch.points
 
 
 def follow_chain(task: ChainTask) -> dict[str, Any]:
-    """Worker: a chain up and down its axis (module doc): the outcomes of the pass up, both passes'
-    summaries, their changes and the hysteresis values."""
-    axis, points, metric = task
-    up, branch_up = _pass(axis, points, metric)
-    down, branch_down = _pass(axis, points[::-1], metric)
+    """Worker: a chain up and down its axis (module doc): the rows of the pass up by point index, both
+    passes' summaries, their changes and the hysteresis values."""
+    points, metric = task
+    up, branch_up = _pass(points)
+    down, branch_down = _pass(points[::-1])
     down, branch_down = down[::-1], branch_down[::-1]
 
     def summary(outcome: dict[str, Any]) -> dict[str, Any]:
         return {"regime": outcome.get("regime", ""), "period_blows": outcome.get("period_blows"),
-                "floquet_max_abs": outcome.get("floquet_max_abs"), metric: outcome["metrics"].get(metric, math.nan)}
+                "floquet_max_abs": outcome.get("floquet_max_abs"), metric: outcome.get(metric, math.nan)}
 
     found = [(direction, change) for direction, branch in (("up", branch_up), ("down", branch_down))
              for change in changes(branch)]
-    return {"outcomes": up, "passes": [(index, value, summary(a), summary(b))
+    return {"rows": {index: row for (index, _, _), row in zip(points, up, strict=True)}, "passes": [(index, value, summary(a), summary(b))
                                        for (index, value, _), a, b in zip(points, up, down, strict=True)],
             "changes": [(direction, c.kind, c.low, c.high, c.detail) for direction, c in found],
             "hysteresis": hysteresis(branch_up, branch_down)}
@@ -74,30 +66,30 @@ def follow_chain(task: ChainTask) -> dict[str, Any]:
 
 def follow_study(study: Study, out: Path, runner: tuple[str, Runner]) -> dict[int, dict[str, Any]]:
     """Every chain of the study followed on the runner (module doc); writes ``continuation.csv`` and
-    ``bifurcations.csv`` into ``out``; each point's outcome of the pass up, by point index."""
+    ``bifurcations.csv`` into ``out``; each point's row of the pass up, by point index."""
     axis, metric = study.continuation_axis, study.spec.metrics[0]
-    tasks = [(axis, [(p.index, p.parameters[axis], p.simulation) for p in chain], metric) for chain in chains(study)]
-    outcomes, passes, found = {}, [], []
+    tasks = [([(p.index, p.values[axis], p.simulation) for p in chain], metric) for chain in chains(study)]
+    rows, passes, found = {}, [], []
     for batch in runner[1](follow_chain, tasks) if tasks else ():
         for chained in batch:
-            outcomes.update({outcome["point"]: outcome for outcome in chained["outcomes"]})
+            rows.update(chained["rows"])
             for index, value, up, down in chained["passes"]:
-                others = {k: v for k, v in study.points[index].parameters.items() if k != axis}
+                others = {k: v for k, v in study.points[index].values.items() if k != axis}
                 passes.append({"point": index, axis: value, **others, **{f"{k}_up": v for k, v in up.items()},
                                **{f"{k}_down": v for k, v in down.items()}})
-            others = {k: v for k, v in study.points[chained["passes"][0][0]].parameters.items() if k != axis}
+            others = {k: v for k, v in study.points[chained["passes"][0][0]].values.items() if k != axis}
             found += [{**others, "pass": direction, "kind": kind, f"{axis}_from": low, f"{axis}_to": high,
                        "detail": detail} for direction, kind, low, high, detail in chained["changes"]]
             found += [{**others, "pass": "both", "kind": "hysteresis", f"{axis}_from": value, f"{axis}_to": value,
                        "detail": "the passes up and down end on different orbits"} for value in chained["hysteresis"]]
     out.mkdir(parents=True, exist_ok=True)
     write_rows_csv(out / "continuation.csv", sorted(passes, key=lambda row: row["point"]))
-    columns = [*[k for k in study.points[0].parameters if k != axis], "pass", "kind", f"{axis}_from", f"{axis}_to",
+    columns = [*[k for k in study.points[0].values if k != axis], "pass", "kind", f"{axis}_from", f"{axis}_to",
                "detail"]
     write_rows_csv(out / "bifurcations.csv", found, columns)
-    return outcomes
+    return rows
 
 
-def given_outcome(outcome: dict[str, Any]) -> dict[str, Any]:
-    """Worker of the results table of a continuation study: the outcome its chain gave (module doc)."""
-    return outcome
+def given_row(row: dict[str, Any]) -> dict[str, Any]:
+    """Worker of the results table of a continuation study: the row its chain gave (module doc)."""
+    return row

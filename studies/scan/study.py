@@ -4,9 +4,10 @@ A study names a ``base_scene`` (a file relative to the study file, or an inline 
 optional ``base_overrides`` (dotted path -> value, each replacing what is at that path, e.g.
 ``solver.end_time_s: 1.5`` or ``rock: {name: sandstone}``), the ``scan`` axes, how they
 ``combine`` (``grid``, ``zip``, or a list of groups zipped inside and crossed with each
-other), the ``metrics`` to collect and the ``plots`` to draw. Every point is prepared once, at load
-(studies.runtime.point_runs); the formulation is the scene's ``solver.formulation`` (e.g. ``base_overrides:
-{solver.formulation: exact}``).
+other), the ``metrics`` to collect and the ``plots`` to draw. Every point is a typed scene, the base
+scene with its axis values (``Scene.with_``: any scene key path is an axis), prepared once, at load
+(studies.runtime.point_runs); the formulation is the scene's ``solver.formulation`` (e.g.
+``base_overrides: {solver.formulation: exact}``).
 
 Example (``studies/paper/stiffness_scan.yaml`` has the full file)::
 
@@ -30,7 +31,6 @@ The end time is the study's choice: the paper scans set ``solver.end_time_s: 1.5
 
 from __future__ import annotations
 
-import copy
 import hashlib
 import itertools
 import json
@@ -42,22 +42,14 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, model_validator
 
 from ...models.definition.formulations import FORMULATIONS
-from ...models.definition.scene import Scene, switch_formulation
+from ...models.definition.scene import Scene
 from ...models.definition.validation import short
 from ...models.solvers.simulation import Simulation
 from ..inputs.arguments import check, choice_problem, file_problem, instance_problem, optional
 from ..inputs.reading import InputError, parse, read_yaml
-from ..inputs.specs import (
-    METRIC_NAMES,
-    Axis,
-    MetricName,
-    SceneSpec,
-    StrictSpec,
-    check_scene_path,
-    set_path,
-)
+from ..inputs.specs import METRIC_NAMES, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, BudgetError, base_estimate_s, check_size
-from ..runtime.point_runs import prepare_point
+from ..runtime.point_runs import prepare_point, where
 
 
 class Plot(StrictSpec):
@@ -105,29 +97,33 @@ class StudySpec(SceneSpec):
 
 @dataclass(frozen=True)
 class StudyPoint:
-    """One scene of a study: its index, its scan parameters, the prepared simulation and its
-    estimated CPU seconds (models.solvers.cost)."""
+    """One scene of a study: its index, its axis values (scene key path -> value), the prepared
+    simulation of ``base.with_(values)`` and its estimated CPU seconds (models.solvers.cost)."""
 
     index: int
-    parameters: dict[str, Any]
-    simulation: Simulation | None
+    values: dict[str, Any]
+    simulation: Simulation
     cpu_s: float
+
+    @property
+    def scene(self) -> Scene:
+        return self.simulation.scene
 
 
 @dataclass(frozen=True)
 class Study:
-    """A validated study with its resolved base scene and its expanded points."""
+    """A validated study with its base scene and its expanded points."""
 
     source: Path
     spec: StudySpec
-    base: dict[str, Any]
+    base: Scene
     axes: dict[str, list[Any]]
     points: list[StudyPoint]
 
     def resolved(self) -> dict[str, Any]:
         """The study with the base scene (overrides applied, defaults filled) and the axis values."""
         data = self.spec.model_dump(mode="json", by_alias=True)
-        data.update(base_scene=Scene.model_validate(self.base).model_dump(mode="json", by_alias=True), scan=self.axes)
+        data.update(base_scene=self.base.model_dump(mode="json", by_alias=True), scan=self.axes)
         return data
 
     @property
@@ -211,33 +207,30 @@ def load_study(path: str | Path, formulation: str | None = None, budget: Budget 
     path = Path(path)
     source = str(path)
     spec = parse(StudySpec, read_yaml(path), source)
-    base = spec.base_scene_dict(path)
+    base = spec.base(path)
     if formulation is not None:
-        base["solver"] = switch_formulation(base.get("solver", {}), formulation)
+        base = base.with_solver(formulation)
     for axis in spec.scan:
         check_scene_path(source, "scan", axis, base, value_only=True)
     if spec.continuation_axis is not None and spec.steady_state != "continuation":
         raise InputError(f"{source}: continuation_axis: {spec.continuation_axis!r}: only with steady_state: continuation")
     if spec.steady_state == "continuation":
         _check_continuation(spec, source)
-        base["solver"] = {**base.get("solver", {}), "steady_state": "periodic"}
+        base = base.with_({"solver.steady_state": "periodic"}, source)
     _check_rock_name_axis(spec, base, source)
     groups = _groups(spec, source)
     count = _point_count(groups, spec, source)
     outputs = {"outputs": {"metrics": list(spec.metrics)}}  # the model records only what these need
     what = f"scan: {count:.6g} points (" + ", ".join(f"scan.{n}: {a.count:.6g} values" for n, a in spec.scan.items()) + ")"
-    check_size(budget, source, what, count, base_estimate_s(source, {**base, **outputs}))
+    check_size(budget, source, what, count, base_estimate_s(source, base, outputs))
     axes = {name: axis.expand() for name, axis in spec.scan.items()}
     _check_distinct(axes, source)
     points, problems, bad_input = [], [], False
-    for index, parameters in enumerate(_combine(groups, axes)):
-        scene = copy.deepcopy(base)
-        for name, value in parameters.items():
-            set_path(scene, name, value)
+    for index, values in enumerate(_combine(groups, axes)):
         try:
-            simulation = prepare_point(source, {**scene, **outputs}, parameters)
-            cost = budget.check_run(simulation, source, f"scan point {parameters}: ")
-            points.append(StudyPoint(index, parameters, simulation, cost.cpu_s))
+            simulation = prepare_point(base, values, source, outputs)
+            cost = budget.check_run(simulation, source, where(values))
+            points.append(StudyPoint(index, values, simulation, cost.cpu_s))
         except (InputError, BudgetError) as error:
             bad_input |= isinstance(error, InputError)
             problems += [line for line in str(error).splitlines() if line not in problems]
@@ -259,16 +252,14 @@ def _check_continuation(spec: StudySpec, source: str) -> None:
         raise InputError(f"{source}: scan.{axis}: a continuation follows an axis of at least two numbers")
 
 
-def _check_rock_name_axis(spec: StudySpec, base: dict[str, Any], source: str) -> None:
+def _check_rock_name_axis(spec: StudySpec, base: Scene, source: str) -> None:
     """A scanned rock.name supplies the rock values only where the base rock gives none."""
     explicit = [k for k in ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n")
-                if k in base.get("rock", {}) and f"rock.{k}" not in spec.scan]
+                if getattr(base.rock, k) is not None and f"rock.{k}" not in spec.scan]
     if "rock.name" in spec.scan and explicit:
         raise InputError(f"{source}: scan.rock.name: the base rock sets {', '.join(explicit)}, which would "
                          "override every named rock; name the base rock only, e.g. "
                          "base_overrides: {rock: {name: sandstone}}")
-
-
 
 
 def _check_distinct(axes: dict[str, list[Any]], source: str) -> None:

@@ -6,7 +6,7 @@ from typing import Any
 
 from scenes import CRUSHING, scene_dict
 
-from rpdrill.models.definition.scene import Scene
+from rpdrill import Scene
 
 
 def _links(stiffness: tuple[float, float, float], damping: tuple[float, float, float]) -> dict[str, Any]:

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..advice.advice_search import FEED, FREQUENCY, Advice
 from ..display.catalogue import metric, parameter
-from .cell_maps import cell_map, no_result_patch
-from .figure_style import OKABE_ITO, plt, save
+from ..figures.cell_maps import cell_map, no_result_patch
+from ..figures.figure_style import OKABE_ITO, figure, save
+from .advice_search import FEED, FREQUENCY, Advice
 
 
 def _title(advice: Advice, what: str) -> str:
@@ -21,8 +21,8 @@ def _title(advice: Advice, what: str) -> str:
 def plot_curves(advice: Advice, path: Path) -> list[Path]:
     """One panel per parameter: the metric across its bounds, the others at the optimum."""
     y = metric(advice.metric)
-    fig, axes = plt.subplots(1, len(advice.slices), figsize=(4.2 * len(advice.slices), 3.8), sharey=True,
-                             squeeze=False, layout="constrained")
+    fig = figure(figsize=(4.2 * len(advice.slices), 3.8), layout="constrained")
+    axes = fig.subplots(1, len(advice.slices), sharey=True, squeeze=False)
     for ax, (path_, curve) in zip(axes[0], advice.slices.items()):
         x = parameter(path_)
         ax.axvspan(*x.display(np.array(curve["band_80"])), color=OKABE_ITO[2], alpha=0.25,
@@ -44,7 +44,8 @@ def plot_feed_map(advice: Advice, path: Path) -> list[Path]:
     """The metric over feed force and impact frequency; the best feed at each frequency and the optimum."""
     grid = advice.feed_map
     frequencies, feeds, z = grid[FREQUENCY], grid[FEED], np.array(grid["metric"], dtype=float)
-    fig, ax = plt.subplots(figsize=(9, 6), layout="constrained")
+    fig = figure(figsize=(9, 6), layout="constrained")
+    ax = fig.subplots()
     position = cell_map(fig, ax, frequencies, feeds, z, parameter(FREQUENCY), parameter(FEED), metric(advice.metric))
     best_feed = [position(f, feeds[int(np.argmax(column))]) for f, column in zip(frequencies, z.T, strict=True)
                  if np.any(column > 0)]

@@ -1,0 +1,6 @@
+"""The ``rpdrill`` command line as the tests run it: ``main(argv)`` in this process, returning the exit
+status (the program's entry point, imported here once so that the tests do not depend on where it lives)."""
+
+from rpdrill.studies.cli.main import COMMANDS, main
+
+__all__ = ["COMMANDS", "main"]
