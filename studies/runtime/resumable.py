@@ -215,8 +215,6 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
     its outcome goes to both. ``finished(i, table)`` is called as soon as table ``i`` is complete (in
     this process, while the workers go on), with the table in point order. Prints what it runs, shows
     progress, records each table's session; returns every table (typed DataFrames)."""
-    import pandas  # noqa: F401 - before the pool's workers start: forked, they have it for the tables they get
-
     label, run = runner
     records, remaining = [], []
     tasks: list[tuple[Callable[[Any], Any], int, Any]] = []

@@ -128,8 +128,6 @@ def run_curve(curve: Curve) -> CurveRun:
 def run_curves(runner: Runner, curves: Sequence[Curve]) -> Iterator[tuple[list[Any], CurveRun]]:
     """Run the curves on the runner, each distinct curve once (two may be the same); yields (the keys of
     the curves it answers, its run) as runs end."""
-    import pandas  # noqa: F401 - before the pool's workers start: forked, they have it for the tables they make
-
     keys: dict[str, list[Any]] = {}
     first: dict[str, Curve] = {}
     for curve in curves:
