@@ -1,6 +1,6 @@
 """What an extended drill gives (docs/extending.md, "What the model's services see"): the figures of issue 35.
 
-Usage: python benchmarks/bench_extensions.py [--parts clamp,solve,energy,rate_law,study,cost]
+Usage: python benchmarks/bench_extensions.py [--parts clamp,solve,energy,rate_law,study,cost,steady]
 Prints, on studies/scenes/paper_base.yaml over 0.5 s:
 
 * clamp: a 300 kg clamp on the collar (examples/clamp_extension.py: a Mass1D on its own Node1D and a
@@ -16,7 +16,12 @@ Prints, on studies/scenes/paper_base.yaml over 0.5 s:
 * study: a scan of the clamp's mass (three points) on two worker processes against the same points run one
   by one in this process (largest relative difference of the rate);
 * cost: CPU s of a run (median of 5, one BLAS thread; shared machine) of the plain scene and with the 1e9 N/m
-  clamp (the same step), and the CPU of sizing the step from the assembled system.
+  clamp (the same step), and the CPU of sizing the step from the assembled system;
+* steady (on tests/pipe_drill.yaml at 65 Hz, not part of the default parts): the periodic steady state
+  (Exudyn, standard preset) with a damped clamp (300 kg, 1e9 N/m, 2e4 N s/m) followed in the section
+  (models/steady/extension_section.py), against the last 10 of 200 blows of its time run, the clamp as a
+  scene body in the exact formulation's orbit, and the orbit with the clamp left out of the section (as
+  before: every map run restarts it at rest on the collar).
 """
 
 from __future__ import annotations
@@ -145,6 +150,36 @@ def cost() -> None:
     print(f"CPU s per run of 0.5 s: plain {plain:.3f}, with the 1e9 N/m clamp {clamped:.3f} "
           f"(steps {round(0.5 / prepare(SCENE).settings.step_s)} both); sizing the step from the assembled system "
           f"{sizing * 1e3:.2f} ms")
+
+
+def steady() -> None:
+    from rpdrill.models.steady import regimes
+
+    frequency = 65.0
+    joint = {"mass_kg": 300.0, "stiffness_n_per_m": 1e9, "damping_n_s_per_m": 2e4}
+    drill = rpdrill.load_scene(ROOT / "tests" / "pipe_drill.yaml").with_({
+        "solver.formulation": "exudyn", "impact.frequency_hz": frequency, "solver.steady_state": "periodic"})
+    clamped = drill.with_({"extensions": {"clamp": {"function": "clamp_extension:add_clamp", "parameters": joint}}})
+    start = time.process_time()
+    orbit = rpdrill.simulate(clamped)
+    cpu = time.process_time() - start
+    print(f"periodic, the clamp in the section: {rate(orbit) * 1e3:.6f} mm/s ({orbit.info['regime']}, |mu|max "
+          f"{orbit.info['floquet_max_abs']:.4f}, {orbit.info['map_runs']} map runs, {cpu:.2f} CPU s)")
+    time_run = rpdrill.simulate(clamped.with_({"solver.steady_state": "time", "solver.end_time_s": 200 / frequency,
+                                               "metrics.transient_blows": 190, "metrics.block_blows": 10}))
+    body = drill.with_({"solver.formulation": "exact", "drill_string.bodies.clamp": {"mass_kg": joint["mass_kg"]},
+                        "drill_string.connectors.clamp_joint": {"from": "collar", "to": "clamp", **{
+                            key: joint[key] for key in ("stiffness_n_per_m", "damping_n_s_per_m")}}})
+    exact = rpdrill.simulate(body)
+    with_extension_coordinates = regimes.with_extension_coordinates
+    regimes.with_extension_coordinates = lambda simulation: simulation  # the section without the clamp
+    try:
+        restarted = rpdrill.simulate(clamped)
+    finally:
+        regimes.with_extension_coordinates = with_extension_coordinates
+    for label, other in (("time run, last 10 of 200 blows", time_run), ("the clamp as a scene body, exact orbit", exact),
+                         ("the clamp left out of the section (restarted at rest every blow)", restarted)):
+        print(f"{label}: {rate(other) * 1e3:.6f} mm/s (relative to the orbit {rate(other) / rate(orbit) - 1:+.2e})")
 
 
 def main() -> None:

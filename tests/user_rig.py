@@ -1,7 +1,9 @@
 """What a user of rpdrill writes for their rig (the tests name it by import path, ``user_rig:NAME``):
 extensions (the clamps of examples/clamp_extension.py: a mass on its own Node1D held on a body by a
 coordinate spring-damper, and one with a spring-force user function and its declared energy terms; sensors
-of one's own) and rock laws of one's own (the paper's law under another name; one without a mode table)."""
+of one's own; an oscillator on ground; a loose mass, a step counter and an anchor to ground, which a steady
+state cannot follow) and
+rock laws of one's own (the paper's law under another name; one without a mode table)."""
 
 from __future__ import annotations
 
@@ -9,12 +11,20 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import exudyn
-from exudyn.itemInterface import SensorNode
+from exudyn.itemInterface import (
+    MarkerNodeCoordinate,
+    Node1D,
+    NodePointGround,
+    ObjectConnectorCoordinateSpringDamper,
+    ObjectMass1D,
+    SensorNode,
+)
 
 from examples.clamp_extension import add_clamp, add_friction_clamp  # the checkout's examples: a user's module
 from rpdrill.rocklaw import JenkinsRock
 
-__all__ = ["ForceOnlyRock", "RenamedJenkins", "add_clamp", "add_friction_clamp", "add_sensors"]
+__all__ = ["ForceOnlyRock", "RenamedJenkins", "add_anchor", "add_clamp", "add_friction_clamp", "add_ground_oscillator",
+           "add_loose_mass", "add_sensors", "add_step_counter"]
 
 
 def add_sensors(model, body: str = "bit") -> None:
@@ -24,6 +34,42 @@ def add_sensors(model, body: str = "bit") -> None:
 
 
 add_sensors.changes_motion = False  # rpdrill: the exact and ODE formulations may run a scene with it
+
+
+def add_loose_mass(model, mass_kg: float = 50.0) -> None:
+    """A Mass1D on its own Node1D, ``loose_mass``, that no spring holds (a free coordinate of one's own)."""
+    node = model.mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[0.0], initialVelocities=[0.0]))
+    model.mbs.AddObject(ObjectMass1D(nodeNumber=node, mass=mass_kg, name="loose_mass"))
+
+
+def add_step_counter(model) -> None:
+    """A per-step function of one's own (``model.add_pre_step``) that counts the steps: a state outside Exudyn's."""
+    steps = []
+    model.add_pre_step(lambda mbs, t: steps.append(t) is None)
+
+
+def add_ground_oscillator(model, mass_kg: float = 10.0, stiffness_n_per_m: float = 1.0e4,
+                          damping_n_s_per_m: float = 100.0) -> None:
+    """A Mass1D, ``oscillator``, on a spring-damper to ground, tied to nothing of the drill (a reference of
+    one's own): coordinates that change no motion of the drill and do not move with it."""
+    mbs = model.mbs
+    node = mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[1e-3], initialVelocities=[0.0]))
+    mbs.AddObject(ObjectMass1D(nodeNumber=node, mass=mass_kg, name="oscillator"))
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
+    mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
+        markerNumbers=[ground, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0))],
+        stiffness=stiffness_n_per_m, damping=damping_n_s_per_m, name="oscillator_spring"))
+
+
+add_ground_oscillator.changes_motion = False  # rpdrill: the exact formulation may run a scene with it
+
+
+def add_anchor(model, stiffness_n_per_m: float, body: str = "collar") -> None:
+    """A coordinate spring, ``anchor``, from ground to ``body`` (no coordinates of its own)."""
+    mbs = model.mbs
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
+    mbs.AddObject(ObjectConnectorCoordinateSpringDamper(markerNumbers=[ground, model.bodies[body].marker_coordinate],
+                                                        stiffness=stiffness_n_per_m, name="anchor"))
 
 
 @dataclass(frozen=True)

@@ -70,6 +70,9 @@ class SimulationResult:
     # a scene with wave rods: the rods' ends at the samples, per-blow section figures, rigid joints' forces
     # (models.waves.record.WaveRecord)
     waves: Any = None
+    # the ODE2 coordinates an Exudyn model's extensions add, where a steady-state run follows them
+    # (Simulation.extension_coordinates): samples x (their positions, then their velocities)
+    extension_state: np.ndarray | None = None
 
     @property
     def scene(self) -> Scene:

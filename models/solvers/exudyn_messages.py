@@ -20,6 +20,18 @@ from ..evaluation.stability import SimulationFailed
 if TYPE_CHECKING:
     from .simulation import Simulation
 
+SOLVER_TYPES = {  # the scene's solver.type as Exudyn's DynamicSolverType
+    "rk67": exu.DynamicSolverType.RK67,
+    "rk44": exu.DynamicSolverType.RK44,
+    "rk33": exu.DynamicSolverType.RK33,
+    "explicit_midpoint": exu.DynamicSolverType.ExplicitMidpoint,
+    "explicit_euler": exu.DynamicSolverType.ExplicitEuler,
+    "generalized_alpha": exu.DynamicSolverType.GeneralizedAlpha,
+    "trapezoidal_index2": exu.DynamicSolverType.TrapezoidalIndex2,
+    "dopri5": exu.DynamicSolverType.DOPRI5,
+    "ode23": exu.DynamicSolverType.ODE23,
+}
+
 
 @contextlib.contextmanager
 def no_cyclic_gc() -> Iterator[None]:

@@ -69,6 +69,7 @@ from ..evaluation.stability import StepLimitWarning, check_result, step_warning
 from ..waves.exudyn_waves import WaveExudyn
 from .exudyn_graphics import DrillGraphics, body_graphics, chain_cylinders, torsion_graphics
 from .exudyn_messages import (
+    SOLVER_TYPES,
     MinimumStepGuard,
     exudyn_messages_as_warnings,
     no_cyclic_gc,
@@ -80,15 +81,16 @@ from .exudyn_messages import (
 )
 from .exudyn_piston import ExudynPiston
 from .exudyn_user_items import (
-    SOLVER_TYPES,
     EnergyTerm,
     ExudynBody,
     ExudynConnector,
     UserAccount,
     add_body,
     assembled_scales,
+    follow_extension_coordinates,
     item_counts,
     link_force_function,
+    time_runs_only,
     user_outcome,
 )
 from .simulation import Simulation, as_simulation, prepare, solver_settings
@@ -136,6 +138,7 @@ class ExudynModel:
     _foreign: Any = None  # a pre-step function of the user's, set on mbs, run after the model's
     solution_path: Path | None = None
     waves: WaveExudyn | None = None  # wave rods: the element updated before every step (models.waves.exudyn_waves)
+    extension_sensors: list[Any] = field(default_factory=list)  # models.solvers.exudyn_user_items
 
     def __post_init__(self) -> None:
         self._account = UserAccount(*(self._built_items[kind] for kind in ("objects", "loads", "sensors")))
@@ -159,7 +162,8 @@ class ExudynModel:
     def settings(self) -> Any:
         """Exudyn's simulation settings of the run, its step sized for the system as assembled now
         (:meth:`prepare`): ``exu.SolveDynamic(model.mbs, model.settings, solverType=model.solver_type)``
-        runs what :meth:`run` runs."""
+        runs what :meth:`run` runs (InputError as :meth:`run`'s)."""
+        time_runs_only(self.simulation)
         self.prepare()
         return self._settings
 
@@ -236,7 +240,9 @@ class ExudynModel:
 
     def run(self, progress: Callable[[float], None] | None = None) -> Result:
         """Run the system (with any items added) by the scene's solver settings; ``progress(t)`` about
-        100 times. The result is ``rpdrill.Result``, as ``rpdrill.simulate`` returns; a model runs once."""
+        100 times. The result is ``rpdrill.Result``, as ``rpdrill.simulate`` returns; a model runs once.
+        InputError for a scene that asks for ``solver.steady_state: periodic``: a built model runs in time."""
+        time_runs_only(self.simulation)
         raw = self.solve(progress)  # the step may change with what was added: the simulation after the run
         return Result(self.simulation.scene, raw, {"source": "build_exudyn", **self.simulation.code_records()})
 
@@ -252,7 +258,8 @@ class ExudynModel:
                                  "state) with a symbolic one, which cannot run beside them; add it with "
                                  "model.add_pre_step(function) instead")
             self._foreign = replaced["function"]
-        settings = self.settings  # prepared for what was added
+        self.prepare()  # for what was added
+        settings = self._settings
         guard = None
         if self.simulation.settings.type in AUTOMATIC_STEP_SOLVERS:
             guard = MinimumStepGuard(settings.timeIntegration.minimumStepSize)
@@ -278,7 +285,8 @@ class ExudynModel:
         """The result of a run by Exudyn's own ``exu.SolveDynamic(model.mbs, model.settings, ...)`` (as
         :meth:`run` returns it). RuntimeError when the system has not run, or when a function set with
         ``mbs.SetPreStepUserFunction`` replaced the model's per-step functions (the rock's state never
-        moved): add such a function with ``model.add_pre_step`` instead."""
+        moved): add such a function with ``model.add_pre_step`` instead; InputError as :meth:`run`'s."""
+        time_runs_only(self.simulation)
         if self.mbs.systemData.GetTime() <= 0:
             raise RuntimeError("model.result(): the system has not run; call model.run() or "
                                "exu.SolveDynamic(model.mbs, model.settings, solverType=model.solver_type) first")
@@ -316,7 +324,6 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
         model = WaveExudyn(simulation, symbolic).model(ExudynModel, ExudynBody, ExudynConnector,
                                                        simulation_settings(simulation), named)
         _apply_extensions(model)
-        model.prepare()
         return model
     chain, impact, piston = simulation.dynamic_chain, simulation.impact, simulation.piston
     initial_positions = simulation.initial_positions_m if piston is None else piston.parked(simulation.initial_positions_m)
@@ -417,12 +424,12 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
                         torsion, drawn, sensors, simulation_settings(simulation), [impact_function, *user_functions],
                         blows, hook, named, symbolic, _built_items=item_counts(mbs), _prepared_items=item_counts(mbs))
     _apply_extensions(model)
-    model.prepare()
     return model
 
 
 def _apply_extensions(model: ExudynModel) -> None:
-    """The scene's extensions (models.definition.extensions) applied to the built model."""
+    """The scene's extensions (models.definition.extensions) applied to the built model, which is then
+    prepared (the coordinates they add followed where a steady-state run asks)."""
     simulation = model.simulation
     for name, extension in (simulation.scene.extensions or {}).items():
         try:
@@ -430,6 +437,7 @@ def _apply_extensions(model: ExudynModel) -> None:
         except Exception as error:
             raise ExtensionFailed(f"scene '{simulation.name}': extensions.{name} ({extension.function}) failed on the "
                                   f"built model: {type(error).__name__}: {error}") from error
+    follow_extension_coordinates(model)  # model.prepare(), the coordinates a steady-state run follows with it
 
 
 class ExtensionFailed(RuntimeError):
@@ -446,7 +454,7 @@ def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
     """The solved system's sensors read into a result (module doc), checked (models.evaluation.stability)."""
     if model.waves is not None:
         result = model.waves.finish(ok, cpu)
-        extra, result.user_energy, result.user_series = user_outcome(model, result.time_s)
+        extra, result.user_energy, result.user_series, result.extension_state = user_outcome(model, result.time_s)
         result.info.update(extra)
         return result
     simulation, mbs = model.simulation, model.mbs
@@ -462,27 +470,18 @@ def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
     rock_state = model.rock.state_at(time_s)
     info: dict[str, Any] = {"solver_success": ok, "coordinates": model.coordinate_count,
                             **({"fresh_fractions": model.blows.fresh_fractions} if model.blows else {})}
-    extra, energy, series = user_outcome(model, time_s)
+    extra, energy, series, extension = user_outcome(model, time_s)
     info.update(extra)
     result = SimulationResult(
-        simulation=simulation,
-        formulation="exudyn",
-        time_s=time_s,
-        position_m=position,
-        velocity_m_per_s=velocity,
+        simulation=simulation, formulation="exudyn", time_s=time_s, position_m=position, velocity_m_per_s=velocity,
         bottom_m=rock_state[:, model.rock.rock.bottom_index],
         rock_force_n=data["rock"][:, 1] if "rock" in data else None,
         impact_force_n=(data["impact"][:, 1] if piston is None else piston.contact_force_n) if "impact" in data
         else None,
         torsion_angle_rad=data["phi"][:, 1] if "phi" in data else None,
         torsion_rate_rad_per_s=data["omega"][:, 1] if "omega" in data else None,
-        cpu_time_s=cpu,
-        info=info,
-        bottom_events=(history[:, 0], history[:, 1]),
-        rock_state_m=rock_state,
-        piston=piston,
-        user_energy=energy,
-        user_series=series,
+        cpu_time_s=cpu, info=info, bottom_events=(history[:, 0], history[:, 1]), rock_state_m=rock_state,
+        piston=piston, user_energy=energy, user_series=series, extension_state=extension,
     )
     check_result(result, solver_ok=ok, reached_s=reached_s)
     return result

@@ -45,22 +45,11 @@ from exudyn.itemInterface import (
 )
 from exudyn.solver import ComputeLinearizedSystem
 
+from ..definition.validation import InputError
 from ..drill.chain import Link
 from ..evaluation.results import UserEnergy
 from ..evaluation.solver_settings import StepScales
 from ..evaluation.stability import scales_of, second_order_eigenvalues_per_s
-
-SOLVER_TYPES = {
-    "rk67": exu.DynamicSolverType.RK67,
-    "rk44": exu.DynamicSolverType.RK44,
-    "rk33": exu.DynamicSolverType.RK33,
-    "explicit_midpoint": exu.DynamicSolverType.ExplicitMidpoint,
-    "explicit_euler": exu.DynamicSolverType.ExplicitEuler,
-    "generalized_alpha": exu.DynamicSolverType.GeneralizedAlpha,
-    "trapezoidal_index2": exu.DynamicSolverType.TrapezoidalIndex2,
-    "dopri5": exu.DynamicSolverType.DOPRI5,
-    "ode23": exu.DynamicSolverType.ODE23,
-}
 
 
 @dataclass(frozen=True)
@@ -119,10 +108,11 @@ def label(item: dict[str, Any], kind: str, index: int) -> str:
     return f"{type_name} {item['name']!r} ({kind} {index})"
 
 
-def assembled_eigenvalues_per_s(mbs: Any, settings: Any, switched: Sequence[Any],
-                                stamps: Sequence[tuple[Any, Any, float, float]]) -> np.ndarray:
-    """The eigenvalues of the assembled system (module doc): ``switched`` the objects left out of Exudyn's
-    linearisation, ``stamps`` (node a or None for ground, node b, stiffness, damping) put in instead."""
+def linearised_system(mbs: Any, settings: Any, switched: Sequence[Any], stamps: Sequence[tuple[Any, Any, float, float]]
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(M, K, D, the constraints' Jacobian: empty without constraints) of the assembled system linearised by
+    Exudyn (module doc): ``switched`` the objects left out of the linearisation, ``stamps`` (node a or None
+    for ground, node b, stiffness, damping) put in instead."""
     active = {item: mbs.GetObjectParameter(item, "activeConnector") for item in switched}
     try:
         for item in switched:
@@ -141,26 +131,40 @@ def assembled_eigenvalues_per_s(mbs: Any, settings: Any, switched: Sequence[Any]
             direction[mbs.GetNodeODE2Index(node_a)] -= 1.0
         stiffness += k * np.outer(direction, direction)
         damping += c * np.outer(direction, direction)
-    jacobian = np.asarray(jacobian, dtype=float)
+    return np.asarray(mass, dtype=float), stiffness, damping, np.asarray(jacobian, dtype=float)
+
+
+def assembled_eigenvalues_per_s(mbs: Any, settings: Any, switched: Sequence[Any],
+                                stamps: Sequence[tuple[Any, Any, float, float]]) -> np.ndarray:
+    """The eigenvalues of the assembled system (module doc, :func:`linearised_system`); constraints of one's
+    own projected out (the null space of their Jacobian)."""
+    mass, stiffness, damping, jacobian = linearised_system(mbs, settings, switched, stamps)
     if jacobian.size and np.any(jacobian):  # constraints of one's own: their null space
         basis = null_space(jacobian.T)
-        mass, stiffness, damping = (basis.T @ matrix @ basis for matrix in (np.asarray(mass), stiffness, damping))
-    return second_order_eigenvalues_per_s(np.asarray(mass, dtype=float), stiffness, damping)
+        mass, stiffness, damping = (basis.T @ matrix @ basis for matrix in (mass, stiffness, damping))
+    return second_order_eigenvalues_per_s(mass, stiffness, damping)
+
+
+def closed_chain(model: Any, rock: bool = True) -> tuple[list[Any], list[tuple[Any, Any, float, float]]]:
+    """What a built model's linearisation switches off and stamps in instead (:func:`linearised_system`):
+    the rock, at its stiffest slope on the bit (``rock`` False: left out), and every nonlinear link of the
+    chain, closed."""
+    law = model.rock.rock
+    nonlinear = [c for c in model.connectors.values() if not c.link.linear]
+    nodes = [body.node for body in model.bodies.values()]
+    stamps = [(None, nodes[model.chain.bit_body], max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m),
+               law.damping_n_s_per_m)] if rock else []
+    stamps += [(None if c.link.body_a is None else nodes[c.link.body_a], nodes[c.link.body_b],
+                c.link.stiffness_n_per_m, c.link.damping_n_s_per_m) for c in nonlinear]
+    return [model.rock.object, *(c.object for c in nonlinear)], stamps
 
 
 def assembled_scales(model: Any) -> StepScales:
     """The step scales (models.evaluation.solver_settings.StepScales) of a built model's system as assembled
     now (:func:`assembled_eigenvalues_per_s`): the rock at its stiffest slope on the bit, every nonlinear
-    link of the chain closed."""
+    link of the chain closed (:func:`closed_chain`)."""
     law = model.rock.rock
-    nonlinear = [c for c in model.connectors.values() if not c.link.linear]
-    nodes = [body.node for body in model.bodies.values()]
-    stamps = [(None, nodes[model.chain.bit_body], max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m),
-               law.damping_n_s_per_m)]
-    stamps += [(None if c.link.body_a is None else nodes[c.link.body_a], nodes[c.link.body_b],
-                c.link.stiffness_n_per_m, c.link.damping_n_s_per_m) for c in nonlinear]
-    eigenvalues = assembled_eigenvalues_per_s(model.mbs, model._settings,
-                                              [model.rock.object, *(c.object for c in nonlinear)], stamps)
+    eigenvalues = assembled_eigenvalues_per_s(model.mbs, model._settings, *closed_chain(model))
     scales = scales_of(eigenvalues, model.simulation.impact.period_s,
                        law.damping_n_s_per_m / model.chain.bodies[model.chain.bit_body].mass_kg)
     if not np.isfinite(scales.spectral_radius_per_s):
@@ -169,15 +173,86 @@ def assembled_scales(model: Any) -> StepScales:
     return scales
 
 
+def extension_nodes(model: Any) -> list[tuple[int, list[int]]]:
+    """The nodes added to a built model after its build (by its extensions, or by a user) that have ODE2
+    coordinates: (node, its coordinates' global ODE2 indices) in the order of the nodes."""
+    mbs, found = model.mbs, []
+    for node in range(model.built_items["nodes"], mbs.systemData.NumberOfNodes()):
+        if "Ground" in mbs.GetNode(node)["nodeType"]:
+            continue
+        indices = [int(i) for i in mbs.systemData.GetNodeLTGODE2(node)]
+        if indices:
+            found.append((node, indices))
+    return found
+
+
+def follow_extension_coordinates(model: Any) -> None:
+    """Prepare a built model (``model.prepare``) with the ODE2 coordinates its extensions add followed, where
+    its simulation asks (Simulation.extension_coordinates, a steady-state run): a sensor of the values and
+    one of the rates of each such node (the model's own: not among the user's series), and their start
+    (Exudyn's initial configuration, set after the last assembly)."""
+    followed = model.simulation.extension_coordinates
+    if followed is None:
+        model.prepare()
+        return
+    nodes = extension_nodes(model)
+    indices = [i for _, node_indices in nodes for i in node_indices]
+    if len(indices) != len(followed.drift):
+        raise ValueError(f"scene '{model.simulation.name}': the extensions added {len(indices)} ODE2 coordinates, "
+                         f"not the {len(followed.drift)} the steady-state section holds")
+    for node, _ in nodes:
+        model.extension_sensors += [model._account.own_sensor(model.mbs, SensorNode(
+            nodeNumber=node, storeInternal=True, writeToFile=False, outputVariableType=output))
+            for output in (OUTPUT.Coordinates, OUTPUT.Coordinates_t)]
+    model.prepare()
+    if followed.start is not None:
+        data, initial, count = model.mbs.systemData, exu.ConfigurationType.Initial, len(indices)
+        for values, read, write in ((followed.start[:count], data.GetODE2Coordinates, data.SetODE2Coordinates),
+                                    (followed.start[count:], data.GetODE2Coordinates_t, data.SetODE2Coordinates_t)):
+            state = np.array(read(configuration=initial))
+            state[indices] = values
+            write(state, configuration=initial)
+
+
+def initial_coordinates(model: Any, indices: list[int]) -> np.ndarray:
+    """The ODE2 coordinates ``indices`` of a prepared model's start (Exudyn's initial configuration): their
+    positions, then their velocities."""
+    data, initial = model.mbs.systemData, exu.ConfigurationType.Initial
+    return np.concatenate([np.asarray(data.GetODE2Coordinates(configuration=initial))[indices],
+                           np.asarray(data.GetODE2Coordinates_t(configuration=initial))[indices]])
+
+
+def extension_history(model: Any, time_s: np.ndarray) -> np.ndarray | None:
+    """The followed extension coordinates (:func:`follow_extension_coordinates`) at ``time_s``: samples x
+    (positions, then velocities); None where none are followed."""
+    if not model.extension_sensors:
+        return None
+    values = [_read(model, sensor, time_s) for sensor in model.extension_sensors]
+    return np.hstack(values[0::2] + values[1::2])
+
+
+def time_runs_only(simulation: Any) -> None:
+    """InputError when a built model's scene asks for ``solver.steady_state: periodic``: a built model (and
+    what a user adds to it) runs in time; the steady state of a scene is rpdrill.simulate's, with the items
+    given as an extension, whose coordinates it follows (models.steady.extension_section)."""
+    if simulation.scene.solver.steady_state == "periodic":
+        raise InputError(f"scene '{simulation.name}': solver.steady_state: 'periodic': a built model runs in time "
+                         "(model.run(), exu.SolveDynamic), so it would not be the periodic orbit the scene asks for; "
+                         "give the items you add as an extension of the scene and run rpdrill.simulate(scene) for "
+                         "its orbit (docs/extending.md), or set solver.steady_state: time for a time run")
+
+
 USER_ITEMS_NOTE = ("items added to model.mbs are seen only by the Exudyn formulation (the exact and ODE "
                    "formulations know the scene's drill only); the step, the energy account and the time series "
                    "take them in")
 
 
-def user_outcome(model: Any, time_s: np.ndarray) -> tuple[dict[str, Any], UserEnergy | None, dict[str, np.ndarray]]:
+def user_outcome(model: Any, time_s: np.ndarray) -> tuple[dict[str, Any], UserEnergy | None, dict[str, np.ndarray],
+                                                       np.ndarray | None]:
     """What a run of a model with items of one's own adds to its result: the info (``exudyn_model``: the
     items, the extensions, the step they were given; ``energy_account``: what is accounted for and what is
-    not), the items' energy, and the user's sensors by name."""
+    not), the items' energy, the user's sensors by name, and the extension coordinates a steady-state run
+    follows (:func:`extension_history`)."""
     mbs, account, simulation = model.mbs, model._account, model.simulation
     added = model.user_items()
     sensors = [i for i in range(account.first_sensor, mbs.systemData.NumberOfSensors()) if i not in account.own_sensors]
@@ -199,7 +274,7 @@ def user_outcome(model: Any, time_s: np.ndarray) -> tuple[dict[str, Any], UserEn
             info["energy_account"]["note"] = (
                 "energy_balance_relative_error is not a number: these items of one's own have no energy account "
                 "(declare their energy with model.add_energy_term, docs/extending.md)")
-    return info, energy, series
+    return info, energy, series, extension_history(model, time_s)
 
 
 @dataclass(frozen=True)
@@ -241,7 +316,8 @@ class UserAccount:
         counts["sensors"] -= len(self.own_sensors)
         return {kind: counts[kind] - built[kind] for kind in counts if counts[kind] != built[kind]}
 
-    def _sensor(self, mbs: Any, sensor: Any) -> Any:
+    def own_sensor(self, mbs: Any, sensor: Any) -> Any:
+        """Add a sensor of the model's own (not among the user's items or series)."""
         index = mbs.AddSensor(sensor)
         self.own_sensors.add(int(index))
         return index
@@ -279,14 +355,14 @@ class UserAccount:
             self._load(mbs, name, item)
 
     def _mass(self, mbs: Any, name: str, item: dict[str, Any], key: str, output: Any) -> None:
-        sensor = self._sensor(mbs, SensorNode(nodeNumber=item["nodeNumber"], storeInternal=True, writeToFile=False,
+        sensor = self.own_sensor(mbs, SensorNode(nodeNumber=item["nodeNumber"], storeInternal=True, writeToFile=False,
                                               outputVariableType=output))
         inertia = float(item[key])
         self._parts.append((name, "stored", lambda m, t: 0.5 * inertia * np.sum(_read(m, sensor, t) ** 2, axis=1)))
 
     def _spring(self, mbs: Any, name: str, index: int, item: dict[str, Any]) -> None:
         def sensor(output: Any) -> Any:
-            return self._sensor(mbs, SensorObject(objectNumber=index, storeInternal=True, writeToFile=False,
+            return self.own_sensor(mbs, SensorObject(objectNumber=index, storeInternal=True, writeToFile=False,
                                                   outputVariableType=output))
         if not item.get("activeConnector", True):
             return
@@ -319,11 +395,11 @@ class UserAccount:
             node = mbs.GetNode(marker["nodeNumber"])
             if node["nodeType"] == "PointGround":
                 return
-            sensor = self._sensor(mbs, SensorNode(nodeNumber=marker["nodeNumber"], storeInternal=True,
+            sensor = self.own_sensor(mbs, SensorNode(nodeNumber=marker["nodeNumber"], storeInternal=True,
                                                   writeToFile=False, outputVariableType=OUTPUT.Coordinates))
             load, column = np.array([float(item["load"])]), [marker["coordinate"]]
         else:
-            sensor = self._sensor(mbs, SensorMarker(markerNumber=item["markerNumber"], storeInternal=True,
+            sensor = self.own_sensor(mbs, SensorMarker(markerNumber=item["markerNumber"], storeInternal=True,
                                                     writeToFile=False, outputVariableType=OUTPUT.Position))
             load, column = np.asarray(item["loadVector"], dtype=float), [0, 1, 2]
 

@@ -63,6 +63,19 @@ class SceneError(ValueError):
 
 
 @dataclass(frozen=True)
+class ExtensionCoordinates:
+    """The ODE2 coordinates an Exudyn model's extensions add, as a steady-state run follows them
+    (models.steady.extension_section): a label each, their ``drift`` with the hole (the shift of each when the
+    whole drill moves by one: 1 for a position that moves with it, 0 for one that does not) and their
+    ``start`` (positions, then velocities; None: as the extensions make them). The Exudyn model records them
+    (SimulationResult.extension_state) and starts them there."""
+
+    labels: tuple[str, ...]
+    drift: tuple[float, ...]
+    start: tuple[float, ...] | None = None
+
+
+@dataclass(frozen=True)
 class Simulation:
     """A scene prepared for a run (module doc)."""
 
@@ -82,6 +95,7 @@ class Simulation:
     # a start in motion (models.steady: a periodic orbit's state at a blow start); None and 0: at rest
     initial_velocities_m_per_s: np.ndarray | None = None
     initial_torsion_rate_rad_per_s: float = 0.0
+    extension_coordinates: ExtensionCoordinates | None = None  # followed by a steady-state run (Exudyn only)
 
     @property
     def initial_velocities(self) -> np.ndarray:

@@ -1,7 +1,7 @@
 """What one run of an n-blow map gives (:class:`MapRun`) and how a run starts from a section state.
 
 :func:`started_at` is the prepared simulation with its start moved to a section state y (models.steady.section:
-positions, velocities, rock states, torsion angle and rate) and its end time to n blow periods: every
+positions, velocities, rock states, torsion angle and rate, an Exudyn scene's extension coordinates) and its end time to n blow periods: every
 formulation starts from the simulation's initial fields (models.solvers.simulation), so the Exudyn model,
 the ODE and the exact formulation all run it as they run a scene; :func:`end_state` reads y back from a
 result.
@@ -49,12 +49,16 @@ def started_at(simulation: Simulation, y: np.ndarray, blows: int, outputs: bool 
     scene = scene.model_copy(update={
         "solver": scene.solver.model_copy(update={"end_time_s": end_s}),
         "metrics": Metrics.model_construct(transient_blows=0, block_blows=blows)})
-    torsion = y[2 * n + states:] if section.torsion else (simulation.initial_torsion_angle_rad, 0.0)
+    tail = 2 * n + states + 2 * section.torsion
+    torsion = y[2 * n + states:tail] if section.torsion else (simulation.initial_torsion_angle_rad, 0.0)
+    followed = simulation.extension_coordinates  # an Exudyn scene's extensions' coordinates, their start
+    followed = followed if followed is None else replace(followed, start=tuple(float(v) for v in y[tail:]))
     changed = replace(
         simulation, scene=scene, settings=replace(simulation.settings, end_time_s=end_s),
         initial_positions_m=np.array(y[:n]), initial_velocities_m_per_s=np.array(y[n:2 * n]),
         initial_rock_state=tuple(float(v) for v in y[2 * n:2 * n + states]),
-        initial_torsion_angle_rad=float(torsion[0]), initial_torsion_rate_rad_per_s=float(torsion[1]))
+        initial_torsion_angle_rad=float(torsion[0]), initial_torsion_rate_rad_per_s=float(torsion[1]),
+        extension_coordinates=followed)
     if not outputs:
         changed = replace(changed, outputs=simulation.outputs.model_copy(update={"metrics": [], "timeseries": []}))
     return changed
@@ -68,6 +72,7 @@ def end_state(result: SimulationResult, time_s: float | None = None) -> np.ndarr
     torsion = result.torsion_angle_rad is not None
     columns = [result.position_m, result.velocity_m_per_s, np.column_stack(result.rock_states())]
     columns += [result.torsion_angle_rad[:, None], result.torsion_rate_rad_per_s[:, None]] if torsion else []
+    columns += [result.extension_state] if result.extension_state is not None else []
     table = np.hstack(columns)
     if time_s is None:
         y, t = table[-1].copy(), float(result.time_s[-1])

@@ -34,9 +34,9 @@ import numpy as np
 
 from ..evaluation.results import SimulationResult
 from ..evaluation.stability import SimulationFailed
-from ..solvers.exact_system import unsupported as exact_unsupported
-from ..solvers.simulation import Simulation, prepare
+from ..solvers.simulation import Simulation, prepare, unsupported
 from .exact_map import ExactPeriodMap, exact_period_map
+from .extension_section import with_extension_coordinates
 from .formulation_map import FormulationMap
 from .map_runs import end_state, started_at
 from .section import drift_problem, section_of
@@ -64,8 +64,9 @@ def newton_tolerance(simulation: Simulation) -> float:
 
 
 def exact_available(simulation: Simulation) -> bool:
-    """Whether the exact formulation runs this scene (its matrices and exits declared)."""
-    return exact_unsupported(simulation) is None
+    """Whether the exact formulation runs this scene (its matrices and exits declared, no extension that
+    changes the motion: the exact model of a scene with a clamp of one's own would be another drill)."""
+    return unsupported("exact", simulation) is None
 
 
 def as_exact(simulation: Simulation) -> Simulation:
@@ -90,8 +91,10 @@ def start_state(simulation: Simulation) -> np.ndarray:
     section = section_of(simulation)
     n = section.bodies
     torsion = [simulation.initial_torsion_angle_rad, simulation.initial_torsion_rate_rad_per_s] if section.torsion else []
-    return np.concatenate([simulation.initial_positions_m, simulation.initial_velocities,
-                           simulation.initial_rock_state, torsion])[:2 * n + section.rock_states + 2 * section.torsion]
+    followed = simulation.extension_coordinates
+    extension = [] if followed is None else followed.start
+    return np.concatenate([simulation.initial_positions_m[:n], simulation.initial_velocities[:n],
+                           simulation.initial_rock_state, torsion, extension])
 
 
 def repeating_period(simulation: Simulation, states: list[np.ndarray], longest: int = MAX_PERIOD_BLOWS
@@ -122,9 +125,13 @@ class RegimeFinder:
         problem = drift_problem(simulation)
         if problem:
             raise SteadyStateUnavailable(problem)
+        simulation = with_extension_coordinates(simulation)  # an Exudyn scene's extensions' coordinates
         self.simulation, self.section = simulation, section_of(simulation)
         self.exact = simulation.settings.formulation == "exact"
-        self.guide = None if self.exact or not exact_available(simulation) else RegimeFinder(as_exact(simulation))
+        # the exact model guides where it runs the scene and the section is its own (not where an extension
+        # said to change no motion still adds coordinates: the exact model does not hold them)
+        self.guide = None if self.exact or not exact_available(simulation) or simulation.extension_coordinates \
+            else RegimeFinder(as_exact(simulation))
         self.maps: dict[int, PeriodMap] = {}
         self.runs = 0
         self.unstable: list[Orbit] = []

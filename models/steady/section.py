@@ -4,12 +4,13 @@ A drilling drill does not return to its state: it advances. What repeats is its 
 bottom. At a blow start (just before any blow-start reset: models.drill.indexing, models.drill.piston) the
 physical state is
 
-    y = (x (n string bodies), v (n), rock states (r), [phi, omega])
+    y = (x (n string bodies), v (n), rock states (r), [phi, omega], [q_u (m), q_u' (m)])
 
-(the exact formulation's layout without its augmented part, models.solvers.exact_system.Layout). Shifting
-every body and every rock state that is a length (a name ending in ``_m``: the bottom, the bilinear
-law's surface) by the same a, y -> y + a e, changes nothing in the equations when no spring holds a
-body to ground: the drill drifts. The section coordinates are then z = y - y_bottom e with the bottom
+(the exact formulation's layout without its augmented part, models.solvers.exact_system.Layout; q_u the
+ODE2 coordinates an Exudyn scene's extensions add: models.steady.extension_section). Shifting every body
+and every rock state that is a length (a name ending in ``_m``: the bottom, the bilinear law's surface),
+and each extension coordinate by its drift e_u, by the same a, y -> y + a e, changes nothing in the
+equations when no spring holds a body to ground: the drill drifts. The section coordinates are then z = y - y_bottom e with the bottom
 entry dropped (d - 1 numbers); a periodic orbit of n blows is a fixed point z = P_n(z) of the n-blow
 map, and the bottom's change over it is the advance of n blows.
 
@@ -38,6 +39,7 @@ class Section:
     torsion: bool
     bottom: int  # index of the borehole bottom in y
     shift: np.ndarray  # e (d)
+    extension: int = 0  # m, the extensions' coordinates (models.steady.extension_section)
 
     @property
     def size(self) -> int:
@@ -68,25 +70,36 @@ class Section:
 
     def labels(self, simulation: Simulation) -> list[str]:
         """A name for every entry of z (positions and the rock's lengths relative to the bottom)."""
+        labels = self.state_labels(simulation)
+        del labels[self.bottom]
+        return labels
+
+    def state_labels(self, simulation: Simulation) -> list[str]:
+        """A name for every entry of y (an extension's coordinates in their own units: a length or an angle)."""
         names = [body.name for body in simulation.chain.bodies]
         labels = [f"{name}_position_m" for name in names] + [f"{name}_velocity_m_per_s" for name in names]
         labels += list(simulation.rock.state_names)
         labels += ["torsion_angle_rad", "torsion_rate_rad_per_s"] if self.torsion else []
-        del labels[self.bottom]
+        followed = simulation.extension_coordinates
+        names = () if followed is None else followed.labels
+        labels += [f"{name}_position" for name in names] + [f"{name}_velocity" for name in names]
         return labels
 
 
 def section_of(simulation: Simulation) -> Section:
     """The section of ``simulation`` (module doc)."""
-    rock = simulation.rock
-    return _section(simulation.chain.size, rock.state_names, rock.bottom_index, simulation.torsion is not None)
+    rock, followed = simulation.rock, simulation.extension_coordinates
+    return _section(simulation.chain.size, rock.state_names, rock.bottom_index, simulation.torsion is not None,
+                    () if followed is None else followed.drift)
 
 
 @lru_cache(maxsize=64)
-def _section(n: int, state_names: tuple[str, ...], bottom_index: int, torsion: bool) -> Section:
+def _section(n: int, state_names: tuple[str, ...], bottom_index: int, torsion: bool,
+             extension_drift: tuple[float, ...]) -> Section:
     lengths = [name.endswith(LENGTH_SUFFIX) for name in state_names]
-    shift = np.concatenate([np.ones(n), np.zeros(n), np.array(lengths, dtype=float), np.zeros(2 * torsion)])
-    return Section(n, len(state_names), torsion, 2 * n + bottom_index, shift)
+    shift = np.concatenate([np.ones(n), np.zeros(n), np.array(lengths, dtype=float), np.zeros(2 * torsion),
+                            extension_drift, np.zeros(len(extension_drift))])
+    return Section(n, len(state_names), torsion, 2 * n + bottom_index, shift, len(extension_drift))
 
 
 def physical_state(simulation: Simulation, w: np.ndarray) -> np.ndarray:

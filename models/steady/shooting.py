@@ -118,7 +118,7 @@ def scales(simulation: Simulation, section: Section, z: np.ndarray) -> np.ndarra
 def floors(simulation: Simulation, section: Section) -> np.ndarray:
     """The floor of each section coordinate's scale: lengths the rock's crushing penetration (F_th / k_n;
     else 1e-4 m), velocities that length x 2 pi f, other rock states (forces) the threshold, the torsion
-    angle 1e-3 rad and its rate 1e-3 rad x 2 pi f."""
+    angle 1e-3 rad and its rate 1e-3 rad x 2 pi f, an extension's coordinates and rates as the bodies'."""
     rock = simulation.rock
     length = rock.crushing_penetration_m if 0.0 < rock.crushing_penetration_m < math.inf else 1e-4
     omega = 2.0 * math.pi * simulation.impact.frequency_hz
@@ -127,6 +127,7 @@ def floors(simulation: Simulation, section: Section) -> np.ndarray:
     values = [length] * n + [length * omega] * n
     values += [length if shift else threshold for shift in section.shift[2 * n:2 * n + section.rock_states]]
     values += [1e-3, 1e-3 * omega] if section.torsion else []
+    values += [length] * section.extension + [length * omega] * section.extension  # as the bodies'
     return np.array(values)[section.kept]
 
 

@@ -11,7 +11,8 @@ Every result's ``info`` then holds ``steady_state`` (what the scene asked for), 
 ``period-n``, ``no periodic orbit found``, or ``time run``), ``period_blows`` (n, or None),
 ``floquet_max_abs`` (max |mu| of the orbit; NaN without one), and with an orbit its ``floquet_multipliers``
 ([re, im] each), ``event_sequence`` (the modes entered over one orbit), ``orbit_state`` (its section state:
-a neighbour's Newton guess), ``newton_iterations``, ``map_runs``, ``jacobian`` and ``steady_state_note``
+a neighbour's Newton guess; an Exudyn scene's extension coordinates last) and ``orbit_state_labels`` (a name
+for each entry), ``newton_iterations``, ``map_runs``, ``jacobian`` and ``steady_state_note``
 (the unstable orbits met, or why none was found). :func:`regime_columns` gives the first four as a results
 table's columns.
 """
@@ -87,7 +88,7 @@ def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
             state = finder.find(*(guess or (None, 1))) if guess is not None or cold_newton else \
                 SteadyState(NONE_FOUND, None)
             if state.orbit is None:  # step 2: the period its time run repeats (models.steady.regimes)
-                time_run = simulation.solve(progress)
+                time_run = finder.simulation.solve(progress)  # (an extension's coordinates recorded)
                 state = finder.settled(time_run, state)
     except SteadyStateUnavailable as why:
         state = SteadyState(NONE_FOUND, None, note=str(why))
@@ -105,7 +106,8 @@ def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
     result.cpu_time_s = time.process_time() - start
     result.info.update(steady_state="periodic", **orbit_info(state))
     if state.orbit is not None:
-        result.info["orbit_residual"] = orbit_residual(simulation, state.orbit, end)
+        result.info["orbit_residual"] = orbit_residual(finder.simulation, state.orbit, end)
+        result.info["orbit_state_labels"] = section_of(finder.simulation).state_labels(finder.simulation)
     return result
 
 
