@@ -160,7 +160,7 @@ def modules(presets: list[str], repeats: int, rounds: int = 3) -> None:
     for _ in range(rounds):
         for module, runs in measured.items():
             environment = {k: v for k, v in os.environ.items() if k != "EXUDYN_MODULE"}
-            environment["EXUDYN_MODULE"] = module  # "fast": as the rpdrill command runs (rocklaw.exudyn_build)
+            environment["EXUDYN_MODULE"] = module  # "fast": as the rpdrill command runs (studies.cli.main.choose_exudyn_build)
             child = subprocess.run([sys.executable, __file__, "--presets", ",".join(presets), "--repeats",
                                     str(repeats), "--one-module"], env=environment, check=True,
                                    capture_output=True, text=True)

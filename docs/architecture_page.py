@@ -110,7 +110,8 @@ FREQUENCY_PATH = (
      ("prepared once (`models.solvers.simulation.prepare`): the `Simulation` holds the scene's `impact` and a "
      "solver step fitted to its period `impact.period_s`; the prepared object goes to a worker as it is")),
     ("studies.runtime.point_runs", "run_point",
-     ("in the worker: `Simulation.run`, the formulation (exact, Exudyn, ODE) placing the blows every "
+     ("in the worker: `models.steady.steady_run.run_scene`, the time run (`Simulation.solve`) or the periodic "
+     "orbit the scene asks for, the formulation (exact, Exudyn, ODE) placing the blows every "
      "`impact.period_s` (`models.drill.pulse`); the row it returns holds floats")),
     ("studies.runtime.resumable", "run_tables",
      ("the row appended to `results.csv` (`studies.runtime.tables.append_rows`: text only in the file) and "

@@ -3,7 +3,7 @@
 progress=None)`` (``progress(t)`` as simulated time advances) and, if it cannot run every scene,
 ``unsupported(simulation) -> str | None``, there or in the lighter ``checks`` module the registry names
 (the exact formulation's exact_system: a study checks its points before any run without loading the
-compiled kernels); models.solvers.simulation calls them (``Simulation.run``, ``unsupported``)."""
+compiled kernels); models.solvers.simulation calls them (``Simulation.solve``, ``unsupported``)."""
 
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ as built, the solver settings of the scene's formulation (an accuracy preset res
 or tolerances), the initial state (rest, or the static preload), and the indexing model (the
 ``indexing`` effect: models.drill.indexing) whose blow starts every formulation applies. Every formulation, the metrics,
 the energy account and the stability checks read these fields; nothing derives them again.
-:meth:`Simulation.run` dispatches through the formulation registry (models.definition.formulations).
+:meth:`Simulation.solve` dispatches through the formulation registry (models.definition.formulations).
 """
 
 from __future__ import annotations
