@@ -122,7 +122,7 @@ class WaveExudyn:
         self._couple(symbolic)
         mbs.Assemble()
         self.exudyn_links = [link for _, link in self.connectors.values()]
-        self.pulse_on_body = chain.impact_body in self.bodies and impact.piston is None
+        self.pulse_on_body = self.stepper.pulse_outside = chain.impact_body in self.bodies and impact.piston is None
         self.last_powers: np.ndarray | None = None
         self.indices = np.array([mbs.GetNodeODE2Index(self.bodies[i][0]) for i in kinematic], dtype=int)
         self.velocity_index = [self.stepper.layout.velocity[i] for i in kinematic]

@@ -55,5 +55,5 @@ def power_forms(stepper, key: Key) -> np.ndarray:
             rods += power
             if p in stepper.own_ports:  # a body's ports: the Exudyn element's works
                 internal += power
-    impact = pair(stepper.impact_row(key), velocity[chain.impact_body])
+    impact = np.zeros((m, m)) if stepper.pulse_outside else pair(stepper.impact_row(key), velocity[chain.impact_body])
     return np.array([impact, internal, rock, rods, piston])
