@@ -9,6 +9,7 @@ file format of the studies use it.
 from __future__ import annotations
 
 import copy
+import functools
 import re
 import types
 import typing
@@ -65,6 +66,7 @@ def _field(model: type[BaseModel], key: Any) -> Any:
     return next((f for name, f in model.model_fields.items() if key in (name, f.alias)), None)
 
 
+@functools.cache  # a pure function of a model class and a key path: each path's walk done once
 def _parent_model(model: type[BaseModel], location: tuple[Any, ...]) -> type[BaseModel] | str | None:
     """The model that holds the last key of ``location`` inside ``model`` (None if not a model there;
     :data:`FREE` inside a mapping of plain values, where any key goes).
