@@ -1,5 +1,6 @@
-"""Cost of the core Exudyn model: CPU s per simulated second, symbolic vs Python user functions,
-and the accuracy of x_n(0.3 s) against step size.
+"""Cost of the core Exudyn model: CPU s per simulated second, symbolic vs Python user functions, the
+build of the system with and without the bodies' graphics, and the accuracy of x_n(0.3 s) against step
+size.
 
 Usage: python benchmarks/bench_core.py [SCENE.yaml] [--repeats N]
 Prints medians over N repeats and ratios measured in this one run (the machine is shared).
@@ -9,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import time
 from pathlib import Path
 
 from rpdrill.models.definition.scene import Scene
@@ -31,6 +33,17 @@ def cpu_per_simulated_second(scene: Scene, repeats: int, symbolic: bool = True) 
     return statistics.median(runs) / scene.solver.end_time_s
 
 
+def build_cpu_s(scene: Scene, repeats: int, graphics: bool) -> float:
+    """Median CPU seconds of building (not running) the scene's Exudyn system."""
+    simulation = prepare(scene)
+    times = []
+    for _ in range(repeats):
+        start = time.process_time()
+        exudyn_model.build_exudyn(simulation, graphics=graphics)
+        times.append(time.process_time() - start)
+    return statistics.median(times)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scene", nargs="?", default=ROOT / "studies" / "scenes" / "paper_base.yaml")
@@ -45,6 +58,9 @@ def main() -> None:
     print(f"symbolic user functions: {symbolic:.3f} CPU s per simulated s (median of {args.repeats})")
     print(f"python user functions:   {python:.3f} CPU s per simulated s")
     print(f"ratio python / symbolic: {python / symbolic:.2f}")
+    drawn, bare = (build_cpu_s(timing, 10 * args.repeats, graphics) for graphics in (True, False))
+    print(f"build of the system: {drawn * 1e3:.1f} ms with the bodies' graphics (rpdrill.build_exudyn), "
+          f"{bare * 1e3:.1f} ms without (a run's own system; median of {10 * args.repeats})")
 
     reference_step = step / 32
     reference = prepare(with_solver(scene, end_time_s=0.3, step_s=reference_step)).solve().bottom_m[-1]

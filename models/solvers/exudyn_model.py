@@ -309,12 +309,15 @@ def _exudyn_simulation(run: Scene | Simulation) -> tuple[Simulation, str]:
     return simulation, named
 
 
-def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
+def build_exudyn(run: Scene | Simulation, symbolic: bool = True, graphics: bool = True) -> ExudynModel:
     """The drill of a scene (or prepared simulation) as an assembled Exudyn system, not yet run
     (:class:`ExudynModel`); ``model.run()`` runs it. A scene of another formulation is built for Exudyn.
 
     ``symbolic=False`` uses Python callbacks for the impact and rock forces (same law, slower:
-    kept for the benchmark that measures what the symbolic functions save).
+    kept for the benchmark that measures what the symbolic functions save). ``graphics=False`` leaves out
+    the bodies' cylinders (models.solvers.exudyn_graphics), which only a renderer shows: a system no one
+    can see (:func:`simulate`'s) is built without them (the paper drill's build: 16.3 ms with them, 1.2 ms
+    without; ``python benchmarks/bench_core.py``).
     """
     if not isinstance(run, (Scene, Simulation)):
         raise InputError(f"rpdrill.build_exudyn: run: {short(run)}: give a rpdrill.Scene (rpdrill.load_scene) or a "
@@ -338,7 +341,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     velocities = np.pad(simulation.initial_velocities, (0, chain.size - simulation.chain.size))  # a piston's: 0
     for body, cylinder, initial, speed in zip(chain.bodies, chain_cylinders(shapes, chain), initial_positions, velocities,
                                               strict=True):
-        shown = VObjectMass1D(graphicsData=body_graphics(cylinder, cylinder.group in rods))
+        shown = VObjectMass1D(graphicsData=body_graphics(cylinder, cylinder.group in rods) if graphics else [])
         bodies.append(add_body(mbs, body.name, lambda n, m=body.mass_kg, x=cylinder.centre_m, v=shown: mbs.AddObject(
             ObjectMass1D(nodeNumber=n, mass=m, referencePosition=[x, 0.0, 0.0], visualization=v)), initial, speed))
         if body.constant_force_n:
@@ -372,7 +375,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True) -> ExudynModel:
     torsion = None
     if tor is not None:  # before the rock: the blow start reads its angle
         bit = shapes.cylinders[chain.bit_body]
-        shown = VObjectRotationalMass1D(graphicsData=torsion_graphics(bit.diameter_m))
+        shown = VObjectRotationalMass1D(graphicsData=torsion_graphics(bit.diameter_m) if graphics else [])
         torsion = add_body(mbs, "torsion", lambda n: mbs.AddObject(ObjectRotationalMass1D(
             nodeNumber=n, inertia=tor.inertia_kg_m2, referencePosition=[bit.centre_m, 0.0, 0.0],
             referenceRotation=AXIS_X_FROM_Z, visualization=shown)), simulation.initial_torsion_angle_rad,
@@ -446,8 +449,9 @@ class ExtensionFailed(RuntimeError):
 
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None,
              symbolic: bool = True) -> SimulationResult:
-    """Build and run the Exudyn model (:func:`build_exudyn`, :meth:`ExudynModel.run`)."""
-    return build_exudyn(run, symbolic).solve(progress)
+    """Build and run the Exudyn model (:func:`build_exudyn`, without the bodies' graphics: the system
+    is not returned, no renderer sees it; :meth:`ExudynModel.solve`)."""
+    return build_exudyn(run, symbolic, graphics=False).solve(progress)
 
 
 def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
