@@ -3,6 +3,7 @@
 Usage:
     python benchmarks/bench_steady_calibration.py run VARIANT --out DIR [--generations N] [--workers W]
     python benchmarks/bench_steady_calibration.py report --out DIR
+    python benchmarks/bench_steady_calibration.py sample --out DIR --from VARIANT [--every K]
 
 ``run`` writes ``DIR/VARIANT.yaml`` (studies/paper/calibration.yaml, its base scene path made
 absolute, ``search.max_generations`` set to N - 1 when given: N generations counting the initial
@@ -12,6 +13,13 @@ budget keys do not change what it has recorded). ``report`` (``--generations N``
 simulation CPU seconds the evaluations recorded (the workers' own process time, summed), the best objective
 after each generation, and the ratios between the variants. Run each variant once, in the background
 (``nohup ... &``); the machine is shared, so the CPU seconds are the workers' own, not wall time.
+
+``sample`` measures the two variants side by side on the parameter sets a whole search visited, without
+running the search twice: every K-th evaluation recorded in ``DIR/VARIANT`` (a finished ``run``, all its
+generations) is evaluated again in this one process with ``steady_state: time`` and ``periodic``, one
+after the other for each set (every distinct target scan, as the calibration runs it: studies.scan.curves
+.run_curve), and it prints the CPU seconds of both, their ratio over all sets and by quarter of the search,
+the points' regimes, and the largest difference between the two variants' objectives.
 """
 
 from __future__ import annotations
@@ -22,6 +30,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -79,14 +88,58 @@ def report(out: Path, generations: int | None) -> None:
               f"{best_p / best_t:.4f} ({(best_p - best_t) / best_t:+.2%})")
 
 
+def sample(out: Path, source: str, every: int) -> None:
+    from rpdrill.studies.calibration.calibration_search import objective, target_curves, target_result
+    from rpdrill.studies.calibration.calibration_spec import load_calibration
+    from rpdrill.studies.runtime.budgets import Budget
+    from rpdrill.studies.scan.curves import run_curve
+
+    rows = records(out / source)[::every]
+    if not rows:
+        sys.exit(f"no evaluations in {out / source}")
+    calibrations = {variant: load_calibration(variant_file(out / "sample", variant, None), Budget(accept_long=True)) for variant in VARIANTS}
+    frequencies = list(calibrations["time"].frequencies_hz)
+    cpu = {variant: [] for variant in VARIANTS}
+    objectives = {variant: [] for variant in VARIANTS}
+    regimes: dict[str, int] = {}
+    for row in rows:
+        for variant, calibration in calibrations.items():
+            curves = target_curves(calibration, 0, row["parameters"], lambda _: frequencies)
+            runs, spent = {}, 0.0
+            for curve in curves:
+                if curve.signature not in runs:
+                    runs[curve.signature] = run_curve(curve)
+                    spent += runs[curve.signature].cpu_time_s
+                    if variant == "periodic":
+                        for regime in runs[curve.signature].table["regime"]:
+                            regimes[regime] = regimes.get(regime, 0) + 1
+            results = [target_result(calibration, t, runs[curve.signature]) for t, curve in enumerate(curves)]
+            cpu[variant].append(spent)
+            objectives[variant].append(objective(calibration, results)[0])
+    time_s, periodic_s = np.array(cpu["time"]), np.array(cpu["periodic"])
+    print(f"{len(rows)} parameter sets (every {every}th of {out / source}), CPU s per evaluation: time "
+          f"{time_s.mean():.3f}, periodic {periodic_s.mean():.3f}; time / periodic {time_s.sum() / periodic_s.sum():.2f}")
+    for q, (t, p) in enumerate(zip(np.array_split(time_s, 4), np.array_split(periodic_s, 4), strict=True), start=1):
+        print(f"  quarter {q} of the search: time / periodic {t.sum() / p.sum():.2f} ({len(t)} sets)")
+    print(f"  periodic points by regime: {dict(sorted(regimes.items(), key=lambda item: -item[1]))}")
+    difference = np.abs(np.array(objectives["periodic"]) - np.array(objectives["time"]))
+    print(f"  objective periodic - time: largest {difference.max():.4g}, median {np.median(difference):.3g}; best "
+          f"set of the sample: time {min(objectives['time']):.6g}, periodic {min(objectives['periodic']):.6g}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("action", choices=("run", "report"))
+    parser.add_argument("action", choices=("run", "report", "sample"))
     parser.add_argument("variant", nargs="?", choices=VARIANTS)
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--generations", type=int)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--from", dest="source", choices=VARIANTS, help="sample: the search whose sets are taken")
+    parser.add_argument("--every", type=int, default=20, help="sample: every K-th evaluation")
     args = parser.parse_args()
+    if args.action == "sample":
+        sample(args.out, args.source or "periodic", args.every)
+        return
     if args.action == "report":
         report(args.out, args.generations)
         return

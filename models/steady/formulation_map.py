@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..solvers.simulation import Simulation
-from .map_runs import MapRun, end_state, started_at
+from .map_runs import MapRun, end_state, started_at, states_at
 from .section import Section, section_of
 
 
@@ -30,4 +30,4 @@ class FormulationMap:
     def blow_states(self, y0: np.ndarray, blows: int) -> list[np.ndarray]:
         """y at every blow start of a run of ``blows`` periods from y0 (the last one its end)."""
         result = started_at(self.simulation, y0, blows, outputs=False).solve()
-        return [end_state(result, k * self.period_s) for k in range(1, blows + 1)]
+        return states_at(result, np.arange(1, blows + 1) * self.period_s)

@@ -3,8 +3,8 @@
 :func:`started_at` is the prepared simulation with its start moved to a section state y (models.steady.section:
 positions, velocities, rock states, torsion angle and rate, an Exudyn scene's extension coordinates) and its end time to n blow periods: every
 formulation starts from the simulation's initial fields (models.solvers.simulation), so the Exudyn model,
-the ODE and the exact formulation all run it as they run a scene; :func:`end_state` reads y back from a
-result.
+the ODE and the exact formulation all run it as they run a scene; :func:`end_state` and :func:`states_at` read y back
+from a result.
 """
 
 from __future__ import annotations
@@ -64,20 +64,27 @@ def started_at(simulation: Simulation, y: np.ndarray, blows: int, outputs: bool 
     return changed
 
 
-def end_state(result: SimulationResult, time_s: float | None = None) -> np.ndarray:
-    """y of a run at ``time_s`` (default its last sample; between samples interpolated, the rock states
-    taken by the law's return map to the bit there: SimulationResult.bottom_at)."""
-    simulation = result.simulation
-    n = simulation.chain.size
-    torsion = result.torsion_angle_rad is not None
-    columns = [result.position_m, result.velocity_m_per_s, np.column_stack(result.rock_states())]
-    columns += [result.torsion_angle_rad[:, None], result.torsion_rate_rad_per_s[:, None]] if torsion else []
-    columns += [result.extension_state] if result.extension_state is not None else []
-    table = np.hstack(columns)
-    if time_s is None:
-        y, t = table[-1].copy(), float(result.time_s[-1])
-    else:
-        t = float(time_s)
-        y = np.array([np.interp(t, result.time_s, column) for column in table.T])
-    y[2 * n + simulation.rock.bottom_index] = result.bottom_at(np.array([t]))[0]
+def end_state(result: SimulationResult) -> np.ndarray:
+    """y at a run's last sample."""
+    y = _state_table(result)[-1].copy()
+    y[2 * result.simulation.chain.size + result.simulation.rock.bottom_index] = \
+        result.bottom_at(result.time_s[-1:])[0]
     return y
+
+
+def states_at(result: SimulationResult, times_s: np.ndarray) -> list[np.ndarray]:
+    """y of a run at each of ``times_s`` (between samples interpolated, the rock states taken by the law's
+    return map to the bit there: SimulationResult.bottom_at)."""
+    table, times = _state_table(result), np.asarray(times_s, dtype=float)
+    states = np.column_stack([np.interp(times, result.time_s, column) for column in table.T])
+    states[:, 2 * result.simulation.chain.size + result.simulation.rock.bottom_index] = result.bottom_at(times)
+    return list(states)
+
+
+def _state_table(result: SimulationResult) -> np.ndarray:
+    """y at every sample of a run (one row a sample; the bottom's column as recorded)."""
+    columns = [result.position_m, result.velocity_m_per_s, np.column_stack(result.rock_states())]
+    if result.torsion_angle_rad is not None:
+        columns += [result.torsion_angle_rad[:, None], result.torsion_rate_rad_per_s[:, None]]
+    columns += [result.extension_state] if result.extension_state is not None else []
+    return np.hstack(columns)

@@ -2,7 +2,11 @@
 
 1. From a guess (a neighbour's orbit in a continuation, else the state after the scene's
    ``metrics.transient_blows`` blows from its start), Newton on the map of the guess's blows (one without a
-   neighbour; models.steady.shooting). A stable orbit is the regime (``period-1``, ``period-n``).
+   neighbour; models.steady.shooting). A stable orbit is the regime (``period-1``, ``period-n``). Where
+   Newton fails from a neighbour's orbit, the drill is run on from that orbit for ``RUN_ON_BLOWS`` blows
+   (by the map, no Jacobian) and read as in step 2, Newton from its last blow start: the neighbour's orbit
+   lies nearer the attractor than the drill at rest, and a short run from it costs a fraction of the time
+   run that step 2 needs.
 2. Otherwise (no convergence, or an unstable orbit, which a drill never shows: its rate is not reported)
    the scene's own time run (what ``steady_state: time`` runs) says, from the section states of its last
    blows, which period n <= ``MAX_PERIOD_BLOWS`` repeats best (:func:`repeating_period`), Newton on the
@@ -38,7 +42,7 @@ from ..solvers.simulation import Simulation, prepare, unsupported
 from .exact_map import ExactPeriodMap, exact_period_map
 from .extension_section import with_extension_coordinates
 from .formulation_map import FormulationMap
-from .map_runs import end_state, started_at
+from .map_runs import end_state, started_at, states_at
 from .section import drift_problem, section_of
 from .shooting import TOLERANCE, NoConvergence, Orbit, PeriodMap, Shooter, scales
 from .steady_state import NONE_FOUND, SteadyState, SteadyStateUnavailable, regime_name
@@ -49,6 +53,8 @@ NEWTON_TRY = 1.0  # ... and tried before running on, from the time run's own las
 EXUDYN_TOLERANCE = 1e-8
 REPEATS_WITHIN = 1e-6  # scaled distance under which an n-blow orbit's state repeats after fewer blows
 STABILITY_MARGIN = 0.01  # multipliers this near the unit circle are taken from the exact Jacobian at the orbit
+RUN_ON_BLOWS = 2 * MAX_PERIOD_BLOWS + 1  # blows run on from a neighbour's orbit where Newton failed from it: the
+# fewest that show every period up to MAX_PERIOD_BLOWS twice (repeating_period)
 
 
 def newton_tolerance(simulation: Simulation) -> float:
@@ -201,9 +207,25 @@ class RegimeFinder:
             guess, periods = guide.orbit.state, guide.orbit.periods
         try:
             orbit = self.shoot(periods, self.warm_state() if guess is None else guess)
+            if orbit is None and guess is not None:  # run on from the neighbour's orbit (module doc, step 1)
+                self.runs += 1
+                orbit = self._from_blows(self.map(1).blow_states(guess, RUN_ON_BLOWS * periods), NEWTON_TRY)
         except SimulationFailed:
             orbit = None
         return self._state(orbit, start, guide)
+
+    def _from_blows(self, states: list[np.ndarray], within: float) -> Orbit | None:
+        """Newton from the last of ``states`` (y at successive blow starts) on one blow, then on the period
+        n that repeats best over them, where it repeats within ``within`` (scaled; the distance kept for the
+        note); None if neither converges to a stable orbit."""
+        n, self.distance = repeating_period(self.simulation, states, min(MAX_PERIOD_BLOWS, (len(states) - 1) // 2))
+        if self.distance > within:
+            return None
+        for periods in dict.fromkeys((1, n)):  # first (a transient's ringing can look like another period)
+            orbit = self.shoot(periods, states[-1])
+            if orbit is not None:
+                return orbit
+        return None
 
     def settled(self, time_run: SimulationResult, found: SteadyState) -> SteadyState:
         """Step 2 (module doc): the period that repeats best over the last blows of ``time_run`` (the scene's
@@ -214,7 +236,7 @@ class RegimeFinder:
         longest = min(MAX_PERIOD_BLOWS, blows // 2 - 1)
         if longest < 1:
             return found
-        states = [end_state(time_run, k * period_s) for k in range(blows - 2 * longest, blows + 1)]
+        states = states_at(time_run, np.arange(blows - 2 * longest, blows + 1) * period_s)
         n, self.distance = repeating_period(self.simulation, states, longest)
         if REPEAT_TOLERANCE < self.distance <= NEWTON_TRY:  # near enough for Newton's basin, perhaps: one blow
             for periods in dict.fromkeys((1, n)):  # first (a transient's ringing can look like another period)

@@ -102,26 +102,36 @@ class CurveRun:
                              metric=metric, along=self.axis, failed=self.failed_runs)
 
 
+def run_order(curve: Curve) -> list[int]:
+    """The order its points run in (indices of ``curve.values``): along the frequency from the highest down
+    (a periodic run starts Newton from its neighbours' orbits, models.steady.continuation; the orbits of the
+    fastest blows have the fewest switches and the irregular bouncing of a poorly tuned drill lies at the
+    slow end, so the branch is followed from where it is surest), along another axis as given."""
+    indices = range(len(curve.values))
+    return sorted(indices, key=lambda i: -curve.values[i]) if curve.axis == FREQUENCY else list(indices)
+
+
 def run_curve(curve: Curve) -> CurveRun:
-    """Worker: every point of the curve in order (a point that does not validate or prepare is a failed
-    row, its message the error; failures are recorded, not raised), the rock-mode frequency of the first
-    point that prepares (along the frequency) and the CPU seconds."""
+    """Worker: every point of the curve (in :func:`run_order`, the table in the curve's order; a point that
+    does not validate or prepare is a failed row, its message the error; failures are recorded, not raised),
+    the rock-mode frequency of the first point that prepares (along the frequency) and the CPU seconds."""
     import pandas as pd
 
     start = time.process_time()
-    rows, resonance = [], None
+    rows, resonance = {}, None
     branch = Continuation()  # solver.steady_state periodic: each orbit from its neighbours' (models.steady)
-    for value in curve.values:
+    for index in run_order(curve):
+        value = curve.values[index]
         try:
             simulation = prepare_point(curve.base, {curve.axis: value}, f"{curve.axis} scan",
                                        {**curve.changes, "outputs": {"metrics": list(curve.metrics)}})
         except InputError as error:
-            rows.append({curve.axis: value, "status": "failed", "error": str(error), "wall_time_s": 0.0})
+            rows[index] = {curve.axis: value, "status": "failed", "error": str(error), "wall_time_s": 0.0}
             continue
         if curve.axis == FREQUENCY:
             resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock) or None
-        rows.append({curve.axis: value, **run_followed(branch, value, simulation)})
-    table = pd.DataFrame(rows, columns=[curve.axis, *point_columns(curve.metrics)])
+        rows[index] = {curve.axis: value, **run_followed(branch, value, simulation)}
+    table = pd.DataFrame([rows[i] for i in sorted(rows)], columns=[curve.axis, *point_columns(curve.metrics)])
     return CurveRun(curve.key, curve.axis, table, resonance, time.process_time() - start)
 
 
