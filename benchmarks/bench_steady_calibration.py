@@ -111,7 +111,7 @@ def sample(out: Path, source: str, every: int) -> None:
                     runs[curve.signature] = run_curve(curve)
                     spent += runs[curve.signature].cpu_time_s
                     if variant == "periodic":
-                        for regime in runs[curve.signature].table["regime"]:
+                        for regime in runs[curve.signature].table["regime"].fillna("failed (no run)"):
                             regimes[regime] = regimes.get(regime, 0) + 1
             results = [target_result(calibration, t, runs[curve.signature]) for t, curve in enumerate(curves)]
             cpu[variant].append(spent)
@@ -120,7 +120,8 @@ def sample(out: Path, source: str, every: int) -> None:
     print(f"{len(rows)} parameter sets (every {every}th of {out / source}), CPU s per evaluation: time "
           f"{time_s.mean():.3f}, periodic {periodic_s.mean():.3f}; time / periodic {time_s.sum() / periodic_s.sum():.2f}")
     for q, (t, p) in enumerate(zip(np.array_split(time_s, 4), np.array_split(periodic_s, 4), strict=True), start=1):
-        print(f"  quarter {q} of the search: time / periodic {t.sum() / p.sum():.2f} ({len(t)} sets)")
+        if len(t):
+            print(f"  quarter {q} of the search: time / periodic {t.sum() / p.sum():.2f} ({len(t)} sets)")
     print(f"  periodic points by regime: {dict(sorted(regimes.items(), key=lambda item: -item[1]))}")
     difference = np.abs(np.array(objectives["periodic"]) - np.array(objectives["time"]))
     print(f"  objective periodic - time: largest {difference.max():.4g}, median {np.median(difference):.3g}; best "

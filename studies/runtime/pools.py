@@ -21,6 +21,7 @@ that workers print nothing themselves.
 from __future__ import annotations
 
 import contextlib
+import gc
 import itertools
 import logging
 import os
@@ -73,7 +74,11 @@ def run_batch(task: tuple[Callable[[Arg], Output], list[Arg]]) -> tuple[list[Out
 
 def start_process_worker() -> None:
     """Process-pool worker initializer: the command's process stops the run (studies.runtime.interrupts),
-    so a worker ignores Ctrl-C, ends at SIGTERM and when that process ends, and runs one BLAS thread."""
+    so a worker ignores Ctrl-C, ends at SIGTERM and when that process ends, and runs one BLAS thread. What
+    it inherited from the command's process (the libraries imported before the fork) is frozen out of its
+    garbage collector (``gc.freeze``): the collector neither walks those objects again nor writes to their
+    pages (no copy-on-write)."""
+    gc.freeze()
     worker_ends_with_its_command()
     threadpool_limits(1)
 
