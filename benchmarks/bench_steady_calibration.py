@@ -111,7 +111,7 @@ def sample(out: Path, source: str, every: int) -> None:
                     runs[curve.signature] = run_curve(curve)
                     spent += runs[curve.signature].cpu_time_s
                     if variant == "periodic":
-                        for regime in runs[curve.signature].table["regime"].fillna("failed (no run)"):
+                        for regime in runs[curve.signature].table["regime"].astype(object).fillna("failed (no run)"):
                             regimes[regime] = regimes.get(regime, 0) + 1
             results = [target_result(calibration, t, runs[curve.signature]) for t, curve in enumerate(curves)]
             cpu[variant].append(spent)
