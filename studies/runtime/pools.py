@@ -144,20 +144,18 @@ class Completed(Iterator[list[Any]]):
 @contextlib.contextmanager
 def process_pool(workers: int | None = None) -> Iterator[Runner[Any, Any]]:
     """A runner bound to one pool of local workers, kept for many calls; every worker starts with the
-    first call, none when nothing is run. pandas and matplotlib's figure, Agg and SVG modules are imported
-    before the workers are forked (pandas 0.2 CPU s a process), which every worker would otherwise import for
-    its tables and plots: the three paper scans (a continuation study starts its pool before its table) 9 %
-    more CPU without pandas, 3 % more without matplotlib's backends and 1.6 % more without its figure module
-    (``python benchmarks/bench_studies.py --base REV``, REV the revision without it)."""
+    first call, none when nothing is run. pandas is imported before the workers are forked (0.2 CPU s a
+    process), which every worker would otherwise import for its tables and plots: the three paper scans
+    (a continuation study starts its pool before its table) 9 % more CPU without it,
+    ``python benchmarks/bench_studies.py --base REV``. (matplotlib imported there too saves 3 to 5 % of
+    their CPU but adds 0.3 s to the wall time of a ``rpdrill study`` command, the parent importing it
+    while the workers wait: not kept.)"""
     workers = workers or os.cpu_count() or 1
     executors: list[ProcessPoolExecutor] = []
     registry: dict[Any, Any] = {}
 
     def run(function: Callable[[Arg], Output], arguments: Sequence[Arg]) -> Iterator[list[Output]]:
         if not executors:
-            import matplotlib.backends.backend_agg  # as pandas: the workers draw the plots
-            import matplotlib.backends.backend_svg
-            import matplotlib.figure  # noqa: F401
             import pandas  # noqa: F401 - before the workers are forked: they make tables and plots from pandas
             executors.append(ProcessPoolExecutor(max_workers=workers, initializer=start_process_worker))
         futures = [executors[0].submit(run_batch, (function, [argument])) for argument in arguments]
