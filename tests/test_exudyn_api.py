@@ -60,6 +60,15 @@ def test_a_normal_run_is_the_build_and_its_run():
     assert "exudyn_model" not in normal.info
 
 
+def test_a_model_built_without_graphics_moves_as_the_drawn_one_and_has_no_body_graphics():
+    s = crushing_scene(solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2)
+    drawn, bare = build_exudyn(s), build_exudyn(s, graphics=False)
+    mbs = bare.mbs
+    items = [mbs.GetObject(i, addGraphicsData=True) for i in range(mbs.systemData.NumberOfObjects())]
+    assert not any(item["VgraphicsData"] for item in items if item["objectType"] == "Mass1D")
+    np.testing.assert_array_equal(drawn.run().raw.position_m, bare.run().raw.position_m)
+
+
 def test_a_scene_of_another_formulation_is_built_and_run_by_exudyn_and_says_so():
     s = crushing_scene(solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2).with_solver("exact")
     result = build_exudyn(s).run()
