@@ -24,12 +24,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..drill.piston import PistonJumps
-from ..drill.pulse import PHASES
 from ..evaluation.results import SimulationResult
 from ..solvers.exact_model import ANCHORS, PER_ANCHOR, ExactSolver, solver_result
 from ..solvers.exact_system import Modes
 from ..solvers.simulation import Simulation
 from .map_runs import MapRun, Switch, started_at
+from .monodromy_kernel import NO_EXIT, monodromy
 from .section import Section, physical_state, section_of
 
 
@@ -56,35 +56,25 @@ class ExactPeriodMap:
         self.simulation, self.periods = simulation, periods
         self.period_s = simulation.impact.period_s
         self.section: Section = section_of(simulation)
-        if shared is not None:  # one solver, its operators and the matrices for maps of any length
+        if shared is not None:  # one solver and its operators for maps of any length
             self.solver = shared.solver if shared.simulation is simulation else \
                 shared.solver.with_frequency(simulation, periods * self.period_s)
-            self._matrices, self._modes, self._series, self._switches, self._blocks = (
-                shared._matrices, shared._modes, shared._series, shared._switches, shared._blocks)
         else:
             self.solver = ExactSolver(simulation)
-            self._matrices: dict[int, np.ndarray] = {}
-            self._modes: dict[int, tuple[Modes, str]] = {}
-            self._series: dict[int, np.ndarray] = {}
-            self._blocks: dict[int, np.ndarray] = {}
-            self._switches: dict[tuple[Modes, Modes], tuple[np.ndarray, list[np.ndarray], list]] = {}
         self.has_exact_jacobian = not (self.solver.blows or self.solver.piston)
         self._columns: np.ndarray | None = None
+        self._modes_of_keys: np.ndarray | None = None
 
     def of_periods(self, periods: int) -> ExactPeriodMap:
         """The map of ``periods`` blows on the same solver."""
         return ExactPeriodMap(self.simulation, periods, shared=self)
 
-    def result(self, y0: np.ndarray, blows: int, cpu_start: float,
-               jacobian: bool = True) -> tuple[SimulationResult, MapRun]:
+    def result(self, y0: np.ndarray, blows: int, cpu_start: float) -> tuple[SimulationResult, np.ndarray]:
         """The scene's result of a run of ``blows`` periods from y0 (models.steady.map_runs.started_at: the
-        metrics' window those blows), by this map's solver, and that run as a map run (its end state, and with
-        ``jacobian`` dY/dy0 where exact)."""
+        metrics' window those blows), by this map's solver, and that run's end state y."""
         ran = self._run(y0, blows)
-        monodromy = self._monodromy(*ran[:2]) if jacobian and self.has_exact_jacobian else None
         end = physical_state(self.simulation, ran[1][-1, :self.solver.layout.size])
-        result = solver_result(self.solver, started_at(self.simulation, y0, blows), cpu_start, ran=ran)
-        return result, MapRun(end, monodromy, ())
+        return solver_result(self.solver, started_at(self.simulation, y0, blows), cpu_start, ran=ran), end
 
     def _run_setup(self, blows: int) -> None:
         """The solver set for a run of ``blows`` periods (fresh blow-start trackers: it starts at a blow)."""
@@ -116,104 +106,35 @@ class ExactPeriodMap:
         size = self.solver.layout.size
         return [physical_state(self.simulation, rows[i, :size]) for i in [*first.tolist(), len(time_s) - 1]]
 
-    def matrix(self, key: int) -> np.ndarray:
-        """A of an operator key of the solver."""
-        if key not in self._matrices:
-            modes, phase = self.key_modes(key)
-            self._matrices[key] = self.solver.model.matrix(modes, phase)
-        return self._matrices[key]
-
-    def propagator(self, key: int, length_s: float) -> np.ndarray:
-        """expm(A t) of a key from the solver's cached operators (models.solvers.exact_model): with E =
-        expm(A h) and t = (q A B + j) h + s, s < h, it is sum_k s^k A^k / k! E^j (E^(A B))^q, E^j from the
-        anchors E^(a B) and powers E^b (b < B), the series from the Taylor matrices, (E^(A B))^q by
-        squaring."""
-        ops, size = self.solver.operators, self.solver.layout.size
-        h, width = ops.step_s, ops.width
-        steps = int(length_s // h)
-        rest = length_s - steps * h
-        if rest < 0.0:
-            steps, rest = steps - 1, rest + h
-        if key not in self._series:  # A^k / k! flattened, one row per k
-            terms = ops.taylor[key].reshape(size, -1, width)[:, :, :size]  # (A^k / k!)^T as [c, k, r]
-            self._series[key] = np.ascontiguousarray(terms.transpose(1, 2, 0).reshape(-1, size * size))
-        series = self._series[key]
-        result = (rest ** np.arange(len(series)) @ series).reshape(size, size)  # sum_k s^k A^k / k!
-        whole, part = divmod(steps, ANCHORS * PER_ANCHOR)
-        anchor, power = divmod(part, PER_ANCHOR)
-        if anchor:
-            result = result @ ops.anchors[key][:, anchor * size:(anchor + 1) * size].T
-        if power:
-            result = result @ ops.readout[key][:, power * width:power * width + size].T
-        if whole:
-            if key not in self._blocks:  # E^(A B) = E^((A - 1) B) E^B
-                anchors = ops.anchors[key]
-                self._blocks[key] = anchors[:, (ANCHORS - 1) * size:ANCHORS * size].T @ anchors[:, size:2 * size].T
-            block = self._blocks[key]
-            while whole:
-                if whole & 1:
-                    result = result @ block
-                whole >>= 1
-                if whole:
-                    block = block @ block
-        return result
-
-    def key_modes(self, key: int) -> tuple[Modes, str]:
-        """(modes, phase) of an operator key."""
-        if key not in self._modes:
-            ops = self.solver.operators
-            mode_id, phase_id = np.argwhere(ops.key_of == key)[0]
-            self._modes[key] = ops.modes[mode_id], PHASES[phase_id]
-        return self._modes[key]
-
-    def _saltated(self, product: np.ndarray, key_before: int, key_after: int, w_before: np.ndarray,
-                  w_after: np.ndarray) -> np.ndarray:
-        """S product for the switch from key_before's modes into key_after's (module doc), without forming S:
-        M product + (f+ - M f-) (c . product) / (c . f-)."""
-        modes = self.key_modes(key_before)[0], self.key_modes(key_after)[0]
-        if modes not in self._switches:  # the exit row and the reset matrices (the bottom's row reset or kept)
-            model = self.solver.model
-            exits = [exit_ for exit_ in model.exits(modes[0]) if exit_[2] == modes[1]]
-            if not exits:
-                raise ValueError(f"no exit from {modes[0]} into {modes[1]}")
-            row, resets = exits[0][0], exits[0][3]
-            monotone = model.pieces[0].monotone
-            both = []
-            for keep_bottom in (False, True):
-                reset = np.eye(len(w_before))
-                for target, reset_row in resets:
-                    if not (keep_bottom and target == monotone):
-                        reset[target] = reset_row
-                both.append(reset)
-            raised = [(target, reset_row) for target, reset_row in resets if target == monotone]
-            self._switches[modes] = row, both, raised
-        row, (resetting, keeping), raised = self._switches[modes]
-        reset = keeping if raised and raised[0][1] @ w_before < w_before[raised[0][0]] else resetting
-        before = self.matrix(key_before) @ w_before
-        jump = self.matrix(key_after) @ w_after - reset @ before
-        return reset @ product + np.outer(jump / (row @ before), row @ product)
+    def _key_modes(self) -> np.ndarray:
+        """The mode id of every key built so far (ops.key_of inverted)."""
+        ops = self.solver.operators
+        if self._modes_of_keys is None or len(self._modes_of_keys) != ops.built:
+            modes = np.full(ops.built, -1, dtype=np.int64)
+            mode_ids, phase_ids = np.nonzero(ops.key_of >= 0)
+            modes[ops.key_of[mode_ids, phase_ids]] = mode_ids
+            self._modes_of_keys = modes
+        return self._modes_of_keys
 
     def _monodromy(self, time_s: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        """dY/dy0 as the product over the run's pieces and switches (module doc)."""
+        """dY/dy0 as the product over the run's pieces and switches (module doc;
+        models.steady.monodromy_kernel)."""
         solver, simulation = self.solver, self.simulation
-        keys, size = solver.row_keys, solver.layout.size
+        ops, size = solver.operators, solver.layout.size
         if self._columns is None:  # dw/dy0: the section's entries placed in w
             n, dynamic, d = simulation.chain.size, simulation.dynamic_chain.size, self.section.size
             columns = np.zeros((size, d))
             columns[:n, :n] = columns[dynamic:dynamic + n, n:2 * n] = np.eye(n)
             columns[2 * dynamic:2 * dynamic + d - 2 * n, 2 * n:] = np.eye(d - 2 * n)
             self._columns = columns
-        product = self._columns
-        # the zero-length intervals (a switch: both sides recorded; a phase boundary) cut the run into pieces
-        # of one key each
-        jumps = np.flatnonzero(np.diff(time_s) <= 0.0)
-        start = 0
-        for i in (*jumps.tolist(), len(time_s) - 1):
-            if i > start:
-                product = self.propagator(keys[start], time_s[i] - time_s[start]) @ product
-            if i < len(time_s) - 1 and self.key_modes(keys[i])[0] != self.key_modes(keys[i + 1])[0]:  # a switch
-                product = self._saltated(product, keys[i], keys[i + 1], rows[i, :size], rows[i + 1, :size])
-            start = i + 1
+        monotone = solver.model.pieces[0].monotone
+        product = np.empty_like(self._columns)
+        status = monodromy(self._columns, time_s, rows, solver.row_keys, self._key_modes(), ops.taylor, ops.anchors,
+                           ops.readout, ops.exit_counts, ops.next_modes, ops.reset_counts, ops.reset_targets,
+                           ops.reset_rows, -1 if monotone is None else monotone, ops.step_s, ANCHORS, PER_ANCHOR,
+                           product)
+        if status == NO_EXIT:
+            raise ValueError(f"scene '{simulation.name}': a switch of the run between modes with no exit between them")
         return physical_state(simulation, product)
 
 

@@ -52,7 +52,6 @@ REPEAT_TOLERANCE = 0.05  # scaled distance of section states n blows apart under
 NEWTON_TRY = 1.0  # ... and tried before running on, from the time run's own last blow
 EXUDYN_TOLERANCE = 1e-8
 REPEATS_WITHIN = 1e-6  # scaled distance under which an n-blow orbit's state repeats after fewer blows
-STABILITY_MARGIN = 0.01  # multipliers this near the unit circle are taken from the exact Jacobian at the orbit
 RUN_ON_BLOWS = 2 * MAX_PERIOD_BLOWS + 1  # blows run on from a neighbour's orbit where Newton failed from it: the
 # fewest that show every period up to MAX_PERIOD_BLOWS twice (repeating_period)
 
@@ -167,9 +166,6 @@ class RegimeFinder:
         shorter = self._minimal_period(orbit)
         if shorter is not None:  # a fixed point of the n-blow map that repeats after d blows: a d-blow orbit
             return self.shoot(shorter, orbit.state)
-        if isinstance(self.map(periods), ExactPeriodMap) and orbit.jacobian != "exact" and not orbit.stable:
-            self.runs += 1  # an updated Jacobian's multipliers say unstable: the exact ones decide
-            orbit = orbit.with_jacobian(self.section.jacobian(self.map(periods)(orbit.state).monodromy), "exact")
         if not orbit.stable:
             self.unstable.append(orbit)
             return None
@@ -271,21 +267,14 @@ class RegimeFinder:
         return SteadyState(regime, orbit, tuple(self.unstable), note, self.runs, time.process_time() - start,
                            None if guide is None else guide.orbit)
 
-    def result(self, orbit: Orbit, cpu_start: float) -> tuple[SimulationResult, Orbit, np.ndarray]:
+    def result(self, orbit: Orbit, cpu_start: float) -> tuple[SimulationResult, np.ndarray]:
         """The scene's run over the orbit (models.steady.map_runs.started_at), by the map's own solver where
-        it is the exact formulation's; the orbit, with the multipliers of that run's exact Jacobian where its
-        own are near the unit circle; the run's end state y."""
+        it is the exact formulation's, and the run's end state y."""
         periodic = self.map(orbit.periods)
         if isinstance(periodic, ExactPeriodMap):
-            # an updated Jacobian's multipliers (measured within 1e-6 of the exact |mu|max on the paper scans)
-            # decide unless they lie within STABILITY_MARGIN of the unit circle
-            near = orbit.jacobian != "exact" and abs(orbit.floquet_max_abs - 1.0) < STABILITY_MARGIN
-            result, ran = periodic.result(orbit.state, orbit.periods, cpu_start, jacobian=near)
-            if ran.monodromy is not None:
-                orbit = orbit.with_jacobian(self.section.jacobian(ran.monodromy), "exact")
-            return result, orbit, ran.end_state
+            return periodic.result(orbit.state, orbit.periods, cpu_start)
         result = started_at(self.simulation, orbit.state, orbit.periods).solve()
-        return result, orbit, end_state(result)
+        return result, end_state(result)
 
     def _why_none(self) -> str:
         distance = getattr(self, "distance", None)

@@ -7,9 +7,9 @@ On the section (models.steady.section) the orbit is z = P_n(z). Newton solves F(
 
 J = dP_n/dz from the map's exact Jacobian (models.steady.exact_map), from a Jacobian given by the caller
 (``jacobian_of``: the exact model's at the same state, for a formulation that has none), or by forward
-differences (one map run per coordinate); after the first, a Jacobian is updated by Broyden's rule,
-J += (dP - J dz) dz^T / dz^T dz, where the last step was below ``BROYDEN_BELOW`` of the scales (with the
-exact map's own Jacobian formed again where it was larger). A step that raises the scaled residual
+differences (one map run per coordinate); the exact map's own Jacobian is formed at every step (with the
+compiled product, models.steady.monodromy_kernel, it costs a fifth of the map's run, and Newton stays
+quadratic), any other after the first is updated by Broyden's rule, J += (dP - J dz) dz^T / dz^T dz. A step that raises the scaled residual
 max_i |F_i| / s_i is halved (at most ``HALVINGS`` times): the map is only piecewise smooth, and a full step
 from a poor guess can cross into another sequence of contacts; ``STALLED_ITERATIONS`` shortened steps in a
 row, or ``MAX_ITERATIONS`` steps, end the search (NoConvergence). The last step is the first whose scaled size max_i |dz_i| / s_i
@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -48,7 +48,6 @@ STALLED_ITERATIONS = 2  # Newton steps in a row that had to be shortened: given 
 # a residual no step lowers is the map's own error (a time-stepping formulation's) when below this many tolerances
 NOISE_FACTOR = 100.0
 DIFFERENCE_STEP = 1e-6  # forward-difference step, relative to each coordinate's scale
-BROYDEN_BELOW = 0.05  # a scaled step below this: the next Jacobian is Broyden's update, not the map's
 
 
 class PeriodMap(Protocol):
@@ -99,10 +98,6 @@ class Orbit:
     def penetration_rate_m_per_s(self) -> float:
         """The advance per n blows x f / n (exact to the orbit's round-off)."""
         return self.advance_m / (self.periods * self.period_s)
-
-    def with_jacobian(self, jacobian: np.ndarray, source: str) -> Orbit:
-        """This orbit with the multipliers of ``jacobian`` (dP/dz at the orbit) from ``source``."""
-        return replace(self, multipliers=_eigenvalues(jacobian), jacobian=source)
 
     @property
     def event_sequence(self) -> tuple[str, ...]:
@@ -214,14 +209,12 @@ class Shooter:
                     advance += float(bottom_row @ step)
                 return Orbit(self.map.periods, self.map.period_s, section.embed(z + step), advance,
                              _eigenvalues(jacobian), run.switches, iteration, self.runs - start_runs, source)
-            # the next Jacobian: the map's own where a step is still large, else Broyden's update of this one
-            fresh = exact and size >= BROYDEN_BELOW
             residual_size = np.max(np.abs(residual) / scale)
             halved = 0
             for _ in range(halvings + 1):
                 trial = z + step
                 try:
-                    trial_image, trial_advance, trial_run = self.evaluate(trial, jacobian=fresh)
+                    trial_image, trial_advance, trial_run = self.evaluate(trial, jacobian=exact)
                 except SimulationFailed:
                     step = step / 2
                     halved += 1

@@ -22,7 +22,6 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -93,12 +92,7 @@ def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
     except SteadyStateUnavailable as why:
         state = SteadyState(NONE_FOUND, None, note=str(why))
     if state.orbit is not None and finder is not None:
-        result, orbit, end = finder.result(state.orbit, start)
-        if orbit.stable:
-            state = replace(state, orbit=orbit)
-        else:  # the exact multipliers of the run over it put it outside: not the drill's rate
-            state = replace(state, regime=NONE_FOUND, orbit=None, unstable=(*state.unstable, orbit),
-                            note="the orbit found is unstable by the multipliers of its exact Jacobian")
+        result, end = finder.result(state.orbit, start)
         if progress is not None:
             progress(simulation.settings.end_time_s)
     if state.orbit is None:

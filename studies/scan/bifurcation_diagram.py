@@ -105,7 +105,7 @@ def _period_one(base: Scene, axis: str, values: Sequence[float], start: BlowFigu
                 orbit = Shooter(period_map, simulation).solve(guess[0])
         except NoConvergence:
             break
-        result, _ = period_map.result(orbit.state, 1, 0.0, jacobian=False)
+        result, _ = period_map.result(orbit.state, 1, 0.0)
         branch.add(branch_point(value, {"regime": "period-1", "period_blows": 1, "orbit_state": orbit.state.tolist()},
                                 math.nan))
         figures.append(blow_figures(result, 1, value, "period-1", orbit.stable))
