@@ -9,16 +9,16 @@ J = dP_n/dz from the map's exact Jacobian (models.steady.exact_map), from a Jaco
 (``jacobian_of``: the exact model's at the same state, for a formulation that has none), or by forward
 differences (one map run per coordinate); the exact map's own Jacobian is formed at every step (with the
 compiled product, models.steady.monodromy_kernel, it costs a fifth of the map's run, and Newton stays
-quadratic), any other after the first is updated by Broyden's rule, J += (dP - J dz) dz^T / dz^T dz. A step that raises the scaled residual
-max_i |F_i| / s_i is halved (at most ``HALVINGS`` times): the map is only piecewise smooth, and a full step
-from a poor guess can cross into another sequence of contacts; ``STALLED_ITERATIONS`` shortened steps in a
-row, or ``MAX_ITERATIONS`` steps, end the search (NoConvergence). The last step is the first whose scaled size max_i |dz_i| / s_i
-is below sqrt(tolerance) / 10 with the exact Jacobian (Newton's convergence is quadratic: the error after it
-is of the order of its square), below ``tolerance`` with another (a chord method converges linearly); it is
-taken and not checked by another map run (the caller's run of the orbit checks it). A residual that no step
-lowers and that is below ``NOISE_FACTOR`` tolerances is the map's own error (a time-stepping formulation's):
-converged as far as it resolves. The scales s_i are the larger of |z_i| and a floor of the coordinate's kind
-(:func:`scales`).
+quadratic), any other after the first is updated by Broyden's rule, J += (dP - J dz) dz^T / dz^T dz. A step
+that raises the scaled residual max_i |F_i| / s_i is halved (at most ``HALVINGS`` times): the map is only
+piecewise smooth, and a full step from a poor guess can cross into another sequence of contacts;
+``STALLED_ITERATIONS`` shortened steps in a row, or ``MAX_ITERATIONS`` steps, end the search (NoConvergence).
+The last step is the first whose scaled size max_i |dz_i| / s_i is below sqrt(tolerance) / 10 with the exact
+Jacobian (Newton's convergence is quadratic: the error after it is of the order of its square), below
+``tolerance`` with another (a chord method converges linearly); it is taken and not checked by another map run
+(the caller's run of the orbit checks it). A residual that no step lowers and that is below ``NOISE_FACTOR``
+tolerances is the map's own error (a time-stepping formulation's): converged as far as it resolves. The scales
+s_i are the larger of |z_i| and a floor of the coordinate's kind (:func:`scales`).
 
 The Floquet multipliers are the eigenvalues of J at the orbit: it is stable when all lie inside the unit
 circle (the drift direction, the one multiplier 1 of the full state, is not in the section). A real
