@@ -8,7 +8,7 @@ On the section (models.steady.section) the orbit is z = P_n(z). Newton solves F(
 J = dP_n/dz from the map's exact Jacobian (models.steady.exact_map), from a Jacobian given by the caller
 (``jacobian_of``: the exact model's at the same state, for a formulation that has none), or by forward
 differences (one map run per coordinate); the exact map's own Jacobian is formed at every step (with the
-compiled product, models.steady.monodromy_kernel, it costs a fifth of the map's run, and Newton stays
+compiled product, models.steady.monodromy_kernel, it costs a third of the map's run, and Newton stays
 quadratic), any other after the first is updated by Broyden's rule, J += (dP - J dz) dz^T / dz^T dz. A step
 that raises the scaled residual max_i |F_i| / s_i is halved (at most ``HALVINGS`` times): the map is only
 piecewise smooth, and a full step from a poor guess can cross into another sequence of contacts;
