@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "InputError": ("models.definition.validation", "InputError"),
          "Result": ("models.evaluation.run_result", "Result"),
+         "Regime": ("models.evaluation.run_record", "Regime"),
          "SimulationFailed": ("models.evaluation.stability", "SimulationFailed"),
          "Advice": ("studies.advice.advice_run", "Advice"),
          "AdviceSearch": ("studies.advice.advice_run", "AdviceSearch"),
@@ -64,6 +65,7 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
 if TYPE_CHECKING:  # the names as type checkers and editors see them
     from .models.definition.scene import Scene
     from .models.definition.validation import InputError
+    from .models.evaluation.run_record import Regime
     from .models.evaluation.run_result import Result
     from .models.evaluation.stability import SimulationFailed
     from .models.solvers.exudyn_model import ExudynModel, build_exudyn
@@ -98,7 +100,7 @@ def __dir__() -> list[str]:
 
 
 __all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult", "Crosscheck",
-           "ExudynModel", "InputError", "ReproductionResult", "Result", "RotationReport", "Scene", "SensitivityResult",
+           "ExudynModel", "InputError", "Regime", "ReproductionResult", "Result", "RotationReport", "Scene", "SensitivityResult",
            "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck", "draw",
            "load_scene", "load_study", "reproduce", "rotation_report", "run_study", "save_result", "sensitivity",
            "simulate", "table_frame", "view_solution", "write_animation"]

@@ -22,6 +22,7 @@ from pathlib import Path
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.evaluation.solver_settings import EXUDYN_PRESETS
 from rpdrill.models.evaluation.workprecision import errors, pareto_front
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.accuracy.accuracy_study import load_accuracy_study, reference_signature, run_setting
 
@@ -48,7 +49,7 @@ def preset_cost(base: Scene, preset: str, seconds: float, repeats: int) -> tuple
                                                  "timeseries": ["borehole_bottom_m"]}}))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        runs = [simulation.solve().cpu_time_s for _ in range(repeats)]
+        runs = [run_simulation(simulation).raw.cpu_time_s for _ in range(repeats)]
     return statistics.median(runs) / seconds, simulation.settings.step_s
 
 

@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 
 from rpdrill.models.definition.scene import Scene
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.cost import CPU_S_PER_STEP, Cause, cost_key, run_cost
 from rpdrill.models.solvers.simulation import prepare, unsupported
 from rpdrill.studies.calibration.calibration_search import target_result
@@ -62,11 +63,11 @@ def simulation(scene: str, formulation: str, options: dict | None = None, output
 
 def measured_steps(result) -> float:
     """Integration steps a run took: Exudyn's fixed steps, the exact sub-grid, the ODE's steps."""
-    info, end = result.info, result.simulation.settings.end_time_s
+    solver, end = result.solver, result.simulation.settings.end_time_s
     if result.formulation == "exact":
-        return end / info["sub_step_s"]
+        return end / solver.sub_step_s
     if result.formulation == "ode":
-        return info["solver_steps"]
+        return solver.solver_steps
     return round(end / result.simulation.settings.step_s)
 
 
@@ -84,13 +85,13 @@ def cpu_table(repeats: int) -> None:
             continue
         measured.add((scene, key))
         try:
-            first = run.solve()  # warm-up: the exact kernels compile, Exudyn loads
+            first = run_simulation(run).raw  # warm-up: the exact kernels compile, Exudyn loads
         except Exception as err:  # noqa: BLE001 - a formulation that fails on a scene is reported, not measured
             print(f"{scene:<17}{key:<22}{run.chain.size:<8}failed: {type(err).__name__}: {err}")
             continue
         steps = measured_steps(first)
         del first  # each result is dropped before the next run, as in a study
-        cpu = statistics.median(run.solve().cpu_time_s for _ in range(repeats))
+        cpu = statistics.median(run_simulation(run).raw.cpu_time_s for _ in range(repeats))
         cost, n = run_cost(run), run.chain.size
         fits.setdefault(key, []).append((n, cpu / steps))
         if formulation == "ode":
@@ -119,7 +120,7 @@ def child(scene: str, formulation: str, options: dict) -> None:
     run = simulation(scene, formulation, options)
     estimate = run_cost(run, Cause("solver.output_interval_s", run.settings.output_interval_s)).memory_bytes
     before = peak_resident_bytes()
-    result = run.solve()
+    result = run_simulation(run).raw
     table = np.column_stack(list(result.resampled(run.settings.output_interval_s).values()))  # as rpdrill simulate
     grown = peak_resident_bytes() - before
     del table

@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 from rpdrill.models.definition.scene import Scene
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers import exudyn_model
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import load_scene
@@ -63,11 +64,11 @@ def main() -> None:
           f"{bare * 1e3:.1f} ms without (a run's own system; median of {10 * args.repeats})")
 
     reference_step = step / 32
-    reference = prepare(with_solver(scene, end_time_s=0.3, step_s=reference_step)).solve().bottom_m[-1]
+    reference = run_simulation(prepare(with_solver(scene, end_time_s=0.3, step_s=reference_step))).raw.bottom_m[-1]
     print(f"\nx_n(0.3 s) against rk44 at step {reference_step:g} s: {reference * 1e3:.6f} mm")
     print("step_s      x_n(0.3 s) [mm]   relative error   CPU s per simulated s")
     for factor in (4, 2, 1, 0.5, 0.25):
-        run = prepare(with_solver(scene, end_time_s=0.3, step_s=step * factor)).solve()
+        run = run_simulation(prepare(with_solver(scene, end_time_s=0.3, step_s=step * factor))).raw
         error = abs(run.bottom_m[-1] - reference) / abs(reference) if reference else float("nan")
         print(f"{step * factor:<10.3g}  {run.bottom_m[-1] * 1e3:<16.6f}  {error:<15.2e}  {run.cpu_time_s / 0.3:.3f}")
 

@@ -38,7 +38,7 @@ def main() -> None:
         exudyn, exact = simulate(scene), simulate(scene, "exact")
         report = compare_runs(ode, exudyn, end)
         histories = report["histories"]
-        print(f"{case:<26}{ode.bottom_m[-1]:<18.4g}{ode.info['mode_switches']:<10}"
+        print(f"{case:<26}{ode.bottom_m[-1]:<18.4g}{ode.solver.mode_switches:<10}"
               f"{report['bottom_at_window_end']['rel']:<10.2e}"
               f"{histories['bit_velocity_m_per_s']['max_rel_to_range']:<14.2e}"
               f"{histories['rock_force_n']['max_rel_to_range']:<12.2e}"

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.exudyn_model import build_exudyn
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
@@ -24,7 +25,7 @@ RATE_ONLY = {"effects": {"rock_damping": True, "joint_damping": True},
 
 def measure(data: dict, repeats: int) -> tuple[int, float, float]:
     simulation = prepare(Scene.model_validate(data))
-    runs = [simulation.solve() for _ in range(repeats)]
+    runs = [run_simulation(simulation).raw for _ in range(repeats)]
     rate = summary_metrics(runs[0])["penetration_rate_m_per_s"]
     return build_exudyn(simulation).coordinate_count, statistics.median(r.cpu_time_s for r in runs), rate
 

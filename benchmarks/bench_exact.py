@@ -40,6 +40,7 @@ import numpy as np
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.evaluation.results import SimulationResult
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.exact_model import OPERATOR_CACHE
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
@@ -55,9 +56,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 sys.path.insert(0, {benchmarks!r})
 from bench_exact import scenes
 from rpdrill.models.solvers.simulation import prepare
+from rpdrill.models.runs.scene_run import run
 simulation = prepare(scenes(0.5)["paper_base"].with_solver("exact"))
 start = time.process_time()
-simulation.solve()
+run(simulation)
 print(time.process_time() - start)
 """
 
@@ -126,7 +128,7 @@ def main() -> None:
     print("scene                 formulation                  CPU s / sim s   x_n rel. error   abs. [m]   x_n(end) [mm]")
     lean = scenes(args.end_time_s, RATE_ONLY)
     for name, scene in scenes(args.end_time_s).items():
-        reference = prepare(scene.with_solver("exact", sample_interval_s=scene.solver.output_interval_s / 100)).solve()
+        reference = run_simulation(prepare(scene.with_solver("exact", sample_interval_s=scene.solver.output_interval_s / 100))).raw
         exudyn = prepare(scene)
         runs = {
             "exact (default)": prepare(scene.with_solver("exact")).run,
@@ -148,11 +150,11 @@ def main() -> None:
                 start = time.process_time()
                 summary_metrics(result)
                 metrics_s = (time.process_time() - start) / args.end_time_s
-                print(f"{'':<24}({result.info['mode_switches']} switches, {result.info['samples']} samples, "
-                      f"every {result.info['sample_interval_s']:.0e} s; its metrics: {metrics_s:.4f} CPU s / sim s; "
+                print(f"{'':<24}({result.solver.mode_switches} switches, {result.solver.samples} samples, "
+                      f"every {result.solver.sample_interval_s:.0e} s; its metrics: {metrics_s:.4f} CPU s / sim s; "
                       f"with the propagators of a run before: {warm / args.end_time_s:.4f} CPU s / sim s)")
             del result
-        print(f"{name:<21} reference: exact, sub-step {reference.info['sub_step_s']:.3g} s")
+        print(f"{name:<21} reference: exact, sub-step {reference.solver.sub_step_s:.3g} s")
 
 if __name__ == "__main__":
     main()

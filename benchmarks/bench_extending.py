@@ -35,6 +35,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 from scenes import scene_dict  # the frozen test drill with overrides
 
+from rpdrill.models.runs.scene_run import run as run_simulation
+
 DOC = ROOT / "docs" / "extending.md"
 STRING = ROOT / "studies" / "scenes" / "four_rod_string.yaml"
 JOINT_STEPS = (2e-5, 5e-6, 1e-6)
@@ -60,7 +62,7 @@ def joint() -> None:
     blow = 1 / 45.0
 
     def run(solver: dict):
-        return prepare(Scene.model_validate({**data, "solver": {"end_time_s": 0.045, **solver}})).solve()
+        return run_simulation(prepare(Scene.model_validate({**data, "solver": {"end_time_s": 0.045, **solver}}))).raw
 
     ode = run({"formulation": "ode", "relative_tolerance": 1e-10, "absolute_tolerance": 1e-13})
     print("joint with play: Exudyn rk44 against the ODE (DOP853, rtol 1e-10)")
@@ -76,7 +78,7 @@ def joint() -> None:
 
 def rate(data: dict, solver: dict) -> float:
     scene = Scene.model_validate({**data, "solver": {**data["solver"], **solver}})
-    return summary_metrics(prepare(scene).solve())["penetration_rate_m_per_s"] * 1e3
+    return summary_metrics(run_simulation(prepare(scene)).raw)["penetration_rate_m_per_s"] * 1e3
 
 
 def string(couplings: bool) -> None:

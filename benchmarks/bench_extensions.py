@@ -163,8 +163,8 @@ def steady() -> None:
     start = time.process_time()
     orbit = rpdrill.simulate(clamped)
     cpu = time.process_time() - start
-    print(f"periodic, the clamp in the section: {rate(orbit) * 1e3:.6f} mm/s ({orbit.info['regime']}, |mu|max "
-          f"{orbit.info['floquet_max_abs']:.4f}, {orbit.info['map_runs']} map runs, {cpu:.2f} CPU s)")
+    print(f"periodic, the clamp in the section: {rate(orbit) * 1e3:.6f} mm/s ({orbit.steady_state.regime_name}, |mu|max "
+          f"{orbit.steady_state.floquet_max_abs:.4f}, {orbit.steady_state.map_runs} map runs, {cpu:.2f} CPU s)")
     time_run = rpdrill.simulate(clamped.with_({"solver.steady_state": "time", "solver.end_time_s": 200 / frequency,
                                                "metrics.transient_blows": 190, "metrics.block_blows": 10}))
     body = drill.with_({"solver.formulation": "exact", "drill_string.bodies.clamp": {"mass_kg": joint["mass_kg"]},

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
@@ -26,7 +27,7 @@ RATE_ONLY = {"outputs": {"metrics": ["penetration_rate_m_per_s"]}}
 def measure(data: dict, repeats: int) -> tuple[float, float]:
     """(median CPU s, penetration rate) of ``repeats`` runs."""
     simulation = prepare(Scene.model_validate(data))
-    runs = [simulation.solve() for _ in range(repeats)]
+    runs = [run_simulation(simulation).raw for _ in range(repeats)]
     return statistics.median(r.cpu_time_s for r in runs), summary_metrics(runs[0])["penetration_rate_m_per_s"]
 
 

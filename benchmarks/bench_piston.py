@@ -25,6 +25,7 @@ import numpy as np
 
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.drill.piston import rigid_piston_pulse_n
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 
 E_PA, RHO = 2.1e11, 7850.0
@@ -58,7 +59,7 @@ def rod_on_rod(piston_segments: int, formulation: str) -> dict[str, float]:
     """Plateau, pulse length and rebound energy of the equal-impedance piston rod (relative errors)."""
     rod_segments = 8 * piston_segments  # a 4 m rod: segments as long as the piston's
     piston = {"length_m": PISTON_LENGTH_M, "segments": piston_segments, **STEEL}
-    result = prepare(scene(piston, 8 * PISTON_LENGTH_M, rod_segments, formulation, 2e-3)).solve()
+    result = run_simulation(prepare(scene(piston, 8 * PISTON_LENGTH_M, rod_segments, formulation, 2e-3))).raw
     t, force = result.time_s, result.piston.contact_force_n
     duration = 2 * PISTON_LENGTH_M / WAVE_SPEED
     plateau = float(np.mean(force[(t > 0.25 * duration) & (t < 0.75 * duration)]))
@@ -81,7 +82,7 @@ def rigid(rod_segments: int, formulation: str, per_segment: float | None = None)
     segment = E_PA * AREA_M2 * rod_segments / RIGID_ROD_M
     contact = RIGID_CONTACT if per_segment is None else per_segment * segment
     piston = {"mass_kg": RIGID_MASS_KG, "contact_stiffness_n_per_m": contact}
-    result = prepare(scene(piston, RIGID_ROD_M, rod_segments, formulation, 1e-3)).solve()
+    result = run_simulation(prepare(scene(piston, RIGID_ROD_M, rod_segments, formulation, 1e-3))).raw
     t, force = result.time_s, result.piston.contact_force_n
     v_after = float(result.piston.rebounds[0, 2])
     caught = t <= _catch_time(result)

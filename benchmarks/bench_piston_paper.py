@@ -24,6 +24,7 @@ from scipy import optimize
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.drill.pulse import impact_force
 from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
@@ -63,7 +64,7 @@ def main() -> None:
     fixed = [] if args.free_mass else [guess[0]]
 
     def residual(logs: np.ndarray) -> float:
-        result = prepare(piston_scene(base, *np.exp([*fixed, *logs]), blows=1)).solve()
+        result = run_simulation(prepare(piston_scene(base, *np.exp([*fixed, *logs]), blows=1))).raw
         target = impact_force(paper.impact, result.time_s)
         return float(np.sqrt(np.mean((result.piston.contact_force_n - target) ** 2)) / amplitude)
 
@@ -71,7 +72,7 @@ def main() -> None:
     fit = optimize.minimize(residual, guess[len(fixed):], method="Nelder-Mead", bounds=np.log(BOUNDS[len(fixed):]),
                             options={"xatol": 1e-4, "fatol": 1e-6, "maxiter": 300})
     mass, speed, stiffness = np.exp([*fixed, *fit.x])
-    one = prepare(piston_scene(base, mass, speed, stiffness, blows=1)).solve()
+    one = run_simulation(prepare(piston_scene(base, mass, speed, stiffness, blows=1))).raw
     print(f"guess (a shank-mass piston on shank + collar + bit, free): m_p {math.exp(guess[0]):.4g} kg, "
           f"v_p {math.exp(guess[1]):.4g} m/s, k_c {math.exp(guess[2]):.4g} N/m: RMS residual {start:.2%} of 220 kN")
     print(f"fitted ({fit.nfev} runs): m_p {mass:.4g} kg, v_p {speed:.4g} m/s, k_c {stiffness:.4g} N/m, blow energy "
@@ -81,7 +82,7 @@ def main() -> None:
           f"{2 / math.pi * amplitude * tau:.4g} N s; rebound energy {one.piston.rebounds[0, 1]:.4g} J")
     for label, scene in (("prescribed pulse", paper.with_solver("exact")),
                          ("fitted piston", piston_scene(base, mass, speed, stiffness))):
-        metrics = summary_metrics(prepare(scene).solve())
+        metrics = summary_metrics(run_simulation(prepare(scene)).raw)
         print(f"{label}: penetration rate {metrics['penetration_rate_m_per_s'] * 1e3:.4g} mm/s, impact energy in the "
               f"window {metrics['impact_energy_j']:.4g} J")
 

@@ -51,6 +51,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))  # the hard scenes of the stability suite
 from stability.hard_scenes import HARD_SCENES, hard_scene
 
+from rpdrill.models.runs.scene_run import run as run_simulation
+
 COST_TARGETS = {"fast": 0.05, "standard": 0.1}
 
 
@@ -61,10 +63,10 @@ def rate_error(metrics: dict[str, float], exact: dict[str, float]) -> float:
 
 def cost(scene: Scene, repeats: int) -> float:
     simulation = prepare(scene)
-    simulation.solve()  # warm-up
+    run_simulation(simulation)  # warm-up
     runs = []
     for _ in range(repeats):
-        runs.append(simulation.solve().cpu_time_s)  # the result is dropped at once
+        runs.append(run_simulation(simulation).raw.cpu_time_s)  # the result is dropped at once
     return statistics.median(runs) / scene.solver.end_time_s
 
 
@@ -90,7 +92,7 @@ def measure(candidates: dict[str, Scene], exact: dict[str, dict[str, float]],
     per_second, errors, energy = float("nan"), {}, 0.0
     for name, candidate in candidates.items():
         try:
-            metrics = summary_metrics(prepare(candidate).solve())
+            metrics = summary_metrics(run_simulation(prepare(candidate)).raw)
         except Exception:  # noqa: BLE001 - a diverged or failed candidate is off the front
             errors[name] = energy = float("inf")
             continue
@@ -151,7 +153,7 @@ def paper_costs(presets: list[str], repeats: int) -> dict[str, tuple[float, floa
     """(CPU s per simulated s, penetration rate) of each preset on the paper scene, in this process."""
     paper = load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml")
     return {preset: (cost(paper.with_solver("exudyn", preset=preset), repeats), summary_metrics(
-        prepare(paper.with_solver("exudyn", preset=preset)).solve())["penetration_rate_m_per_s"]) for preset in presets}
+        run_simulation(prepare(paper.with_solver("exudyn", preset=preset))).raw)["penetration_rate_m_per_s"]) for preset in presets}
 
 
 def modules(presets: list[str], repeats: int, rounds: int = 3) -> None:
@@ -193,7 +195,7 @@ def main() -> None:
         return
     scenes = {"paper_base": load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml")}
     scenes.update({name: hard_scene(overrides) for name, overrides in HARD_SCENES.items()})
-    exact = {name: summary_metrics(prepare(scene.with_solver("exact")).solve()) for name, scene in scenes.items()}
+    exact = {name: summary_metrics(run_simulation(prepare(scene.with_solver("exact"))).raw) for name, scene in scenes.items()}
     if args.front:
         front(scenes, exact, args.repeats, args.sweeps.split(","))
         return
@@ -210,7 +212,7 @@ def main() -> None:
         worst = {"rate": 0.0, "energy": 0.0}
         for name, scene in scenes.items():
             simulation = prepare(scene.with_solver("exudyn", preset=preset))
-            result = simulation.solve()
+            result = run_simulation(simulation).raw
             metrics = summary_metrics(result)
             error, energy = rate_error(metrics, exact[name]), metrics["energy_balance_relative_error"]
             worst = {"rate": max(worst["rate"], error), "energy": max(worst["energy"], energy)}
@@ -221,7 +223,7 @@ def main() -> None:
     undamped = scenes[UNDAMPED]
     nudged = undamped.model_copy(update={"impact": undamped.impact.model_copy(
         update={"amplitude_n": undamped.impact.amplitude_n * (1 + 1e-9)})})
-    change = rate_error(summary_metrics(prepare(nudged.with_solver("exact")).solve()), exact[UNDAMPED])
+    change = rate_error(summary_metrics(run_simulation(prepare(nudged.with_solver("exact"))).raw), exact[UNDAMPED])
     print(f"\n{UNDAMPED}: the exact penetration rate changes by {change:.1e} (relative) for a 1e-9 relative change "
           "of the impact amplitude (the scene is not sensitive: its preset errors are the solvers')")
 

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from rpdrill.models.definition.scene import Scene
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.exact_model import BLAS, OPERATOR_CACHE, ExactSolver
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
@@ -64,7 +65,7 @@ def exact_run(scene: Scene) -> dict[str, float]:
 
 def exudyn_run(scene: Scene) -> dict[str, float]:
     simulation = prepare(scene)
-    result = simulation.solve()
+    result = run_simulation(simulation).raw
     return {"cpu_s": result.cpu_time_s, "step_s": simulation.settings.step_s,
             "steps": round(scene.solver.end_time_s / simulation.settings.step_s)}
 

@@ -32,6 +32,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))  # the hard scenes of the stability suite
 from stability.hard_scenes import HARD_SCENES, hard_scene
 
+from rpdrill.models.runs.scene_run import run as run_simulation
+
 SOLVERS = ("rk67", "rk44", "rk33", "explicit_midpoint", "explicit_euler")
 FACTORS = (0.05, 0.1, 0.2, 0.4, 0.8, 1.0, 1.2, 1.6, 2.0, 2.4, 2.8)
 UNDAMPED = "no_damping"
@@ -47,7 +49,7 @@ def attempt(name: str, solver: str, factor: float, radius: float) -> tuple[bool,
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # StepLimitWarning: the point is to go beyond the limit
-            result = prepare(scene).solve()
+            result = run_simulation(prepare(scene)).raw
     except SimulationFailed as failure:
         # "diverged": non-finite or runaway states, or energy created; "stopped": end time not reached
         return False, "stopped" if "stopped at" in str(failure) else "diverged", float("nan")

@@ -25,9 +25,9 @@ import numpy as np
 import rpdrill
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.evaluation.solver_settings import EXUDYN_PRESETS
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.models.steady.regimes import steady_state
-from rpdrill.models.steady.steady_run import run_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SCANS = ("frequency_scan", "impulse_scan", "stiffness_scan")
@@ -38,8 +38,8 @@ def settled_advance(scene: rpdrill.Scene, settle: float) -> tuple[float, int]:
     frequency = scene.impact.frequency_hz
     blows = 400
     while True:
-        run = prepare(scene.with_({"solver.end_time_s": blows / frequency, "solver.steady_state": "time",
-                                   "outputs": {"metrics": ["penetration_rate_m_per_s"]}})).solve()
+        run = run_simulation(prepare(scene.with_({"solver.end_time_s": blows / frequency, "solver.steady_state": "time",
+                                   "outputs": {"metrics": ["penetration_rate_m_per_s"]}}))).raw
         advances = np.diff(run.bottom_at(np.arange(blows - 2, blows + 1) / frequency))
         if abs(advances[-1] - advances[-2]) <= settle * abs(advances[-1]) or blows >= 25600:
             return float(advances[-1]), blows
@@ -97,12 +97,12 @@ def exudyn_points(preset: str) -> None:
         scene = point.simulation.scene.with_({"solver.preset": preset,
                                               "outputs": {"metrics": ["penetration_rate_m_per_s"]}})
         periodic = scene.with_({"solver.steady_state": "periodic"})
-        exudyn = summary_metrics(run_scene(prepare(periodic)))["penetration_rate_m_per_s"]
-        exact = summary_metrics(run_scene(prepare(periodic.with_solver("exact"))))["penetration_rate_m_per_s"]
+        exudyn = run_simulation(prepare(periodic)).metrics["penetration_rate_m_per_s"]
+        exact = run_simulation(prepare(periodic.with_solver("exact"))).metrics["penetration_rate_m_per_s"]
         difference = abs(exudyn - exact) / abs(exact)
         if difference > largest:
             largest, where = difference, str(point.parameters)
-        runs = [summary_metrics(prepare(s).solve())["penetration_rate_m_per_s"] for s in (scene, scene.with_solver("exact"))]
+        runs = [summary_metrics(run_simulation(prepare(s)).raw)["penetration_rate_m_per_s"] for s in (scene, scene.with_solver("exact"))]
         own = max(own, abs(runs[0] - runs[1]) / abs(runs[1]))
     print(f"Exudyn ({preset} preset) shooting against the exact orbit, frequency scan: largest relative difference "
           f"in the rate {largest:.3g} at {where}; its 1.5 s time runs against the exact ones: {own:.3g} (stated "

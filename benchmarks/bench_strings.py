@@ -26,6 +26,7 @@ import numpy as np
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.evaluation.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import load_scene, read_yaml
 
@@ -40,7 +41,7 @@ def wave_table(segment_counts: tuple[int, ...]) -> None:
     for n in segment_counts:
         data["drill_string"]["bodies"]["rod"]["segments"] = n
         scene = Scene.model_validate(data)
-        run = prepare(scene).solve()
+        run = run_simulation(prepare(scene)).raw
         rod = scene.drill_string.bodies["rod"]
         travel = travel_time_s(run)
         pulse = transmitted_pulse_n(run, grid)
@@ -53,11 +54,11 @@ def wave_table(segment_counts: tuple[int, ...]) -> None:
 
 def cost(name: str, formulation: str, repeats: int) -> float:
     simulation = prepare(load_scene(SCENES / f"{name}.yaml").with_solver(formulation))
-    first = simulation.solve()  # also the warm-up (the exact formulation's kernels load on the first call)
+    first = run_simulation(simulation).raw  # also the warm-up (the exact formulation's kernels load on the first call)
     bodies, rate = first.position_m.shape[1], summary_metrics(first)["penetration_rate_m_per_s"]
     del first  # each result is dropped before the next run, as in a study (docs/exact.md: page faults)
     end_time_s = simulation.settings.end_time_s
-    cpu = statistics.median(simulation.solve().cpu_time_s for _ in range(repeats)) / end_time_s
+    cpu = statistics.median(run_simulation(simulation).raw.cpu_time_s for _ in range(repeats)) / end_time_s
     step = f"{simulation.settings.step_s:.3g}" if formulation == "exudyn" else "-"
     print(f"{name:<18}{formulation:<13}{bodies:<8}{step:<12}{cpu:<18.4f}{rate * 1e3:.4f}")
     return cpu

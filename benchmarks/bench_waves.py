@@ -37,6 +37,7 @@ from rpdrill.models.definition.scene import Scene
 from rpdrill.models.drill.piston import rigid_piston_pulse_n
 from rpdrill.models.drill.wave_rod import reflected_force_share, transmitted_force_share
 from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
@@ -64,7 +65,7 @@ def rod(length_m: float, **more: Any) -> dict:
 
 def timed(scene: Scene) -> tuple[Any, float]:
     start = time.process_time()
-    result = prepare(scene).solve()
+    result = run_simulation(prepare(scene)).raw
     return result, time.process_time() - start
 
 

@@ -36,7 +36,8 @@ ROLES = {
     "models.drill": "The drill string's mechanics: the chain of bodies and connectors (incidence, stiffness, "
                     "static preload), its modes, its piecewise-linear modes of contact, the impact pulse, bit "
                     "indexing, the piston, a rod as a wave element (impedance, transit time, its ends' law).",
-    "models.evaluation": "What a run gives: the result and its time series, the energy account, metrics, "
+    "models.evaluation": "What a run gives: the result and its time series, its typed records (solver, steady "
+                         "state, items of one's own), the energy account, metrics, "
                          "stability checks and step bounds, the solver presets, comparisons between runs, "
                          "work-precision fronts, stress-wave checks.",
     "models.waves": "Rods carried as waves: the characteristics at a stated step (the waves in flight, "
@@ -47,7 +48,9 @@ ROLES = {
                      "bottom by shooting (the exact map's Jacobian from matrix exponentials and saltation "
                      "matrices, finite differences for the other formulations), its Floquet multipliers, the "
                      "regime of a scene (period-1, period-n, none), continuation along a scan and its "
-                     "bifurcations, and the run a scene's solver.steady_state asks for.",
+                     "bifurcations.",
+    "models.runs": "The one path from a prepared scene to its `rpdrill.Result`: the time run, or the steady state "
+                   "the scene's solver.steady_state asks for, with its typed records.",
     "models.solvers": "Preparing a scene for a run and the three formulations of one model: the Exudyn "
                       "multibody system, the exact piecewise-linear propagation (its linear system and "
                       "compiled kernels), the paper's Eq. 4 as a SciPy ODE; a run's cost estimate.",
@@ -110,8 +113,8 @@ FREQUENCY_PATH = (
      ("prepared once (`models.solvers.simulation.prepare`): the `Simulation` holds the scene's `impact` and a "
      "solver step fitted to its period `impact.period_s`; the prepared object goes to a worker as it is")),
     ("studies.runtime.point_runs", "run_point",
-     ("in the worker: `models.steady.steady_run.run_scene`, the time run (`Simulation.solve`) or the periodic "
-     "orbit the scene asks for, the formulation (exact, Exudyn, ODE) placing the blows every "
+     ("in the worker: `models.runs.scene_run.run`, the time run (`models.solvers.time_run.time_run`) or the "
+     "periodic orbit the scene asks for, the formulation (exact, Exudyn, ODE) placing the blows every "
      "`impact.period_s` (`models.drill.pulse`); the row it returns holds floats")),
     ("studies.runtime.resumable", "run_tables",
      ("the row appended to `results.csv` (`studies.runtime.tables.append_rows`: text only in the file) and "

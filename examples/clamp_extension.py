@@ -111,13 +111,13 @@ def main() -> None:
     print(f"clamped collar (Exudyn): {rate * 1e3:.4f} mm/s; collar 300 kg heavier (exact): {reference * 1e3:.4f} mm/s "
           f"(relative difference {abs(rate / reference - 1):.2e})")
     print(f"energy balance with the clamp: {result.metrics['energy_balance_relative_error']:.2e} "
-          f"({', '.join(result.info['energy_account']['accounted'])})")
+          f"({', '.join(result.user_energy.accounted)})")
     print(f"clamp_velocity sensor: peak {result.timeseries['clamp_velocity'].abs().max():.4f} m/s")
     friction = base.with_({"extensions": {"friction": {"function": "clamp_extension:add_friction_clamp", "parameters": {
         "mass_kg": 300.0, "stiffness_n_per_m": 1e9, "damping_n_s_per_m": 2e4}}}})
     declared = rpdrill.simulate(friction)
     print(f"energy balance with the friction clamp and its declared terms: "
-          f"{declared.metrics['energy_balance_relative_error']:.2e} ({', '.join(declared.info['energy_account']['declared'])})")
+          f"{declared.metrics['energy_balance_relative_error']:.2e} ({', '.join(declared.user_energy.declared)})")
 
 
 if __name__ == "__main__":

@@ -66,9 +66,7 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     write_columns_csv(folder / "timeseries.csv", columns)
     write_json(folder / "summary.json", {"scene": result.scene.name, "formulation": result.formulation,
                                          "status": run_status(result.raw, result.metrics)[0], "metrics": result.metrics,
-                                         "run": {key: value for key, value in result.raw.info.items()
-                                                 if key != "solution_file"},  # a scratch file of the run
-                                         "provenance": result.provenance})
+                                         "run": run_record(result), "provenance": result.provenance})
     write_resolved(folder / "scene.resolved.yaml", result.raw.simulation.resolved_scene())
     written = [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml",
                *plot_timeseries(columns, result.scene, folder / "timeseries.png"),
@@ -79,11 +77,21 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     return written
 
 
+def run_record(result: Result) -> dict[str, Any]:
+    """What ``summary.json`` records of how a run went: the solver's record, the steady state, the items of
+    one's own an Exudyn model ran with and their energy account, the warnings (docs/api.md)."""
+    energy = result.raw.user_energy
+    return {"solver": result.solver, "steady_state": result.steady_state, "exudyn_model": result.exudyn_model,
+            "energy_account": None if energy is None else {"accounted": energy.accounted, "declared": energy.declared,
+                                                           "unaccounted": energy.unaccounted, "note": energy.note},
+            "warnings": result.warnings}
+
+
 def _animated(result: Result) -> Any:
     """What the animation of a run draws: an Exudyn run of a scene with extensions, from its solution file
     (``simulate(..., solution_file=...)``), as its model rebuilt (every item of the extensions drawn); any
     other run as the drill string of its scene."""
-    solution = result.raw.info.get("solution_file")
+    solution = result.raw.solution_file
     if not result.scene.extensions or result.formulation != "exudyn" or not solution or not Path(solution).exists():
         return result.raw
     from ..models.solvers.exudyn_model import build_exudyn
@@ -103,8 +111,8 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
     (for its SolutionViewer: studies.drawings.drill_animation.view_solution). Loads no figure module:
     the caller's matplotlib is left as it is. A scene with ``solver.steady_state: periodic`` gives its
-    steady state (models.steady.steady_run.run_scene)."""
-    from ..models.steady.steady_run import run_scene
+    steady state (models.runs.scene_run.run)."""
+    from ..models.runs.scene_run import run
 
     check("rpdrill.simulate", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
     check("rpdrill.simulate", "progress", progress, callable_problem)
@@ -117,8 +125,8 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     if budget is not None:
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
-    raw = run_scene(simulation, progress=progress, solution=None if solution_file is None else Path(solution_file))
-    return Result(scene, raw, {"source": source, **simulation.code_records()})
+    return run(simulation, progress, solution_file=None if solution_file is None else Path(solution_file),
+               source=source)
 
 
 def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:

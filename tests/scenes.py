@@ -8,6 +8,7 @@ from typing import Any
 
 from rpdrill import Scene
 from rpdrill.models.evaluation.results import SimulationResult
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
@@ -46,4 +47,4 @@ def crushing_scene(**overrides: Any) -> Scene:
 
 def simulate(scene: Scene, formulation: str | None = None, **options: Any) -> SimulationResult:
     """Run ``scene`` with ``formulation`` (default: the scene's) and solver ``options``."""
-    return prepare(scene.with_solver(formulation, **options)).solve()
+    return run_simulation(prepare(scene.with_solver(formulation, **options))).raw

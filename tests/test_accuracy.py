@@ -46,7 +46,7 @@ def linear_scene(solver_type: str, step_s: float) -> rpdrill.Scene:
 def reference():
     result = simulate(linear_scene("rk44", 1e-5), "exact")
     # the bit meets the rock at t = 0+ (from rest) and stays on it: the model is linear
-    assert all(t < 1e-9 for t in result.info["switch_times_s"])
+    assert all(t < 1e-9 for t in result.solver.switch_times_s)
     assert result.bit_position_m[result.time_s > 0].min() > 0
     return signature(result, GRID)
 

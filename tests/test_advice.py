@@ -15,6 +15,7 @@ from scenes import crushing_scene, scene, scene_dict, simulate
 import rpdrill
 from rpdrill.models.drill.pulse import impulse_per_blow_n_s
 from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.advice.advice_search import (
     FEED,
@@ -65,7 +66,7 @@ def test_mean_thrust_is_the_mean_rock_force_of_a_steady_run():
                                         outputs={"metrics": ["rock_force_max_n", RATE]}))
     expected = simulation.scene.feed.force_n + impulse_per_blow_n_s(simulation.impact) * simulation.impact.frequency_hz
     assert simulation.mean_thrust_n == pytest.approx(expected)
-    result = simulation.solve()
+    result = run_simulation(simulation).raw
     window = result.time_s >= 10 / simulation.impact.frequency_hz
     t, force = result.time_s[window], result.rock_force_n[window]
     assert np.trapezoid(force, t) / (t[-1] - t[0]) == pytest.approx(simulation.mean_thrust_n, rel=1e-3)

@@ -184,7 +184,7 @@ def test_exudyn_agrees_with_exact(runs):
         surface, bottom = r.rock_state_m.T  # never backwards (the exact solution's to round-off of its events)
         assert np.all(np.diff(bottom) >= -1e-15) and np.all(surface <= bottom)
         assert np.min(r.bit_position_m - r.bottom_m) < -1e-6  # the bit lifts off between blows
-    assert {"loading", "unloading", "lifted"} <= set(exact.info["switches_into"])
+    assert {"loading", "unloading", "lifted"} <= set(exact.solver.switches_into)
 
 
 BOUNCING = {**ROCK, "unloading_stiffness_n_per_m": 5e9}  # a stiff unloading: the bit rings off and comes back

@@ -111,8 +111,10 @@ def test_an_out_folder_holding_another_run_is_refused_unless_overwrite(tmp_path,
 
 
 def test_simulate_with_the_exact_formulation_writes_its_run_info(tmp_path):
-    """The exact run's info holds arrays (switch times): summary.json writes them as lists."""
+    """The exact run's record holds arrays (switch times): summary.json writes them as lists, its steady state
+    as the regime's text."""
     path = write(tmp_path, scene_dict(**QUICK, solver={"formulation": "exact", "end_time_s": 0.1}))
     assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     run = json.loads((tmp_path / "out" / "summary.json").read_text())["run"]
-    assert run["mode_switches"] == len(run["switch_times_s"]) > 0
+    assert run["solver"]["mode_switches"] == len(run["solver"]["switch_times_s"]) > 0
+    assert run["steady_state"]["regime"] == "time run" and run["steady_state"]["requested"] == "time"

@@ -73,7 +73,7 @@ def test_exudyn_agrees_with_the_reference(case: str, reference: str) -> None:
         assert bool(r.bottom_m[-1] > 1e-6) is crushes, r.bottom_m[-1]
         assert bool(np.min(r.bit_position_m - r.bottom_m) < -LIFT_OFF_M) is lifts_off
     if not crushes:
-        assert expected.bottom_m.max() == 0.0 and "crushing" not in expected.info["switches_into"]
+        assert expected.bottom_m.max() == 0.0 and "crushing" not in expected.solver.switches_into
     np.testing.assert_allclose(exudyn.torsion_angle_rad[-1], expected.torsion_angle_rad[-1], rtol=1e-6)
 
 

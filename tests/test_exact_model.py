@@ -107,7 +107,7 @@ def test_agrees_with_tight_ode(feed: str, damping_mode: str) -> None:
     held on the rock by the feed on every body, makes its last switch in its fourth blow."""
     reference = simulate(crushing(feed, damping_mode, blows=ODE_BLOWS), "exact")
     ode = simulate(reference.scene, "ode", method="DOP853", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
-    assert reference.info["switches_into"].get("crushing", 0) >= 2
+    assert reference.solver.switches_into.get("crushing", 0) >= 2
     assert reference.bottom_m[-1] > 5e-4  # the bottom advanced by crushing
     assert relative_error(ode, reference, "bottom_m") < AGREEMENT
     assert relative_error(ode, reference, "bit_position_m") < AGREEMENT
@@ -121,7 +121,7 @@ def test_other_pulse_shapes_agree_with_tight_ode(shape: str) -> None:
     """The rectangular pulse (constant state) and the triangular one (ramp state, two phases)."""
     reference = simulate(crushing("carriage", "contact", blows=6, impact__shape=shape), "exact")
     ode = simulate(reference.scene, "ode", method="DOP853", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
-    assert reference.info["switches_into"].get("crushing", 0) >= 4
+    assert reference.solver.switches_into.get("crushing", 0) >= 4
     assert relative_error(ode, reference, "bottom_m") < AGREEMENT
     assert relative_error(ode, reference, "bit_position_m") < AGREEMENT
 
@@ -163,7 +163,7 @@ def test_energy_conserved_to_round_off_without_damping(threshold_n: float | None
     between = result.time_s - blow * impact.period_s >= impact.duration_s - 1e-15
     spread = max(np.ptp(total[between & (blow == b)]) for b in np.unique(blow[between]))
     assert (result.bottom_m[-1] > 0) == (threshold_n is None)
-    assert result.info["mode_switches"] > 8
+    assert result.solver.mode_switches > 8
     largest_term = np.max(energy.kinetic_j + energy.elastic_j + np.abs(energy.feed_work_j))
     assert spread < 1e-12 * largest_term
 
@@ -171,18 +171,18 @@ def test_energy_conserved_to_round_off_without_damping(threshold_n: float | None
 def test_switch_just_after_a_grid_point_is_found() -> None:
     """Shift the sub-grid so that a point lies 1e-6 sub-steps before a contact event."""
     base = exact("carriage", "contact")
-    times, modes = base.info["switch_times_s"], base.info["switch_modes"]
+    times, modes = base.solver.switch_times_s, base.solver.switch_modes
     contact_made = next(t for t, mode, before in zip(times[1:], modes[1:], modes)
                         if mode[0] == "contact" and before[0] == "free")
-    step = base.info["sub_step_s"]
-    per_sample = round(base.info["sample_interval_s"] / step)
+    step = base.solver.sub_step_s
+    per_sample = round(base.solver.sample_interval_s / step)
     points = math.floor(contact_made / step)
     shifted_step = (contact_made - 1e-6 * step) / points
     shifted = simulate(base.scene, "exact", sample_interval_s=shifted_step * per_sample)
-    assert shifted.info["sub_step_s"] == pytest.approx(shifted_step, rel=1e-14)
-    assert 0 < contact_made - points * shifted.info["sub_step_s"] < 2e-6 * step
-    assert shifted.info["switch_modes"] == modes
-    assert np.max(np.abs(shifted.info["switch_times_s"] - times)) < 1e-13
+    assert shifted.solver.sub_step_s == pytest.approx(shifted_step, rel=1e-14)
+    assert 0 < contact_made - points * shifted.solver.sub_step_s < 2e-6 * step
+    assert shifted.solver.switch_modes == modes
+    assert np.max(np.abs(shifted.solver.switch_times_s - times)) < 1e-13
     assert abs(shifted.bottom_m[-1] - base.bottom_m[-1]) < 1e-12 * base.bottom_m[-1]
 
 
@@ -218,9 +218,9 @@ def test_switches_do_not_depend_on_the_sample_interval() -> None:
     1e-4 s samples) are found whatever the sub-grid: the same switches as on a 2 us sub-grid."""
     s = crushing_scene(rock=BILINEAR, solver__end_time_s=0.1, **SHORT_METRICS)
     sparse, dense = (simulate(s, "exact", sample_interval_s=interval) for interval in (1e-4, 2e-6))
-    assert sparse.info["sub_step_s"] > 5 * dense.info["sub_step_s"]
-    assert sparse.info["switch_modes"] == dense.info["switch_modes"]
-    np.testing.assert_allclose(sparse.info["switch_times_s"], dense.info["switch_times_s"], rtol=0, atol=1e-12)
+    assert sparse.solver.sub_step_s > 5 * dense.solver.sub_step_s
+    assert sparse.solver.switch_modes == dense.solver.switch_modes
+    np.testing.assert_allclose(sparse.solver.switch_times_s, dense.solver.switch_times_s, rtol=0, atol=1e-12)
 
 
 # a light bit loosely held by a light collar on a stiff rock, little feed: ~70 switches per blow
@@ -232,8 +232,8 @@ def test_chattering_contact_runs_to_the_end() -> None:
     chatter = scene(solver__end_time_s=10 / 65, **SHORT_METRICS, **CHATTER)
     result = simulate(chatter, "exact")
     assert result.time_s[-1] == pytest.approx(chatter.solver.end_time_s)
-    assert result.info["mode_switches"] > 30 * 10
-    assert np.min(np.diff(result.info["switch_times_s"])) >= result.info["min_switch_interval_s"]
+    assert result.solver.mode_switches > 30 * 10
+    assert np.min(np.diff(result.solver.switch_times_s)) >= result.solver.min_switch_interval_s
     assert result.cpu_time_s < 10.0
     with pytest.raises(SimulationFailed, match="chattering"):
         simulate(chatter, "exact", max_switches_per_blow=5)
@@ -251,8 +251,8 @@ def test_compiled_loop_gives_the_former_answer() -> None:
     result = exact("carriage", "contact")
     for column, former in FORMER.items():
         assert getattr(result, column)[-1] == pytest.approx(former, rel=1e-12)
-    assert result.info["switches_into"] == FORMER_SWITCHES
-    np.testing.assert_allclose(result.info["switch_times_s"][:4], FORMER_SWITCH_TIMES_S, rtol=1e-12, atol=1e-15)
+    assert result.solver.switches_into == FORMER_SWITCHES
+    np.testing.assert_allclose(result.solver.switch_times_s[:4], FORMER_SWITCH_TIMES_S, rtol=1e-12, atol=1e-15)
 
 
 def test_compiled_loop_matches_its_python_execution(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -261,7 +261,7 @@ def test_compiled_loop_matches_its_python_execution(monkeypatch: pytest.MonkeyPa
     compiled = simulate(short, "exact", sample_interval_s=1e-4)
     monkeypatch.setattr(rpdrill.models.solvers.exact_model, "run_events", run_events.py_func)
     interpreted = simulate(short, "exact", sample_interval_s=1e-4)
-    assert compiled.info["switch_modes"] == interpreted.info["switch_modes"]
+    assert compiled.solver.switch_modes == interpreted.solver.switch_modes
     np.testing.assert_array_equal(compiled.time_s, interpreted.time_s)
     for column in ("position_m", "velocity_m_per_s", "bottom_m", "rock_force_n", "torsion_angle_rad"):
         values, reference = getattr(compiled, column), getattr(interpreted, column)
@@ -337,7 +337,7 @@ def test_piecewise_laws_agree_with_the_ode_to_1e_9_in_the_bottom(make):
     s = make()
     exact = simulate(s, "exact")
     ode = simulate(s, "ode", relative_tolerance=1e-12, absolute_tolerance=1e-15)
-    assert exact.bottom_m[-1] > 0 and exact.info["mode_switches"] == ode.info["mode_switches"]
+    assert exact.bottom_m[-1] > 0 and exact.solver.mode_switches == ode.solver.mode_switches
     assert abs(exact.bottom_m[-1] - ode.bottom_m[-1]) <= 1e-9 * exact.bottom_m[-1]
 
 
@@ -352,7 +352,7 @@ def test_works_from_the_propagators_close_the_energy_balance_at_sparse_samples(m
     ((4 T(h / 2) - T(h)) / 3: the trapezoid's h^2 error removed)."""
     scene_ = make()
     sparse = simulate(scene_, "exact")
-    assert sparse.works_j is not None and sparse.info["sample_interval_s"] == scene_.solver.output_interval_s
+    assert sparse.works_j is not None and sparse.solver.sample_interval_s == scene_.solver.output_interval_s
     account = energy_account(sparse)
     assert account.relative_residual() < 1e-8
     assert account.crushing_work_j[-1] > 0 and account.damping_j[-1] > 0
@@ -373,10 +373,10 @@ def test_a_scan_reuses_the_propagators_and_its_results_are_those_of_a_fresh_buil
     cache.clear()
     fresh = simulate(base)
     keys = len(cache.entries)
-    assert keys == fresh.info["operator_keys"] > 0
+    assert keys == fresh.solver.operator_keys > 0
     again = simulate(base)
     other = simulate(base.model_copy(update={"impact": base.impact.model_copy(update={"frequency_hz": 47.0})}))
-    assert len(cache.entries) == keys and other.info["operator_keys"] <= keys
+    assert len(cache.entries) == keys and other.solver.operator_keys <= keys
     for name in ("time_s", "position_m", "velocity_m_per_s", "bottom_m", "rock_force_n"):
         assert np.array_equal(getattr(fresh, name), getattr(again, name)), name
     assert all(np.array_equal(fresh.works_j[k], again.works_j[k]) for k in fresh.works_j)

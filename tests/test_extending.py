@@ -109,7 +109,7 @@ def test_exact_formulation_runs_the_new_type_from_its_modes(joint_type):
     s = Scene.model_validate(s.model_dump(by_alias=True, exclude={"effects", "outputs"}) | {
         "solver": {"formulation": "exact", "end_time_s": 2 / 45.0}, "metrics": {"transient_blows": 0, "block_blows": 2}})
     exact, ode = simulate(s), simulate(s, "ode", relative_tolerance=1e-12, absolute_tolerance=1e-15)
-    assert exact.bottom_m[-1] > 0 and exact.info["mode_switches"] == ode.info["mode_switches"]
+    assert exact.bottom_m[-1] > 0 and exact.solver.mode_switches == ode.solver.mode_switches
     assert abs(exact.bottom_m[-1] - ode.bottom_m[-1]) <= 1e-9 * exact.bottom_m[-1]
 
 

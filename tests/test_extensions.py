@@ -18,6 +18,7 @@ from scenes import crushing_scene
 
 import rpdrill
 from rpdrill.models.evaluation.stability import SimulationFailed, StepLimitWarning
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -47,7 +48,7 @@ def test_a_stiff_clamp_added_in_python_runs_at_the_step_it_needs_and_equals_a_he
     body_step = prepare(as_body).settings.step_s
     assert body_step < 0.2 * prepare(PAPER).settings.step_s  # the clamp's mode sets the step
     assert result.raw.simulation.settings.step_s == pytest.approx(body_step, rel=1e-9)
-    assert result.info["exudyn_model"]["step_s"] == pytest.approx(body_step, rel=1e-9)
+    assert result.exudyn_model.step_s == pytest.approx(body_step, rel=1e-9)
     heavier = PAPER.with_({"drill_string.bodies.collar.mass_kg": 1830.0 + 300.0})
     exact = rate(rpdrill.simulate(heavier, formulation="exact"))
     assert rate(result) == pytest.approx(exact, rel=2e-3)
@@ -85,7 +86,7 @@ def test_a_pre_step_function_set_on_mbs_runs_beside_the_models_or_is_refused():
     result = model.run()
     steps = round(PAPER.solver.end_time_s / result.raw.simulation.settings.step_s)
     assert len(calls) == steps and rate(result) == rate(reference)
-    assert "SetPreStepUserFunction" in result.info["exudyn_model"]["pre_step"]
+    assert result.exudyn_model.foreign_pre_step
     model = rpdrill.build_exudyn(PAPER)
     model.mbs.SetPreStepUserFunction(lambda mbs, t: True)
     exudyn.SolveDynamic(model.mbs, model.settings, solverType=model.solver_type)
@@ -118,7 +119,7 @@ def test_a_damped_clamp_enters_the_energy_account():
     error = result.metrics["energy_balance_relative_error"]
     assert error < 1e-3 and error < 10 * plain, (error, plain)
     assert {"Mass1D 'clamp'", "ConnectorCoordinateSpringDamper 'clamp_joint'"} <= \
-        {name.split(" (")[0] for name in result.info["energy_account"]["accounted"]}
+        {name.split(" (")[0] for name in result.user_energy.accounted}
 
 
 def test_an_item_the_account_cannot_take_makes_the_balance_not_a_number_unless_declared():
@@ -126,13 +127,13 @@ def test_an_item_the_account_cannot_take_makes_the_balance_not_a_number_unless_d
     user_rig.add_friction_clamp(model, 300.0, 1e9, 2e4, declare=False)
     result = model.run()
     assert math.isnan(result.metrics["energy_balance_relative_error"])
-    assert result.info["energy_account"]["unaccounted"] == ["ConnectorCoordinateSpringDamper 'friction_joint' (object 12)"]
-    assert "add_energy_term" in result.info["energy_account"]["note"]
+    assert result.user_energy.unaccounted == ("ConnectorCoordinateSpringDamper 'friction_joint' (object 12)",)
+    assert "add_energy_term" in result.user_energy.note
     model = rpdrill.build_exudyn(PAPER)
     user_rig.add_friction_clamp(model, 300.0, 1e9, 2e4, declare=True)
     declared = model.run()
     assert declared.metrics["energy_balance_relative_error"] < 1e-3
-    assert declared.info["energy_account"]["declared"] == ["friction joint, stored", "friction joint, dissipated"]
+    assert declared.user_energy.declared == ("friction joint, stored", "friction joint, dissipated")
     with pytest.raises(ValueError, match="kind 'lost' is not one of stored, dissipated, work_in"):
         model.add_energy_term("x", "lost", lambda model, t: t)
 
@@ -141,9 +142,9 @@ def test_an_extension_named_by_the_scene_is_applied_in_every_run_and_recorded(tm
     scene = PAPER.with_({"extensions": {"clamp": {**CLAMP, "parameters": {"mass_kg": 300.0, "stiffness_n_per_m": 1e9}}}})
     result = rpdrill.simulate(scene)
     by_hand = clamped(stiffness_n_per_m=1e9).run()
-    assert rate(result) == rate(by_hand) and result.info["exudyn_model"]["extensions"] == ["clamp"]
+    assert rate(result) == rate(by_hand) and result.exudyn_model.extensions == ("clamp",)
     simulation = pickle.loads(pickle.dumps(prepare(scene)))  # data: a worker rebuilds the model by name
-    assert rate(rpdrill.Result(scene, simulation.solve())) == rate(by_hand)
+    assert rate(run_simulation(simulation)) == rate(by_hand)
     rpdrill.save_result(result, tmp_path)
     recorded = rpdrill.load_scene(tmp_path / "scene.resolved.yaml").extensions["clamp"]
     assert recorded.recorded["import_path"] == "user_rig:add_clamp" and recorded.recorded["file"].endswith("user_rig.py")

@@ -48,16 +48,16 @@ def test_a_tuned_absorber_added_by_the_user_changes_the_penetration_rate():
     assert plain > 0 and abs(tuned - plain) > 0.2 * plain, (plain, tuned)
     swing = model.mbs.GetSensorStoredData(sensor)[:, 1]  # the user's sensor, read back through mbs
     assert np.ptp(swing) > 1e-5
-    told = result.info["exudyn_model"]
-    assert told["user_items"] == {"nodes": 1, "objects": 2, "markers": 1, "sensors": 1}
-    assert "only by the Exudyn formulation" in told["note"]
+    told = result.exudyn_model
+    assert told.user_items == {"nodes": 1, "objects": 2, "markers": 1, "sensors": 1}
+    assert "only by the Exudyn formulation" in told.note
 
 
 def test_a_normal_run_is_the_build_and_its_run():
     s = crushing_scene(solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2)
     normal, built = simulate(s), build_exudyn(s).run()
     np.testing.assert_array_equal(normal.position_m, built.position_m)
-    assert "exudyn_model" not in normal.info
+    assert normal.exudyn_model is None
 
 
 def test_a_model_built_without_graphics_moves_as_the_drawn_one_and_has_no_body_graphics():
@@ -73,8 +73,8 @@ def test_a_scene_of_another_formulation_is_built_and_run_by_exudyn_and_says_so()
     s = crushing_scene(solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2).with_solver("exact")
     result = build_exudyn(s).run()
     assert result.formulation == "exudyn"
-    assert result.info["exudyn_model"]["scene_formulation"] == "exact"
-    assert "only by the Exudyn formulation" in result.info["exudyn_model"]["note"]
+    assert result.exudyn_model.scene_formulation == "exact"
+    assert "only by the Exudyn formulation" in result.exudyn_model.note
 
 
 def test_a_model_runs_once():

@@ -135,9 +135,9 @@ def test_exudyn_agrees_with_the_reference_with_indexing_on(name):
     assert rate(exudyn) == pytest.approx(rate(reference), rel=1e-4)
     for result in (reference, exudyn):
         assert summary_metrics(result)["energy_balance_relative_error"] < 1e-4
-    etas = np.array(reference.info["fresh_fractions"])
+    etas = np.array(reference.solver.fresh_fractions)
     assert len(etas) == math.ceil(reference.scene.solver.end_time_s * reference.scene.impact.frequency_hz)
-    np.testing.assert_allclose(exudyn.info["fresh_fractions"], etas, rtol=1e-3)
+    np.testing.assert_allclose(exudyn.solver.fresh_fractions, etas, rtol=1e-3)
 
 
 def test_torsion_angle_between_blows_sets_each_share():
@@ -145,11 +145,11 @@ def test_torsion_angle_between_blows_sets_each_share():
     the first blow); the share settles as the bit spins up."""
     ode, _ = indexed("torsion")
     indexing = ode.simulation.indexing
-    starts = np.arange(len(ode.info["fresh_fractions"])) * ode.scene.impact.period_s
+    starts = np.arange(len(ode.solver.fresh_fractions)) * ode.scene.impact.period_s
     phi = np.interp(starts, ode.time_s, ode.torsion_angle_rad)
     turned = np.diff(phi, prepend=phi[0])
-    np.testing.assert_allclose(ode.info["fresh_fractions"], [indexing.fresh_fraction(a) for a in turned], rtol=1e-6)
-    assert ode.info["fresh_fractions"][0] == MIN_FRESH_FRACTION and len(set(ode.info["fresh_fractions"])) > 3
+    np.testing.assert_allclose(ode.solver.fresh_fractions, [indexing.fresh_fraction(a) for a in turned], rtol=1e-6)
+    assert ode.solver.fresh_fractions[0] == MIN_FRESH_FRACTION and len(set(ode.solver.fresh_fractions)) > 3
 
 
 def test_exact_refuses_a_torsion_driven_share_with_the_reason():
@@ -170,7 +170,7 @@ def test_exact_agrees_with_ode_with_indexing_on():
     bilinear = crushing_scene(**window, **SPINNING, bit=BIT, rock={"law": "bilinear", "loading_stiffness_n_per_m": 2e8,
                                                                   "unloading_stiffness_n_per_m": 1e9})
     exact, reference = simulate(bilinear, "exact"), simulate(bilinear, "ode", preset="reference")
-    assert exact.info["fresh_fractions"][3] < 1 and rate(exact) == pytest.approx(rate(reference), rel=1e-6)
+    assert exact.solver.fresh_fractions[3] < 1 and rate(exact) == pytest.approx(rate(reference), rel=1e-6)
 
 
 def test_rotation_speed_is_a_scan_axis(tmp_path):

@@ -74,11 +74,11 @@ def test_damping_always_pulls_off_the_bottom() -> None:
 def test_crushing_runs_at_threshold_and_lift_off_without_crushing() -> None:
     r = result("crushing_contact")
     crushing = np.diff(r.bottom_m) > 0
-    assert r.bottom_m[-1] > 1e-4 and r.info["switches_into"]["crushing"] > 5
+    assert r.bottom_m[-1] > 1e-4 and r.solver.switches_into["crushing"] > 5
     spring = r.simulation.rock.spring_force(r.bit_position_m, r.rock_states())
     np.testing.assert_allclose(spring[1:][crushing], r.scene.rock.threshold_n, rtol=1e-9)
     lift = result("lift_off_no_crushing")
-    assert lift.bottom_m.max() == 0.0 and "crushing" not in lift.info["switches_into"]
+    assert lift.bottom_m.max() == 0.0 and "crushing" not in lift.solver.switches_into
     assert (lift.bit_position_m < lift.bottom_m).any()
 
 
@@ -98,7 +98,7 @@ def test_methods_agree_with_dop853(method: str) -> None:
     scene = _one_blow(**{"rock.threshold_n": 60e3})
     reference = simulate(scene, "ode", preset="reference")
     other = simulate(scene, "ode", method=method, relative_tolerance=1e-9, absolute_tolerance=1e-12)
-    assert other.info["mode_switches"] == reference.info["mode_switches"]
+    assert other.solver.mode_switches == reference.solver.mode_switches
     assert other.bottom_m[-1] == pytest.approx(reference.bottom_m[-1], rel=1e-5)
     v = np.interp(reference.time_s, other.time_s, other.bit_velocity_m_per_s)
     assert np.max(np.abs(v - reference.bit_velocity_m_per_s)) < 1e-4 * np.ptp(reference.bit_velocity_m_per_s)

@@ -15,6 +15,7 @@ from rpdrill.models.drill.modal import rock_mode_frequency_hz
 from rpdrill.models.evaluation.compare import compare_runs, verdict
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.scan.curve_optima import curve_optimum
 
@@ -33,7 +34,7 @@ def main_lobe_optimum_hz(frequencies_hz: np.ndarray, metric: str, **overrides: o
         simulation = prepare(pipe_drill(**overrides, **{"impact.frequency_hz": float(frequency),
                                                          "outputs": {"metrics": [metric]}}))
         resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock)
-        values.append(summary_metrics(simulation.solve())[metric])
+        values.append(summary_metrics(run_simulation(simulation).raw)[metric])
     found = curve_optimum(frequencies_hz, values, resonance, metric=metric).optimum
     assert found is not None, f"no optimum of {metric} with {overrides}"
     return found
@@ -66,7 +67,7 @@ def crushing_window() -> rpdrill.Scene:
 def runs():
     """The crushing window by the exact formulation (the reference, to round-off) and the Exudyn model."""
     scene = crushing_window()
-    return {"exact": prepare(scene).solve(), "exudyn": prepare(scene.with_solver("exudyn", type="rk44", step_s=5e-6)).solve()}
+    return {"exact": run_simulation(prepare(scene)).raw, "exudyn": run_simulation(prepare(scene.with_solver("exudyn", type="rk44", step_s=5e-6))).raw}
 
 
 def test_the_arrangement_crushes_and_balances_its_energy(runs):
@@ -85,7 +86,7 @@ def test_the_ode_crushes_balances_its_energy_and_agrees_with_exact_and_exudyn(ru
     """The independent formulation on the arrangement (tight tolerance): it drills, closes its energy
     balance, ends with the exact solution's bottom to 1e-9 and agrees with the Exudyn model within the
     cross-check's tolerances."""
-    ode = prepare(crushing_window().with_solver("ode", relative_tolerance=1e-11, absolute_tolerance=1e-14)).solve()
+    ode = run_simulation(prepare(crushing_window().with_solver("ode", relative_tolerance=1e-11, absolute_tolerance=1e-14))).raw
     assert ode.bottom_m[-1] > 1e-4 and energy_account(ode).relative_residual() < 1e-3
     assert abs(runs["exact"].bottom_m[-1] - ode.bottom_m[-1]) <= 1e-9 * runs["exact"].bottom_m[-1]
     report = compare_runs(ode, runs["exudyn"], ode.scene.solver.end_time_s)

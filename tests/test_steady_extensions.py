@@ -43,10 +43,10 @@ def rate(result: rpdrill.Result) -> float:
 
 def test_the_clamp_is_in_the_section_and_its_orbit_is_the_clamped_drills_settled_rate(monkeypatch):
     result = rpdrill.simulate(clamped())
-    info = result.info
-    assert info["regime"] == "period-1" and info["orbit_residual"] < 1e-8
-    labels, state = info["orbit_state_labels"], info["orbit_state"]
-    assert labels[-2:] == ["clamp_position", "clamp_velocity"] and len(labels) == len(state)
+    orbit = result.steady_state.orbit
+    assert result.steady_state.regime_name == "period-1" and orbit.residual < 1e-8
+    labels, state = orbit.state_labels, orbit.state
+    assert labels[-2:] == ("clamp_position", "clamp_velocity") and len(labels) == len(state)
     # the run over the orbit starts the clamp where the orbit has it (not at rest on the collar) and records it
     clamp = result.raw.extension_state
     assert clamp.shape == (len(result.time_s), 2)
@@ -67,7 +67,7 @@ def test_the_clamp_is_in_the_section_and_its_orbit_is_the_clamped_drills_settled
     # orbit found is another machine's (measured: 7.4 % slower), which the tolerance above would not pass
     monkeypatch.setattr(regimes, "with_extension_coordinates", lambda simulation: simulation)
     restarted = rpdrill.simulate(clamped())
-    assert restarted.info["regime"] == "period-1" and "clamp_position" not in restarted.info["orbit_state_labels"]
+    assert restarted.steady_state.regime_name == "period-1" and "clamp_position" not in restarted.steady_state.orbit.state_labels
     assert abs(rate(restarted) / rate(time_run) - 1) > 100 * STATED
 
 
@@ -75,10 +75,10 @@ def test_coordinates_that_do_not_move_with_the_drill_stay_where_their_forces_hol
     """An oscillator on ground drifts by 0 with the hole (K e = 0): the orbit holds it at rest where its spring
     is relaxed, not riding with the bit; it changes no motion (and says so), so the rate is the plain drill's."""
     oscillator = rpdrill.simulate(drill(extensions={"reference": {"function": "user_rig:add_ground_oscillator"}}))
-    info = oscillator.info
-    assert info["regime"] == "period-1" and info["orbit_state_labels"][-2:] == ["oscillator_position",
-                                                                                  "oscillator_velocity"]
-    np.testing.assert_allclose(info["orbit_state"][-2:], 0.0, atol=1e-9)  # it started at 1 mm: its orbit is rest
+    orbit = oscillator.steady_state.orbit
+    assert oscillator.steady_state.regime_name == "period-1"
+    assert orbit.state_labels[-2:] == ("oscillator_position", "oscillator_velocity")
+    np.testing.assert_allclose(orbit.state[-2:], 0.0, atol=1e-9)  # it started at 1 mm: its orbit is rest
     assert rate(oscillator) == pytest.approx(rate(rpdrill.simulate(drill())), rel=1e-9)
 
 
@@ -91,9 +91,10 @@ def test_an_extension_the_section_cannot_hold_is_refused_by_name(function, param
     scene = drill(**{"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 3},
                   extensions={"rig": {"function": f"user_rig:{function}", "parameters": parameters}})
     result = rpdrill.simulate(scene)
-    assert result.info["regime"] == "no periodic orbit found"
-    assert result.info["steady_state_note"].startswith(f"scene 'pipe_drill': extensions rig {why}")
-    assert "use solver.steady_state: time" in result.info["steady_state_note"]
+    assert result.steady_state.regime is rpdrill.Regime.REFUSED  # the scene cannot have an orbit: said, with why
+    assert result.steady_state.regime_name == "periodic orbit refused"
+    assert result.steady_state.note.startswith(f"scene 'pipe_drill': extensions rig {why}")
+    assert "use solver.steady_state: time" in result.steady_state.note
     assert result.time_s[-1] == pytest.approx(0.1)  # the scene's time run, as with steady_state: time
 
 

@@ -21,12 +21,14 @@ from scenes import PER_BODY, scene
 import rpdrill
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.evaluation.solver_settings import EXUDYN_PRESETS
-from rpdrill.models.solvers.simulation import Simulation, prepare
+from rpdrill.models.runs import scene_run
+from rpdrill.models.runs.scene_run import run as run_simulation
+from rpdrill.models.solvers.simulation import prepare
+from rpdrill.models.steady import regimes
 from rpdrill.models.steady.continuation import BranchPoint, Continuation, changes, hysteresis
 from rpdrill.models.steady.exact_map import exact_period_map
 from rpdrill.models.steady.regimes import RegimeFinder, steady_state
 from rpdrill.models.steady.shooting import NoConvergence, Shooter
-from rpdrill.models.steady.steady_run import run_scene
 from rpdrill.models.steady.steady_state import SteadyStateUnavailable
 
 PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"
@@ -58,8 +60,8 @@ def settled_advance(scene_: rpdrill.Scene, settle_to: float = 1e-9) -> tuple[flo
     frequency = scene_.impact.frequency_hz
     blows = 400
     while True:
-        run = prepare(scene_.with_({"solver.end_time_s": blows / frequency, "solver.steady_state": "time",
-                                    "outputs": {"metrics": ["penetration_rate_m_per_s"]}})).solve()
+        run = run_simulation(prepare(scene_.with_({"solver.end_time_s": blows / frequency, "solver.steady_state": "time",
+                                    "outputs": {"metrics": ["penetration_rate_m_per_s"]}}))).raw
         advances = np.diff(run.bottom_at(np.arange(blows + 1) / frequency))
         if abs(advances[-1] - advances[-2]) <= settle_to * abs(advances[-1]) or blows >= 6400:
             return float(advances[-1]), advances
@@ -115,7 +117,7 @@ def test_a_period_doubling_the_time_run_shows_is_found_and_the_unstable_orbit_is
     assert advances[-1] + advances[-2] == pytest.approx(state.orbit.advance_m, rel=1e-6)
     # what a run reports is the attractor's rate, not the unstable orbit's (100 times smaller)
     result = rpdrill.simulate(scene_.with_({"solver.steady_state": "periodic"}))
-    assert result.info["regime"] == "period-2" and result.info["period_blows"] == 2
+    assert result.steady_state.regime_name == "period-2" and result.steady_state.period_blows == 2
     rate = result.metrics["penetration_rate_m_per_s"]
     assert rate == pytest.approx(state.orbit.penetration_rate_m_per_s, rel=1e-9)
     assert rate > 50 * parent.penetration_rate_m_per_s
@@ -126,24 +128,26 @@ def test_a_drill_held_to_ground_has_no_orbit_relative_to_the_bottom_and_says_so(
     with pytest.raises(SteadyStateUnavailable, match="shock_absorber hold the drill string to ground"):
         steady_state(prepare(held))
     result = rpdrill.simulate(held.with_({"solver.steady_state": "periodic"}))
-    assert result.info["regime"] == "no periodic orbit found"
-    assert "no periodic orbit relative to the bottom" in result.info["steady_state_note"]
+    assert result.steady_state.regime is rpdrill.Regime.REFUSED
+    assert "no periodic orbit relative to the bottom" in result.steady_state.note
     assert result.time_s[-1] == pytest.approx(held.solver.end_time_s)  # the time run, as without it
 
 
 def test_a_periodic_run_gives_every_metric_of_the_orbit():
     scene_ = pipe_drill(**{"impact.frequency_hz": 65.0, "solver.steady_state": "periodic"})
     result = rpdrill.simulate(scene_)
-    info, metrics = result.info, result.metrics
-    assert info["steady_state"] == "periodic" and info["regime"] == "period-1" and info["period_blows"] == 1
-    assert 0 < info["floquet_max_abs"] < 1 and info["orbit_residual"] < 1e-8
+    steady, metrics = result.steady_state, result.metrics
+    assert steady.requested == "periodic" and steady.regime_name == "period-1" and steady.period_blows == 1
+    assert steady.regime is rpdrill.Regime.PERIODIC
+    assert 0 < steady.floquet_max_abs < 1 and steady.orbit.residual < 1e-8
+    assert all(isinstance(mu, complex) for mu in steady.orbit.multipliers)
     period_s = 1 / 65.0
     assert result.time_s[-1] == pytest.approx(period_s)  # one blow: the orbit
     assert metrics["penetration_rate_m_per_s"] == pytest.approx(metrics["advance_per_blow_m"] / period_s)
     assert abs(metrics["energy_balance_relative_error"]) < 1e-9  # the exact works over the orbit
     # the same figures as the last blows of a long time run (peaks and efficiency included)
-    long_run = prepare(scene_.with_({"solver.steady_state": "time", "solver.end_time_s": 800 * period_s,
-                                     "metrics": {"transient_blows": 795, "block_blows": 5}})).solve()
+    long_run = run_simulation(prepare(scene_.with_({"solver.steady_state": "time", "solver.end_time_s": 800 * period_s,
+                                     "metrics": {"transient_blows": 795, "block_blows": 5}}))).raw
     settled = summary_metrics(long_run)
     for name in ("penetration_rate_m_per_s", "collar_velocity_rms_m_per_s", "energy_transfer_efficiency",
                  "rock_force_max_n"):
@@ -161,14 +165,14 @@ def test_steady_state_is_a_solver_key_with_a_stated_default_and_a_clear_error():
                                                  r"'periodic'"):
         pipe_drill(**{"solver.steady_state": "orbit"})
     time_run = rpdrill.simulate(pipe_drill(**{"solver.end_time_s": 0.25}))
-    assert time_run.info["regime"] == "time run" and np.isnan(time_run.info["floquet_max_abs"])
+    assert time_run.steady_state.regime_name == "time run" and np.isnan(time_run.steady_state.floquet_max_abs)
 
 
 def test_exudyn_and_ode_shooting_agree_with_the_exact_orbit():
     scene_ = pipe_drill(**{"impact.frequency_hz": 65.0, "solver.steady_state": "periodic"})
     exact = rpdrill.simulate(scene_).metrics["penetration_rate_m_per_s"]
     exudyn = rpdrill.simulate(scene_, formulation="exudyn")
-    assert exudyn.info["regime"] == "period-1" and exudyn.info["jacobian"].startswith("exact model")
+    assert exudyn.steady_state.regime_name == "period-1" and exudyn.steady_state.orbit.jacobian.startswith("exact model")
     stated = EXUDYN_PRESETS["standard"].penetration_rate_error
     assert exudyn.metrics["penetration_rate_m_per_s"] == pytest.approx(exact, rel=stated)
     ode = rpdrill.simulate(scene_, formulation="ode")
@@ -182,12 +186,11 @@ def test_continuation_follows_the_branch_of_independent_solves():
                                            "outputs": {"metrics": ["penetration_rate_m_per_s"]}}))
         guess = branch.guess(frequency)
         assert (guess is None) == (frequency == 60.0)
-        result = run_scene(simulation, guess)
-        branch.add(BranchPoint(frequency, result.info["regime"], 1, 0.0, np.array(result.info["orbit_state"]),
+        result = run_simulation(simulation, guess=guess)
+        branch.add(BranchPoint(frequency, result.steady_state.regime_name, 1, 0.0, result.steady_state.orbit.state,
                                np.array([]), ()))
-        cold = run_scene(simulation)
-        solved.append((summary_metrics(result)["penetration_rate_m_per_s"],
-                       summary_metrics(cold)["penetration_rate_m_per_s"]))
+        cold = run_simulation(simulation)
+        solved.append((result.metrics["penetration_rate_m_per_s"], cold.metrics["penetration_rate_m_per_s"]))
     for followed, cold in solved:
         assert followed == pytest.approx(cold, rel=1e-8)
 
@@ -197,17 +200,19 @@ def test_a_neighbours_orbit_newton_fails_from_is_run_on_to_the_orbit_without_the
                                                  "solver.steady_state": "periodic",
                                                  "outputs": {"metrics": ["penetration_rate_m_per_s"]}})
     at = lambda frequency_hz: prepare(base.with_({"impact.frequency_hz": frequency_hz}))
-    neighbour = np.array(run_scene(at(65.0)).info["orbit_state"])
+    neighbour = run_simulation(at(65.0)).steady_state.orbit.state
     simulation = at(60.0)
     with pytest.raises(NoConvergence):
         Shooter(exact_period_map(simulation), simulation).solve(neighbour)
-    cold = run_scene(simulation)  # from rest: the transient blows, then Newton
-    monkeypatch.setattr(Simulation, "solve", lambda *args, **kwargs: pytest.fail("the scene's time run was run"))
-    followed = run_scene(simulation, (neighbour, 1))
-    assert cold.info["regime"] == followed.info["regime"] == "period-1"
+    cold = run_simulation(simulation)  # from rest: the transient blows, then Newton
+    never = lambda *args, **kwargs: pytest.fail("the scene's time run was run")
+    monkeypatch.setattr(scene_run, "time_run", never)
+    monkeypatch.setattr(regimes, "time_run", never)
+    followed = run_simulation(simulation, guess=(neighbour, 1))
+    assert cold.steady_state.regime_name == followed.steady_state.regime_name == "period-1"
     # the same orbit: the two Newton runs end within their tolerance (measured 3.7e-8 apart; the orbits'
     # agreement with long time runs is stated to 1e-6, docs/steady_state.md)
-    rate = [summary_metrics(run)["penetration_rate_m_per_s"] for run in (followed, cold)]
+    rate = [run.metrics["penetration_rate_m_per_s"] for run in (followed, cold)]
     assert rate[0] == pytest.approx(rate[1], rel=1e-6) and rate[0] > 0
 
 

@@ -22,6 +22,7 @@ from rpdrill.models.drill.piston import rigid_piston_pulse_n
 from rpdrill.models.drill.wave_rod import reflected_force_share, transmitted_force_share
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
+from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import SceneError, prepare
 from rpdrill.studies.cli.main import main
 from rpdrill.studies.inputs.reading import prepare_scene, read_yaml
@@ -55,7 +56,7 @@ def one_blow(bodies: dict, impact: dict, rock: dict, end_time_s: float, formulat
 
 
 def run(data: dict):
-    return prepare(Scene.model_validate(data)).solve()
+    return run_simulation(prepare(Scene.model_validate(data))).raw
 
 
 # ---- scene keys and refusals ------------------------------------------------------------------------
@@ -102,7 +103,7 @@ def test_a_periodic_steady_state_falls_back_to_the_time_run_with_a_note():
     data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4, "frequency_hz": 1000.0},
                     {"name": "sandstone"}, 3e-3, "exact", steady_state="periodic")
     result = rpdrill.simulate(Scene.model_validate(data))
-    assert result.info["regime"] != "period-1" and "waves in flight" in result.info["steady_state_note"]
+    assert result.steady_state.regime_name != "period-1" and "waves in flight" in result.steady_state.note
 
 
 def test_the_cost_of_a_wave_run_counts_the_steps_of_the_characteristics():
@@ -175,13 +176,13 @@ def test_the_equal_impedance_pistons_rectangular_pulse(formulation):
     result = run(one_blow({"rod": rod(4.0)}, {"piston": {**rod(0.5), "velocity_m_per_s": SPEED}},
                           {"name": "sandstone"}, 2e-3, formulation, output_interval_s=1e-7))
     t, force = result.time_s, result.piston.contact_force_n
-    duration = 2 * 0.5 / C * (1 + result.info["transit_time_errors"]["piston"])
+    duration = 2 * 0.5 / C * (1 + result.solver.transit_time_errors["piston"])
     plateau = force[(t > 0.25 * duration) & (t < 0.75 * duration)]
     assert np.allclose(plateau, Z * SPEED / 2, rtol=1e-9)
     assert force.max() <= Z * SPEED / 2 * (1 + 1e-9)
     above = t[force > 0.5 * Z * SPEED / 2]
     assert above.max() - above.min() == pytest.approx(duration, abs=2e-7)  # the samples, 0.1 us apart
-    assert abs(result.info["transit_time_errors"]["piston"]) < 1e-3
+    assert abs(result.solver.transit_time_errors["piston"]) < 1e-3
     assert result.piston.rebounds[0, 1] < 1e-9 * 0.5 * RHO * AREA * 0.5 * SPEED**2
 
 
@@ -318,7 +319,7 @@ def test_an_item_of_ones_own_on_a_body_acts_through_the_wave_element(both):
         markerNumbers=[model.bodies["bit"].marker_position, model.mbs.AddMarker(MarkerNodePosition(nodeNumber=node))],
         stiffness=k, damping=0.2 * math.sqrt(k * 50.0), referenceLength=1.0))
     result = model.run()
-    assert result.info["exudyn_model"]["user_items"] == {"nodes": 1, "objects": 2, "markers": 1}
+    assert result.exudyn_model.user_items == {"nodes": 1, "objects": 2, "markers": 1}
     assert result.metrics["advance_per_blow_m"] < 0.5 * summary_metrics(both["exudyn"])["advance_per_blow_m"]
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -11,6 +12,7 @@ from ..definition.scene import Scene
 from ..drill.chain import AxialChain
 from .parts import link_series
 from .rod_outputs import stress_columns
+from .run_record import ExudynModelRecord, SolverRecord, SteadyStateRecord
 
 if TYPE_CHECKING:
     from ..drill.piston import PistonHistory
@@ -31,13 +33,23 @@ class UserEnergy:
     accounted: tuple[str, ...] = ()
     declared: tuple[str, ...] = ()
 
+    @property
+    def note(self) -> str:
+        """Why the energy balance is not a number, when items have no account (else empty)."""
+        if not self.unaccounted:
+            return ""
+        return ("energy_balance_relative_error is not a number: these items of one's own have no energy account "
+                "(declare their energy with model.add_energy_term, docs/extending.md)")
+
 
 @dataclass
 class SimulationResult:
     """State histories at the stored solver steps (rows) of one run.
 
     Positions and velocities are along the drilling axis, positive into the rock, one column
-    per body of the simulation's chain. ``bottom_m`` is the borehole bottom x_n.
+    per body of the simulation's chain. ``bottom_m`` is the borehole bottom x_n. ``solver``: what the
+    formulation's solver did; ``steady_state``: the regime of the run (a time run unless the scene asked
+    for its periodic orbit: models.runs.scene_run).
     """
 
     simulation: PreparedRun
@@ -46,12 +58,13 @@ class SimulationResult:
     position_m: np.ndarray
     velocity_m_per_s: np.ndarray
     bottom_m: np.ndarray
+    solver: SolverRecord
     rock_force_n: np.ndarray | None = None  # None when no output needs forces
     impact_force_n: np.ndarray | None = None
     torsion_angle_rad: np.ndarray | None = None
     torsion_rate_rad_per_s: np.ndarray | None = None
     cpu_time_s: float = float("nan")
-    info: dict = field(default_factory=dict)
+    steady_state: SteadyStateRecord = field(default_factory=SteadyStateRecord)
     # (time, x_n) at every change of the bottom, when the formulation records it (exact x_n
     # between stored samples); None: bottom_m is stored at every solver step
     bottom_events: tuple[np.ndarray, np.ndarray] | None = None
@@ -73,6 +86,10 @@ class SimulationResult:
     # the ODE2 coordinates an Exudyn model's extensions add, where a steady-state run follows them
     # (Simulation.extension_coordinates): samples x (their positions, then their velocities)
     extension_state: np.ndarray | None = None
+    # an Exudyn model run with items of one's own (or by a scene of another formulation)
+    exudyn_model: ExudynModelRecord | None = None
+    # Exudyn's coordinates solution file written during the run (simulate(..., solution_file=...))
+    solution_file: Path | None = None
 
     @property
     def scene(self) -> Scene:

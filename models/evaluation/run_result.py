@@ -1,8 +1,9 @@
 """One run of a scene as a user holds it (``rpdrill.Result``): its metrics, its time series as a
-pandas table, the formulation's raw result and where the run came from."""
+pandas table, the formulation's raw result, its steady state and where the run came from."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
@@ -10,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 from ..definition.scene import Scene
 from .metrics import summary_metrics
 from .results import SimulationResult
+from .run_record import ExudynModelRecord, SolverRecord, SteadyStateRecord
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -19,17 +21,40 @@ if TYPE_CHECKING:
 class Result:
     """One run: ``metrics`` (the scene's outputs' metrics, SI units in the names), ``timeseries`` (a
     DataFrame every ``solver.output_interval_s``, columns with units in their names, as
-    ``timeseries.csv``), ``raw`` (the formulation's result: every sample, the chain, the run info) and
-    ``provenance``. The raw result's attributes read through (``result.time_s``, ``result.position_m``,
-    ``result.info``)."""
+    ``timeseries.csv``), ``raw`` (the formulation's result: every sample, the chain), ``steady_state`` (the
+    regime: a time run, or the periodic orbit with its Floquet multipliers), ``solver`` (what the
+    formulation's solver did), ``exudyn_model`` (the items of one's own an Exudyn model ran with, or None),
+    ``source`` (the scene's file, or how it was made), ``code`` (the code of one's own the run imported:
+    every extension and a rock law of one's own, by import path, package, version and file) and
+    ``warnings`` (what the run warned of). The raw result's histories read through (``result.time_s``,
+    ``result.position_m``)."""
 
     scene: Scene
     raw: SimulationResult
-    provenance: dict[str, Any] = field(default_factory=dict)
+    source: str = ""
+    code: Mapping[str, Any] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
 
     @cached_property
     def metrics(self) -> dict[str, float]:
         return summary_metrics(self.raw)
+
+    @property
+    def steady_state(self) -> SteadyStateRecord:
+        return self.raw.steady_state
+
+    @property
+    def solver(self) -> SolverRecord:
+        return self.raw.solver
+
+    @property
+    def exudyn_model(self) -> ExudynModelRecord | None:
+        return self.raw.exudyn_model
+
+    @property
+    def provenance(self) -> dict[str, Any]:
+        """Where the run came from, as ``summary.json`` records it: the source and the code records."""
+        return {"source": self.source, **self.code}
 
     @cached_property
     def timeseries(self) -> pd.DataFrame:

@@ -75,6 +75,7 @@ from ..drill.pulse import (
     phase_row,
 )
 from ..evaluation.results import SimulationResult
+from ..evaluation.run_record import ExactSolverRecord
 from ..evaluation.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
 from ..waves import exact_waves
 from .exact_kernels import (
@@ -453,18 +454,12 @@ def solver_result(solver: ExactSolver, simulation: Simulation, cpu_start: float,
         torsion_rate_rad_per_s=rows[:, angle + 1] if layout.torsion else None,
         cpu_time_s=cpu,
         works_j=works,
-        info={
-            "solver_success": True,
-            "sub_step_s": solver.step_s,
-            "sample_interval_s": solver.step_s * solver.per_sample,
-            "samples": len(time_s),
-            "mode_switches": len(switch_times),
-            "switches_into": _switch_counts(solver.model, initial, entered),
-            "switch_times_s": switch_times,
-            "switch_modes": entered,  # the modes entered at each switch time
-            "operator_keys": solver.operators.built,
-            "min_switch_interval_s": solver.min_switch_interval_s,
-            **({"fresh_fractions": solver.blows.fresh_fractions} if solver.blows else {}),
-        },
+        solver=ExactSolverRecord(
+            samples=len(time_s), sample_interval_s=solver.step_s * solver.per_sample, mode_switches=len(switch_times),
+            switches_into=_switch_counts(solver.model, initial, entered), switch_times_s=switch_times,
+            switch_modes=tuple(entered),  # the modes entered at each switch time
+            fresh_fractions=tuple(solver.blows.fresh_fractions) if solver.blows else (),
+            sub_step_s=solver.step_s, min_switch_interval_s=solver.min_switch_interval_s,
+            operator_keys=solver.operators.built),
         piston=piston,
     )

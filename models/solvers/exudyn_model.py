@@ -64,6 +64,7 @@ from ..drill.indexing import BlowStarts
 from ..drill.pulse import impact_force
 from ..drill.shapes import layout
 from ..evaluation.results import SimulationResult
+from ..evaluation.run_record import ExudynSolverRecord
 from ..evaluation.run_result import Result
 from ..evaluation.stability import StepLimitWarning, check_result, step_warning
 from ..waves.exudyn_waves import WaveExudyn
@@ -243,11 +244,12 @@ class ExudynModel:
         100 times. The result is ``rpdrill.Result``, as ``rpdrill.simulate`` returns; a model runs once.
         InputError for a scene that asks for ``solver.steady_state: periodic``: a built model runs in time."""
         time_runs_only(self.simulation)
-        raw = self.solve(progress)  # the step may change with what was added: the simulation after the run
-        return Result(self.simulation.scene, raw, {"source": "build_exudyn", **self.simulation.code_records()})
+        raw = self.run_raw(progress)  # the step may change with what was added: the simulation after the run
+        return Result(self.simulation.scene, raw, source="build_exudyn", code=self.simulation.code_records())
 
-    def solve(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
-        """Run the system and return the formulation's raw result (:meth:`run` wraps it)."""
+    def run_raw(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
+        """Run the system and return the formulation's raw result: what :meth:`run` wraps, and the Exudyn
+        formulation's time run (models.solvers.time_run)."""
         if self.has_run:
             raise RuntimeError("an ExudynModel runs once (its rock state has moved on): build_exudyn(scene) again")
         self._ran = True
@@ -295,8 +297,8 @@ class ExudynModel:
                                "so the rock's state never moved during that solve; add per-step functions with "
                                "model.add_pre_step(function), or run model.run(), which runs both")
         self._ran = True
-        return Result(self.simulation.scene, _read_result(self, True, math.nan),
-                      {"source": "exu.SolveDynamic", **self.simulation.code_records()})
+        return Result(self.simulation.scene, _read_result(self, True, math.nan), source="exu.SolveDynamic",
+                      code=self.simulation.code_records())
 
 
 def _exudyn_simulation(run: Scene | Simulation) -> tuple[Simulation, str]:
@@ -451,15 +453,15 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
              symbolic: bool = True) -> SimulationResult:
     """Build and run the Exudyn model (:func:`build_exudyn`, without the bodies' graphics: the system
     is not returned, no renderer sees it; :meth:`ExudynModel.solve`)."""
-    return build_exudyn(run, symbolic, graphics=False).solve(progress)
+    return build_exudyn(run, symbolic, graphics=False).run_raw(progress)
 
 
 def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
     """The solved system's sensors read into a result (module doc), checked (models.evaluation.stability)."""
     if model.waves is not None:
         result = model.waves.finish(ok, cpu)
-        extra, result.user_energy, result.user_series, result.extension_state = user_outcome(model, result.time_s)
-        result.info.update(extra)
+        result.exudyn_model, result.user_energy, result.user_series, result.extension_state = \
+            user_outcome(model, result.time_s)
         return result
     simulation, mbs = model.simulation, model.mbs
     reached_s = mbs.systemData.GetTime()
@@ -472,10 +474,9 @@ def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
     piston = None if model.piston is None else model.piston.history(time_s, position, velocity)
     position, velocity = position[:, :simulation.chain.size], velocity[:, :simulation.chain.size]
     rock_state = model.rock.state_at(time_s)
-    info: dict[str, Any] = {"solver_success": ok, "coordinates": model.coordinate_count,
-                            **({"fresh_fractions": model.blows.fresh_fractions} if model.blows else {})}
-    extra, energy, series, extension = user_outcome(model, time_s)
-    info.update(extra)
+    solver = ExudynSolverRecord(success=ok, samples=len(time_s), coordinates=model.coordinate_count,
+                                fresh_fractions=tuple(model.blows.fresh_fractions) if model.blows else ())
+    record, energy, series, extension = user_outcome(model, time_s)
     result = SimulationResult(
         simulation=simulation, formulation="exudyn", time_s=time_s, position_m=position, velocity_m_per_s=velocity,
         bottom_m=rock_state[:, model.rock.rock.bottom_index],
@@ -484,8 +485,8 @@ def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
         else None,
         torsion_angle_rad=data["phi"][:, 1] if "phi" in data else None,
         torsion_rate_rad_per_s=data["omega"][:, 1] if "omega" in data else None,
-        cpu_time_s=cpu, info=info, bottom_events=(history[:, 0], history[:, 1]), rock_state_m=rock_state,
-        piston=piston, user_energy=energy, user_series=series, extension_state=extension,
+        solver=solver, cpu_time_s=cpu, bottom_events=(history[:, 0], history[:, 1]), rock_state_m=rock_state,
+        piston=piston, user_energy=energy, user_series=series, extension_state=extension, exudyn_model=record,
     )
     check_result(result, solver_ok=ok, reached_s=reached_s)
     return result

@@ -48,6 +48,7 @@ from exudyn.solver import ComputeLinearizedSystem
 from ..definition.validation import InputError
 from ..drill.chain import Link
 from ..evaluation.results import UserEnergy
+from ..evaluation.run_record import ExudynModelRecord
 from ..evaluation.solver_settings import StepScales
 from ..evaluation.stability import scales_of, second_order_eigenvalues_per_s
 
@@ -247,34 +248,25 @@ USER_ITEMS_NOTE = ("items added to model.mbs are seen only by the Exudyn formula
                    "take them in")
 
 
-def user_outcome(model: Any, time_s: np.ndarray) -> tuple[dict[str, Any], UserEnergy | None, dict[str, np.ndarray],
-                                                       np.ndarray | None]:
-    """What a run of a model with items of one's own adds to its result: the info (``exudyn_model``: the
-    items, the extensions, the step they were given; ``energy_account``: what is accounted for and what is
-    not), the items' energy, the user's sensors by name, and the extension coordinates a steady-state run
-    follows (:func:`extension_history`)."""
+def user_outcome(model: Any, time_s: np.ndarray) -> tuple[ExudynModelRecord | None, UserEnergy | None,
+                                                       dict[str, np.ndarray], np.ndarray | None]:
+    """What a run of a model with items of one's own adds to its result: its record (the items, the
+    extensions, the step they were given: None for a model of the scene alone), the items' energy (what is
+    accounted for and what is not), the user's sensors by name, and the extension coordinates a steady-state
+    run follows (:func:`extension_history`)."""
     mbs, account, simulation = model.mbs, model._account, model.simulation
     added = model.user_items()
     sensors = [i for i in range(account.first_sensor, mbs.systemData.NumberOfSensors()) if i not in account.own_sensors]
     series, unstored = user_series(mbs, sensors, time_s)
     energy = account.energies(model, time_s) if added.keys() - {"sensors"} or account.terms else None
-    info: dict[str, Any] = {}
+    record = None
     if added or model.scene_formulation != "exudyn" or model._foreign is not None:
-        info["exudyn_model"] = {"scene_formulation": model.scene_formulation, "user_items": added,
-                                "extensions": list(simulation.scene.extensions or {}), "note": USER_ITEMS_NOTE,
-                                "step_s": simulation.settings.step_s,
-                                "spectral_radius_per_s": simulation.spectral_radius_per_s,
-                                **({"sensors_not_stored": unstored} if unstored else {}),
-                                **({"pre_step": "a function set with mbs.SetPreStepUserFunction, run after the "
-                                    "model's own"} if model._foreign is not None else {})}
-    if energy is not None:
-        info["energy_account"] = {"accounted": list(energy.accounted), "declared": list(energy.declared),
-                                  "unaccounted": list(energy.unaccounted)}
-        if energy.unaccounted:
-            info["energy_account"]["note"] = (
-                "energy_balance_relative_error is not a number: these items of one's own have no energy account "
-                "(declare their energy with model.add_energy_term, docs/extending.md)")
-    return info, energy, series, extension_history(model, time_s)
+        record = ExudynModelRecord(
+            scene_formulation=model.scene_formulation, user_items=added,
+            extensions=tuple(simulation.scene.extensions or {}), step_s=simulation.settings.step_s,
+            spectral_radius_per_s=simulation.spectral_radius_per_s, note=USER_ITEMS_NOTE,
+            sensors_not_stored=tuple(unstored), foreign_pre_step=model._foreign is not None)
+    return record, energy, series, extension_history(model, time_s)
 
 
 @dataclass(frozen=True)

@@ -45,6 +45,7 @@ from ..drill.piecewise import Element, elements, rock_element, undeclared
 from ..drill.piston import CAUGHT, CONTACT, PistonJumps, PistonSetup, piston_history
 from ..drill.pulse import blow_start_times, impact_force, switch_times
 from ..evaluation.results import SimulationResult
+from ..evaluation.run_record import OdeSolverRecord
 from ..evaluation.stability import SimulationFailed, diverged_index
 from .simulation import Scene, Simulation, as_simulation
 
@@ -368,19 +369,12 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
         torsion_angle_rad=states[:, -2] if torsion else None,
         torsion_rate_rad_per_s=states[:, -1] if torsion else None,
         cpu_time_s=cpu,
-        info={
-            "solver_success": True,
-            "method": settings.method,
-            "rtol": settings.relative_tolerance,
-            "atol": settings.absolute_tolerance,
-            "solver_steps": record.solver_steps,
-            "samples": len(time_s),
-            "sample_interval_s": settings.sample_interval_s,
-            "pieces": record.pieces,
-            "rhs_evaluations": record.rhs_evaluations,
-            "mode_switches": sum(record.switches.values()),
-            "switches_into": dict(record.switches),
-            **({"fresh_fractions": blows.fresh_fractions} if blows else {}),
-        },
+        solver=OdeSolverRecord(
+            samples=len(time_s), sample_interval_s=settings.sample_interval_s,
+            mode_switches=sum(record.switches.values()), switches_into=dict(record.switches),
+            fresh_fractions=tuple(blows.fresh_fractions) if blows else (),
+            method=settings.method, relative_tolerance=settings.relative_tolerance,
+            absolute_tolerance=settings.absolute_tolerance, solver_steps=record.solver_steps, pieces=record.pieces,
+            rhs_evaluations=record.rhs_evaluations),
         piston=history,
     )

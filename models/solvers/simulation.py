@@ -6,16 +6,15 @@ as built, the solver settings of the scene's formulation (an accuracy preset res
 or tolerances), the initial state (rest, or the static preload), and the indexing model (the
 ``indexing`` effect: models.drill.indexing) whose blow starts every formulation applies. Every formulation, the metrics,
 the energy account and the stability checks read these fields; nothing derives them again.
-:meth:`Simulation.solve` dispatches through the formulation registry (models.definition.formulations).
+models.solvers.time_run runs it through the formulation registry (models.definition.formulations).
 """
 
 from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -49,9 +48,6 @@ from ..evaluation.stability import FastestElement, StepScales, fastest_element, 
 from ..waves.statics import wave_preload_m
 from ..waves.steps import wave_settings
 from .dispatch import implementation
-
-if TYPE_CHECKING:
-    from ..evaluation.results import SimulationResult
 
 
 class SceneError(ValueError):
@@ -155,17 +151,6 @@ class Simulation:
     def needed_data(self) -> frozenset[str]:
         """What must be recorded for the requested outputs: ``forces``, ``energy``."""
         return needs(self.outputs.metrics, self.outputs.timeseries).data
-
-    def solve(self, progress: Callable[[float], None] | None = None) -> SimulationResult:
-        """Simulate with the scene's formulation (models.solvers.dispatch); ``progress(t)`` as simulated
-        time advances. The formulation's own result (``solve``, as ``ExudynModel.solve``); ``rpdrill.simulate``
-        and ``ExudynModel.run`` wrap it into ``rpdrill.Result``. SceneError naming the extension when the
-        formulation builds no Exudyn model and the scene has an extension that changes the motion
-        (models.definition.extensions)."""
-        refused = refusal(self.scene.extensions, self.settings.formulation)
-        if refused:
-            raise SceneError(("extensions", refused[0]), self.scene.extensions[refused[0]].function, refused[1])
-        return implementation(self.settings.formulation).simulate(self, progress)
 
     def code_records(self) -> dict[str, Any]:
         """The code of one's own the run imports, as provenance keeps it: every extension (import path,

@@ -26,10 +26,10 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
+from ..evaluation.run_record import SteadyStateRecord
 from .steady_state import NONE_FOUND
 
 UNIT_CIRCLE_MARGIN = 1e-9  # |mu| within this of 1 counts as on the circle
@@ -38,7 +38,7 @@ UNIT_CIRCLE_MARGIN = 1e-9  # |mu| within this of 1 counts as on the circle
 @dataclass(frozen=True)
 class BranchPoint:
     """One orbit of a continuation: the axis ``value``, the regime, the orbit's blows, advance per blow,
-    section state, multipliers and event sequence (a run's info, models.steady.steady_run)."""
+    section state, multipliers and event sequence (a run's steady state: :func:`branch_point`)."""
 
     value: float
     regime: str
@@ -53,12 +53,14 @@ class BranchPoint:
         return float(np.max(np.abs(self.multipliers))) if len(self.multipliers) else float("nan")
 
 
-def branch_point(value: float, info: dict[str, Any], advance_per_blow_m: float) -> BranchPoint:
-    """A branch point from a run's info (models.steady.steady_run.orbit_info)."""
-    multipliers = np.array([complex(re, im) for re, im in info.get("floquet_multipliers", [])])
-    state = info.get("orbit_state")
-    return BranchPoint(value, info.get("regime", ""), info.get("period_blows"), advance_per_blow_m,
-                       None if state is None else np.array(state), multipliers, tuple(info.get("event_sequence", ())))
+def branch_point(value: float, steady: SteadyStateRecord | None, advance_per_blow_m: float) -> BranchPoint:
+    """A branch point from a run's steady state (None: the run failed)."""
+    orbit = None if steady is None else steady.orbit
+    if orbit is None:
+        return BranchPoint(value, "" if steady is None else steady.regime_name, None, advance_per_blow_m, None,
+                           np.array([], dtype=complex), ())
+    return BranchPoint(value, steady.regime_name, orbit.period_blows, advance_per_blow_m, orbit.state,
+                       np.array(orbit.multipliers, dtype=complex), orbit.event_sequence)
 
 
 @dataclass
@@ -85,7 +87,7 @@ class Continuation:
     @property
     def cold_newton(self) -> bool:
         """Whether a point without a guess tries Newton from its own start: not after a neighbour where none
-        was found (models.steady.steady_run.run_scene)."""
+        was found (models.runs.scene_run.run)."""
         return not self.points or self.points[-1].regime != NONE_FOUND
 
 

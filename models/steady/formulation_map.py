@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..solvers.simulation import Simulation
+from ..solvers.time_run import time_run
 from .map_runs import MapRun, end_state, started_at, states_at
 from .section import Section, section_of
 
@@ -24,10 +25,10 @@ class FormulationMap:
 
     def __call__(self, y0: np.ndarray, jacobian: bool = False) -> MapRun:
         """Y(y0) (no Jacobian, no switches: this formulation does not report its events)."""
-        result = started_at(self.simulation, y0, self.periods, outputs=False).solve()
+        result = time_run(started_at(self.simulation, y0, self.periods, outputs=False))
         return MapRun(end_state(result), None, ())
 
     def blow_states(self, y0: np.ndarray, blows: int) -> list[np.ndarray]:
         """y at every blow start of a run of ``blows`` periods from y0 (the last one its end)."""
-        result = started_at(self.simulation, y0, blows, outputs=False).solve()
+        result = time_run(started_at(self.simulation, y0, blows, outputs=False))
         return states_at(result, np.arange(1, blows + 1) * self.period_s)

@@ -14,7 +14,7 @@
    ``REPEAT_TOLERANCE`` the drill is run on as many blows again from its end (by the exact map) and read
    again, Newton from its last blow start. A stable orbit is ``period-n``. A periodic run costs at most
    about two time runs more than a time run.
-3. Otherwise ``no periodic orbit found``: the result is that time run (models.steady.steady_run), and the
+3. Otherwise ``no periodic orbit found``: the result is that time run (models.runs.scene_run), and the
    unstable orbits found are kept for the report.
 
 A guess from a neighbour follows the branch it is on: where two stable orbits coexist (hysteresis), a
@@ -39,6 +39,7 @@ import numpy as np
 from ..evaluation.results import SimulationResult
 from ..evaluation.stability import SimulationFailed
 from ..solvers.simulation import Simulation, prepare, unsupported
+from ..solvers.time_run import time_run
 from .exact_map import ExactPeriodMap, exact_period_map
 from .extension_section import with_extension_coordinates
 from .formulation_map import FormulationMap
@@ -273,7 +274,7 @@ class RegimeFinder:
         periodic = self.map(orbit.periods)
         if isinstance(periodic, ExactPeriodMap):
             return periodic.result(orbit.state, orbit.periods, cpu_start)
-        result = started_at(self.simulation, orbit.state, orbit.periods).solve()
+        result = time_run(started_at(self.simulation, orbit.state, orbit.periods))
         return result, end_state(result)
 
     def _why_none(self) -> str:
@@ -294,4 +295,4 @@ def steady_state(simulation: Simulation, guess: np.ndarray | None = None, period
     bottom."""
     finder = RegimeFinder(simulation)
     found = finder.find(guess, periods)
-    return found if found.orbit is not None else finder.settled(simulation.solve(), found)
+    return found if found.orbit is not None else finder.settled(time_run(simulation), found)

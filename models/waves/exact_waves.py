@@ -18,6 +18,7 @@ from threadpoolctl import ThreadpoolController
 
 from ..drill.piston import PistonHistory
 from ..evaluation.results import SimulationResult
+from ..evaluation.run_record import WaveSolverRecord
 from .history import transit_errors
 from .record import WaveRecord
 from .stepping import Stepper
@@ -38,7 +39,7 @@ def simulate(simulation, progress: Callable[[float], None] | None = None) -> Sim
     return result(stepper, "exact", cpu)
 
 
-def result(stepper: Stepper, formulation: str, cpu_s: float, info: dict | None = None) -> SimulationResult:
+def result(stepper: Stepper, formulation: str, cpu_s: float, coordinates: int | None = None) -> SimulationResult:
     """The run's result from the stepper's samples (module doc)."""
     simulation, layout, samples = stepper.simulation, stepper.layout, stepper.samples
     time_s = np.array(samples.time_s)
@@ -63,10 +64,11 @@ def result(stepper: Stepper, formulation: str, cpu_s: float, info: dict | None =
         torsion_angle_rad=states[:, layout.angle] if layout.torsion else None,
         torsion_rate_rad_per_s=states[:, layout.angle + 1] if layout.torsion else None,
         cpu_time_s=cpu_s, works_j={"impact": works[:, 0], "internal": works[:, 1]},
-        info={"solver_success": True, "wave_step_s": stepper.step_s, "samples": len(time_s),
-              "mode_switches": len(stepper.switch_times), "switch_times_s": np.array(stepper.switch_times),
-              "transit_time_errors": record.transit_errors, "keys": len(stepper.system.keys),
-              **({"fresh_fractions": stepper.blows.fresh_fractions} if stepper.blows else {}), **(info or {})},
+        solver=WaveSolverRecord(samples=len(time_s), mode_switches=len(stepper.switch_times),
+                                switch_times_s=np.array(stepper.switch_times), wave_step_s=stepper.step_s,
+                                transit_time_errors=record.transit_errors, keys=len(stepper.system.keys),
+                                coordinates=coordinates,
+                                fresh_fractions=tuple(stepper.blows.fresh_fractions) if stepper.blows else ()),
         piston=piston, waves=record)
 
 

@@ -27,6 +27,7 @@ on every step's ends.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -303,8 +304,7 @@ class WaveExudyn:
             raise SimulationFailed(f"scene '{simulation.name}': solver {simulation.settings.type} with the wave step "
                                    f"{stepper.step_s:g} s failed at t = {at:.6g} s; try solver.step_s "
                                    f"{stepper.step_s / 2:g}")
-        out = result(stepper, "exudyn", cpu_s, {"coordinates": len(mbs.systemData.GetODE2Coordinates()),
-                                                "solver_success": bool(ok)})
+        out = result(stepper, "exudyn", cpu_s, coordinates=len(mbs.systemData.GetODE2Coordinates()))
         if self.rock is not None:  # the rock on a bit with mass is Exudyn's
             law, states = self.rock.rock, self.rock.state_at(out.time_s)
             out.rock_state_m = states
@@ -312,7 +312,7 @@ class WaveExudyn:
             out.rock_force_n = np.asarray(law.force(out.bit_position_m, out.bit_velocity_m_per_s, tuple(states.T)))
             out.bottom_events = tuple(np.array(column) for column in zip(*self.rock.bottom_history, strict=True))
             if self.rock_blows:
-                out.info["fresh_fractions"] = self.rock_blows.fresh_fractions
+                out.solver = replace(out.solver, fresh_fractions=tuple(self.rock_blows.fresh_fractions))
         return out
 
 

@@ -58,6 +58,7 @@ from ...models.evaluation.workprecision import (
     signature,
     uniform_grid_s,
 )
+from ...models.runs.scene_run import run
 from ...models.solvers.cost import Cause
 from ...models.solvers.simulation import prepare
 from ..inputs.reading import InputError, parse, prepare_scene, read_yaml
@@ -232,7 +233,7 @@ def simulate_setting(scene: Scene, setting: Setting, grid_interval_s: float) -> 
     run is reported as SimulationFailed by the formulation)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return prepare(scene_for(scene, setting, grid_interval_s)).solve()
+        return run(prepare(scene_for(scene, setting, grid_interval_s))).raw
 
 
 class TimeLimitExceeded(RuntimeError):

@@ -41,15 +41,15 @@ def run(args: argparse.Namespace) -> int:
         return 1
     exudyn, ode = check.exudyn.raw, check.ode.raw
     print(f"{check.exudyn.scene.name}: {args.blows} blows, exudyn {exudyn.simulation.settings.type} at {args.step:g} s, "
-          f"ode {args.method} at rtol {args.rtol:g} ({ode.info['mode_switches']} rock mode switches)")
+          f"ode {args.method} at rtol {args.rtol:g} ({ode.solver.mode_switches} rock mode switches)")
     print(check.table())
     if args.out:
         with staged_directory(args.out) as stage:
             write_json(stage / "crosscheck.json", {"scene": check.exudyn.scene.name, "blows": args.blows,
                                                     "exudyn": {"solver": exudyn.simulation.settings.type,
                                                                "step_s": args.step,
-                                                               **exudyn.info},
-                                                    "ode": ode.info, "checks": check.checks, "passed": check.passed,
+                                                               "run": exudyn.solver},
+                                                    "ode": ode.solver, "checks": check.checks, "passed": check.passed,
                                                     **check.report})
             plot_overlay(ode, exudyn, f"{check.exudyn.scene.name}: first {args.blows} blows", stage / "crosscheck.png")
         print(f"wrote {args.out}")

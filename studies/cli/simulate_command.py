@@ -73,10 +73,10 @@ def run(args: argparse.Namespace) -> int:
                 (stage / SOLUTION_FILE).write_bytes(solution.read_bytes())
     shown = ", ".join(f"{metric(name).name} {metric(name).show_with_unit(value)}"
                       for name, value in result.metrics.items() if name in HEADLINE)
-    info = result.raw.info
-    regime = "" if info.get("steady_state") != "periodic" else (
-        f", {info['regime']}" + (f" (|mu|max {info['floquet_max_abs']:.4g})" if info.get("period_blows") else
-                                 f": {info.get('steady_state_note', '')}"))
+    steady = result.steady_state
+    regime = "" if steady.requested != "periodic" else (
+        f", {steady.regime_name}" + (f" (|mu|max {steady.floquet_max_abs:.4g})" if steady.orbit is not None else
+                                     f": {steady.note}"))
     print(f"{result.scene.name} ({result.formulation}{regime}): {shown or 'no metrics asked for'}; wrote {args.out}")
     if solution is not None:
         print(f"Exudyn's viewer: python -c \"from rpdrill.studies.drawings.drill_animation import view_solution; "

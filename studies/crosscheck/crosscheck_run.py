@@ -12,6 +12,7 @@ from ...models.definition.formulations import ODE_METHODS
 from ...models.definition.scene import Scene
 from ...models.evaluation.compare import compare_runs, verdict
 from ...models.evaluation.run_result import Result
+from ...models.runs.scene_run import run
 from ..inputs.arguments import check, choice_problem, count_problem, instance_problem, positive_problem
 from ..inputs.reading import prepare_scene, scene_and_source
 from ..runtime.budgets import DEFAULT_BUDGET, Budget
@@ -58,7 +59,6 @@ def crosscheck(scene: Scene | str | Path, blows: int = 20, step_s: float = DEFAU
     if budget is not None:
         for simulation in simulations:
             budget.check_run(simulation, source, f"{simulation.settings.formulation} window: ")
-    exudyn, ode = (Result(window, simulation.solve(), {"source": source})
-                   for window, simulation in zip(windows, simulations, strict=True))
+    exudyn, ode = (run(simulation, source=source) for simulation in simulations)
     report = compare_runs(ode.raw, exudyn.raw, windows[0].solver.end_time_s)
     return Crosscheck(exudyn, ode, blows, step_s, report, verdict(report))

@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import dataclasses
 import json
 import math
 import os
 import re
 import shutil
 import tempfile
-from collections.abc import Iterator, Sequence
-from pathlib import Path
+from collections.abc import Iterator, Mapping, Sequence
+from enum import Enum
+from pathlib import Path, PurePath
 from typing import IO, Any
 
 import numpy as np
@@ -146,12 +148,22 @@ def write_columns_csv(path: Path, columns: dict[str, np.ndarray]) -> None:
 
 def json_ready(value: Any) -> Any:
     """``value`` as JSON holds it: NumPy arrays and scalars as lists and numbers, tuples as lists, a
-    number that is not finite as None (null)."""
+    number that is not finite as None (null), a complex number as [re, im], an enum as its value, a path
+    as text, a dataclass as the mapping of its fields (and of its properties named in ``json_properties``)."""
     if isinstance(value, (np.ndarray, np.generic)):
         value = value.tolist()
     if isinstance(value, float):
         return value if math.isfinite(value) else None
-    if isinstance(value, dict):
+    if isinstance(value, complex):
+        return [json_ready(value.real), json_ready(value.imag)]
+    if isinstance(value, Enum):
+        return json_ready(value.value)
+    if isinstance(value, PurePath):
+        return str(value)
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        fields = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
+        return json_ready({**fields, **{name: getattr(value, name) for name in getattr(value, "json_properties", ())}})
+    if isinstance(value, Mapping):
         return {key: json_ready(item) for key, item in value.items()}
     if isinstance(value, (list, tuple)):
         return [json_ready(item) for item in value]

@@ -5,7 +5,7 @@ scene key path the scene accepts is an axis), its problems tied to the axis that
 there is one (:func:`point_scene`). It is prepared once where it is made (models.solvers.simulation.prepare:
 the chain, the rock law, the solver settings, the initial state; studies.inputs.reading.prepare_scene);
 a worker receives the prepared simulation and builds the formulation's model itself (Exudyn systems
-cannot be pickled). :func:`run_point` runs it as its scene asks (models.steady.steady_run.run_scene: a time
+cannot be pickled). :func:`run_point` runs it as its scene asks (models.runs.scene_run.run: a time
 run, or its steady state) into one row of a results table: the columns :func:`point_columns` names, what
 the run returns (its status, the steady state's columns, the metrics). Points along an axis run in order
 (a curve, a continuation study's chain: :func:`run_followed`) start each periodic orbit's Newton from
@@ -21,16 +21,16 @@ from typing import Any
 
 from ...models.definition.scene import Scene
 from ...models.definition.validation import short
-from ...models.evaluation.metrics import summary_metrics
-from ...models.evaluation.results import SimulationResult
+from ...models.evaluation.run_record import SteadyStateRecord
+from ...models.evaluation.run_result import Result
 from ...models.evaluation.run_status import STATUSES, run_status
+from ...models.runs.scene_run import OrbitGuess, run
 from ...models.solvers.simulation import Simulation
 from ...models.steady.continuation import Continuation, branch_point
-from ...models.steady.steady_run import OrbitGuess, regime_columns, run_scene
 from ..inputs.reading import InputError, prepare_scene
 
 # what a run returns besides its metrics, in the order of a results table's columns (the steady state's:
-# models.steady.steady_run.regime_columns)
+# models.evaluation.run_record.SteadyStateRecord.columns)
 STATUS_COLUMNS = ("status", "error", "steady_state", "regime", "wall_time_s", "period_blows", "floquet_max_abs")
 # a finished point's status: ok; failed (its error says why); unstable, unsettled, not_finite or
 # unbalanced (metrics written, but the run's figures do not stand as they are: models.evaluation.run_status)
@@ -81,8 +81,8 @@ def point_columns(metrics: Sequence[str]) -> list[str]:
 
 
 def run_prepared(simulation: Simulation, guess: OrbitGuess | None = None, cold_newton: bool = True
-                 ) -> tuple[dict[str, Any], SimulationResult | None]:
-    """Run one prepared point as its scene asks (models.steady.steady_run.run_scene: a time run, or its
+                 ) -> tuple[dict[str, Any], Result | None]:
+    """Run one prepared point as its scene asks (models.runs.scene_run.run: a time run, or its
     steady state from ``guess``, a neighbour's orbit; ``cold_newton``: as there) into its row
     (:func:`point_columns`): status (models.evaluation.run_status: ok, unstable, unsettled, not_finite or
     unbalanced, the reason in ``error``; a steady state's note where the run is ok), the steady state's
@@ -90,16 +90,17 @@ def run_prepared(simulation: Simulation, guess: OrbitGuess | None = None, cold_n
     exception in ``error``, no metrics), not raised. The row and the run (None if it failed)."""
     start = time.perf_counter()
     try:
-        result = run_scene(simulation, guess, cold_newton=cold_newton)
-        metrics = summary_metrics(result)
-        status, why = run_status(result, metrics)
+        result = run(simulation, guess=guess, cold_newton=cold_newton)
+        metrics = result.metrics
+        status, why = run_status(result.raw, metrics)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the analysis goes on
-        return {"status": "failed", "error": f"{type(err).__name__}: {err}", **regime_columns(None),
-                "steady_state": simulation.scene.solver.steady_state, "wall_time_s": time.perf_counter() - start}, None
-    if result.info.get("steady_state_note") and status == "ok":
-        why = result.info["steady_state_note"]
-    return {"status": status, "error": why, **regime_columns(result), "wall_time_s": time.perf_counter() - start,
-            **metrics}, result
+        failed = SteadyStateRecord(simulation.scene.solver.steady_state).columns()
+        return {"status": "failed", "error": f"{type(err).__name__}: {err}", **failed, "regime": "",
+                "wall_time_s": time.perf_counter() - start}, None
+    if result.steady_state.note and status == "ok":
+        why = result.steady_state.note
+    return {"status": status, "error": why, **result.steady_state.columns(),
+            "wall_time_s": time.perf_counter() - start, **metrics}, result
 
 
 def run_point(simulation: Simulation) -> dict[str, Any]:
@@ -112,5 +113,6 @@ def run_followed(branch: Continuation, value: float, simulation: Simulation) -> 
     Newton from ``branch``'s prediction, which then takes this point's orbit (every point's, a failed
     one's too, so that the passes of a chain align: models.steady.continuation). Its row."""
     row, result = run_prepared(simulation, branch.guess(value), branch.cold_newton)
-    branch.add(branch_point(value, {} if result is None else result.info, row.get("advance_per_blow_m", math.nan)))
+    branch.add(branch_point(value, None if result is None else result.steady_state,
+                            row.get("advance_per_blow_m", math.nan)))
     return row

@@ -7,7 +7,7 @@ For each value of the axis (:func:`bifurcation_data`):
   rock force of each of its last ``last_blows`` blows (a period-n response shows n values, an irregular one
   a cloud);
 * the attractors followed from both ends of the axis (models.steady.continuation through
-  models.steady.steady_run.run_scene: the stable orbits, their advance and peak rock force per blow of the
+  models.runs.scene_run.run: the stable orbits, their advance and peak rock force per blow of the
   orbit, and the regime);
 * the period-1 orbit followed up the axis from the first stable one whatever its stability, until Newton
   loses it (its unstable stretches are the orbits a drill never shows).
@@ -25,12 +25,12 @@ import numpy as np
 
 from ...models.definition.scene import Scene
 from ...models.evaluation.results import SimulationResult
+from ...models.runs.scene_run import run
 from ...models.solvers.exact_model import BLAS
 from ...models.solvers.simulation import prepare
-from ...models.steady.continuation import Continuation, branch_point
+from ...models.steady.continuation import BranchPoint, Continuation, branch_point
 from ...models.steady.exact_map import exact_period_map
 from ...models.steady.shooting import NoConvergence, Shooter
-from ...models.steady.steady_run import run_scene
 
 
 @dataclass(frozen=True)
@@ -81,12 +81,13 @@ def _followed(base: Scene, axis: str, values: Sequence[float]) -> list[BlowFigur
     """The attractors along ``values`` in their order (module doc)."""
     branch, figures = Continuation(), []
     for value in values:
-        result = run_scene(prepare(_scene(base, axis, value, steady_state="periodic")), branch.guess(value),
-                           cold_newton=branch.cold_newton)
-        branch.add(branch_point(value, result.info, math.nan))
-        blows = result.info.get("period_blows") or result.scene.metrics.block_blows
-        figures.append(replace(blow_figures(result, blows, value, result.info["regime"]),
-                               state=tuple(result.info.get("orbit_state") or ()) or None))
+        result = run(prepare(_scene(base, axis, value, steady_state="periodic")), guess=branch.guess(value),
+                     cold_newton=branch.cold_newton)
+        steady = result.steady_state
+        branch.add(branch_point(value, steady, math.nan))
+        blows = steady.period_blows or result.scene.metrics.block_blows
+        figures.append(replace(blow_figures(result.raw, blows, value, steady.regime_name),
+                               state=None if steady.orbit is None else tuple(steady.orbit.state)))
     return figures
 
 
@@ -106,8 +107,7 @@ def _period_one(base: Scene, axis: str, values: Sequence[float], start: BlowFigu
         except NoConvergence:
             break
         result, _ = period_map.result(orbit.state, 1, 0.0)
-        branch.add(branch_point(value, {"regime": "period-1", "period_blows": 1, "orbit_state": orbit.state.tolist()},
-                                math.nan))
+        branch.add(BranchPoint(value, "period-1", 1, math.nan, orbit.state, np.array(orbit.multipliers), ()))
         figures.append(blow_figures(result, 1, value, "period-1", orbit.stable))
     return figures
 
@@ -120,7 +120,7 @@ def bifurcation_data(base: Scene, axis: str, values: Sequence[float], settle_blo
     for value in values:
         frequency_hz = float(value) if axis == "impact.frequency_hz" else base.impact.frequency_hz
         scene = _scene(base, axis, value, end_time_s=settle_blows / frequency_hz, steady_state="time")
-        diagram.brute_force.append(blow_figures(prepare(scene).solve(), last_blows, value))
+        diagram.brute_force.append(blow_figures(run(prepare(scene)).raw, last_blows, value))
     diagram.up = _followed(base, axis, values)
     diagram.down = _followed(base, axis, values[::-1])[::-1]
     diagram.period_one = _period_one(base, axis, values, next((f for f in diagram.up if f.regime == "period-1"), None))
