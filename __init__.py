@@ -22,7 +22,8 @@ inputs, scans, analyses, reports and the command line); dependencies run one way
 rocklaw (``docs/architecture.md``).
 """
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING as _TYPE_CHECKING
+from typing import Any as _Any
 
 # Every public name is imported when first used, not at ``import rpdrill``: the ``rpdrill`` program starts
 # (and takes its Ctrl-C handler, studies.cli.main.console) before NumPy, pydantic or Exudyn load; the program
@@ -38,12 +39,15 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "load_scene": ("studies.api", "load_scene"),
          "load_study": ("studies.api", "load_study"),
          "run_study": ("studies.api", "run_study"),
+         "shipped_files": ("studies.inputs.shipped", "shipped_files"),
+         "ShippedFile": ("studies.inputs.shipped", "ShippedFile"),
          "save_result": ("studies.api", "save_result"),
          "simulate": ("studies.api", "simulate"),
          "table_frame": ("studies.api", "table_frame"),
          "Crosscheck": ("studies.crosscheck.crosscheck_run", "Crosscheck"),
          "crosscheck": ("studies.crosscheck.crosscheck_run", "crosscheck"),
          "Budget": ("studies.runtime.budgets", "Budget"),
+         "RunOptions": ("studies.runtime.run_options", "RunOptions"),
          "BudgetError": ("studies.runtime.budgets", "BudgetError"),
          "Study": ("studies.scan.study", "Study"),
          "build_exudyn": ("models.solvers.exudyn_model", "build_exudyn"),
@@ -62,7 +66,7 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "rotation_report": ("studies.pages.rotation_note", "rotation_report"),
          "RotationReport": ("studies.pages.rotation_note", "RotationReport")}
 
-if TYPE_CHECKING:  # the names as type checkers and editors see them
+if _TYPE_CHECKING:  # the names as type checkers and editors see them
     from .models.definition.scene import Scene
     from .models.definition.validation import InputError
     from .models.evaluation.run_record import Regime
@@ -77,14 +81,16 @@ if TYPE_CHECKING:  # the names as type checkers and editors see them
     from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
     from .studies.drawings.drill_animation import view_solution, write_animation
     from .studies.drawings.drill_drawing import draw
+    from .studies.inputs.shipped import ShippedFile, shipped_files
     from .studies.pages.reproduction_run import ReproductionResult, reproduce
     from .studies.pages.rotation_note import RotationReport, rotation_report
     from .studies.runtime.budgets import Budget, BudgetError
+    from .studies.runtime.run_options import RunOptions
     from .studies.scan.study import Study
     from .studies.sensitivity.sensitivity_run import SensitivityResult, sensitivity
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> _Any:
     if name in _LAZY:
         import importlib
 
@@ -96,11 +102,14 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *_LAZY})
+    """The public names only (``__all__``)."""
+    return sorted(__all__)
 
 
-__all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult", "Crosscheck",
-           "ExudynModel", "InputError", "Regime", "ReproductionResult", "Result", "RotationReport", "Scene", "SensitivityResult",
-           "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck", "draw",
-           "load_scene", "load_study", "reproduce", "rotation_report", "run_study", "save_result", "sensitivity",
-           "simulate", "table_frame", "view_solution", "write_animation"]
+__all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult",
+           "Crosscheck", "ExudynModel", "InputError", "Regime", "ReproductionResult", "Result",
+           "RotationReport", "RunOptions", "Scene", "SensitivityResult", "ShippedFile",
+           "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck",
+           "draw", "load_scene", "load_study", "reproduce", "rotation_report", "run_study",
+           "save_result", "sensitivity", "shipped_files", "simulate", "table_frame", "view_solution",
+           "write_animation"]

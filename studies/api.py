@@ -24,7 +24,6 @@ from .inputs.arguments import (
     boolean_problem,
     callable_problem,
     check,
-    check_run_options,
     choice_problem,
     either,
     file_problem,
@@ -36,9 +35,10 @@ from .inputs.arguments import (
 from .inputs.reading import InputError, load_scene, prepare_scene, scene_and_source
 from .runtime.budgets import DEFAULT_BUDGET, Budget
 from .runtime.output_files import check_out, write_columns_csv, write_json, write_resolved
+from .runtime.run_options import RunOptions
 from .runtime.tables import table_of
 from .scan.study import Study, load_study
-from .study_runs import run_studies, run_study_files, study_folders
+from .study_runs import STUDY_OPTIONS, run_studies, run_study_files, study_folders
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -138,22 +138,22 @@ def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
     return table_of(list(rows[0]) if rows else [], [list(row.values()) for row in rows])
 
 
-def run_study(study: Study | str | Path, workers: int | None = None, out: str | Path | None = None,
-              dask: str | None = None, quiet: bool = True) -> pd.DataFrame:
-    """Run a study (or a study file) on ``workers`` processes (default all cores; 1: in this process) or
-    a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (results.csv, study.json,
-    optima.csv, plots; resumable as the command's) or, without ``out``, a scratch folder that is
-    removed after (no plots). The results table as a DataFrame, one row a point."""
+def run_study(study: Study | str | Path, options: RunOptions | None = None, **run: Any) -> pd.DataFrame:
+    """Run a study (or a study file) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
+    ``workers``, ``dask``, ``out``, ``budget``, ``quiet``): into ``out`` (results.csv, study.json, optima.csv,
+    plots; resumable as the command's) or, without ``out``, a scratch folder that is removed after (no plots).
+    The results table as a DataFrame, one row a point."""
     from .runtime.pools import pool
 
-    check("rpdrill.run_study", "study", study, either(file_problem, instance_problem(Study, "a rpdrill Study or a "
-                                                                                    "study file's path")))
-    check_run_options("rpdrill.run_study", workers, out, dask, quiet)
+    where = "rpdrill.run_study"
+    check(where, "study", study, either(file_problem, instance_problem(Study, "a rpdrill Study or a study file's "
+                                                                              "path")))
+    options = RunOptions.of(where, options, run, STUDY_OPTIONS)
     if not isinstance(study, Study):
-        study = load_study(study)
+        study = load_study(study, budget=options.budget)
     with tempfile.TemporaryDirectory(prefix="rpdrill-study-") as scratch:
-        folder = study_folders([str(study.source)], str(out or scratch))[0]
-        if out is None:  # a scratch folder keeps no plots
+        folder = study_folders([str(study.source)], str(options.out or scratch))[0]
+        if options.out is None:  # a scratch folder keeps no plots
             study = dataclasses.replace(study, spec=study.spec.model_copy(update={"plots": []}))
-        with pool(dask, workers, "rpdrill.run_study: dask") as runner:
-            return run_studies([study], [folder], runner, dask is not None, quiet)[0].table
+        with pool(options.dask, options.workers, f"{where}: dask") as runner:
+            return run_studies([study], [folder], runner, options.dask is not None, options.quiet)[0].table

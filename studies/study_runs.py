@@ -4,19 +4,18 @@ command both run through :func:`run_study_files` / :func:`run_studies`)."""
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from .figures.plot_tasks import start_plots
 from .inputs.reading import InputError
-from .runtime.budgets import DEFAULT_BUDGET, Budget
 from .runtime.output_files import check_out, write_json, write_rows_csv
 from .runtime.point_runs import point_columns, run_point
 from .runtime.pools import Runner, pool, sequential
 from .runtime.resumable import RECORD, Table, run_tables
+from .runtime.run_options import RunOptions
 from .scan.continuation_runs import follow_study, given_row
 from .scan.curve_optima import Optimum
 from .scan.study import Study, StudyPoint, load_study
@@ -26,11 +25,10 @@ if TYPE_CHECKING:
     import pandas as pd
 
 
-def write_optima(study: Study, out: Path, table: pd.DataFrame) -> list[Optimum]:
-    """The study's optima (studies.scan.study_optima) into optima.csv and study.json."""
+def write_optima(study: Study, out: Path, table: pd.DataFrame, record: dict[str, Any]) -> list[Optimum]:
+    """The study's optima (studies.scan.study_optima) into optima.csv and, beside its ``record``, study.json."""
     optima = study_optima(study, table)
     write_rows_csv(out / "optima.csv", csv_rows(optima))
-    record = json.loads((out / "study.json").read_text(encoding="utf-8"))
     write_json(out / "study.json", {**record, "optima": [optimum.record for optimum in optima]})
     return optima
 
@@ -74,8 +72,8 @@ def run_studies(studies: list[Study], folders: list[Path], runner: tuple[str, Ru
     whose workers may write on another machine)."""
     started: dict[int, tuple[list[Optimum], Callable[[], tuple[list[Path], list[str]]]]] = {}
 
-    def finished(i: int, table: pd.DataFrame) -> None:
-        optima = write_optima(studies[i], folders[i], table)
+    def finished(i: int, table: pd.DataFrame, record: dict[str, Any]) -> None:
+        optima = write_optima(studies[i], folders[i], table, record)
         started[i] = optima, start_plots(studies[i], table, optima, folders[i],
                                          sequential if plots_here else runner[1])
 
@@ -95,13 +93,17 @@ def _table(study: Study, out: Path, runner: tuple[str, Runner]) -> Table:
     return Table(study, out, "results.csv", columns, _task, run_point, scene_keys=study.scene_keys)
 
 
-def run_study_files(paths: Sequence[str | Path], out: str | Path, formulation: str | None = None,
-                    budget: Budget = DEFAULT_BUDGET, workers: int | None = None, dask: str | None = None,
-                    quiet: bool = True) -> list[StudyRun]:
-    """Read the study files (InputError or BudgetError before anything runs), then run them into ``out``
-    (one study) or ``out``/<file stem> (several) on a pool of ``workers`` processes (1: in this process)
-    or Dask (``dask``: an address, or "" for a LocalCluster)."""
-    folders = study_folders([str(path) for path in paths], str(out))
-    studies = [load_study(path, formulation, budget) for path in paths]
-    with pool(dask, workers) as runner:
-        return run_studies(studies, folders, runner, dask is not None, quiet)
+STUDY_OPTIONS = ("workers", "dask", "out", "budget", "quiet")  # the run options of a study (rpdrill.RunOptions)
+
+
+def run_study_files(paths: Sequence[str | Path], options: RunOptions, formulation: str | None = None
+                    ) -> list[StudyRun]:
+    """Read the study files (InputError or BudgetError before anything runs), then run them as ``options`` say
+    into ``options.out`` (one study) or ``options.out``/<file stem> (several)."""
+    options = RunOptions.of("rpdrill study", options, {}, STUDY_OPTIONS)
+    if options.out is None:
+        raise InputError("rpdrill study: --out: give the folder the studies write into")
+    folders = study_folders([str(path) for path in paths], str(options.out))
+    studies = [load_study(path, formulation, options.budget) for path in paths]
+    with pool(options.dask, options.workers) as runner:
+        return run_studies(studies, folders, runner, options.dask is not None, options.quiet)

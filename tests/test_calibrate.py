@@ -7,6 +7,7 @@ import csv
 import json
 import shutil
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -84,8 +85,8 @@ def test_objective_sums_weighted_squared_misses_and_the_rising_shortfall(tmp_pat
     calibration = load_calibration(write(tmp_path / "c.yaml", spec(targets=[
         {"label": "a", "optimum_hz": 60, "weight": 2.0}, {"label": "b", "optimum_hz": 70},
         {"label": "c", "optimum_hz": 80}], rising=[["a", "b", "c"]], rising_weight=0.5)))
-    results = [{"label": "a", "optimum": 66.0, "miss": 0.1}, {"label": "b", "optimum": 63.0, "miss": -0.1},
-               {"label": "c", "optimum": None, "miss": 1.0}]  # a above b: 3 Hz short; c without optimum
+    results = [SimpleNamespace(label="a", optimum=66.0, miss=0.1), SimpleNamespace(label="b", optimum=63.0, miss=-0.1),
+               SimpleNamespace(label="c", optimum=None, miss=1.0)]  # a above b: 3 Hz short; c without optimum
     total, penalty = objective(calibration, results)
     assert penalty == pytest.approx(3.0 / 70)
     assert total == pytest.approx(2 * 0.01 + 0.01 + 1.0 + 0.5 * 3.0 / 70)
@@ -143,8 +144,8 @@ def test_calibrate_as_a_library_call_gives_the_command_s_result(tiny):
     result = rpdrill.calibrate(path, workers=1)
     report = json.loads((out / "calibration.json").read_text())
     assert isinstance(result, rpdrill.CalibrationResult) and result.out is None and len(result.records) == 10
-    assert result.best["objective"] == report["best"]["objective"]
-    assert result.best["parameters"] == report["best"]["parameters"]
+    assert result.best.objective == report["best"]["objective"]
+    assert result.best.parameters == report["best"]["parameters"]
     assert result.scene.drill_string.bodies["collar"].mass_kg == report["best"]["parameters"][COLLAR]
     assert set(result.optima_hz) == {"a", "b", "a again"}
 

@@ -140,12 +140,10 @@ def test_preload_that_would_crush_is_refused():
 
 MODULE_PROBE = """
 import json, sys
-from rpdrill import load_scene
-from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.models.solvers.simulation import prepare
+from rpdrill import load_scene, simulate
 from rpdrill.rocklaw.exudyn_module import FAST
 scene = load_scene(sys.argv[1]).with_solver("exudyn", preset="fast", end_time_s=0.3)
-rate = summary_metrics(run_simulation(prepare(scene)).raw)["penetration_rate_m_per_s"]
+rate = simulate(scene).metrics["penetration_rate_m_per_s"]
 print(json.dumps({"fast": FAST, "loaded": sorted(m for m in sys.modules if m.startswith("exudyn.exudynCPP")),
                   "rate": rate}))
 """
@@ -202,7 +200,6 @@ import json, sys
 from rpdrill.studies.cli.main import choose_exudyn_build
 choose_exudyn_build()  # what the rpdrill program does first (studies.cli.main.console)
 import rpdrill.models.solvers.exudyn_model
-from rpdrill.models.runs.scene_run import run as run_simulation
 print(json.dumps({"loaded": sorted(m for m in sys.modules if m.startswith("exudyn.exudynCPP"))}))
 """
 

@@ -223,13 +223,17 @@ def test_a_figure_of_one_requested_series_draws_it(tmp_path):
 def test_a_checkpoint_line_edited_to_nan_is_refused_not_replayed(tmp_path):
     """rpdrill writes null for a number that is not finite; a NaN or Infinity in evaluations.jsonl was
     put there by hand: refused naming the line (it would be replayed as a result)."""
+    from rpdrill.studies.advice.advice_search import AdviceEvaluation
     from rpdrill.studies.runtime.evaluation_log import EVALUATIONS, EvaluationLog
 
     identity, source = {"hash": "0" * 64}, tmp_path / "search.yaml"
-    log = EvaluationLog(tmp_path, identity, source)
-    log.append({"point": {"impact.frequency_hz": 50.0}, "value": float("nan")})
+    log = EvaluationLog(tmp_path, identity, source, AdviceEvaluation)
+    log.append(AdviceEvaluation(rock="", point={"impact.frequency_hz": 50.0}, value=float("nan"), failed_runs=0,
+                                error=""))
     log.close()
-    assert json.loads((tmp_path / EVALUATIONS).read_text())["value"] is None  # written as null
-    (tmp_path / EVALUATIONS).write_text('{"point": {"impact.frequency_hz": 50.0}, "value": Infinity}\n')
+    line = json.loads((tmp_path / EVALUATIONS).read_text())
+    assert line["value"] is None  # written as null
+    assert EvaluationLog(tmp_path, identity, source, AdviceEvaluation).records[0].value is None  # and replayed
+    (tmp_path / EVALUATIONS).write_text(json.dumps({**line, "value": "Infinity"}).replace('"Infinity"', "Infinity") + "\n")
     with pytest.raises(InputError, match="line 1 is not an evaluation rpdrill wrote"):
-        EvaluationLog(tmp_path, identity, source)
+        EvaluationLog(tmp_path, identity, source, AdviceEvaluation)

@@ -20,16 +20,15 @@ from ...models.evaluation.workprecision import Signature
 from ..figures.workprecision_figure import plot_workprecision
 from ..inputs.arguments import (
     check,
-    check_run_options,
     either,
     file_problem,
     instance_problem,
 )
-from ..runtime.budgets import DEFAULT_BUDGET, Budget
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import check_out, write_json
 from ..runtime.pools import pool
 from ..runtime.resumable import RECORD, Table, run_points
+from ..runtime.run_options import RunOptions
 from ..runtime.tables import write_table
 from .accuracy_study import (
     COLUMNS,
@@ -50,6 +49,7 @@ if TYPE_CHECKING:
 
 TABLE = "workprecision.csv"
 WHERE = "rpdrill.accuracy"
+TAKES = ("workers", "dask", "out", "budget", "quiet")  # the run options it has a use for (rpdrill.RunOptions)
 
 
 class ReferenceFailed(RuntimeError):
@@ -90,24 +90,23 @@ def _reference(study: AccuracyStudy, setting: Setting | None, what: str, cpu: di
     return signature
 
 
-def accuracy(study: AccuracyStudy | str | Path, workers: int | None = None, out: str | Path | None = None,
-             dask: str | None = None, budget: Budget = DEFAULT_BUDGET, quiet: bool = True) -> AccuracyResult:
-    """Run a work-precision study (or file) on ``workers`` processes (default all cores; 1: in this process)
-    or a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (resumable: module doc) or a
-    scratch folder. InputError or BudgetError before anything runs, ReferenceFailed when a reference
-    run fails; ``quiet``: no progress bar."""
+def accuracy(study: AccuracyStudy | str | Path, options: RunOptions | None = None, **run: Any) -> AccuracyResult:
+    """Run a work-precision study (or file) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
+    ``workers``, ``dask``, ``out``, ``budget``, ``quiet``): into ``out`` (resumable: module doc) or a scratch
+    folder. InputError or BudgetError before anything runs, ReferenceFailed when a reference run fails."""
     check(WHERE, "study", study,
           either(file_problem, instance_problem(AccuracyStudy, "a work-precision study file's path or its loaded study")))
-    check_run_options(WHERE, workers, out, dask, quiet)
-    check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
-    folder = None if out is None else check_out(out, None, RECORD)
+    options = RunOptions.of(WHERE, options, run, TAKES)
+    folder = None if options.out is None else check_out(options.out, None, RECORD)
     if not isinstance(study, AccuracyStudy):
-        study = load_accuracy_study(study, budget)
+        study = load_accuracy_study(study, options.budget)
+    quiet = options.quiet
     wall: dict[str, float] = {}
     reference = _reference(study, study.reference, "reference", wall)
     second = _reference(study, study.reference_check, "reference check", wall)
     spec = study.spec
-    with tempfile.TemporaryDirectory(prefix="rpdrill-accuracy-") as scratch, pool(dask, workers) as runner:
+    with tempfile.TemporaryDirectory(prefix="rpdrill-accuracy-") as scratch, \
+            pool(options.dask, options.workers) as runner:
         table = run_points(Table(study, folder or Path(scratch), TABLE, COLUMNS,
                                  lambda p: (study.scene, study.runs[p.index], spec.grid_interval_s, spec.time_limit_s),
                                  run_setting, lambda point, outcome: outcome_row(study, reference, point, outcome),

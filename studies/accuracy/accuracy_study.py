@@ -62,6 +62,7 @@ from ...models.runs.scene_run import run
 from ...models.solvers.cost import Cause
 from ...models.solvers.simulation import prepare
 from ..inputs.reading import InputError, parse, prepare_scene, read_yaml
+from ..inputs.shipped import shipped_path
 from ..inputs.specs import Axis, SceneSpec, StrictSpec
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, check_size
 from ..runtime.point_runs import STATUS_COLUMNS
@@ -198,7 +199,7 @@ def _checked(setting: Setting, scene: Scene, spec: AccuracySpec, source: str, ke
 def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> AccuracyStudy:
     """Read, validate and expand a work-precision study, every run checked against the ``budget``;
     InputError naming file and key, BudgetError naming the cost, otherwise."""
-    path = Path(path)
+    path = Path(shipped_path(path, "accuracy", "rpdrill.load_accuracy_study"))
     source = str(path)
     spec = parse(AccuracySpec, read_yaml(path), source)
     base = spec.base(path)

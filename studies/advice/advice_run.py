@@ -21,23 +21,20 @@ from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import metric as metric_entry
 from ..display.catalogue import parameter
 from ..inputs.arguments import (
-    boolean_problem,
     bounds_problem,
     check,
     choice_problem,
-    dask_problem,
     file_problem,
-    folder_problem,
     instance_problem,
     names_problem,
     optional,
     positive_problem,
-    workers_problem,
 )
 from ..inputs.reading import InputError, scene_and_source
 from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog
 from ..runtime.output_files import check_file_target, check_out, staged_directory, write_atomic, write_json
 from ..runtime.pools import pool
+from ..runtime.run_options import RunOptions
 from .advice_figures import plot_curves, plot_feed_map
 from .advice_report import advice_markdown, advice_record
 from .advice_search import (
@@ -46,6 +43,7 @@ from .advice_search import (
     METRICS,
     PARAMETERS,
     Advice,
+    AdviceEvaluation,
     AdviceSearch,
     Request,
     advice_hash,
@@ -54,22 +52,24 @@ from .advice_search import (
     search_advice,
 )
 
+ADVISE_OPTIONS = ("workers", "dask", "out", "overwrite", "quiet")  # its run options (rpdrill.RunOptions)
+
 
 def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float]], metric: str = METRICS[0],
                  rocks: list[str] | None = None, power_kw: float | None = None, max_thrust_ratio: float = 1.0,
-                 search: AdviceSearch | None = None, workers: int | None = None,
-                 dask: str | None = None, out: str | Path | None = None, overwrite: bool = False,
-                 markdown: str | Path | None = None, quiet: bool = True, command: str | None = None,
-                 max_rod_stress_pa: float | None = None) -> list[Advice]:
+                 search: AdviceSearch | None = None, markdown: str | Path | None = None, command: str | None = None,
+                 max_rod_stress_pa: float | None = None, options: RunOptions | None = None,
+                 **run: Any) -> list[Advice]:
     """Maximise ``metric`` over ``bounds`` (``{"impact.frequency_hz": (45, 70), "feed.force_n": (35e3,
     60e3)}``, optionally ``"impact.amplitude_n"`` and an extension's ``"extensions.NAME.parameters.KEY"``; SI
     units) for the scene's rock, or for each Table 1
     rock of ``rocks``; ``power_kw``: a fixed hammer power (a piston scene, the blow energy P / f). One
-    :class:`Advice` per rock (SI units). ``out``: the folder of the checkpoint and the report (module doc;
-    new, empty or an earlier advice's, or any folder with ``overwrite``, which starts afresh there);
+    :class:`Advice` per rock (SI units). ``options`` (rpdrill.RunOptions, or its names as keywords: ``workers``,
+    ``dask``, ``out``, ``overwrite``, ``quiet``): ``out`` the folder of the checkpoint and the report (module
+    doc; new, empty or an earlier advice's, or any folder with ``overwrite``, which starts afresh there);
     ``markdown``: a copy of advice.md; ``command``: the command the report names (default: this call);
     ``max_rod_stress_pa``: the best point whose rods stay below this stress (rod_stress_max_pa, a scene with rods).
-    InputError before anything runs when an input cannot be used; ``quiet``: no progress bar."""
+    InputError before anything runs when an input cannot be used."""
     where = "rpdrill.advise"
     check(where, "bounds", bounds, bounds_problem)
     check(where, "metric", metric, choice_problem(METRICS, "metric"))
@@ -77,12 +77,9 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     check(where, "power_kw", power_kw, optional(positive_problem))
     check(where, "max_thrust_ratio", max_thrust_ratio, positive_problem)
     check(where, "search", search, instance_problem(AdviceSearch, "a rpdrill.AdviceSearch or None", optional=True))
-    check(where, "workers", workers, optional(workers_problem))
-    check(where, "dask", dask, dask_problem)
-    check(where, "out", out, optional(folder_problem))
-    check(where, "overwrite", overwrite, boolean_problem)
+    options = RunOptions.of(where, options, run, ADVISE_OPTIONS)
+    workers, dask, out, overwrite, quiet = options.workers, options.dask, options.out, options.overwrite, options.quiet
     check(where, "markdown", markdown, optional(file_problem))
-    check(where, "quiet", quiet, boolean_problem)
     check(where, "max_rod_stress_pa", max_rod_stress_pa, optional(positive_problem))
     folder = None if out is None else check_out(out, overwrite, CHECKPOINT)
     if markdown is not None:
@@ -106,7 +103,7 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     advices: list[Advice] = []
     with contextlib.ExitStack() as stack:
         log = None if folder is None else stack.enter_context(
-            contextlib.closing(EvaluationLog(folder, identity, Path(source), overwrite)))
+            contextlib.closing(EvaluationLog(folder, identity, Path(source), AdviceEvaluation, overwrite)))
         label, runner = stack.enter_context(pool(dask, workers, f"{where}: dask"))
         bar = stack.enter_context(tqdm(total=planned_evaluations(request) * len(scenes), desc="advise", unit="point",
                                        disable=quiet))

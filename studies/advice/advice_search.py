@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict
 from scipy import optimize
 
 from ...models.definition.scene import Scene
@@ -277,6 +278,20 @@ def _point_key(rock: str | None, point: Point) -> tuple[Any, ...]:
     return (rock or "", *sorted((path, float(value)) for path, value in point.items()))
 
 
+class AdviceEvaluation(BaseModel):
+    """One point run by a search (a line of ``evaluations.jsonl``): the ``rock`` (a Table 1 name, or '' for the
+    scene's own), the ``point`` (key path -> value), the metric's ``value`` there (None where it is not a
+    number), the runs that failed and the first error, and under a rod-stress bound the largest rod stress."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    rock: str
+    point: dict[str, float]
+    value: float | None
+    failed_runs: int
+    error: str
+    rod_stress_max_pa: float | None = None
+
+
 class AdviceEvaluator:
     """The metric at batches of points, the runs of a batch on the runner at once (points that ``log``
     recorded replayed, new ones recorded as they return); counts runs, replays, failures and points
@@ -287,7 +302,7 @@ class AdviceEvaluator:
                  log: EvaluationLog | None = None) -> None:
         self.scene, self.request, self.runner, self.progress = scene, request, runner, progress
         self.rock, self.log = rock, log
-        self.recorded = {_point_key(r["rock"], r["point"]): r for r in (log.records if log else [])}
+        self.recorded = {_point_key(r.rock, r.point): r for r in (log.records if log else [])}
         self.earlier = set(self.recorded)  # recorded by an earlier session (the rest: this one's repeats)
         self.runs = self.replayed = self.failed = self.beyond_limit = self.beyond_stress = 0
         self.stress = np.empty(0)
@@ -296,14 +311,14 @@ class AdviceEvaluator:
         self.best_point: Point = {}
         self.best_value = -math.inf
 
-    def _take(self, values: np.ndarray, index: int, record: dict[str, Any]) -> None:
-        values[index] = math.nan if record["value"] is None else record["value"]
-        self.failed += record["failed_runs"]
-        self.first_error = self.first_error or record["error"]
-        bound, stress = self.request.max_rod_stress_pa, record.get(STRESS)
+    def _take(self, values: np.ndarray, index: int, record: AdviceEvaluation) -> None:
+        values[index] = math.nan if record.value is None else record.value
+        self.failed += record.failed_runs
+        self.first_error = self.first_error or record.error
+        bound, stress = self.request.max_rod_stress_pa, record.rod_stress_max_pa
         if bound is not None:
             self.stress[index] = math.nan if stress is None else stress
-            self.stress_at[_point_key(record["rock"] or None, record["point"])] = self.stress[index]
+            self.stress_at[_point_key(record.rock or None, record.point)] = self.stress[index]
             if stress is not None and stress > bound:  # not allowed: no value on the curves and the map
                 values[index] = math.nan
                 self.beyond_stress += 1
@@ -321,16 +336,17 @@ class AdviceEvaluator:
                   for i in run if i not in replays]
         for point_run in (r for batch in self.runner(run_curve, curves) for r in batch) if curves else ():
             value = float(point_run.values(self.request.metric)[0])
-            record = {"rock": self.rock or "", "point": {k: float(v) for k, v in points[point_run.key].items()},
-                      "value": None if math.isnan(value) else value, "failed_runs": point_run.failed_runs,
-                      "error": point_run.error}
+            stress = math.nan
             if self.request.max_rod_stress_pa is not None:
                 stress = float(point_run.values(STRESS)[0])
-                record[STRESS] = None if math.isnan(stress) else stress
+            record = AdviceEvaluation(rock=self.rock or "",
+                                      point={k: float(v) for k, v in points[point_run.key].items()},
+                                      value=None if math.isnan(value) else value, failed_runs=point_run.failed_runs,
+                                      error=point_run.error, rod_stress_max_pa=None if math.isnan(stress) else stress)
             self._take(values, point_run.key, record)
             if self.log is not None:
                 self.log.append(record)
-                self.recorded[_point_key(self.rock, record["point"])] = record
+                self.recorded[_point_key(self.rock, record.point)] = record
         self.runs += len(run)
         self.replayed += sum(_point_key(self.rock, points[i]) in self.earlier for i in replays)
         self.beyond_limit += len(points) - len(run)

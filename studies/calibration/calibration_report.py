@@ -19,10 +19,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...models.evaluation.workprecision import non_dominated
-from ..runtime.evaluation_log import Record
 from ..runtime.output_files import write_json, write_resolved, write_rows_csv
 from ..runtime.tables import write_table
-from .calibration_search import SearchResult
+from .calibration_search import CalibrationEvaluation, SearchResult, TargetResult
 from .calibration_spec import Calibration
 
 if TYPE_CHECKING:
@@ -42,7 +41,7 @@ HEADER = ("| target | metric | paper [Hz] | reached, main lobe [Hz] (80 % band) 
 TARGET_FORMATS = {**dict.fromkeys(TARGET_COLUMNS, ".4g"), "relative_miss": ".3g", "tolerance": ".3g"}
 
 
-def target_table(calibration: Calibration, results: list[Record]) -> pd.DataFrame:
+def target_table(calibration: Calibration, results: list[TargetResult]) -> pd.DataFrame:
     """One row per target (TARGET_COLUMNS, typed; None where there is no value); miss and tolerance are
     relative to the paper's optimum."""
     import pandas as pd
@@ -50,16 +49,16 @@ def target_table(calibration: Calibration, results: list[Record]) -> pd.DataFram
     rows = []
     for index, (target, result) in enumerate(zip(calibration.spec.targets, results, strict=True)):
         band = target.band_hz or (None, None)
-        reached = result["band_80"] or (None, None)
+        reached = result.band_80 or (None, None)
         rows.append({
-            "label": result["label"], "metric": calibration.metric(index),
+            "label": result.label, "metric": calibration.metric(index),
             "paper_optimum_hz": target.optimum_hz, "paper_band_low_hz": band[0], "paper_band_high_hz": band[1],
-            "resonance_estimate_hz": result["resonance_hz"], "main_lobe_optimum_hz": result["optimum"],
+            "resonance_estimate_hz": result.resonance_hz, "main_lobe_optimum_hz": result.optimum,
             "main_lobe_band_80_low_hz": reached[0], "main_lobe_band_80_high_hz": reached[1],
-            "global_max_optimum_hz": result["global_optimum"], "relative_miss": result["miss"],
-            "tolerance": target.tolerance, "within_tolerance": "yes" if abs(result["miss"]) <= target.tolerance else "no",
-            "main_lobe_peak_value": result["optimum_value"] or 0.0, "global_max_peak_value": result["best_value"] or 0.0,
-            "failed_runs": result["failed"],
+            "global_max_optimum_hz": result.global_optimum, "relative_miss": result.miss,
+            "tolerance": target.tolerance, "within_tolerance": "yes" if abs(result.miss) <= target.tolerance else "no",
+            "main_lobe_peak_value": result.optimum_value or 0.0, "global_max_peak_value": result.best_value or 0.0,
+            "failed_runs": result.failed,
         })
     return pd.DataFrame(rows, columns=list(TARGET_COLUMNS), dtype=object)
 
@@ -86,14 +85,14 @@ def targets_markdown(calibration: Calibration, table: pd.DataFrame, refine_note:
     return "\n".join(lines) + "\n"
 
 
-def pareto_rows(calibration: Calibration, records: list[Record]) -> list[dict[str, Any]]:
+def pareto_rows(calibration: Calibration, records: list[CalibrationEvaluation]) -> list[dict[str, Any]]:
     """The non-dominated evaluations over the |misses|, by objective: parameters, signed misses,
     rising penalty, objective."""
-    misses = np.array([[abs(t["miss"]) for t in r["targets"]] for r in records])
-    front = sorted(non_dominated(misses), key=lambda i: records[i]["objective"])
-    return [{"evaluation": i, "objective": records[i]["objective"], "rising_penalty": records[i]["rising_penalty"],
-             **records[i]["parameters"],
-             **{f"miss {label}": t["miss"] for label, t in zip(calibration.labels, records[i]["targets"], strict=True)}}
+    misses = np.array([[abs(t.miss) for t in r.targets] for r in records])
+    front = sorted(non_dominated(misses), key=lambda i: records[i].objective)
+    return [{"evaluation": i, "objective": records[i].objective, "rising_penalty": records[i].rising_penalty,
+             **records[i].parameters,
+             **{f"miss {label}": t.miss for label, t in zip(calibration.labels, records[i].targets, strict=True)}}
             for i in front]
 
 
@@ -101,7 +100,7 @@ def write_report(directory: Path, calibration: Calibration, result: SearchResult
                  sessions: list[dict[str, Any]]) -> None:
     """Every output file of a calibration with a best evaluation (module docstring)."""
     best, final = result.best, result.final
-    scene = calibration.scene(best["parameters"]).model_dump(mode="json", by_alias=True, exclude_none=True)
+    scene = calibration.scene(best.parameters).model_dump(mode="json", by_alias=True, exclude_none=True)
     write_resolved(directory / "calibrated_scene.yaml", scene)
     table = target_table(calibration, final.results)
     write_table(directory / "targets.csv", table, TARGET_FORMATS)

@@ -21,19 +21,18 @@ from tqdm import tqdm
 
 from ...models.definition.scene import Scene
 from ..inputs.arguments import (
-    boolean_problem,
     check,
-    check_run_options,
     either,
     file_problem,
     instance_problem,
 )
-from ..runtime.budgets import DEFAULT_BUDGET, Budget, duration
-from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog, Record
+from ..runtime.budgets import duration
+from ..runtime.evaluation_log import CHECKPOINT, EvaluationLog
 from ..runtime.output_files import check_out, staged_directory
 from ..runtime.pools import pool
+from ..runtime.run_options import RunOptions
 from .calibration_report import write_report
-from .calibration_search import FinalScan, search_calibration
+from .calibration_search import CalibrationEvaluation, FinalScan, search_calibration
 from .calibration_spec import Calibration, load_calibration
 
 WHERE = "rpdrill.calibrate"
@@ -47,8 +46,8 @@ class CalibrationResult:
     calibrated ``scene``, what this session cost (``session``) and the folder written (``out``, or None)."""
 
     calibration: Calibration
-    records: list[Record]
-    best: Record | None
+    records: list[CalibrationEvaluation]
+    best: CalibrationEvaluation | None
     final: FinalScan | None
     session: dict[str, Any]
     failed_targets: list[str]
@@ -60,36 +59,34 @@ class CalibrationResult:
         """The first error of a failed target's runs (of any target's when none failed entirely)."""
         failed = [i for i, label in enumerate(self.calibration.labels) if label in self.failed_targets]
         targets = failed or range(len(self.calibration.spec.targets))
-        return next((r["targets"][i]["error"] for r in self.records for i in targets if r["targets"][i]["error"]),
-                    "none")
+        return next((r.targets[i].error for r in self.records for i in targets if r.targets[i].error), "none")
 
     @property
     def optima_hz(self) -> dict[str, float | None]:
         """Each target's main-lobe optimum of the final scan (empty without a best evaluation)."""
-        return {} if self.final is None else {r["label"]: r["optimum"] for r in self.final.results}
+        return {} if self.final is None else {r.label: r.optimum for r in self.final.results}
 
 
-def calibrate(calibration: Calibration | str | Path, workers: int | None = None, out: str | Path | None = None,
-              dask: str | None = None, budget: Budget = DEFAULT_BUDGET, overwrite: bool = False,
-              quiet: bool = True) -> CalibrationResult:
-    """Fit a calibration file's parameters (module doc) on ``workers`` processes (default all cores; 1: in
-    this process) or a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (resumable; a
+def calibrate(calibration: Calibration | str | Path, options: RunOptions | None = None,
+              **run: Any) -> CalibrationResult:
+    """Fit a calibration file's parameters (module doc) as ``options`` say (rpdrill.RunOptions, or its names as
+    keywords: ``workers``, ``dask``, ``out``, ``overwrite``, ``budget``, ``quiet``): into ``out`` (resumable; a
     folder holding anything else, or another calibration, is refused unless ``overwrite``, which starts
-    afresh there) or a scratch folder. InputError or BudgetError before anything runs; ``quiet``: no
-    progress bar. An ``out`` that was new is removed again when no evaluation has a best (nothing to keep)."""
+    afresh there) or a scratch folder. InputError or BudgetError before anything runs. An ``out`` that was
+    new is removed again when no evaluation has a best (nothing to keep)."""
     check(WHERE, "calibration", calibration,
           either(file_problem, instance_problem(Calibration, "a calibration file's path or its loaded Calibration")))
-    check_run_options(WHERE, workers, out, dask, quiet)
-    check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
-    check(WHERE, "overwrite", overwrite, boolean_problem)
-    folder = None if out is None else check_out(out, overwrite, CHECKPOINT)
+    options = RunOptions.of(WHERE, options, run)
+    workers, dask, quiet, overwrite = options.workers, options.dask, options.quiet, options.overwrite
+    folder = None if options.out is None else check_out(options.out, overwrite, CHECKPOINT)
     if not isinstance(calibration, Calibration):
-        calibration = load_calibration(calibration, budget)
+        calibration = load_calibration(calibration, options.budget)
     spec = calibration.spec
     with tempfile.TemporaryDirectory(prefix="rpdrill-calibration-") as scratch:
         target = folder or Path(scratch) / "calibration"
         new = not target.exists() or all(p.name.startswith(".") for p in target.iterdir())  # (its lock)
-        with contextlib.closing(EvaluationLog(target, calibration.identity, calibration.source, overwrite)) as log, \
+        with contextlib.closing(EvaluationLog(target, calibration.identity, calibration.source, CalibrationEvaluation,
+                                                   overwrite)) as log, \
                 pool(dask, workers) as (label, runner), \
                 tqdm(total=calibration.evaluations, desc=spec.name, unit="eval", disable=quiet) as bar:
             print(f"{spec.name}: {len(calibration.names)} parameters, {len(spec.targets)} targets x "
@@ -98,13 +95,13 @@ def calibrate(calibration: Calibration | str | Path, workers: int | None = None,
                   file=sys.stderr)
             best = [float("inf")]
 
-            def progress(record: Record, replayed: bool) -> None:
-                best[0] = min(best[0], record["objective"])
+            def progress(record: CalibrationEvaluation, replayed: bool) -> None:
+                best[0] = min(best[0], record.objective)
                 bar.update(1)
                 bar.set_postfix(best=f"{best[0]:.4g}", replayed="yes" if replayed else "no")
 
             found = search_calibration(calibration, runner, log, progress, label)
-        scene = None if found.best is None else calibration.scene(found.best["parameters"])
+        scene = None if found.best is None else calibration.scene(found.best.parameters)
         if found.best is None and folder is not None and new:  # nothing worth keeping: a rerun would replay failures
             shutil.rmtree(folder)
         elif found.best is not None and folder is not None:

@@ -26,39 +26,87 @@ from datetime import datetime, timezone
 from typing import Any
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict
 from scipy import optimize
 
-from ..runtime.evaluation_log import EvaluationLog, Record, unit_key
+from ..runtime.evaluation_log import EvaluationLog, unit_key
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.pools import Runner
 from ..scan.curves import Curve, CurveRun, rising_shortfalls, run_all, run_curves, runs_cost
 from .calibration_spec import Calibration
 
-Progress = Callable[[Record, bool], None]  # (record, replayed)
+RECORD = ConfigDict(extra="forbid", frozen=True)
 
 
-def target_result(calibration: Calibration, index: int, run: CurveRun) -> Record:
+class TargetResult(BaseModel):
+    """One target's scan in an evaluation: its ``label``, the optimum of its main lobe and its global maximum
+    (the fields of studies.scan.curve_optima.Optimum.record: SI values), the first failed run's ``error`` and the
+    relative ``miss`` of the main-lobe optimum (1 where there is none)."""
+
+    model_config = RECORD
+    label: str
+    metric: str
+    curve: dict[str, Any]
+    along: str
+    points: int
+    failed: int
+    best: float | None
+    best_value: float | None
+    optimum: float | None
+    optimum_value: float | None
+    peak_at_scan_end: bool | None
+    band_80: tuple[float, float] | None
+    band_50: tuple[float, float] | None
+    global_optimum: float | None
+    resonance_hz: float | None
+    lobes: int
+    value_unit: str
+    no_optimum_reason: str | None
+    error: str
+    miss: float
+
+
+class CalibrationEvaluation(BaseModel):
+    """One evaluated parameter set (a line of ``evaluations.jsonl``): its ``unit`` point, the ``parameters``
+    (scene key path -> value), each target's result, the rising penalty, the objective J (module doc) and
+    what its scans cost."""
+
+    model_config = RECORD
+    unit: tuple[float, ...]
+    parameters: dict[str, float]
+    targets: tuple[TargetResult, ...]
+    rising_penalty: float
+    objective: float
+    simulations: int
+    failed_runs: int
+    cpu_time_s: float
+
+
+Progress = Callable[[CalibrationEvaluation, bool], None]  # (record, replayed)
+
+
+def target_result(calibration: Calibration, index: int, run: CurveRun) -> TargetResult:
     """The optimum of one target's scan (studies.scan.curve_optima.Optimum.record), its label, the first
     failed run's error and the relative miss of its main-lobe optimum."""
     target = calibration.spec.targets[index]
     optimum = run.optimum(calibration.metric(index))
     main = optimum.optimum
-    return {"label": calibration.labels[index], **optimum.record, "error": run.error,
-            "miss": 1.0 if main is None else (main - target.optimum_hz) / target.optimum_hz}
+    return TargetResult(label=calibration.labels[index], **optimum.record, error=run.error,
+                        miss=1.0 if main is None else (main - target.optimum_hz) / target.optimum_hz)
 
 
-def rising_penalty(calibration: Calibration, results: list[Record]) -> float:
+def rising_penalty(calibration: Calibration, results: list[TargetResult]) -> float:
     """sum over neighbours (a, b) of each rising list of max(0, f_a - f_b) / f_b* (pairs where a
     target has no optimum are left out: their misses already count 1)."""
     paper = {label: t.optimum_hz for label, t in zip(calibration.labels, calibration.spec.targets, strict=True)}
-    shortfalls = rising_shortfalls(calibration.spec.rising, {r["label"]: r["optimum"] for r in results})
+    shortfalls = rising_shortfalls(calibration.spec.rising, {r.label: r.optimum for r in results})
     return sum(max(0.0, shortfall) / paper[b] for _, b, shortfall in shortfalls)
 
 
-def objective(calibration: Calibration, results: list[Record]) -> tuple[float, float]:
+def objective(calibration: Calibration, results: list[TargetResult]) -> tuple[float, float]:
     """(J, its rising penalty) of an evaluation's per-target results (module docstring)."""
     penalty = rising_penalty(calibration, results)
-    misses = sum(t.weight * r["miss"] ** 2 for t, r in zip(calibration.spec.targets, results, strict=True))
+    misses = sum(t.weight * r.miss ** 2 for t, r in zip(calibration.spec.targets, results, strict=True))
     return misses + calibration.spec.rising_weight * penalty, penalty
 
 
@@ -74,10 +122,10 @@ class CalibrationEvaluator:
     """J for batches of unit points: recorded points are replayed, the others' scans (every target
     of every point) go to the runner in one batch; each point is recorded as its last scan ends."""
 
-    def __init__(self, calibration: Calibration, runner: Runner, log: EvaluationLog,
+    def __init__(self, calibration: Calibration, runner: Runner, log: EvaluationLog[CalibrationEvaluation],
                  progress: Progress | None = None) -> None:
         self.calibration, self.runner, self.log, self.progress = calibration, runner, log, progress
-        self.memo = {unit_key(r["unit"]): r for r in log.records}
+        self.memo = {unit_key(r.unit): r for r in log.records}
         self.evaluated = self.replayed = self.simulations = 0
         self.cpu_time_s = 0.0
 
@@ -90,7 +138,7 @@ class CalibrationEvaluator:
                 self.progress(self.memo[key], True)
         todo = list(dict.fromkeys(k for k in keys if k not in self.memo))
         self._run(todo)
-        return np.array([self.memo[k]["objective"] for k in keys])
+        return np.array([self.memo[k].objective for k in keys])
 
     def _run(self, keys: list[tuple[float, ...]]) -> None:
         calibration = self.calibration
@@ -112,8 +160,8 @@ class CalibrationEvaluator:
         results = [target_result(self.calibration, t, run) for t, run in enumerate(runs)]
         raise_if_stopped()  # scans cut by an interrupt are not an evaluation
         total, penalty = objective(self.calibration, results)
-        record = {"unit": list(key), "parameters": values, "targets": results, "rising_penalty": penalty,
-                  "objective": total, **cost}
+        record = CalibrationEvaluation(unit=key, parameters=values, targets=tuple(results), rising_penalty=penalty,
+                                       objective=total, **cost)
         self.log.append(record)
         self.memo[key] = record
         self.evaluated += 1
@@ -162,16 +210,16 @@ def refined_frequencies_hz(axis_hz: tuple[float, ...], around_hz: Iterable[float
 class FinalScan:
     """The best parameter set scanned on the refined axes: per-target results and curves."""
 
-    results: list[Record]
+    results: list[TargetResult]
     curves: list[tuple[list[float], list[float]]]  # (frequencies, metric values) per target
     cost: dict[str, Any]  # studies.scan.curves.runs_cost
 
 
-def final_scan(calibration: Calibration, best: Record, runner: Runner) -> FinalScan:
+def final_scan(calibration: Calibration, best: CalibrationEvaluation, runner: Runner) -> FinalScan:
     """Scan every target of the best evaluation again, refined around its main and global optima."""
-    axes = [refined_frequencies_hz(calibration.frequencies_hz, (r["optimum"], r["global_optimum"]),
-                                   calibration.spec.refine_hz) for r in best["targets"]]
-    curves = target_curves(calibration, "best", best["parameters"], lambda t: axes[t])
+    axes = [refined_frequencies_hz(calibration.frequencies_hz, (r.optimum, r.global_optimum),
+                                   calibration.spec.refine_hz) for r in best.targets]
+    curves = target_curves(calibration, "best", best.parameters, lambda t: axes[t])
     runs, cost = run_all(runner, curves)
     results = [target_result(calibration, t, runs[("best", t)]) for t in range(len(curves))]
     values = [(axes[t], runs[("best", t)].values(calibration.metric(t))) for t in range(len(curves))]
@@ -183,18 +231,18 @@ class SearchResult:
     """Every recorded evaluation, the best one (None if every simulation of every evaluation failed,
     or every run of a target did: ``failed_targets``), its final scan, and what this session cost."""
 
-    records: list[Record]
-    best: Record | None
+    records: list[CalibrationEvaluation]
+    best: CalibrationEvaluation | None
     final: FinalScan | None
     session: dict[str, Any]
     failed_targets: list[str]
 
 
-def failed_targets(calibration: Calibration, records: list[Record]) -> list[str]:
+def failed_targets(calibration: Calibration, records: list[CalibrationEvaluation]) -> list[str]:
     """The labels of the targets whose every run failed in every evaluation."""
     count = len(calibration.frequencies_hz)
     return [label for t, label in enumerate(calibration.labels)
-            if all(record["targets"][t]["failed"] >= count for record in records)]
+            if all(record.targets[t].failed >= count for record in records)]
 
 
 def _session(evaluator: CalibrationEvaluator, final: FinalScan | None, runner_label: str, start_wall: float,
@@ -207,7 +255,7 @@ def _session(evaluator: CalibrationEvaluator, final: FinalScan | None, runner_la
             "wall_time_s": time.perf_counter() - start_wall}
 
 
-def search_calibration(calibration: Calibration, runner: Runner, log: EvaluationLog,
+def search_calibration(calibration: Calibration, runner: Runner, log: EvaluationLog[CalibrationEvaluation],
                        progress: Progress | None = None, runner_label: str = "") -> SearchResult:
     """Search (replaying what ``log`` holds), then scan the best parameter set for the report. An
     interrupted search (Ctrl-C, SIGTERM) records its session before it stops."""
@@ -216,8 +264,8 @@ def search_calibration(calibration: Calibration, runner: Runner, log: Evaluation
     try:
         search(calibration, evaluator)
         failed = failed_targets(calibration, log.records)
-        usable = [r for r in log.records if r["failed_runs"] < r["simulations"]]
-        best = min(usable, key=lambda r: r["objective"]) if usable and not failed else None
+        usable = [r for r in log.records if r.failed_runs < r.simulations]
+        best = min(usable, key=lambda r: r.objective) if usable and not failed else None
         final = final_scan(calibration, best, runner) if best else None
     except KeyboardInterrupt:
         log.add_session(_session(evaluator, None, runner_label, start_wall, interrupted=True))

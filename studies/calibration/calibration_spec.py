@@ -39,6 +39,7 @@ from pydantic import Field, ValidationInfo, field_validator, model_validator
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, field_at, parse
 from ..inputs.reading import read_yaml
+from ..inputs.shipped import shipped_path
 from ..inputs.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path, scene_value
 from ..runtime.budgets import (
     AXIS_VALUE_BYTES,
@@ -356,7 +357,7 @@ def scans_per_evaluation(spec: CalibrationSpec) -> int:
 def load_calibration(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Calibration:
     """Read and validate a calibration file, its runs checked against the ``budget``; InputError naming
     the file, key path and value, BudgetError naming the cost, otherwise."""
-    path = Path(path)
+    path = Path(shipped_path(path, "calibration", "rpdrill.load_calibration"))
     source = str(path)
     spec = parse(CalibrationSpec, read_yaml(path), source)
     base = spec.base(path)

@@ -24,8 +24,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..accuracy.accuracy_run import TABLE, ReferenceFailed, accuracy
-from .options import add_resumable_arguments, budget
+from ..accuracy.accuracy_run import TABLE, TAKES, ReferenceFailed, accuracy
+from .options import add_resumable_arguments, run_options
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,7 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        result = accuracy(args.study, args.workers, args.out, args.dask, budget(args), args.quiet)
+        result = accuracy(args.study, run_options(args, *TAKES))
     except ReferenceFailed as error:
         print(error, file=sys.stderr)
         return 1

@@ -13,13 +13,13 @@ from pathlib import Path
 
 from ...rocklaw.catalog import TABLE_1
 from ..advice.advice_report import advice_text, best_table
-from ..advice.advice_run import advise_scene
+from ..advice.advice_run import ADVISE_OPTIONS, advise_scene
 from ..advice.advice_search import METRICS, PARAMETERS, AdviceSearch, AdviseParameter
 from ..display.catalogue import parameter
 from ..inputs.arguments import choice_problem, cli_type
 from ..runtime.evaluation_log import CHECKPOINT, EVALUATIONS
 from ..runtime.output_files import check_file_target, check_out
-from .options import add_runner_arguments, positive_count, positive_number, seed
+from .options import add_runner_arguments, positive_count, positive_number, run_options, seed
 
 FILES = f"""files written to DIR (an interrupted advice keeps its points there: the same command again
 replays them and runs the rest):
@@ -97,9 +97,9 @@ def run(args: argparse.Namespace) -> int:
     bounds = {e.path: e.si_bounds(_given(args, e)) for e in PARAMETERS if _given(args, e) is not None}
     advices = advise_scene(args.scene, bounds, args.metric, args.rock, args.power_kw, args.max_thrust_ratio,
                            AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed),
-                           args.workers, args.dask, args.out, args.overwrite, args.markdown, args.quiet,
-                           command_line(args),
-                           max_rod_stress_pa=args.max_rod_stress_mpa * 1e6 if args.max_rod_stress_mpa else None)
+                           args.markdown, command_line(args),
+                           max_rod_stress_pa=args.max_rod_stress_mpa * 1e6 if args.max_rod_stress_mpa else None,
+                           options=run_options(args, *ADVISE_OPTIONS))
     for advice in advices:
         print(advice_text(advice))
     print(best_table(advices))

@@ -18,7 +18,8 @@ import argparse
 import sys
 
 from ..calibration.calibration_run import calibrate
-from .options import add_resumable_arguments, budget
+from ..runtime.run_options import FIELDS
+from .options import add_resumable_arguments, run_options
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -28,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    result = calibrate(args.calibration, args.workers, args.out, args.dask, budget(args), args.overwrite, args.quiet)
+    result = calibrate(args.calibration, run_options(args, *FIELDS))
     if result.best is None:
         which = f"targets {', '.join(result.failed_targets)}: every run" if result.failed_targets else "every simulation"
         print(f"{args.calibration}: {which} of all {len(result.records)} evaluations failed; first error: "
@@ -36,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
         return 1
     reached = ", ".join(f"{label}: {'none' if hz is None else format(hz, '.1f')}" for label, hz in result.optima_hz.items())
     session = result.session
-    print(f"{result.calibration.spec.name}: best objective {result.best['objective']:.4g} of {len(result.records)} "
+    print(f"{result.calibration.spec.name}: best objective {result.best.objective:.4g} of {len(result.records)} "
           f"evaluations ({session['evaluations_run']} run, {session['evaluations_replayed']} replayed, "
           f"{session['wall_time_s']:.0f} s); main-lobe optima [Hz] {reached}; wrote {result.out}", file=sys.stderr)
     return 0

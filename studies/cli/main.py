@@ -49,6 +49,7 @@ COMMANDS = {
     "sensitivity": "how the frequency optima move with each scene parameter (+-10 %%, SALib global indices)",
     "rotation-report": "the rotation-speed note (rpm x frequency map, best speed against the manual's rule)",
     "advise": "the operating point that maximises a metric within bounds",
+    "shipped": "list the scenes, studies and analyses that ship with rpdrill, by the names that open them",
 }
 
 
@@ -73,6 +74,8 @@ def command_module(name: str) -> ModuleType:
         from . import rotation_report_command as module
     elif name == "advise":
         from . import advise_command as module
+    elif name == "shipped":
+        from . import shipped_command as module
     else:
         raise KeyError(name)
     return module

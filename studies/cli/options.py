@@ -17,6 +17,7 @@ from ..inputs.arguments import (
     workers_problem,
 )
 from ..runtime.budgets import DEFAULT_MAX_MEMORY_GB, DEFAULT_MAX_STEPS, MAX_CPU_HOURS, Budget
+from ..runtime.run_options import RunOptions
 
 # The options' types: the library's checks of the same arguments (studies.inputs.arguments), same words
 positive_number = cli_type(positive_problem, number)  # a positive finite number
@@ -42,6 +43,15 @@ def add_budget_arguments(parser: argparse.ArgumentParser, many_runs: bool = True
 def budget(args: argparse.Namespace) -> Budget:
     """The budget the command line gives."""
     return Budget(args.max_steps, args.max_memory_gb, getattr(args, "yes", False))
+
+
+def run_options(args: argparse.Namespace, *takes: str) -> RunOptions:
+    """The run options (rpdrill.RunOptions) the command line gives, those named in ``takes``."""
+    given = {"workers": getattr(args, "workers", None), "dask": getattr(args, "dask", None), "out": args.out,
+             "overwrite": getattr(args, "overwrite", False), "quiet": getattr(args, "quiet", True)}
+    if "budget" in takes:
+        given["budget"] = budget(args)
+    return RunOptions(**{name: value for name, value in given.items() if name in takes})
 
 
 def add_resumable_arguments(parser: argparse.ArgumentParser, name: str, help: str, many: bool = False) -> None:

@@ -20,7 +20,7 @@ import sys
 from pathlib import Path
 
 from ..pages.reproduction_run import DEFAULT, reproduce
-from .options import add_runner_arguments
+from .options import add_runner_arguments, run_options
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -35,8 +35,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    result = reproduce(args.reproduction, args.out, args.calibration, args.sensitivity, args.docs, args.workers,
-                       args.dask, args.overwrite)
+    result = reproduce(args.reproduction, args.calibration, args.sensitivity, args.docs,
+                       options=run_options(args, "workers", "dask", "out", "overwrite"))
     trends = result.trends
     print(f"{result.reproduction.spec.name}: {sum(t['rises'] for t in trends)} of {len(trends)} trends hold; "
           f"{len(result.reached)} of {len(result.stated)} optima the paper states reached within "

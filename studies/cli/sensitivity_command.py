@@ -13,8 +13,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..sensitivity.sensitivity_run import sensitivity
-from .options import add_resumable_arguments, budget
+from ..sensitivity.sensitivity_run import TAKES, sensitivity
+from .options import add_resumable_arguments, run_options
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -22,7 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    result = sensitivity(args.sensitivity, args.workers, args.out, args.dask, budget(args), args.quiet)
+    result = sensitivity(args.sensitivity, run_options(args, *TAKES))
     name, summary = result.study.spec.name, result.summary
     for metric, figures_of in summary["metrics"].items():
         top = ", ".join(f"{p} {v:.1%}" for p, v in list(figures_of["parameters_by_peak_change"].items())[:4])

@@ -21,8 +21,8 @@ from ...models.evaluation.run_status import STATUSES, USABLE
 from ..api import run_study_files
 from ..inputs.arguments import choice_problem, cli_type
 from ..scan.study_optima import optima_table
-from ..study_runs import StudyRun
-from .options import add_resumable_arguments, budget
+from ..study_runs import STUDY_OPTIONS, StudyRun
+from .options import add_resumable_arguments, run_options
 
 FILES = """files written to DIR (to DIR/<file name without .yaml> for each of several studies):
   results.csv    one row per point (scan values, status, error, wall time, metrics in SI units),
@@ -64,8 +64,7 @@ def report(run: StudyRun) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    runs = run_study_files(args.study, args.out, formulation=args.formulation, budget=budget(args),
-                           workers=args.workers, dask=args.dask, quiet=args.quiet)
+    runs = run_study_files(args.study, run_options(args, *STUDY_OPTIONS), formulation=args.formulation)
     for study_run in runs:
         report(study_run)
     useless = [study_run.study.source for study_run in runs if not study_run.table["status"].isin(USABLE).any()]

@@ -19,6 +19,7 @@ from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, parse, short
 from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
 from .arguments import check, scene_file_problem
+from .shipped import shipped_path
 from .strict_yaml import MAX_DEPTH, MAX_VALUES, parse_yaml
 
 __all__ = ["MAX_DEPTH", "MAX_FILE_BYTES", "MAX_VALUES", "InputError", "load_scene", "parse", "parse_yaml",
@@ -58,7 +59,8 @@ def read_text(path: str | Path) -> str:
     path = Path(path)
     try:
         if not path.exists():
-            raise InputError(f"{path}: no such file")
+            shipped = "" if path.suffix else "; nor a shipped file's name (rpdrill shipped lists them)"
+            raise InputError(f"{path}: no such file{shipped}")
         if path.is_dir():
             raise InputError(f"{path}: is a directory; give a YAML file")
         if not path.is_file():
@@ -95,8 +97,9 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file."""
+    """Read and validate a scene file, or a shipped scene by its name (``"paper_base"``: studies.inputs.shipped)."""
     check("rpdrill.load_scene", "path", path, scene_file_problem)
+    path = shipped_path(path, "scene", "rpdrill.load_scene")
     return parse(Scene, read_yaml(path), str(path))
 
 
@@ -106,7 +109,8 @@ def scene_and_source(scene: Scene | str | Path, function: str = "rpdrill") -> tu
     if isinstance(scene, Scene):
         return scene, f"scene {scene.name!r}"
     check(function, "scene", scene, scene_file_problem)
-    return load_scene(scene), str(scene)
+    path = shipped_path(scene, "scene", function)
+    return load_scene(path), str(path)
 
 
 def prepare_scene(scene: Scene, source: str, where: str = "") -> Simulation:

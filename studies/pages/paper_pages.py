@@ -12,6 +12,7 @@ from typing import Any
 
 from ...models.drill.modal import rock_mode_frequency_hz
 from ...models.solvers.simulation import prepare
+from ..calibration.calibration_search import CalibrationEvaluation
 from ..calibration.calibration_spec import Calibration, CalibrationSpec
 from ..reproduction.paper_reproduction import (
     CaseResult,
@@ -143,13 +144,13 @@ def _calibration_run(run: Path | None) -> str:
     if run is None or not (run / "calibration.json").exists():
         return ("No calibration run was given to the command that generated this page "
                 "(`rpdrill calibrate studies/paper/calibration.yaml --out runs/calibration`).")
-    record = json.loads((run / "calibration.json").read_text(encoding="utf-8"))
-    cost, best = record["cost"], record["best"]
+    record = json.loads((run / "calibration.json").read_text(encoding="utf-8"))  # an earlier command's run
+    cost, best = record["cost"], CalibrationEvaluation.model_validate(record["best"])
     targets = (run / "targets.md").read_text(encoding="utf-8").split("\n", 2)[2]
     alternatives = len(read_table(run / "pareto.csv"))
     return (f"`rpdrill calibrate studies/paper/calibration.yaml --out runs/calibration`: {cost['evaluations']} "
             f"evaluations ({cost['simulations']} simulations, {cost['simulation_cpu_time_s']:.0f} CPU s, "
-            f"{cost['wall_time_s'] / 60:.1f} min wall time); best objective {best['objective']:.4g}, "
+            f"{cost['wall_time_s'] / 60:.1f} min wall time); best objective {best.objective:.4g}, "
             f"{alternatives} non-dominated alternatives in its `pareto.csv`. Its per-target table (the best set "
             f"scanned again around its optima):\n{targets}")
 
@@ -165,7 +166,7 @@ def parameters_page(reproduction: Reproduction, results: list[CaseResult], calib
     best = {}
     if calibration_run is not None and (calibration_run / "calibration.json").exists():
         record = json.loads((calibration_run / "calibration.json").read_text(encoding="utf-8"))
-        best = record["best"]["parameters"]
+        best = CalibrationEvaluation.model_validate(record["best"]).parameters
         fitted = CalibrationSpec.model_validate(record["calibration"]).parameters
     rows = []
     for path, value in values.items():
@@ -221,7 +222,7 @@ def sensitivity_page(run: Path, tornados: list[str], made_by: str) -> str:
                      f"| {figures['largest_peak_change']:.1%} | {top} |")
     trends = read_table(run / "trends.csv", text=("parameter", "shortfalls"))
     broken = [r for r in trends.to_dict("records") if r["parameter"] != "nominal"
-              and not (r["every_scan_has_an_optimum"] == "True" and r["rising_kept"] == "True")]
+              and not (r["every_scan_has_an_optimum"] and r["rising_kept"])]
     broken_rows = [f"| `{r['parameter']}` {r['change']:+.0%} | {r['shortfalls'] or 'a scan has no optimum'} |"
                    for r in broken]
     morris, not_computed = [], {}

@@ -25,13 +25,10 @@ from typing import Any
 from ..calibration.calibration_spec import load_calibration
 from ..figures.paper_figures import draw_figure
 from ..inputs.arguments import (
-    boolean_problem,
     check,
-    dask_problem,
     file_problem,
     folder_problem,
     optional,
-    workers_problem,
 )
 from ..inputs.reading import InputError
 from ..reproduction.paper_reproduction import (
@@ -45,6 +42,7 @@ from ..reproduction.paper_reproduction import (
 from ..runtime.budgets import Budget
 from ..runtime.output_files import check_out, staged_directory, write_json, write_rows_csv
 from ..runtime.pools import pool
+from ..runtime.run_options import RunOptions
 from .paper_pages import figures_page, parameters_page, reproduction_page, sensitivity_page
 
 PAPER = Path(__file__).resolve().parents[1] / "paper"
@@ -118,21 +116,19 @@ def made_by(file: Path, reproduction: Reproduction, out: Path | None, calibratio
     return f"`{shlex.join(words)}` (inputs: {', '.join(f'`{name}`' for name in inputs)})"
 
 
-def reproduce(reproduction: str | Path = DEFAULT, out: str | Path | None = None, calibration: str | Path | None = None,
-              sensitivity: str | Path | None = None, docs: str | Path | None = None, workers: int | None = None,
-              dask: str | None = None, overwrite: bool = False) -> ReproductionResult:
-    """Reproduce the paper (module doc) on ``workers`` processes (default all cores; 1: in this process) or
-    a Dask cluster (``dask``: an address, "" a LocalCluster); ``calibration``, ``sensitivity``: the
-    ``--out`` folders of ``rpdrill calibrate`` and ``rpdrill sensitivity`` for parameters.md and
-    sensitivity.md. ``out`` must be new, empty or an earlier reproduction's (``overwrite``: any folder).
-    InputError before anything runs."""
+def reproduce(reproduction: str | Path = DEFAULT, calibration: str | Path | None = None,
+              sensitivity: str | Path | None = None, docs: str | Path | None = None, options: RunOptions | None = None,
+              **run: Any) -> ReproductionResult:
+    """Reproduce the paper (module doc) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
+    ``workers``, ``dask``, ``out``, ``overwrite``); ``calibration``, ``sensitivity``: the ``--out`` folders of
+    ``rpdrill calibrate`` and ``rpdrill sensitivity`` for parameters.md and sensitivity.md. ``out`` must be
+    new, empty or an earlier reproduction's (``overwrite``: any folder). InputError before anything runs."""
     where = "rpdrill.reproduce"
     check(where, "reproduction", reproduction, file_problem)
-    for name, value in (("out", out), ("calibration", calibration), ("sensitivity", sensitivity), ("docs", docs)):
+    for name, value in (("calibration", calibration), ("sensitivity", sensitivity), ("docs", docs)):
         check(where, name, value, optional(folder_problem))
-    check(where, "workers", workers, optional(workers_problem))
-    check(where, "dask", dask, dask_problem)
-    check(where, "overwrite", overwrite, boolean_problem)
+    options = RunOptions.of(where, options, run, ("workers", "dask", "out", "overwrite"))
+    out, workers, dask, overwrite = options.out, options.workers, options.dask, options.overwrite
     file = Path(reproduction)
     folder = None if out is None else check_out(out, overwrite, "reproduction.json")
     docs_folder = None if docs is None else check_out(docs, True, option="--docs")

@@ -24,6 +24,7 @@ from pydantic import Field, model_validator
 
 from ...models.definition.scene import Scene
 from ..inputs.reading import InputError, parse, read_yaml
+from ..inputs.shipped import shipped_path
 from ..inputs.specs import Axis, MetricName, SceneSpec, StrictSpec, check_scene_path
 from ..runtime.pools import Runner
 from ..scan.curve_optima import Optimum
@@ -154,7 +155,7 @@ class CaseResult:
 
 def load_reproduction(path: str | Path) -> Reproduction:
     """Read and validate a reproduction file; InputError naming the file and key otherwise."""
-    path = Path(path)
+    path = Path(shipped_path(path, "reproduction", "rpdrill.load_reproduction"))
     spec = parse(ReproductionSpec, read_yaml(path), str(path))
     base = spec.base(path)
     for i, case in enumerate(spec.cases):

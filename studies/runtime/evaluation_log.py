@@ -13,13 +13,15 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, Generic, TextIO, TypeVar
+
+from pydantic import BaseModel, ValidationError
 
 from ...models.definition.validation import InputError
 from .output_files import json_text, write_atomic, write_json
 from .resumable import checked_record
 
-Record = dict[str, Any]
+RecordT = TypeVar("RecordT", bound=BaseModel)  # a search's typed evaluation (calibration, advice)
 EVALUATIONS = "evaluations.jsonl"
 CHECKPOINT = "checkpoint.json"
 
@@ -33,9 +35,9 @@ def _not_json(constant: str) -> None:
     raise json.JSONDecodeError(f"{constant} is not JSON", constant, 0)
 
 
-def _complete_records(path: Path) -> list[Record]:
-    """The records of whole lines (a last line cut by a kill is left out); InputError naming the file
-    and line when a whole line is not a record."""
+def _complete_records(path: Path, kind: type[RecordT]) -> list[RecordT]:
+    """The records of whole lines as ``kind`` (a last line cut by a kill is left out); InputError naming the
+    file and line when a whole line is not such a record."""
     records = []
     try:
         lines = path.read_text(encoding="utf-8").splitlines(keepends=True) if path.exists() else []
@@ -43,22 +45,23 @@ def _complete_records(path: Path) -> list[Record]:
         raise InputError(f"--out: {path}: not evaluations rpdrill wrote (not UTF-8 text)") from None
     for number, line in enumerate(lines, 1):
         try:  # (rpdrill writes null for a number that is not finite: a NaN or Infinity was edited in)
-            records.append(json.loads(line, parse_constant=_not_json))
-        except json.JSONDecodeError:
+            records.append(kind.model_validate(json.loads(line, parse_constant=_not_json)))
+        except (json.JSONDecodeError, ValidationError):
             if line.endswith("\n"):
                 raise InputError(f"--out: {path}: line {number} is not an evaluation rpdrill wrote") from None
     return records
 
 
-class EvaluationLog:
-    """The recorded evaluations of one search in one output directory (close it when done):
-    ``identity`` names the search and holds its ``hash``; ``source`` is the input file messages name."""
+class EvaluationLog(Generic[RecordT]):
+    """The recorded evaluations (of type ``kind``) of one search in one output directory (close it when
+    done): ``identity`` names the search and holds its ``hash``; ``source`` is the input file messages name."""
 
-    def __init__(self, out: Path, identity: dict[str, Any], source: Path, overwrite: bool = False) -> None:
+    def __init__(self, out: Path, identity: dict[str, Any], source: Path, kind: type[RecordT],
+                 overwrite: bool = False) -> None:
         self.out = out
         self.checkpoint, resumed = self._checkpoint(identity, source, overwrite)
         path = out / EVALUATIONS
-        self.records = _complete_records(path) if resumed else []
+        self.records: list[RecordT] = _complete_records(path, kind) if resumed else []
         write_atomic(path, "".join(json_text(r) + "\n" for r in self.records))
         self._handle: TextIO = path.open("a", encoding="utf-8")
 
@@ -70,7 +73,7 @@ class EvaluationLog:
         write_json(self.out / CHECKPOINT, checkpoint)
         return checkpoint, checkpoint is not fresh
 
-    def append(self, record: Record) -> None:
+    def append(self, record: RecordT) -> None:
         """Record an evaluation now (one line, flushed)."""
         self._handle.write(json_text(record) + "\n")
         self._handle.flush()

@@ -25,6 +25,7 @@ from typing import IO, Any
 
 import numpy as np
 import yaml
+from pydantic import BaseModel
 
 from ..inputs.reading import InputError
 
@@ -160,6 +161,8 @@ def json_ready(value: Any) -> Any:
         return json_ready(value.value)
     if isinstance(value, PurePath):
         return str(value)
+    if isinstance(value, BaseModel):
+        return json_ready(value.model_dump())
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         fields = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
         return json_ready({**fields, **{name: getattr(value, name) for name in getattr(value, "json_properties", ())}})

@@ -208,12 +208,14 @@ def run_tagged(item: tuple[Callable[[Any], Any], int, Any]) -> tuple[int, Any]:
 
 
 def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
-               finished: Callable[[int, pd.DataFrame], None] = lambda index, table: None) -> list[pd.DataFrame]:
+               finished: Callable[[int, pd.DataFrame, dict[str, Any]], None] = lambda index, table, record: None
+               ) -> list[pd.DataFrame]:
     """Run the points of every table without a finished row (module doc) in one call of ``runner``, so
     that the workers go from one study's points to the next without waiting; each batch's rows are
     appended to their tables as it completes; a point whose scene key equals another's runs once and
-    its outcome goes to both. ``finished(i, table)`` is called as soon as table ``i`` is complete (in
-    this process, while the workers go on), with the table in point order. Prints what it runs, shows
+    its outcome goes to both. ``finished(i, table, record)`` is called as soon as table ``i`` is complete (in
+    this process, while the workers go on), with the table in point order and its record as written to
+    ``study.json``. Prints what it runs, shows
     progress, records each table's session; returns every table (typed DataFrames)."""
     label, run = runner
     records, remaining = [], []
@@ -246,7 +248,7 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
     def complete(i: int, interrupted: bool = False) -> None:
         frames[i] = _record_session(records[i], tables[i], label, ran[i], copied[i], start, interrupted)
         if not interrupted:
-            finished(i, frames[i])
+            finished(i, frames[i], records[i])
 
     try:
         for i in range(len(tables)):

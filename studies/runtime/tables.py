@@ -98,7 +98,8 @@ def is_finite(text: str) -> bool:
 
 def typed(frame: pd.DataFrame, text: Sequence[str] = ()) -> pd.DataFrame:
     """A table of text cells typed: a column whose every non-empty cell is a number becomes numbers
-    (empty cells NaN), the others stay text; status, error and the ``text`` columns are text."""
+    (empty cells NaN), one whose every cell is ``True`` or ``False`` (as Python writes a bool) booleans, the
+    others stay text; status, error and the ``text`` columns are text."""
     import pandas as pd  # 0.3 s to import: only where a table is asked for
 
     frame = frame.copy()
@@ -106,6 +107,9 @@ def typed(frame: pd.DataFrame, text: Sequence[str] = ()) -> pd.DataFrame:
         if column in TEXT_COLUMNS or column in text or frame[column].dtype != object:
             continue
         cells = frame[column].astype(str)
+        if len(cells) and cells.isin(("True", "False")).all():
+            frame[column] = cells == "True"
+            continue
         numbers = pd.to_numeric(cells, errors="coerce")
         number = numbers.notna() | cells.str.strip().str.lower().isin(NOT_A_NUMBER)
         if number.sum() == cells.ne("").sum():

@@ -47,6 +47,7 @@ from ...models.definition.validation import short
 from ...models.solvers.simulation import Simulation
 from ..inputs.arguments import check, choice_problem, file_problem, instance_problem, optional
 from ..inputs.reading import InputError, parse, read_yaml
+from ..inputs.shipped import shipped_path
 from ..inputs.specs import METRIC_NAMES, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, BudgetError, base_estimate_s, check_size
 from ..runtime.point_runs import prepare_point, where
@@ -204,7 +205,7 @@ def load_study(path: str | Path, formulation: str | None = None, budget: Budget 
     check("rpdrill.load_study", "path", path, file_problem)
     check("rpdrill.load_study", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
     check("rpdrill.load_study", "budget", budget, instance_problem(Budget, "a rpdrill Budget"))
-    path = Path(path)
+    path = Path(shipped_path(path, "study", "rpdrill.load_study"))
     source = str(path)
     spec = parse(StudySpec, read_yaml(path), source)
     base = spec.base(path)

@@ -17,15 +17,14 @@ from typing import TYPE_CHECKING, Any
 from ..figures.tornado_figures import draw_tornados
 from ..inputs.arguments import (
     check,
-    check_run_options,
     either,
     file_problem,
     instance_problem,
 )
-from ..runtime.budgets import DEFAULT_BUDGET, Budget
 from ..runtime.output_files import check_out, write_json
 from ..runtime.pools import pool
 from ..runtime.resumable import RECORD, Table, run_points
+from ..runtime.run_options import RunOptions
 from ..runtime.tables import write_table
 from .sensitivity_study import (
     TEXT_COLUMNS,
@@ -47,6 +46,7 @@ if TYPE_CHECKING:
 
 
 WHERE = "rpdrill.sensitivity"
+TAKES = ("workers", "dask", "out", "budget", "quiet")  # the run options it has a use for (rpdrill.RunOptions)
 
 
 @dataclass(frozen=True)
@@ -71,19 +71,20 @@ class SensitivityResult:
         return self.table[self.table["status"] != "ok"]
 
 
-def sensitivity(study: SensitivityStudy | str | Path, workers: int | None = None, out: str | Path | None = None,
-                dask: str | None = None, budget: Budget = DEFAULT_BUDGET, quiet: bool = True) -> SensitivityResult:
-    """Run a sensitivity study (or file) on ``workers`` processes (default all cores; 1: in this process) or
-    a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (resumable: module doc) or a
-    scratch folder. InputError or BudgetError before anything runs; ``quiet``: no progress bar."""
+def sensitivity(study: SensitivityStudy | str | Path, options: RunOptions | None = None,
+                **run: Any) -> SensitivityResult:
+    """Run a sensitivity study (or file) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
+    ``workers``, ``dask``, ``out``, ``budget``, ``quiet``): into ``out`` (resumable: module doc) or a scratch
+    folder. InputError or BudgetError before anything runs."""
     check(WHERE, "study", study,
           either(file_problem, instance_problem(SensitivityStudy, "a sensitivity file's path or its loaded study")))
-    check_run_options(WHERE, workers, out, dask, quiet)
-    check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
-    folder = None if out is None else check_out(out, None, RECORD)
+    options = RunOptions.of(WHERE, options, run, TAKES)
+    folder = None if options.out is None else check_out(options.out, None, RECORD)
     if not isinstance(study, SensitivityStudy):
-        study = load_sensitivity(study, budget)
-    with tempfile.TemporaryDirectory(prefix="rpdrill-sensitivity-") as scratch, pool(dask, workers) as runner:
+        study = load_sensitivity(study, options.budget)
+    quiet = options.quiet
+    with tempfile.TemporaryDirectory(prefix="rpdrill-sensitivity-") as scratch, \
+            pool(options.dask, options.workers) as runner:
         table = run_points(Table(study, folder or Path(scratch), "results.csv", columns(study),
                                  lambda point: curve(study, point), run_variation, formats=number_formats(study),
                                  text=TEXT_COLUMNS), runner, quiet)

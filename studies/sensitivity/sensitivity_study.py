@@ -35,6 +35,7 @@ from pydantic import Field, model_validator
 
 from ...models.definition.scene import Scene
 from ..inputs.reading import InputError, parse, read_yaml
+from ..inputs.shipped import shipped_path
 from ..inputs.specs import MAX_NUM, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path
 from ..runtime.budgets import DEFAULT_BUDGET, Budget, base_estimate_s
 from ..runtime.point_runs import point_scene
@@ -206,7 +207,7 @@ def _problem(spec: GlobalAnalysis) -> dict[str, Any]:
 def load_sensitivity(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> SensitivityStudy:
     """Read, validate and expand a sensitivity file; InputError naming the file and key otherwise,
     BudgetError when its runs together are beyond ``budget``."""
-    path = Path(path)
+    path = Path(shipped_path(path, "sensitivity", "rpdrill.load_sensitivity"))
     spec = parse(SensitivitySpec, read_yaml(path), str(path))
     base = spec.base(path)
     for i, scan in enumerate(spec.scans):
