@@ -125,6 +125,28 @@ FREQUENCY_PATH = (
 )
 
 
+# One scene from `rpdrill.simulate` to its `rpdrill.Result`: the one run path (same form as FREQUENCY_PATH).
+SCENE_ROUTE = (
+    ("studies.api", "simulate", "the call's arguments checked; the scene given, or read from its file"),
+    ("studies.inputs.reading", "scene_and_source",
+     "a file, or a shipped scene by its name (`studies.inputs.shipped.shipped_path`), read strictly into a `Scene`"),
+    ("studies.inputs.reading", "prepare_scene",
+     ("prepared once (`models.solvers.simulation.prepare`): the chain, the rock law, the solver settings, the start; "
+     "a scene that cannot run as given refused naming its key")),
+    ("studies.runtime.budgets", "Budget.check_run", "its steps and memory estimated and held against the budget"),
+    ("models.runs.scene_run", "run",
+     ("the one path from a prepared scene to its result: the time run, or the steady state "
+     "`solver.steady_state: periodic` asks for (`models.steady.regimes.RegimeFinder`, its runs by the same "
+     "formulation)")),
+    ("models.solvers.time_run", "time_run",
+     ("the formulation's run (`models.solvers.dispatch.implementation`: exact, Exudyn or ODE), its samples and "
+     "a `SolverRecord` of what it did")),
+    ("models.evaluation.run_result", "Result",
+     ("the typed result: metrics (`models.evaluation.metrics.summary_metrics`, on first use), the time series as a "
+     "DataFrame, the `SteadyStateRecord`, the source and the code it ran")),
+)
+
+
 def defines(path: Path, name: str) -> bool:
     """Whether a module's file defines ``name`` at its top level (``Class.method`` inside the class)."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
@@ -136,24 +158,35 @@ def defines(path: Path, name: str) -> bool:
     return any(isinstance(node, ast.FunctionDef) and node.name == inner for node in getattr(found, "body", []))
 
 
-def frequency_path(root: Path = ROOT) -> list[str]:
-    """The page's section on :data:`FREQUENCY_PATH`; SystemExit naming a step the files no longer define."""
+def route_section(title: str, intro: str, route: tuple[tuple[str, str, str], ...], root: Path = ROOT) -> list[str]:
+    """A section following ``route`` (module, name defined there, what happens): a flowchart and its steps;
+    SystemExit naming a step the files no longer define."""
     files = package_files(root)
-    gone = [f"{module}.{name}" for module, name, _ in FREQUENCY_PATH
-            if module not in files or not defines(files[module], name)]
+    gone = [f"{module}.{name}" for module, name, _ in route if module not in files or not defines(files[module], name)]
     if gone:
-        raise SystemExit(f"docs/architecture_page.py: FREQUENCY_PATH names {', '.join(gone)}, which the files "
+        raise SystemExit(f"docs/architecture_page.py: the route '{title}' names {', '.join(gone)}, which the files "
                          "do not define")
-    lines = ["## The impact frequency from a study file to the solver", "",
-             ("One value followed through the layers (`studies/paper/frequency_scan.yaml`): it is a typed "
-             "value at every step, never written into a raw mapping and never read back from text but by the "
-             "table's one reader."), ""]
-    lines += ["```mermaid", "flowchart TD"]
-    lines += [f'    step{i}["{i}. {module}.{name}"]' + (f" --> step{i + 1}" if i < len(FREQUENCY_PATH) else "")
-              for i, (module, name, _) in enumerate(FREQUENCY_PATH, 1)]
+    lines = [f"## {title}", "", intro, "", "```mermaid", "flowchart TD"]
+    lines += [f'    step{i}["{i}. {module}.{name}"]' + (f" --> step{i + 1}" if i < len(route) else "")
+              for i, (module, name, _) in enumerate(route, 1)]
     lines += ["```", ""]
-    lines += [f"{i}. `{module}.{name}`: {text}." for i, (module, name, text) in enumerate(FREQUENCY_PATH, 1)]
+    lines += [f"{i}. `{module}.{name}`: {text}." for i, (module, name, text) in enumerate(route, 1)]
     return [*lines, ""]
+
+
+def frequency_path(root: Path = ROOT) -> list[str]:
+    """The page's sections on :data:`SCENE_ROUTE` and :data:`FREQUENCY_PATH`."""
+    scene = route_section(
+        "One scene from `rpdrill.simulate` to its result",
+        ("The route of one run (`rpdrill simulate` is the same call, then `save_result`): one way from a prepared "
+         "scene to a result whatever its `solver.steady_state`; the study's points take it from step 5 in their "
+         "workers (`studies.runtime.point_runs.run_prepared`)."), SCENE_ROUTE, root)
+    frequency = route_section(
+        "The impact frequency from a study file to the solver",
+        ("One value followed through the layers (`studies/paper/frequency_scan.yaml`): it is a typed "
+         "value at every step, never written into a raw mapping and never read back from text but by the "
+         "table's one reader."), FREQUENCY_PATH, root)
+    return [*scene, *frequency]
 
 
 def package_files(root: Path = ROOT) -> dict[str, Path]:

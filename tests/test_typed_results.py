@@ -73,8 +73,8 @@ def test_warnings_of_a_run_are_shown_and_kept():
 
 @pytest.mark.parametrize(("call", "given", "message"), [
     (rpdrill.run_study, {"workers": 0}, "rpdrill.run_study: workers: 0: must be a whole number of at least 1"),
-    (rpdrill.run_study, {"overwrite": True}, "rpdrill.run_study: overwrite: not an option of this call; its "
-                                             "options: workers, dask, out, budget, quiet"),
+    (rpdrill.run_study, {"overwrite": True}, ("rpdrill.run_study: overwrite: not an option of this call; its "
+                                             "options: workers, dask, out, budget, quiet")),
     (rpdrill.sensitivity, {"quiet": "no"}, "rpdrill.sensitivity: quiet: 'no': must be True or False"),
     (rpdrill.calibrate, {"budget": 3}, "rpdrill.calibrate: budget: 3: .*rpdrill.Budget"),
     (rpdrill.accuracy, {"options": {"workers": 2}}, "rpdrill.accuracy: options: .*rpdrill.RunOptions"),
