@@ -29,6 +29,8 @@ from typing import TYPE_CHECKING, Any
 # chooses Exudyn's build in its entry point, and a user's ``import exudyn`` gets the regular one.
 _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "InputError": ("models.definition.validation", "InputError"),
+         "extension": ("models.definition.own_code", "extension"),
+         "RockLaw": ("rocklaw.base", "RockLaw"),
          "Result": ("models.evaluation.run_result", "Result"),
          "SimulationFailed": ("models.evaluation.stability", "SimulationFailed"),
          "Advice": ("studies.advice.advice_run", "Advice"),
@@ -62,11 +64,13 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "RotationReport": ("studies.pages.rotation_note", "RotationReport")}
 
 if TYPE_CHECKING:  # the names as type checkers and editors see them
+    from .models.definition.own_code import extension
     from .models.definition.scene import Scene
     from .models.definition.validation import InputError
     from .models.evaluation.run_result import Result
     from .models.evaluation.stability import SimulationFailed
     from .models.solvers.exudyn_model import ExudynModel, build_exudyn
+    from .rocklaw.base import RockLaw
     from .studies.accuracy.accuracy_run import AccuracyResult, accuracy
     from .studies.advice.advice_run import Advice, AdviceSearch
     from .studies.advice.advice_run import advise_scene as advise
@@ -98,7 +102,7 @@ def __dir__() -> list[str]:
 
 
 __all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult", "Crosscheck",
-           "ExudynModel", "InputError", "ReproductionResult", "Result", "RotationReport", "Scene", "SensitivityResult",
-           "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck", "draw",
+           "ExudynModel", "InputError", "ReproductionResult", "Result", "RockLaw", "RotationReport", "Scene", "SensitivityResult",
+           "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck", "draw", "extension",
            "load_scene", "load_study", "reproduce", "rotation_report", "run_study", "save_result", "sensitivity",
            "simulate", "table_frame", "view_solution", "write_animation"]

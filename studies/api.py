@@ -16,11 +16,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..models.definition.formulations import FORMULATIONS
+from ..models.definition.own_code import blame
 from ..models.definition.scene import Scene
 from ..models.evaluation.run_result import Result
 from ..models.evaluation.run_status import run_status
+from ..models.evaluation.stability import SimulationFailed
 from ..models.solvers.cost import Cause
 from .inputs.arguments import (
+    allow_code_problem,
     boolean_problem,
     callable_problem,
     check,
@@ -95,7 +98,7 @@ def _animated(result: Result) -> Any:
 
 def simulate(scene: Scene | str | Path, formulation: str | None = None,
              progress: Callable[[float], None] | None = None, budget: Budget | None = DEFAULT_BUDGET,
-             solution_file: Path | None = None) -> Result:
+             solution_file: Path | None = None, allow_code: Sequence[str] | str = ()) -> Result:
     """Run a scene (or a scene file) with its formulation, or ``formulation`` (``exudyn``, ``exact``,
     ``ode``; the scene's options of another formulation dropped). InputError when it cannot run as
     given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
@@ -103,21 +106,28 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
     (for its SolutionViewer: studies.drawings.drill_animation.view_solution). Loads no figure module:
     the caller's matplotlib is left as it is. A scene with ``solver.steady_state: periodic`` gives its
-    steady state (models.steady.steady_run.run_scene)."""
+    steady state (models.steady.steady_run.run_scene). ``allow_code``: the modules of one's own the scene
+    may run (models.definition.own_code; a scene file's never come from the file)."""
     from ..models.steady.steady_run import run_scene
 
     check("rpdrill.simulate", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
     check("rpdrill.simulate", "progress", progress, callable_problem)
     check("rpdrill.simulate", "budget", budget, instance_problem(Budget, "a rpdrill Budget or None", optional=True))
     check("rpdrill.simulate", "solution_file", solution_file, optional(file_problem))
-    scene, source = scene_and_source(scene, "rpdrill.simulate")
+    scene, source = scene_and_source(scene, "rpdrill.simulate", allow_code)
     if formulation is not None:
         scene = scene.with_solver(formulation)
     simulation = prepare_scene(scene, source)
     if budget is not None:
         budget.check_run(simulation, source, resampled=Cause("solver.output_interval_s",
                                                               scene.solver.output_interval_s))
-    raw = run_scene(simulation, progress=progress, solution=None if solution_file is None else Path(solution_file))
+    try:
+        raw = run_scene(simulation, progress=progress, solution=None if solution_file is None else Path(solution_file))
+    except Exception as error:
+        why = blame(error, scene)  # the user's code raised it: a failed run, not rpdrill's error
+        if why is None or isinstance(error, (InputError, SimulationFailed)):
+            raise
+        raise SimulationFailed(f"scene '{scene.name}': {why}") from None
     return Result(scene, raw, {"source": source, **simulation.code_records()})
 
 
@@ -131,18 +141,23 @@ def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
 
 
 def run_study(study: Study | str | Path, workers: int | None = None, out: str | Path | None = None,
-              dask: str | None = None, quiet: bool = True) -> pd.DataFrame:
+              dask: str | None = None, quiet: bool = True, allow_code: Sequence[str] | str = ()) -> pd.DataFrame:
     """Run a study (or a study file) on ``workers`` processes (default all cores; 1: in this process) or
     a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (results.csv, study.json,
     optima.csv, plots; resumable as the command's) or, without ``out``, a scratch folder that is
-    removed after (no plots). The results table as a DataFrame, one row a point."""
+    removed after (no plots); ``allow_code``: the modules of one's own a study file's scenes may run
+    (models.definition.own_code). The results table as a DataFrame, one row a point."""
     from .runtime.pools import pool
 
     check("rpdrill.run_study", "study", study, either(file_problem, instance_problem(Study, "a rpdrill Study or a "
                                                                                     "study file's path")))
     check_run_options("rpdrill.run_study", workers, out, dask, quiet)
+    check("rpdrill.run_study", "allow_code", allow_code, allow_code_problem)
+    if isinstance(study, Study) and allow_code:
+        raise InputError("rpdrill.run_study: allow_code: a loaded Study's scenes may run what rpdrill.load_study "
+                         "allowed them; give allow_code to rpdrill.load_study")
     if not isinstance(study, Study):
-        study = load_study(study)
+        study = load_study(study, allow_code=allow_code)
     with tempfile.TemporaryDirectory(prefix="rpdrill-study-") as scratch:
         folder = study_folders([str(study.source)], str(out or scratch))[0]
         if out is None:  # a scratch folder keeps no plots

@@ -97,11 +97,11 @@ def _table(study: Study, out: Path, runner: tuple[str, Runner]) -> Table:
 
 def run_study_files(paths: Sequence[str | Path], out: str | Path, formulation: str | None = None,
                     budget: Budget = DEFAULT_BUDGET, workers: int | None = None, dask: str | None = None,
-                    quiet: bool = True) -> list[StudyRun]:
+                    quiet: bool = True, allow_code: Sequence[str] | str = ()) -> list[StudyRun]:
     """Read the study files (InputError or BudgetError before anything runs), then run them into ``out``
     (one study) or ``out``/<file stem> (several) on a pool of ``workers`` processes (1: in this process)
     or Dask (``dask``: an address, or "" for a LocalCluster)."""
     folders = study_folders([str(path) for path in paths], str(out))
-    studies = [load_study(path, formulation, budget) for path in paths]
+    studies = [load_study(path, formulation, budget, allow_code) for path in paths]
     with pool(dask, workers) as runner:
         return run_studies(studies, folders, runner, dask is not None, quiet)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -19,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from ...models.evaluation.workprecision import Signature
 from ..figures.workprecision_figure import plot_workprecision
 from ..inputs.arguments import (
+    allow_code_problem,
     check,
     check_run_options,
     either,
@@ -91,18 +93,21 @@ def _reference(study: AccuracyStudy, setting: Setting | None, what: str, cpu: di
 
 
 def accuracy(study: AccuracyStudy | str | Path, workers: int | None = None, out: str | Path | None = None,
-             dask: str | None = None, budget: Budget = DEFAULT_BUDGET, quiet: bool = True) -> AccuracyResult:
+             dask: str | None = None, budget: Budget = DEFAULT_BUDGET, quiet: bool = True,
+             allow_code: Sequence[str] | str = ()) -> AccuracyResult:
     """Run a work-precision study (or file) on ``workers`` processes (default all cores; 1: in this process)
     or a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (resumable: module doc) or a
     scratch folder. InputError or BudgetError before anything runs, ReferenceFailed when a reference
-    run fails; ``quiet``: no progress bar."""
+    run fails; ``quiet``: no progress bar; ``allow_code``: the modules of one's own its scene may run
+    (models.definition.own_code)."""
     check(WHERE, "study", study,
           either(file_problem, instance_problem(AccuracyStudy, "a work-precision study file's path or its loaded study")))
     check_run_options(WHERE, workers, out, dask, quiet)
     check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
+    check(WHERE, "allow_code", allow_code, allow_code_problem)
     folder = None if out is None else check_out(out, None, RECORD)
     if not isinstance(study, AccuracyStudy):
-        study = load_accuracy_study(study, budget)
+        study = load_accuracy_study(study, budget, allow_code)
     wall: dict[str, float] = {}
     reference = _reference(study, study.reference, "reference", wall)
     second = _reference(study, study.reference_check, "reference check", wall)

@@ -13,6 +13,7 @@ import contextlib
 import shutil
 import sys
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -21,6 +22,7 @@ from tqdm import tqdm
 
 from ...models.definition.scene import Scene
 from ..inputs.arguments import (
+    allow_code_problem,
     boolean_problem,
     check,
     check_run_options,
@@ -71,20 +73,23 @@ class CalibrationResult:
 
 def calibrate(calibration: Calibration | str | Path, workers: int | None = None, out: str | Path | None = None,
               dask: str | None = None, budget: Budget = DEFAULT_BUDGET, overwrite: bool = False,
-              quiet: bool = True) -> CalibrationResult:
+              quiet: bool = True, allow_code: Sequence[str] | str = ()) -> CalibrationResult:
     """Fit a calibration file's parameters (module doc) on ``workers`` processes (default all cores; 1: in
     this process) or a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (resumable; a
     folder holding anything else, or another calibration, is refused unless ``overwrite``, which starts
     afresh there) or a scratch folder. InputError or BudgetError before anything runs; ``quiet``: no
-    progress bar. An ``out`` that was new is removed again when no evaluation has a best (nothing to keep)."""
+    progress bar. An ``out`` that was new is removed again when no evaluation has a best (nothing to keep).
+    ``allow_code``: the modules of one's own its scenes may run (models.definition.own_code), never read from
+    the file."""
     check(WHERE, "calibration", calibration,
           either(file_problem, instance_problem(Calibration, "a calibration file's path or its loaded Calibration")))
     check_run_options(WHERE, workers, out, dask, quiet)
     check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
     check(WHERE, "overwrite", overwrite, boolean_problem)
+    check(WHERE, "allow_code", allow_code, allow_code_problem)
     folder = None if out is None else check_out(out, overwrite, CHECKPOINT)
     if not isinstance(calibration, Calibration):
-        calibration = load_calibration(calibration, budget)
+        calibration = load_calibration(calibration, budget, allow_code)
     spec = calibration.spec
     with tempfile.TemporaryDirectory(prefix="rpdrill-calibration-") as scratch:
         target = folder or Path(scratch) / "calibration"

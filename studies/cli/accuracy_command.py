@@ -34,7 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        result = accuracy(args.study, args.workers, args.out, args.dask, budget(args), args.quiet)
+        result = accuracy(args.study, args.workers, args.out, args.dask, budget(args), args.quiet, args.allow_code)
     except ReferenceFailed as error:
         print(error, file=sys.stderr)
         return 1

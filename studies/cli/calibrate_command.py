@@ -28,7 +28,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    result = calibrate(args.calibration, args.workers, args.out, args.dask, budget(args), args.overwrite, args.quiet)
+    result = calibrate(args.calibration, args.workers, args.out, args.dask, budget(args), args.overwrite, args.quiet,
+                       args.allow_code)
     if result.best is None:
         which = f"targets {', '.join(result.failed_targets)}: every run" if result.failed_targets else "every simulation"
         print(f"{args.calibration}: {which} of all {len(result.records)} evaluations failed; first error: "

@@ -65,7 +65,7 @@ def report(run: StudyRun) -> None:
 
 def run(args: argparse.Namespace) -> int:
     runs = run_study_files(args.study, args.out, formulation=args.formulation, budget=budget(args),
-                           workers=args.workers, dask=args.dask, quiet=args.quiet)
+                           workers=args.workers, dask=args.dask, quiet=args.quiet, allow_code=args.allow_code)
     for study_run in runs:
         report(study_run)
     useless = [study_run.study.source for study_run in runs if not study_run.table["status"].isin(USABLE).any()]

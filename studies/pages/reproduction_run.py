@@ -18,6 +18,7 @@ import importlib.metadata
 import shlex
 import shutil
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,7 @@ from typing import Any
 from ..calibration.calibration_spec import load_calibration
 from ..figures.paper_figures import draw_figure
 from ..inputs.arguments import (
+    allow_code_problem,
     boolean_problem,
     check,
     dask_problem,
@@ -120,12 +122,13 @@ def made_by(file: Path, reproduction: Reproduction, out: Path | None, calibratio
 
 def reproduce(reproduction: str | Path = DEFAULT, out: str | Path | None = None, calibration: str | Path | None = None,
               sensitivity: str | Path | None = None, docs: str | Path | None = None, workers: int | None = None,
-              dask: str | None = None, overwrite: bool = False) -> ReproductionResult:
+              dask: str | None = None, overwrite: bool = False, allow_code: Sequence[str] | str = ()) -> ReproductionResult:
     """Reproduce the paper (module doc) on ``workers`` processes (default all cores; 1: in this process) or
     a Dask cluster (``dask``: an address, "" a LocalCluster); ``calibration``, ``sensitivity``: the
     ``--out`` folders of ``rpdrill calibrate`` and ``rpdrill sensitivity`` for parameters.md and
     sensitivity.md. ``out`` must be new, empty or an earlier reproduction's (``overwrite``: any folder).
-    InputError before anything runs."""
+    InputError before anything runs. ``allow_code``: the modules of one's own its scenes may run
+    (models.definition.own_code)."""
     where = "rpdrill.reproduce"
     check(where, "reproduction", reproduction, file_problem)
     for name, value in (("out", out), ("calibration", calibration), ("sensitivity", sensitivity), ("docs", docs)):
@@ -133,6 +136,7 @@ def reproduce(reproduction: str | Path = DEFAULT, out: str | Path | None = None,
     check(where, "workers", workers, optional(workers_problem))
     check(where, "dask", dask, dask_problem)
     check(where, "overwrite", overwrite, boolean_problem)
+    check(where, "allow_code", allow_code, allow_code_problem)
     file = Path(reproduction)
     folder = None if out is None else check_out(out, overwrite, "reproduction.json")
     docs_folder = None if docs is None else check_out(docs, True, option="--docs")
@@ -141,10 +145,10 @@ def reproduce(reproduction: str | Path = DEFAULT, out: str | Path | None = None,
     for option, command in (("calibration", "calibrate"), ("sensitivity", "sensitivity")):
         if runs[option] is not None and not runs[option].is_dir():
             raise InputError(f"--{option}: {runs[option]}: not a folder; give the --out of `rpdrill {command}`")
-    loaded = load_reproduction(file)
+    loaded = load_reproduction(file, allow_code)
     # only the calibration's bounds and reasons are read (its search is not run): no limit on its CPU estimate
     calibration_file = None if loaded.calibration_file is None else \
-        load_calibration(loaded.calibration_file, Budget(accept_long=True))
+        load_calibration(loaded.calibration_file, Budget(accept_long=True), allow_code)
     with pool(dask, workers) as (label, runner):
         print(f"{loaded.spec.name}: {len(loaded.spec.cases)} cases x {len(loaded.frequencies_hz)} "
               f"frequencies on {label}", file=sys.stderr)

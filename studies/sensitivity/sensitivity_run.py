@@ -10,12 +10,14 @@ and SVG); without ``out`` the table lives in a scratch folder removed after, and
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..figures.tornado_figures import draw_tornados
 from ..inputs.arguments import (
+    allow_code_problem,
     check,
     check_run_options,
     either,
@@ -72,17 +74,20 @@ class SensitivityResult:
 
 
 def sensitivity(study: SensitivityStudy | str | Path, workers: int | None = None, out: str | Path | None = None,
-                dask: str | None = None, budget: Budget = DEFAULT_BUDGET, quiet: bool = True) -> SensitivityResult:
+                dask: str | None = None, budget: Budget = DEFAULT_BUDGET, quiet: bool = True,
+                allow_code: Sequence[str] | str = ()) -> SensitivityResult:
     """Run a sensitivity study (or file) on ``workers`` processes (default all cores; 1: in this process) or
     a Dask cluster (``dask``: an address, "" a LocalCluster), into ``out`` (resumable: module doc) or a
-    scratch folder. InputError or BudgetError before anything runs; ``quiet``: no progress bar."""
+    scratch folder. InputError or BudgetError before anything runs; ``quiet``: no progress bar; ``allow_code``:
+    the modules of one's own its scenes may run (models.definition.own_code)."""
     check(WHERE, "study", study,
           either(file_problem, instance_problem(SensitivityStudy, "a sensitivity file's path or its loaded study")))
     check_run_options(WHERE, workers, out, dask, quiet)
     check(WHERE, "budget", budget, instance_problem(Budget, "a rpdrill.Budget"))
+    check(WHERE, "allow_code", allow_code, allow_code_problem)
     folder = None if out is None else check_out(out, None, RECORD)
     if not isinstance(study, SensitivityStudy):
-        study = load_sensitivity(study, budget)
+        study = load_sensitivity(study, budget, allow_code)
     with tempfile.TemporaryDirectory(prefix="rpdrill-sensitivity-") as scratch, pool(dask, workers) as runner:
         table = run_points(Table(study, folder or Path(scratch), "results.csv", columns(study),
                                  lambda point: curve(study, point), run_variation, formats=number_formats(study),
