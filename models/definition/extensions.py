@@ -68,8 +68,12 @@ def record(path: str, found: Found | None = None) -> dict[str, str]:
     version; ``file`` where the module was loaded from; the entry point it is registered as (``found``)."""
     module = sys.modules.get(path.partition(":")[0])
     where = {"file": str(module.__file__)} if module is not None and getattr(module, "__file__", None) else {}
-    registered = {"entry_point": found.entry_point} if found is not None and found.entry_point else {}
-    return {"import_path": path, **package_version(path), **where, **registered}
+    package = package_version(path)
+    registered = {}
+    if found is not None and found.entry_point:
+        registered = {"entry_point": found.entry_point}
+        package = {"package": found.package, "version": found.version} if found.package else package
+    return {"import_path": path, **package, **where, **registered}
 
 
 STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, arbitrary_types_allowed=True)

@@ -112,12 +112,13 @@ def refusal(module: str, kind: Kind) -> str:
 @dataclass(frozen=True)
 class Found:
     """What a scene's name resolved to: the object, its import path, and the entry point it is registered
-    as (``group:name``) with the distribution that registers it, if it is registered."""
+    as (``group:name``) with the package (distribution) and version that register it, if it is registered."""
 
     target: Any
     import_path: str
     entry_point: str | None = None
-    distribution: str | None = None
+    package: str | None = None
+    version: str | None = None
 
 
 def resolve(name: str, kind: Kind, allowed: Sequence[str]) -> Found:
@@ -175,7 +176,7 @@ def _registered(name: str, kind: Kind) -> Found:
                          f"named {name!r} (entry point group {kind.group!r}: {names}); code of one's own is named "
                          f"'package.module:{kind.names}' and its module allowed for the run ({SECURITY})")
     if len(chosen) > 1:
-        raise ValueError(f"{name!r} is registered more than once in entry point group {kind.group!r}: "
+        raise ValueError(f"registered more than once in entry point group {kind.group!r}: "
                          + ", ".join(f"{value} ({_distribution(point)})" for value, point in sorted(chosen.items()))
                          + "; uninstall one of the packages")
     point = next(iter(chosen.values()))
@@ -185,7 +186,8 @@ def _registered(name: str, kind: Kind) -> Found:
     except (Exception, SystemExit) as error:  # noqa: BLE001 - the package's module, the user's code
         raise ValueError(f"entry point {point.value!r} ({_distribution(point)}) does not load: "
                          f"{failure(error, point.module)}") from None
-    return Found(target, point.value, f"{kind.group}:{name}", _distribution(point))
+    dist = getattr(point, "dist", None)
+    return Found(target, point.value, f"{kind.group}:{name}", *((dist.name, dist.version) if dist else ()))
 
 
 def _distribution(point: Any) -> str:

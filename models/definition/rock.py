@@ -23,7 +23,7 @@ from ...rocklaw import BilinearRock, JenkinsRock, RockLaw
 from ...rocklaw.base import is_rock_law_class, missing_members
 from ...rocklaw.catalog import TABLE_1
 from .drill_string import NonNegative, Positive, Strict, _key_error, _problem
-from .extensions import check_parameters
+from .extensions import check_parameters, record
 from .own_code import IMPORT_PATH, REGISTERED_NAME, ROCK_LAW, Found, allowance, failure, resolve
 
 JENKINS_VALUES = ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n")
@@ -90,6 +90,11 @@ class Rock(Strict):
         (models.definition.own_code.resolve); ValueError where it may not run or does not resolve."""
         return resolve(self.law, ROCK_LAW, self._allowed)
 
+    def code_record(self) -> dict[str, str]:
+        """What a run records of a law of one's own (models.definition.extensions.record)."""
+        found = self.found
+        return record(found.import_path, found)
+
     @model_validator(mode="after")
     def _complete(self, info: ValidationInfo) -> Rock:
         self._allowed = allowance(info)
@@ -125,9 +130,10 @@ class Rock(Strict):
         except ValueError as error:
             raise _key_error("Rock", ("law",), self.law, "{why}", why=str(error)) from None
         if not is_rock_law_class(found.target):
-            kind = "a class" if isinstance(found.target, type) else f"a {type(found.target).__name__}, not a class"
-            raise _key_error("Rock", ("law",), self.law, "{kind} that does not subclass rocklaw.base.RockLaw: a scene's "
-                             "rock law is a class written as one, class MyLaw(RockLaw) (docs/extending.md)", kind=kind)
+            kind = "a class that does not subclass rocklaw.base.RockLaw" if isinstance(found.target, type) else \
+                f"a {type(found.target).__name__}, not a class"
+            raise _key_error("Rock", ("law",), self.law, "{kind}: a scene's rock law is a class written as one, "
+                             "class MyLaw(RockLaw), and nothing else is constructed (docs/extending.md)", kind=kind)
         given = [key for keys in ROCK_LAW_KEYS.values() for key in keys if getattr(self, key) is not None]
         if given:
             raise _key_error("Rock", (given[0],), getattr(self, given[0]), "a key of the built-in laws; the keys of a "
@@ -141,7 +147,7 @@ class Rock(Strict):
             raise _key_error("Rock", ("parameters",), self.parameters, "{law} refuses these parameters: {why}",
                              law=self.law, why=failure(error, module)) from None
         except (Exception, SystemExit) as error:  # noqa: BLE001 - the user's constructor: its error is the user's
-            raise _key_error("Rock", ("law",), self.law, "the law's constructor raised {why}",
+            raise _key_error("Rock", ("law",), self.law, "the law's constructor failed: {why}",
                              why=failure(error, module)) from None
         missing = missing_members(law)
         if missing:
