@@ -102,12 +102,13 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     """Run a scene (or a scene file) with its formulation, or ``formulation`` (``exudyn``, ``exact``,
     ``ode``; the scene's options of another formulation dropped). InputError when it cannot run as
     given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
-    it starts; models.evaluation.stability.SimulationFailed when the run diverges. ``solution_file``:
+    it starts; ``allow_code``: the modules of one's own the scene may run (models.definition.own_code; never
+    a scene file's own); models.evaluation.stability.SimulationFailed when the run diverges (or the user's
+    code fails in it). ``solution_file``:
     with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
     (for its SolutionViewer: studies.drawings.drill_animation.view_solution). Loads no figure module:
     the caller's matplotlib is left as it is. A scene with ``solver.steady_state: periodic`` gives its
-    steady state (models.steady.steady_run.run_scene). ``allow_code``: the modules of one's own the scene
-    may run (models.definition.own_code; a scene file's never come from the file)."""
+    steady state (models.steady.steady_run.run_scene)."""
     from ..models.steady.steady_run import run_scene
 
     check("rpdrill.simulate", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))

@@ -13,14 +13,7 @@ from ...models.definition.formulations import ODE_METHODS
 from ...models.definition.scene import Scene
 from ...models.evaluation.compare import compare_runs, verdict
 from ...models.evaluation.run_result import Result
-from ..inputs.arguments import (
-    allow_code_problem,
-    check,
-    choice_problem,
-    count_problem,
-    instance_problem,
-    positive_problem,
-)
+from ..inputs.arguments import check, choice_problem, count_problem, instance_problem, positive_problem
 from ..inputs.reading import prepare_scene, scene_and_source
 from ..runtime.budgets import DEFAULT_BUDGET, Budget
 from .crosscheck_windows import DEFAULT_STEP_S, comparison_table, window_scenes
@@ -50,7 +43,8 @@ class Crosscheck:
 
 
 def crosscheck(scene: Scene | str | Path, blows: int = 20, step_s: float = DEFAULT_STEP_S, method: str = "DOP853",
-               rtol: float = 1e-10, budget: Budget | None = DEFAULT_BUDGET, allow_code: Sequence[str] | str = ()) -> Crosscheck:
+               rtol: float = 1e-10, budget: Budget | None = DEFAULT_BUDGET,
+               allow_code: Sequence[str] | str = ()) -> Crosscheck:
     """The Exudyn model (the scene's solver type at ``step_s``) against the ODE (``method`` at relative
     tolerance ``rtol``) over the first ``blows`` impact periods. InputError or BudgetError before
     anything runs; SimulationFailed when a run diverges. ``allow_code``: the modules of one's own the scene may
@@ -61,8 +55,7 @@ def crosscheck(scene: Scene | str | Path, blows: int = 20, step_s: float = DEFAU
     check(where, "method", method, choice_problem(ODE_METHODS, "method"))
     check(where, "rtol", rtol, positive_problem)
     check(where, "budget", budget, instance_problem(Budget, "a rpdrill Budget or None", optional=True))
-    check(where, "allow_code", allow_code, allow_code_problem)
-    scene, source = scene_and_source(scene, where, allow_code)
+    scene, source = scene_and_source(scene, where, allow_code)  # (allow_code checked there)
     windows = window_scenes(scene, blows, step_s, method, rtol, source)
     simulations = [prepare_scene(window, source) for window in windows]
     if budget is not None:

@@ -19,7 +19,6 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ...models.definition.own_code import blame
 from ...models.definition.scene import Scene
 from ...models.definition.validation import short
 from ...models.evaluation.metrics import summary_metrics
@@ -95,8 +94,7 @@ def run_prepared(simulation: Simulation, guess: OrbitGuess | None = None, cold_n
         metrics = summary_metrics(result)
         status, why = run_status(result, metrics)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the analysis goes on
-        why = blame(err, simulation.scene) or f"{type(err).__name__}: {err}"  # (the user's code's error: whose)
-        return {"status": "failed", "error": why, **regime_columns(None),
+        return {"status": "failed", "error": f"{type(err).__name__}: {err}", **regime_columns(None),
                 "steady_state": simulation.scene.solver.steady_state, "wall_time_s": time.perf_counter() - start}, None
     if result.info.get("steady_state_note") and status == "ok":
         why = result.info["steady_state_note"]
