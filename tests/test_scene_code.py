@@ -29,7 +29,7 @@ from rpdrill.models.solvers.simulation import prepare
 
 ROOT = Path(__file__).resolve().parents[1]
 SHORT = {"solver.end_time_s": 0.08, "metrics.transient_blows": 1, "metrics.block_blows": 3}
-MODULES = ("my_rig", "my_rigx", "rig_pkg", "canary", "rigdist_mod")
+MODULES = ("my_rig", "my_rigx", "rig_pkg", "canary", "rigdist_mod", "needs_dep", "missing_rig", "broken")
 JENKINS = {"stiffness_n_per_m": 5.0e8, "damping_n_s_per_m": 1.98e3, "threshold_n": 138.0e3}
 
 # The rig of the tests' user: marked extensions (a counted one, a clamp, ones that fail in every way the
@@ -43,7 +43,7 @@ from typing import ClassVar
 from exudyn.itemInterface import MarkerNodeCoordinate, Node1D, ObjectConnectorCoordinateSpringDamper, ObjectMass1D
 
 import rpdrill
-from rpdrill.rocklaw import JenkinsRock
+from rpdrill.rocklaw import JenkinsRock, RockLaw
 
 CALLS = os.path.join(os.path.dirname(__file__), "calls.txt")
 
@@ -99,6 +99,21 @@ def typo(model):
     model.bodies["colar"]  # TYPO
 
 
+@rpdrill.extension
+def no_model(*, mass_kg: float = 1.0):
+    pass
+
+
+class Unspeakable(Exception):
+    def __str__(self):
+        raise RuntimeError("no words")
+
+
+@rpdrill.extension
+def unspeakable(model):
+    raise Unspeakable()  # UNSPEAKABLE
+
+
 def not_marked(model):
     open(CALLS, "a").write("called\\n")
 
@@ -110,6 +125,10 @@ def make_law(**parameters):
 class Plain:
     def __init__(self, **parameters):
         open(CALLS, "a").write("constructed\\n")
+
+
+class Empty(RockLaw):
+    pass
 
 
 @dataclass(frozen=True)
@@ -287,6 +306,8 @@ def test_the_allowance_travels_with_the_scene_and_never_comes_from_its_file(code
     assert plain.with_(extension("my_rig:clamp"), allow_code=["my_rig"]).allowed_code == ("my_rig",)
     with pytest.raises(rpdrill.InputError, match=r"rpdrill.load_scene: allow_code: 5: give module names"):
         rpdrill.load_scene(path, allow_code=5)
+    with pytest.raises(rpdrill.InputError, match="module 'my_rig' is code of one's own"):
+        rpdrill.load_scene(path, allow_code=None)  # None allows nothing
     with pytest.raises(rpdrill.InputError, match="rpdrill.simulate: allow_code: 'my_rig:clamp': not a module name"):
         rpdrill.simulate(path, allow_code=["my_rig:clamp"])
 
@@ -495,6 +516,18 @@ def test_a_studys_points_an_extension_refuses_fail_and_the_others_run(code, tmp_
     ({"rock": {"law": "rate dependent"}}, [], 2, ["'rate dependent' is not a built-in law"]),
     ({"rock": {"law": "my_law", "parameters": {}}}, [], 2, ["no installed package registers a rock law named 'my_law'"]),
     ({"rock": {"law": "my_rig:RaisingLaw", "parameters": JENKINS}}, [], 2, ["module 'my_rig' is code of one's own"]),
+    ({"rock": {"law": "my_rig:Empty", "parameters": {}}}, ["my_rig"], 2, [
+        "not a rock law: it lacks name, state_names, bottom_index, crushes"]),
+    (extension("my_rig:no_model"), ["my_rig"], 2, [("'my_rig:no_model': takes no model: an extension is called as "
+                                                   "f(model, **parameters)")]),
+    (extension("missing_rig:clamp"), ["missing_rig"], 2, [("cannot import module 'missing_rig' (No module named "
+                                                          "'missing_rig')")]),
+    (extension("needs_dep:clamp"), ["needs_dep"], 2, [("module 'needs_dep' failed to import: ModuleNotFoundError: No "
+                                                      "module named 'not_installed_dep'"), "needs_dep.py, line 1"]),
+    (extension("my_rig:unspeakable"), ["my_rig"], 1, [("extensions.rig (my_rig:unspeakable) failed on the built model: "
+                                                      "Unspeakable ("), "my_rig.py, line"]),
+    (extension("this"), [], 2, ["no installed package registers an extension named 'this'"]),  # nothing imported
+    (extension("__import__('os').system"), [], 2, ["not a registered extension's name nor an import path"]),
 ])
 def test_misuse_of_code_of_ones_own_is_refused_or_fails_cleanly(code, tmp_path, capsys, changes, allow, status, words):
     code()
@@ -502,12 +535,14 @@ def test_misuse_of_code_of_ones_own_is_refused_or_fails_cleanly(code, tmp_path, 
     package.mkdir()
     (package / "__init__.py").write_text("", encoding="utf-8")
     (package / "sub.py").write_text("from my_rig import clamp\n", encoding="utf-8")
+    code("needs_dep", "import not_installed_dep\n")
     scene = scene_file(tmp_path / "scene.yaml", **changes)
     options = [option for module in allow for option in ("--allow-code", module)]
     got, message = run(capsys, "simulate", scene, "--out", tmp_path / "out", "--quiet", *options)
     assert got == status and clean(message), message
     assert all(word in message for word in words), message
     assert not (tmp_path / "code" / "calls.txt").exists()  # nothing unmarked called, nothing unchecked constructed
+    assert "this" not in sys.modules
 
 
 @pytest.mark.parametrize(("argv", "words"), [

@@ -158,6 +158,9 @@ class Extension(Strict):
             raise _key_error("Extension", ("function",), self.function, "{kind}, not marked as an rpdrill extension: "
                              "rpdrill calls only a function made to be one, marked with the decorator "
                              "@rpdrill.extension (docs/extending.md, \"Security\")", kind=kind)
+        if not _takes_a_model(target):
+            raise _key_error("Extension", ("function",), self.function, "takes no model: an extension is called as "
+                             "f(model, **parameters), the built model its first argument")
         check_parameters(target, self.parameters, ("parameters",), "Extension", skip=1, path=self.function)
         return self
 
@@ -181,6 +184,17 @@ class Extension(Strict):
     def apply(self, model: Any) -> None:
         """Call the extension on a built model."""
         self.target(model, **self.parameters)
+
+
+def _takes_a_model(target: Callable[..., Any]) -> bool:
+    """Whether ``target`` takes a first positional argument (the model)."""
+    try:
+        parameters = list(inspect.signature(target).parameters.values())
+    except (TypeError, ValueError):  # no signature to read: called as it is
+        return True
+    return bool(parameters) and parameters[0].kind in (inspect.Parameter.POSITIONAL_ONLY,
+                                                       inspect.Parameter.POSITIONAL_OR_KEYWORD,
+                                                       inspect.Parameter.VAR_POSITIONAL)
 
 
 def refusal(extensions: Mapping[str, Extension] | None, formulation: str) -> tuple[str, str] | None:

@@ -69,10 +69,10 @@ def module_name_problem(value: Any) -> str | None:
 
 
 def allowed_modules(value: Any) -> tuple[str, ...]:
-    """The modules of an allowance as given (one name, or a list or tuple of names), sorted, each once;
-    ValueError saying what is wrong otherwise."""
-    names = [value] if isinstance(value, str) else list(value) if isinstance(value, (list, tuple, set, frozenset)) \
-        else None
+    """The modules of an allowance as given (one name, or a list or tuple of names; None: none), sorted, each
+    once; ValueError saying what is wrong otherwise."""
+    names = [] if value is None else [value] if isinstance(value, str) else \
+        list(value) if isinstance(value, (list, tuple, set, frozenset)) else None
     if names is None:
         raise ValueError(f"{value!r}: give module names, e.g. ('my_rig',)")
     for name in names:
@@ -256,7 +256,11 @@ def failure(error: BaseException, module_name: str) -> str:
         text = f"SyntaxError: {error.msg}"
     else:  # (a KeyError of a name a model lacks says so as KeyError: models.solvers.exudyn_messages)
         kind = "KeyError" if isinstance(error, KeyError) else type(error).__name__
-        text = f"{kind}: {error}" if str(error) else kind
+        try:
+            said = str(error)
+        except Exception:  # noqa: BLE001 - the user's exception's own text fails: its type says what it is
+            said = ""
+        text = f"{kind}: {said}" if said else kind
     where = user_line(error, module_name)
     return f"{text} ({where})" if where else text
 
