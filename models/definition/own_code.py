@@ -268,11 +268,16 @@ def failure(error: BaseException, module_name: str) -> str:
 def named_code(scene: Any) -> dict[str, tuple[str, str]]:
     """The code of one's own a validated scene names: key (``extensions.NAME``, ``rock.law``) -> (its name in
     the scene, its module)."""
-    named = {f"extensions.{name}": (extension.function, extension.found.import_path.partition(":")[0])
-             for name, extension in (scene.extensions or {}).items()}
+    named = {f"extensions.{name}": (extension.function, extension) for name, extension in (scene.extensions or {}).items()}
     if scene.rock.own_law:
-        named["rock.law"] = (scene.rock.law, scene.rock.found.import_path.partition(":")[0])
-    return named
+        named["rock.law"] = (scene.rock.law, scene.rock)
+    modules = {}
+    for key, (name, holder) in named.items():
+        try:
+            modules[key] = (name, holder.found.import_path.partition(":")[0])
+        except ValueError:  # (no longer resolves here: nothing of it ran)
+            continue
+    return modules
 
 
 def blame(error: BaseException, scene: Any) -> str | None:
