@@ -82,5 +82,5 @@ def run(args: argparse.Namespace) -> int:
     print(f"{result.scene.name} ({result.formulation}{regime}): {shown or 'no metrics asked for'}; wrote {args.out}")
     if solution is not None:
         print(f"Exudyn's viewer: python -c \"from rpdrill.studies.drawings.drill_animation import view_solution; "
-              f"view_solution('{args.out}')\"")
+              f"view_solution('{args.out}'{f', allow_code={args.allow_code!r}' if args.allow_code else ''})\"")
     return 0
