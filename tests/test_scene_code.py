@@ -490,6 +490,13 @@ def test_a_studys_points_an_extension_refuses_fail_and_the_others_run(code, tmp_
     assert rows[100.0]["status"] == rows[300.0]["status"] == "ok" and rows[900.0]["status"] == "failed"
     assert "extensions.rig (my_rig:refuses_heavy) failed on the built model: ValueError: a clamp of 900.0 kg does not " \
            f"fit ({rig}, line {line_of(RIG, 'REFUSES')})" in rows[900.0]["error"]
+    data["base_overrides"] = {**SHORT, "solver.step_s": None, "solver.type": None, **extension("my_rig:typo")}
+    data["scan"] = {"impact.frequency_hz": [50.0, 60.0]}  # every point fails, planned with the standard step
+    (tmp_path / "all.yaml").write_text(yaml.safe_dump(data), encoding="utf-8")
+    table = rpdrill.run_study(rpdrill.load_study(tmp_path / "all.yaml", allow_code=["my_rig"]), workers=1)
+    assert (table["status"] == "failed").all()
+    assert table["error"].str.contains("extensions.rig (my_rig:typo) failed on the built model: KeyError: the built "
+                                       "model has no body 'colar'", regex=False).all()
 
 
 # --- Misuse of the same kinds, with other numbers and files ---------------------------------------------------
