@@ -344,7 +344,7 @@ def test_code_registered_by_an_entry_point_runs_by_its_name_without_an_allowance
     code()
     monkeypatch.setattr(importlib.metadata, "entry_points", entry_points({
         "rpdrill.extensions": [("clamp", "my_rig:clamp"), ("unmarked", "my_rig:not_marked"), ("twice", "my_rig:clamp"),
-                               ("twice", "my_rig:typo")],
+                               ("twice", "my_rig:typo"), ("gone", "gone_rig:clamp"), ("lost", "my_rig:lost")],
         "rpdrill.rock_laws": [("raising", "my_rig:RaisingLaw"), ("plain", "my_rig:Plain")]}))
     scene = rpdrill.load_scene(scene_file(tmp_path / "scene.yaml", **extension("clamp", mass_kg=200.0)))
     assert scene.allowed_code == () and scene.extensions["rig"].found.entry_point == "rpdrill.extensions:clamp"
@@ -353,8 +353,10 @@ def test_code_registered_by_an_entry_point_runs_by_its_name_without_an_allowance
             ("unmarked", "'unmarked': function, not marked as an rpdrill extension"),
             ("twice", ("'twice': registered more than once in entry point group 'rpdrill.extensions': my_rig:clamp "
                       r"\(an entry point\), my_rig:typo")),
+            ("gone", "'gone': entry point 'gone_rig:clamp' \\(an entry point\\): cannot import module 'gone_rig'"),
+            ("lost", "'lost': entry point 'my_rig:lost' \\(an entry point\\) does not load: AttributeError"),
             ("crank", ("'crank': no installed package registers an extension named 'crank' \\(entry point group "
-                      "'rpdrill.extensions': clamp, twice, unmarked\\)"))):
+                      "'rpdrill.extensions': clamp, gone, lost, twice, unmarked\\)"))):
         with pytest.raises(rpdrill.InputError, match=f"extensions.rig.function: {message}"):
             scene.with_(extension(function))
     with pytest.raises(rpdrill.InputError, match="rock.law: 'raising': the law's constructor failed: RuntimeError"):

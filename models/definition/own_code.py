@@ -180,12 +180,15 @@ def _registered(name: str, kind: Kind) -> Found:
                          + ", ".join(f"{value} ({_distribution(point)})" for value, point in sorted(chosen.items()))
                          + "; uninstall one of the packages")
     point = next(iter(chosen.values()))
-    import_own_module(point.module)
+    where = f"entry point {point.value!r} ({_distribution(point)})"
+    try:
+        import_own_module(point.module)
+    except ValueError as error:
+        raise ValueError(f"{where}: {error}") from None
     try:
         target = point.load()
     except (Exception, SystemExit) as error:  # noqa: BLE001 - the package's module, the user's code
-        raise ValueError(f"entry point {point.value!r} ({_distribution(point)}) does not load: "
-                         f"{failure(error, point.module)}") from None
+        raise ValueError(f"{where} does not load: {failure(error, point.module)}") from None
     dist = getattr(point, "dist", None)
     return Found(target, point.value, f"{kind.group}:{name}", *((dist.name, dist.version) if dist else ()))
 
