@@ -109,6 +109,11 @@ def refusal(module: str, kind: Kind) -> str:
             f"{kind.group!r} and name it by its registered name ({SECURITY})")
 
 
+# the modules of one's own this process resolved, and what named them: where an error that escaped a run came
+# from (:func:`blame_resolved`, the command line's last resort)
+RESOLVED: dict[str, str] = {}
+
+
 @dataclass(frozen=True)
 class Found:
     """What a scene's name resolved to: the object, its import path, and the entry point it is registered
@@ -138,6 +143,7 @@ def resolve(name: str, kind: Kind, allowed: Sequence[str]) -> Found:
         if not hasattr(target, part):
             raise ValueError(f"module {module_name!r} has no {attribute!r}")
         target = getattr(target, part)
+    RESOLVED[module_name] = f"{kind.what} {name}"
     return Found(target, name)
 
 
@@ -190,6 +196,7 @@ def _registered(name: str, kind: Kind) -> Found:
     except (Exception, SystemExit) as error:  # noqa: BLE001 - the package's module, the user's code
         raise ValueError(f"{where} does not load: {failure(error, point.module)}") from None
     dist = getattr(point, "dist", None)
+    RESOLVED[point.module] = f"{kind.what} {name} ({point.value})"
     return Found(target, point.value, f"{kind.group}:{name}", *((dist.name, dist.version) if dist else ()))
 
 
@@ -298,3 +305,17 @@ def blame(error: BaseException, scene: Any) -> str | None:
         return None
     _, key, name, module = found
     return f"{key} ({name}) raised {failure(error, module)}"
+
+
+def blame_resolved(error: BaseException) -> str | None:
+    """What a message says of an error that escaped a command, when the code of one's own this process resolved
+    (:data:`RESOLVED`) raised it (the deepest frame of its traceback in that code), None otherwise."""
+    frames = [frame for frame in traceback.extract_tb(error.__traceback__) if not frame.filename.startswith("<")]
+    found = None
+    for module, named in RESOLVED.items():
+        places = roots(module)
+        depth = max((i for i, frame in enumerate(frames) if any(_inside(frame.filename, p) for p in places)),
+                    default=None)
+        if depth is not None and (found is None or depth > found[0]):
+            found = (depth, module, named)
+    return None if found is None else f"the {found[2]} raised {failure(error, found[1])}"
