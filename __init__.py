@@ -30,6 +30,8 @@ from typing import Any as _Any
 # chooses Exudyn's build in its entry point, and a user's ``import exudyn`` gets the regular one.
 _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "InputError": ("models.definition.validation", "InputError"),
+         "extension": ("models.definition.own_code", "extension"),
+         "RockLaw": ("rocklaw.base", "RockLaw"),
          "Result": ("models.evaluation.run_result", "Result"),
          "Regime": ("models.evaluation.run_record", "Regime"),
          "SimulationFailed": ("models.evaluation.stability", "SimulationFailed"),
@@ -67,12 +69,14 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "RotationReport": ("studies.pages.rotation_note", "RotationReport")}
 
 if _TYPE_CHECKING:  # the names as type checkers and editors see them
+    from .models.definition.own_code import extension
     from .models.definition.scene import Scene
     from .models.definition.validation import InputError
     from .models.evaluation.run_record import Regime
     from .models.evaluation.run_result import Result
     from .models.evaluation.stability import SimulationFailed
     from .models.solvers.exudyn_model import ExudynModel, build_exudyn
+    from .rocklaw.base import RockLaw
     from .studies.accuracy.accuracy_run import AccuracyResult, accuracy
     from .studies.advice.advice_run import Advice, AdviceSearch
     from .studies.advice.advice_run import advise_scene as advise
@@ -108,8 +112,8 @@ def __dir__() -> list[str]:
 
 __all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult",
            "Crosscheck", "ExudynModel", "InputError", "Regime", "ReproductionResult", "Result",
-           "RotationReport", "RunOptions", "Scene", "SensitivityResult", "ShippedFile",
+           "RockLaw", "RotationReport", "RunOptions", "Scene", "SensitivityResult", "ShippedFile",
            "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck",
-           "draw", "load_scene", "load_study", "reproduce", "rotation_report", "run_study",
+           "draw", "extension", "load_scene", "load_study", "reproduce", "rotation_report", "run_study",
            "save_result", "sensitivity", "shipped_files", "simulate", "table_frame", "view_solution",
            "write_animation"]

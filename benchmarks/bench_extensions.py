@@ -47,7 +47,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "examples"))
 import clamp_extension  # the examples folder, as a user's module
 
-SCENE = rpdrill.load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml").with_({"solver.end_time_s": 0.5})
+ALLOWED = ["clamp_extension", "rate_dependent_rock"]  # the examples' modules: code of one's own, allowed here
+SCENE = rpdrill.load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml", allow_code=ALLOWED).with_(
+    {"solver.end_time_s": 0.5})
 COLLAR = SCENE.drill_string.bodies["collar"].mass_kg
 
 
@@ -117,7 +119,7 @@ def study(tmp: Path) -> None:
                 "function": "clamp_extension:add_clamp", "parameters": {"mass_kg": 300.0, "stiffness_n_per_m": 1e9}}}},
             "scan": {"extensions.clamp.parameters.mass_kg": [100.0, 300.0, 600.0]}, "metrics": ["penetration_rate_m_per_s"]}
     (tmp / "scan.yaml").write_text(yaml.safe_dump(data))
-    table = rpdrill.run_study(rpdrill.load_study(tmp / "scan.yaml"), workers=2)
+    table = rpdrill.run_study(rpdrill.load_study(tmp / "scan.yaml", allow_code=ALLOWED), workers=2)
     base = SCENE.with_({"extensions": data["base_overrides"]["extensions"]})
     worst = max(abs(row.penetration_rate_m_per_s / rate(rpdrill.simulate(
         base.with_({"extensions.clamp.parameters.mass_kg": mass}))) - 1)
@@ -157,7 +159,7 @@ def steady() -> None:
 
     frequency = 65.0
     joint = {"mass_kg": 300.0, "stiffness_n_per_m": 1e9, "damping_n_s_per_m": 2e4}
-    drill = rpdrill.load_scene(ROOT / "tests" / "pipe_drill.yaml").with_({
+    drill = rpdrill.load_scene(ROOT / "tests" / "pipe_drill.yaml", allow_code=ALLOWED).with_({
         "solver.formulation": "exudyn", "impact.frequency_hz": frequency, "solver.steady_state": "periodic"})
     clamped = drill.with_({"extensions": {"clamp": {"function": "clamp_extension:add_clamp", "parameters": joint}}})
     start = time.process_time()

@@ -32,7 +32,8 @@ ROLES = {
               "command line.",
     "models.definition": "What a scene is: the typed scene (data only), validated edits of it by key path and "
                          "the messages of bad values, the outputs a scene can ask for, the connector types, "
-                         "the registry of formulations and their solver keys.",
+                         "the registry of formulations and their solver keys, the code of one's own a scene may "
+                         "name and when it runs (registered or allowed: a scene is data).",
     "models.drill": "The drill string's mechanics: the chain of bodies and connectors (incidence, stiffness, "
                     "static preload), its modes, its piecewise-linear modes of contact, the impact pulse, bit "
                     "indexing, the piston, a rod as a wave element (impedance, transit time, its ends' law).",

@@ -1,8 +1,10 @@
 """Extensions of one's own: a clamp on the collar, its sensor and an energy term, named by a scene.
 
-Shows: a Python extension is a function ``f(model, **parameters)`` that adds Exudyn items to the built model
-(rpdrill.build_exudyn); a scene names it by import path with its parameters, so every run builds it, a
-worker process too, and a study can scan its parameters (``extensions.clamp.parameters.mass_kg``). The
+Shows: a Python extension is a function ``f(model, **parameters)`` marked ``@rpdrill.extension`` that adds
+Exudyn items to the built model (rpdrill.build_exudyn); a scene names it by import path with its parameters
+and runs it where its reader allows the module (``allow_code=["clamp_extension"]``, ``--allow-code
+clamp_extension``: a scene is data, docs/extending.md "Security"), so every run builds it, a worker process
+too, and a study can scan its parameters (``extensions.clamp.parameters.mass_kg``). The
 clamp (a Mass1D on its own Node1D and a coordinate spring-damper to the collar) is stepped as the assembled
 system needs, enters the energy account by itself, and its sensor comes back in the time series. The
 friction clamp has a spring-force user function the energy account cannot see into, so it declares its own
@@ -32,6 +34,8 @@ from exudyn.itemInterface import (
     SensorObject,
 )
 
+import rpdrill
+
 SCENE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
 
 
@@ -45,6 +49,7 @@ def _clamp_node(model, body: str, mass_kg: float, name: str) -> tuple:
     return node, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0))
 
 
+@rpdrill.extension
 def add_clamp(model, mass_kg: float, stiffness_n_per_m: float, damping_n_s_per_m: float = 0.0,
               body: str = "collar") -> None:
     """A clamp of ``mass_kg`` held on ``body`` by a coordinate spring-damper; a sensor of its velocity,
@@ -57,6 +62,7 @@ def add_clamp(model, mass_kg: float, stiffness_n_per_m: float, damping_n_s_per_m
                                    outputVariableType=exudyn.OutputVariableType.Coordinates_t))
 
 
+@rpdrill.extension
 def add_friction_clamp(model, mass_kg: float, stiffness_n_per_m: float, damping_n_s_per_m: float,
                        body: str = "collar", declare: bool = True) -> None:
     """A clamp whose joint computes its force in Python (a spring-force user function): the energy account
@@ -97,11 +103,10 @@ def main() -> None:
     parser.add_argument("--stiffness-n-per-m", type=float, default=1e12)
     args = parser.parse_args()
     sys.path.insert(0, str(Path(__file__).resolve().parent))  # this folder: the extensions importable by name
-    import rpdrill
-
+    allowed = ["clamp_extension"]  # the module of one's own the scenes below may run (this script's)
     base = rpdrill.load_scene(SCENE).with_({"solver.end_time_s": args.end_time_s})
     clamped = base.with_({"extensions": {"clamp": {"function": "clamp_extension:add_clamp", "parameters": {
-        "mass_kg": 300.0, "stiffness_n_per_m": args.stiffness_n_per_m, "damping_n_s_per_m": 1e3}}}})
+        "mass_kg": 300.0, "stiffness_n_per_m": args.stiffness_n_per_m, "damping_n_s_per_m": 1e3}}}}, allow_code=allowed)
     result = rpdrill.simulate(clamped)
     heavier = rpdrill.simulate(base.with_({"drill_string.bodies.collar.mass_kg":
                                            base.drill_string.bodies["collar"].mass_kg + 300.0}), formulation="exact")
@@ -114,7 +119,7 @@ def main() -> None:
           f"({', '.join(result.user_energy.accounted)})")
     print(f"clamp_velocity sensor: peak {result.timeseries['clamp_velocity'].abs().max():.4f} m/s")
     friction = base.with_({"extensions": {"friction": {"function": "clamp_extension:add_friction_clamp", "parameters": {
-        "mass_kg": 300.0, "stiffness_n_per_m": 1e9, "damping_n_s_per_m": 2e4}}}})
+        "mass_kg": 300.0, "stiffness_n_per_m": 1e9, "damping_n_s_per_m": 2e4}}}}, allow_code=allowed)
     declared = rpdrill.simulate(friction)
     print(f"energy balance with the friction clamp and its declared terms: "
           f"{declared.metrics['energy_balance_relative_error']:.2e} ({', '.join(declared.user_energy.declared)})")

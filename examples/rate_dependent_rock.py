@@ -9,13 +9,16 @@ x_n' = (k_n (x - x_n) - F_0) / c_r. It is linear between switches, so it declare
 contact, crushing) and the exact and ODE formulations run it; the Exudyn formulation records its force
 symbolically and advances the slider once per step (``step_update``: backward Euler over the step).
 
-The scene names it by import path, its keys under ``rock.parameters``::
+The class subclasses rocklaw.base.RockLaw (a scene names no other class as its law). The scene names it by
+import path, its keys under ``rock.parameters``::
 
     rock: {law: "rate_dependent_rock:RateDependentRock",
            parameters: {stiffness_n_per_m: 5.0e8, threshold_n: 138.0e3, rate_n_s_per_m: 1.0e5}}
 
-(``rate_dependent_rock`` must be importable where the scene runs: this folder on PYTHONPATH, or the
-module in an installed package.) Printed: the penetration rate on the paper's base scene of the Exudyn
+and runs it only where its reader allows the module (a scene is data: ``allow_code=["rate_dependent_rock"]``,
+``--allow-code rate_dependent_rock``), or, installed as a package that registers it under the entry point group
+``rpdrill.rock_laws`` as ``rate_dependent``, by that name (docs/extending.md, "Security"). The module must be
+importable where the scene runs (this folder on PYTHONPATH, or the module in an installed package). Printed: the penetration rate on the paper's base scene of the Exudyn
 and the exact formulations with this law, and of the paper's law at the same static threshold F_0.
 
     python examples/rate_dependent_rock.py [--end-time-s 0.5] [--rate-n-s-per-m 1e5]
@@ -33,7 +36,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from rpdrill.rocklaw.backends import NUMERIC, Backend
-from rpdrill.rocklaw.base import POSITION, State, trapezoidal_plastic_work_j
+from rpdrill.rocklaw.base import POSITION, RockLaw, State, trapezoidal_plastic_work_j
 from rpdrill.rocklaw.modes import ONE, Mode, ModeTable, Switch
 
 BOTTOM = "bottom_m"
@@ -41,7 +44,7 @@ SCENE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base
 
 
 @dataclass(frozen=True)
-class RateDependentRock:
+class RateDependentRock(RockLaw):
     """k_n in series with a slider of threshold F_0 + c_r x_n' (module doc); a rocklaw.base.RockLaw."""
 
     stiffness_n_per_m: float
@@ -138,7 +141,7 @@ def main() -> None:
     rock = base.rock.completed()
     own = base.with_({"rock": {"law": "rate_dependent_rock:RateDependentRock", "parameters": {
         "stiffness_n_per_m": rock.stiffness_n_per_m, "threshold_n": rock.threshold_n,
-        "rate_n_s_per_m": args.rate_n_s_per_m}}})
+        "rate_n_s_per_m": args.rate_n_s_per_m}}}, allow_code=["rate_dependent_rock"])  # the module this script allows
     rates = {name: rpdrill.simulate(own, formulation=name).metrics["penetration_rate_m_per_s"]
              for name in ("exudyn", "exact")}
     paper = rpdrill.simulate(base, formulation="exact").metrics["penetration_rate_m_per_s"]

@@ -29,7 +29,8 @@ and the state:
 
 What each formulation needs (:data:`MEMBERS`, :func:`missing_members`): the Exudyn formulation everything
 but the mode table; the exact and ODE formulations the mode table too (``modes``, ``initial_mode``).
-A law of one's own names its class by import path in a scene (``rock.law: module:Class``).
+A law of one's own subclasses :class:`RockLaw`; a scene names it by the name its package registers or by its
+import path (``rock.law: module:Class``) where its module is allowed for the run (docs/extending.md).
 
 Implementations: :class:`rocklaw.jenkins.JenkinsRock` (the paper's Eq. 1, 2) and
 :class:`rocklaw.bilinear.BilinearRock`.
@@ -51,29 +52,24 @@ POSITION, VELOCITY = "position", "velocity"  # the bit's local variables in a la
 
 @runtime_checkable
 class RockLaw(Protocol):
-    """A bit-rock contact law (module docstring). Lengths in m, forces in N."""
+    """A bit-rock contact law (module docstring). Lengths in m, forces in N.
 
-    @property
-    def name(self) -> str: ...
-    @property
-    def state_names(self) -> tuple[str, ...]: ...
-    @property
-    def bottom_index(self) -> int: ...
-    @property
-    def crushes(self) -> bool: ...
-    @property
-    def loading_stiffness_n_per_m(self) -> float: ...
-    @property
-    def unloading_stiffness_n_per_m(self) -> float: ...
-    @property
-    def threshold_n(self) -> float: ...
-    @property
-    def damping_n_s_per_m(self) -> float: ...
-    @property
-    def crushing_penetration_m(self) -> float:
-        """Penetration from the bottom at which crushing starts: the law's length scale
-        (Jenkins F_th / k_n; 0 for a law that indents from the first contact; inf if elastic)."""
-        ...
+    A law's class subclasses it (``class MyLaw(RockLaw)``; the built-in laws do): a scene names no other class
+    as its ``rock.law`` (models.definition.rock). Its values are declared as attributes, so that a
+    dataclass's fields, a class attribute or a property of the law give them; a method a law does not
+    define stays this protocol's stub, which :func:`missing_members` counts as missing."""
+
+    name: str
+    state_names: tuple[str, ...]
+    bottom_index: int
+    crushes: bool
+    loading_stiffness_n_per_m: float
+    unloading_stiffness_n_per_m: float
+    threshold_n: float
+    damping_n_s_per_m: float
+    # Penetration from the bottom at which crushing starts: the law's length scale (Jenkins F_th / k_n; 0 for a
+    # law that indents from the first contact; inf if elastic)
+    crushing_penetration_m: float
 
     def initial_state(self) -> State:
         """The state of an untouched rock with its surface at x = 0."""
@@ -94,18 +90,12 @@ class RockLaw(Protocol):
         """The state after the bit reached ``bit_position_m`` (once per step, before the step)."""
         ...
 
-    @property
-    def fresh_fraction(self) -> float:
-        """eta, the share of the blow's footprint on fresh rock (0 < eta <= 1)."""
-        ...
-    @property
-    def modes_follow_fresh_fraction(self) -> bool:
-        """Whether the mode rows carry eta (a new table when eta changes)."""
-        ...
-    @property
-    def resets_at_blows(self) -> bool:
-        """Whether :meth:`start_blow` changes the state (else no formulation calls it)."""
-        ...
+    # eta, the share of the blow's footprint on fresh rock (0 < eta <= 1)
+    fresh_fraction: float
+    # whether the mode rows carry eta (a new table when eta changes)
+    modes_follow_fresh_fraction: bool
+    # whether :meth:`start_blow` changes the state (else no formulation calls it)
+    resets_at_blows: bool
 
     def start_blow(self, bit_position_m: float, state: State) -> State:
         """The state a blow starting now meets (applied at every blow start)."""
@@ -138,10 +128,20 @@ def missing_members(law: object, members: tuple[str, ...] = MEMBERS) -> list[str
     missing = []
     for name in members:
         try:
+            found = getattr(type(law), name, None)
             getattr(law, name)
         except Exception:  # noqa: BLE001 - a property that fails is as good as absent
             missing.append(name)
+            continue
+        if found is not None and found is RockLaw.__dict__.get(name):  # the protocol's stub, inherited
+            missing.append(name)
     return missing
+
+
+def is_rock_law_class(target: object) -> bool:
+    """Whether ``target`` is a class that subclasses :class:`RockLaw` (by name, not by its shape: checked
+    before anything of it is constructed)."""
+    return isinstance(target, type) and RockLaw in target.__mro__ and target is not RockLaw
 
 
 def local_values(law: RockLaw, bit_position_m: float, bit_velocity_m_per_s: float,

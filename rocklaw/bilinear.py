@@ -58,7 +58,7 @@ from typing import Any
 import numpy as np
 
 from .backends import NUMERIC, Backend
-from .base import POSITION, VELOCITY, State, trapezoidal_plastic_work_j
+from .base import POSITION, VELOCITY, RockLaw, State, trapezoidal_plastic_work_j
 from .modes import Mode, ModeTable, Switch
 
 FREE, LIFTED, LOADING, UNLOADING = "free", "lifted", "loading", "unloading"
@@ -66,7 +66,7 @@ SURFACE, BOTTOM = "surface_m", "bottom_m"
 
 
 @dataclass(frozen=True)
-class BilinearRock:
+class BilinearRock(RockLaw):
     """Loading stiffness k_l, unloading stiffness k_u >= k_l; a :class:`rocklaw.base.RockLaw`."""
 
     loading_stiffness_n_per_m: float

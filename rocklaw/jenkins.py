@@ -58,7 +58,7 @@ from typing import Any, Literal
 import numpy as np
 
 from .backends import NUMERIC, Backend
-from .base import POSITION, VELOCITY, State, trapezoidal_plastic_work_j
+from .base import POSITION, VELOCITY, RockLaw, State, trapezoidal_plastic_work_j
 from .modes import ONE, Mode, ModeTable, Switch
 
 DampingMode = Literal["contact", "always"]
@@ -67,7 +67,7 @@ BOTTOM, THRESHOLD = "bottom_m", "threshold_n"
 
 
 @dataclass(frozen=True)
-class JenkinsRock:
+class JenkinsRock(RockLaw):
     """Parameters of the paper's visco-elastic-plastic rock (Eq. 1, 2); a :class:`rocklaw.base.RockLaw`."""
 
     stiffness_n_per_m: float

@@ -21,6 +21,7 @@ from ..models.evaluation.run_result import Result
 from ..models.evaluation.run_status import run_status
 from ..models.solvers.cost import Cause
 from .inputs.arguments import (
+    allow_code_problem,
     boolean_problem,
     callable_problem,
     check,
@@ -103,11 +104,13 @@ def _animated(result: Result) -> Any:
 
 def simulate(scene: Scene | str | Path, formulation: str | None = None,
              progress: Callable[[float], None] | None = None, budget: Budget | None = DEFAULT_BUDGET,
-             solution_file: Path | None = None) -> Result:
+             solution_file: Path | None = None, allow_code: Sequence[str] | str = ()) -> Result:
     """Run a scene (or a scene file) with its formulation, or ``formulation`` (``exudyn``, ``exact``,
     ``ode``; the scene's options of another formulation dropped). InputError when it cannot run as
     given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
-    it starts; models.evaluation.stability.SimulationFailed when the run diverges. ``solution_file``:
+    it starts; ``allow_code``: the modules of one's own the scene may run (models.definition.own_code; never
+    a scene file's own); models.evaluation.stability.SimulationFailed when the run diverges (or the user's
+    code fails in it). ``solution_file``:
     with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
     (for its SolutionViewer: studies.drawings.drill_animation.view_solution). Loads no figure module:
     the caller's matplotlib is left as it is. A scene with ``solver.steady_state: periodic`` gives its
@@ -118,7 +121,7 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
     check("rpdrill.simulate", "progress", progress, callable_problem)
     check("rpdrill.simulate", "budget", budget, instance_problem(Budget, "a rpdrill Budget or None", optional=True))
     check("rpdrill.simulate", "solution_file", solution_file, optional(file_problem))
-    scene, source = scene_and_source(scene, "rpdrill.simulate")
+    scene, source = scene_and_source(scene, "rpdrill.simulate", allow_code)
     if formulation is not None:
         scene = scene.with_solver(formulation)
     simulation = prepare_scene(scene, source)
@@ -138,19 +141,25 @@ def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
     return table_of(list(rows[0]) if rows else [], [list(row.values()) for row in rows])
 
 
-def run_study(study: Study | str | Path, options: RunOptions | None = None, **run: Any) -> pd.DataFrame:
+def run_study(study: Study | str | Path, options: RunOptions | None = None, *,
+              allow_code: Sequence[str] | str = (), **run: Any) -> pd.DataFrame:
     """Run a study (or a study file) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
     ``workers``, ``dask``, ``out``, ``budget``, ``quiet``): into ``out`` (results.csv, study.json, optima.csv,
-    plots; resumable as the command's) or, without ``out``, a scratch folder that is removed after (no plots).
-    The results table as a DataFrame, one row a point."""
+    plots; resumable as the command's) or, without ``out``, a scratch folder that is removed after (no plots);
+    ``allow_code``: the modules of one's own a study file's scenes may run (models.definition.own_code). The
+    results table as a DataFrame, one row a point."""
     from .runtime.pools import pool
 
     where = "rpdrill.run_study"
     check(where, "study", study, either(file_problem, instance_problem(Study, "a rpdrill Study or a study file's "
                                                                               "path")))
     options = RunOptions.of(where, options, run, STUDY_OPTIONS)
+    check(where, "allow_code", allow_code, allow_code_problem)
+    if isinstance(study, Study) and allow_code:
+        raise InputError(f"{where}: allow_code: a loaded Study's scenes may run what rpdrill.load_study "
+                         "allowed them; give allow_code to rpdrill.load_study")
     if not isinstance(study, Study):
-        study = load_study(study, budget=options.budget)
+        study = load_study(study, budget=options.budget, allow_code=allow_code)
     with tempfile.TemporaryDirectory(prefix="rpdrill-study-") as scratch:
         folder = study_folders([str(study.source)], str(options.out or scratch))[0]
         if options.out is None:  # a scratch folder keeps no plots

@@ -96,14 +96,15 @@ def _table(study: Study, out: Path, runner: tuple[str, Runner]) -> Table:
 STUDY_OPTIONS = ("workers", "dask", "out", "budget", "quiet")  # the run options of a study (rpdrill.RunOptions)
 
 
-def run_study_files(paths: Sequence[str | Path], options: RunOptions, formulation: str | None = None
-                    ) -> list[StudyRun]:
-    """Read the study files (InputError or BudgetError before anything runs), then run them as ``options`` say
-    into ``options.out`` (one study) or ``options.out``/<file stem> (several)."""
+def run_study_files(paths: Sequence[str | Path], options: RunOptions, formulation: str | None = None,
+                    allow_code: Sequence[str] | str = ()) -> list[StudyRun]:
+    """Read the study files (InputError or BudgetError before anything runs; ``allow_code``: the modules of one's
+    own their scenes may run), then run them as ``options`` say into ``options.out`` (one study) or
+    ``options.out``/<file stem> (several)."""
     options = RunOptions.of("rpdrill study", options, {}, STUDY_OPTIONS)
     if options.out is None:
         raise InputError("rpdrill study: --out: give the folder the studies write into")
     folders = study_folders([str(path) for path in paths], str(options.out))
-    studies = [load_study(path, formulation, options.budget) for path in paths]
+    studies = [load_study(path, formulation, options.budget, allow_code) for path in paths]
     with pool(options.dask, options.workers) as runner:
         return run_studies(studies, folders, runner, options.dask is not None, options.quiet)

@@ -18,6 +18,7 @@ import rpdrill
 from rpdrill.studies.sensitivity.sensitivity_study import scene_values
 
 MASS = "extensions.clamp.parameters.mass_kg"
+ALLOW = ["user_rig"]  # the tests' rig (tests/user_rig.py): code of one's own, allowed by who reads the scenes
 CLAMP = {"clamp": {"function": "user_rig:add_clamp",
                    "parameters": {"mass_kg": 300.0, "stiffness_n_per_m": 1.0e8, "damping_n_s_per_m": 1.0e3}}}
 SHORT = {"solver.end_time_s": 0.15, "metrics.transient_blows": 2, "metrics.block_blows": 4, "impact.amplitude_n": 400e3,
@@ -33,7 +34,7 @@ def study_file(path: Path, **changes) -> Path:
 
 
 def single_runs() -> dict[float, float]:
-    base = rpdrill.load_scene(PAPER_BASE).with_({**SHORT, "extensions": CLAMP})
+    base = rpdrill.load_scene(PAPER_BASE, allow_code=ALLOW).with_({**SHORT, "extensions": CLAMP})
     return {mass: rpdrill.simulate(base.with_({MASS: mass})).metrics["penetration_rate_m_per_s"]
             for mass in (100.0, 400.0, 900.0)}
 
@@ -45,7 +46,8 @@ def singles() -> dict[float, float]:
 
 def test_a_yaml_study_scans_an_extension_parameter_on_two_workers_as_single_runs_give(tmp_path, singles):
     out = tmp_path / "out"
-    assert main(["study", str(study_file(tmp_path / "scan.yaml")), "--out", str(out), "--workers", "2", "--quiet"]) == 0
+    assert main(["study", str(study_file(tmp_path / "scan.yaml")), "--out", str(out), "--workers", "2", "--quiet",
+                 "--allow-code", "user_rig"]) == 0
     with (out / "results.csv").open(newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert {float(r[MASS]): float(r["penetration_rate_m_per_s"]) for r in rows} == pytest.approx(singles, rel=1e-9)
@@ -61,7 +63,7 @@ def test_a_yaml_study_scans_an_extension_parameter_on_two_workers_as_single_runs
 
 @pytest.mark.parametrize("runner", ["processes", "dask"])
 def test_run_study_scans_an_extension_parameter_on_processes_and_a_dask_local_cluster(tmp_path, singles, runner):
-    study = rpdrill.load_study(study_file(tmp_path / "scan.yaml", plots=[]))
+    study = rpdrill.load_study(study_file(tmp_path / "scan.yaml", plots=[]), allow_code=ALLOW)
     table = rpdrill.run_study(study, workers=2, dask="" if runner == "dask" else None)
     assert (table["status"] == "ok").all()
     assert dict(zip(table[MASS], table["penetration_rate_m_per_s"], strict=True)) == pytest.approx(singles, rel=1e-9)
@@ -76,13 +78,14 @@ def test_an_extension_parameter_is_a_calibration_axis(tmp_path):
         "search": {"popsize": 2, "max_generations": 1, "seed": 1}}
     path = tmp_path / "calibration.yaml"
     path.write_text(yaml.safe_dump(calibration, sort_keys=False), encoding="utf-8")
-    assert main(["calibrate", str(path), "--out", str(tmp_path / "out"), "--workers", "2", "--quiet"]) == 0
+    assert main(["calibrate", str(path), "--out", str(tmp_path / "out"), "--workers", "2", "--quiet",
+                 "--allow-code", "user_rig"]) == 0
     fitted = yaml.safe_load((tmp_path / "out" / "calibrated_scene.yaml").read_text())
     assert 100.0 <= fitted["extensions"]["clamp"]["parameters"]["mass_kg"] <= 900.0
 
 
 def test_an_extension_parameter_is_a_sensitivity_parameter(tmp_path):
-    base = rpdrill.load_scene(PAPER_BASE).with_({**SHORT, "extensions": CLAMP})
+    base = rpdrill.load_scene(PAPER_BASE, allow_code=ALLOW).with_({**SHORT, "extensions": CLAMP})
     values = scene_values(base)
     assert values[MASS] == 300.0 and values["extensions.clamp.parameters.stiffness_n_per_m"] == 1e8
     sensitivity = {"name": "clamp_sensitivity", "base_scene": str(PAPER_BASE),
@@ -90,13 +93,14 @@ def test_an_extension_parameter_is_a_sensitivity_parameter(tmp_path):
                    "scans": [{"label": "400 kN"}], "parameters": [MASS]}
     path = tmp_path / "sensitivity.yaml"
     path.write_text(yaml.safe_dump(sensitivity, sort_keys=False), encoding="utf-8")
-    assert main(["sensitivity", str(path), "--out", str(tmp_path / "out"), "--workers", "2", "--quiet"]) == 0
+    assert main(["sensitivity", str(path), "--out", str(tmp_path / "out"), "--workers", "2", "--quiet",
+                 "--allow-code", "user_rig"]) == 0
     with (tmp_path / "out" / "one_at_a_time.csv").open(newline="") as handle:
         assert {row["parameter"] for row in csv.DictReader(handle)} == {MASS}
 
 
 def test_an_extension_parameter_is_an_advice_axis():
-    scene = rpdrill.load_scene(PAPER_BASE).with_({**SHORT, "extensions": CLAMP, "solver.end_time_s": 0.07,
+    scene = rpdrill.load_scene(PAPER_BASE, allow_code=ALLOW).with_({**SHORT, "extensions": CLAMP, "solver.end_time_s": 0.07,
                                                   "metrics.transient_blows": 1, "metrics.block_blows": 2})
     (advice,) = rpdrill.advise(scene, {"impact.frequency_hz": (45.0, 60.0), "feed.force_n": (20e3, 30e3),
                                        MASS: (100.0, 900.0)},

@@ -1,4 +1,6 @@
-"""What a user of rpdrill writes for their rig (the tests name it by import path, ``user_rig:NAME``):
+"""What a user of rpdrill writes for their rig (the tests name it by import path, ``user_rig:NAME``, and allow the
+module, ``allow_code=["user_rig"]``: a scene runs no code unasked; each extension marked ``@rpdrill.extension``,
+each law a subclass of rocklaw.base.RockLaw, through the built-in law it derives from):
 extensions (the clamps of examples/clamp_extension.py: a mass on its own Node1D held on a body by a
 coordinate spring-damper, and one with a spring-force user function and its declared energy terms; sensors
 of one's own; an oscillator on ground; a loose mass, a step counter and an anchor to ground, which a steady
@@ -20,6 +22,7 @@ from exudyn.itemInterface import (
     SensorNode,
 )
 
+import rpdrill
 from examples.clamp_extension import add_clamp, add_friction_clamp  # the checkout's examples: a user's module
 from rpdrill.rocklaw import JenkinsRock
 
@@ -27,6 +30,7 @@ __all__ = ["ForceOnlyRock", "RenamedJenkins", "add_anchor", "add_clamp", "add_fr
            "add_loose_mass", "add_sensors", "add_step_counter"]
 
 
+@rpdrill.extension
 def add_sensors(model, body: str = "bit") -> None:
     """A sensor of one's own on a body's velocity, ``<body>_speed_sensor``; nothing else (it changes no motion)."""
     model.mbs.AddSensor(SensorNode(nodeNumber=model.bodies[body].node, storeInternal=True, name=f"{body}_speed_sensor",
@@ -36,18 +40,21 @@ def add_sensors(model, body: str = "bit") -> None:
 add_sensors.changes_motion = False  # rpdrill: the exact and ODE formulations may run a scene with it
 
 
+@rpdrill.extension
 def add_loose_mass(model, mass_kg: float = 50.0) -> None:
     """A Mass1D on its own Node1D, ``loose_mass``, that no spring holds (a free coordinate of one's own)."""
     node = model.mbs.AddNode(Node1D(referenceCoordinates=[0.0], initialCoordinates=[0.0], initialVelocities=[0.0]))
     model.mbs.AddObject(ObjectMass1D(nodeNumber=node, mass=mass_kg, name="loose_mass"))
 
 
+@rpdrill.extension
 def add_step_counter(model) -> None:
     """A per-step function of one's own (``model.add_pre_step``) that counts the steps: a state outside Exudyn's."""
     steps = []
     model.add_pre_step(lambda mbs, t: steps.append(t) is None)
 
 
+@rpdrill.extension(changes_motion=False)  # the exact formulation may run a scene with it
 def add_ground_oscillator(model, mass_kg: float = 10.0, stiffness_n_per_m: float = 1.0e4,
                           damping_n_s_per_m: float = 100.0) -> None:
     """A Mass1D, ``oscillator``, on a spring-damper to ground, tied to nothing of the drill (a reference of
@@ -61,9 +68,8 @@ def add_ground_oscillator(model, mass_kg: float = 10.0, stiffness_n_per_m: float
         stiffness=stiffness_n_per_m, damping=damping_n_s_per_m, name="oscillator_spring"))
 
 
-add_ground_oscillator.changes_motion = False  # rpdrill: the exact formulation may run a scene with it
 
-
+@rpdrill.extension
 def add_anchor(model, stiffness_n_per_m: float, body: str = "collar") -> None:
     """A coordinate spring, ``anchor``, from ground to ``body`` (no coordinates of its own)."""
     mbs = model.mbs

@@ -1,59 +1,51 @@
-"""Python of one's own named by a scene: extensions of the Exudyn model, and what imports them by name.
+"""Python of one's own named by a scene: extensions of the Exudyn model, and what a run records of them.
 
-A scene's ``extensions`` section names callables by their import path, each with its parameters::
+A scene's ``extensions`` section names callables, each with its parameters::
 
     extensions:
       clamp:                                   # a name of the user's choosing
-        function: my_rig.clamps:add_clamp      # an importable callable f(model, **parameters)
+        function: my_rig.clamps:add_clamp      # f(model, **parameters): an allowed module's, or a registered name
         parameters: {mass_kg: 300.0, stiffness_n_per_m: 1.0e9}
 
-The Exudyn builder (models.solvers.exudyn_model) imports each callable by name and calls it on the built
-model before it runs, in every process that runs the scene: a scene is data, and a worker imports the
-callable itself (nothing pickles a built model). The parameters are checked here against the callable's
-signature as strictly as a scene's own keys (unknown or missing keys, types of the annotations), and
-``extensions.NAME.parameters.KEY`` is a key path like any other (``Scene.with_``, scan axes).
+A scene is data and runs no code unasked (models.definition.own_code): ``function`` is the name an installed
+package registers under the entry point group ``rpdrill.extensions``, or the import path of a callable of a
+module its reader allowed for the run; the callable must be marked as an extension (``@rpdrill.extension``).
+The Exudyn builder (models.solvers.exudyn_model) calls each on the built model before it runs, in every
+process that runs the scene: a worker resolves the callable itself (nothing pickles a built model; the scene
+carries its allowance). The parameters are checked here against the callable's signature as strictly as a
+scene's own keys (unknown or missing keys, types of the annotations), and ``extensions.NAME.parameters.KEY``
+is a key path like any other (``Scene.with_``, scan axes).
 
 An extension changes the motion of the Exudyn model unless its callable says otherwise with the attribute
-``changes_motion = False`` (one that only adds sensors, energy terms or graphics): a scene with an
-extension that changes the motion runs in the Exudyn formulation only (the exact and ODE formulations
-refuse it naming the extension, :func:`refusal`). A rock law of one's own is named the same way
-(``rock.law: module:Class``, models.definition.rock).
+``changes_motion = False`` (``@rpdrill.extension(changes_motion=False)``: one that only adds sensors, energy
+terms or graphics): a scene with an extension that changes the motion runs in the Exudyn formulation only
+(the exact and ODE formulations refuse it naming the extension, :func:`refusal`). A rock law of one's own is
+named the same way (``rock.law``, models.definition.rock).
 """
 
 from __future__ import annotations
 
 import functools
-import importlib
 import importlib.metadata
 import inspect
-import re
 import sys
 import typing
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    ValidationInfo,
+    create_model,
+    model_validator,
+)
 
 from .drill_string import Strict, _key_error, _problem
-
-IMPORT_PATH = re.compile(r"[A-Za-z_][\w]*(\.[A-Za-z_][\w]*)*:[A-Za-z_][\w]*(\.[A-Za-z_][\w]*)*")
-
-
-def import_object(path: str) -> Any:
-    """The object an import path ``module.sub:name`` names; ValueError saying what is wrong otherwise."""
-    if not IMPORT_PATH.fullmatch(path):
-        raise ValueError("not an import path 'package.module:name'")
-    module_name, _, attribute = path.partition(":")
-    try:
-        target: Any = importlib.import_module(module_name)
-    except ImportError as error:
-        raise ValueError(f"cannot import module {module_name!r} ({error}); it must be importable where the scene "
-                         "runs (installed, or on PYTHONPATH)") from None
-    for part in attribute.split("."):
-        if not hasattr(target, part):
-            raise ValueError(f"module {module_name!r} has no {attribute!r}")
-        target = getattr(target, part)
-    return target
+from .own_code import EXTENSION, Found, allowance, is_extension, resolve
 
 
 def package_version(path: str) -> dict[str, str]:
@@ -71,12 +63,17 @@ def _distributions() -> Mapping[str, list[str]]:
     return importlib.metadata.packages_distributions()
 
 
-def record(path: str) -> dict[str, str]:
+def record(path: str, found: Found | None = None) -> dict[str, str]:
     """What a run records of the code an import path names: the path and, where it has one, its package and
-    version; ``file`` where the module was loaded from."""
+    version; ``file`` where the module was loaded from; the entry point it is registered as (``found``)."""
     module = sys.modules.get(path.partition(":")[0])
     where = {"file": str(module.__file__)} if module is not None and getattr(module, "__file__", None) else {}
-    return {"import_path": path, **package_version(path), **where}
+    package = package_version(path)
+    registered = {}
+    if found is not None and found.entry_point:
+        registered = {"entry_point": found.entry_point}
+        package = {"package": found.package, "version": found.version} if found.package else package
+    return {"import_path": path, **package, **where, **registered}
 
 
 STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, arbitrary_types_allowed=True)
@@ -139,30 +136,44 @@ def _name(target: Any) -> str:
 
 
 class Extension(Strict):
-    """One Python extension of the Exudyn model (module doc): ``function`` 'module:callable', called as
-    ``function(model, **parameters)`` on the built model before it runs."""
+    """One Python extension of the Exudyn model (module doc): ``function`` a registered name or 'module:callable'
+    of an allowed module, called as ``function(model, **parameters)`` on the built model before it runs."""
 
-    function: str = Field(description="import path 'package.module:callable' of f(model, **parameters)")
+    function: str = Field(description="a registered extension's name, or the import path 'package.module:callable' "
+                                      "of f(model, **parameters) in a module allowed for the run")
     parameters: dict[str, Any] = Field(default_factory=dict, description="keyword arguments of the callable")
     recorded: dict[str, str] | None = Field(None, description="informational: what the run that wrote a resolved "
                                             "scene imported (import path, package, version, file)")
+    _allowed: tuple[str, ...] = PrivateAttr(())  # the modules its reader allowed (models.definition.own_code)
 
     @model_validator(mode="after")
-    def _importable_and_parameters_fit(self) -> Extension:
+    def _allowed_marked_and_parameters_fit(self, info: ValidationInfo) -> Extension:
+        self._allowed = allowance(info)
         try:
-            target = import_object(self.function)
+            target = self.found.target
         except ValueError as error:
             raise _key_error("Extension", ("function",), self.function, "{why}", why=str(error)) from None
-        if not callable(target):
-            raise _key_error("Extension", ("function",), self.function, "not a callable: {kind}",
-                             kind=type(target).__name__)
+        if not is_extension(target):
+            kind = "a class" if isinstance(target, type) else type(target).__name__
+            raise _key_error("Extension", ("function",), self.function, "{kind}, not marked as an rpdrill extension: "
+                             "rpdrill calls only a function made to be one, marked with the decorator "
+                             "@rpdrill.extension (docs/extending.md, \"Security\")", kind=kind)
+        if not _takes_a_model(target):
+            raise _key_error("Extension", ("function",), self.function, "takes no model: an extension is called as "
+                             "f(model, **parameters), the built model its first argument")
         check_parameters(target, self.parameters, ("parameters",), "Extension", skip=1, path=self.function)
         return self
 
     @property
+    def found(self) -> Found:
+        """What ``function`` names, resolved as its reader allowed (models.definition.own_code.resolve);
+        ValueError where it may not run or does not resolve."""
+        return resolve(self.function, EXTENSION, self._allowed)
+
+    @property
     def target(self) -> Callable[..., Any]:
-        """The function the import path names."""
-        return import_object(self.function)
+        """The function ``function`` names."""
+        return self.found.target
 
     @property
     def changes_motion(self) -> bool:
@@ -175,6 +186,17 @@ class Extension(Strict):
         self.target(model, **self.parameters)
 
 
+def _takes_a_model(target: Callable[..., Any]) -> bool:
+    """Whether ``target`` takes a first positional argument (the model)."""
+    try:
+        parameters = list(inspect.signature(target).parameters.values())
+    except (TypeError, ValueError):  # no signature to read: called as it is
+        return True
+    return bool(parameters) and parameters[0].kind in (inspect.Parameter.POSITIONAL_ONLY,
+                                                       inspect.Parameter.POSITIONAL_OR_KEYWORD,
+                                                       inspect.Parameter.VAR_POSITIONAL)
+
+
 def refusal(extensions: Mapping[str, Extension] | None, formulation: str) -> tuple[str, str] | None:
     """(the extension's name, why) when ``formulation`` cannot run a scene with these extensions: the exact
     and ODE formulations run no Exudyn items, so an extension that changes the motion is Exudyn's only."""
@@ -184,12 +206,13 @@ def refusal(extensions: Mapping[str, Extension] | None, formulation: str) -> tup
         if extension.changes_motion:
             return name, (f"extension {name!r} ({extension.function}) adds to the Exudyn model, which the {formulation} "
                           "formulation does not build; use solver.formulation exudyn, or, if the extension changes "
-                          "nothing of the motion (sensors, energy terms, graphics), set changes_motion = False on "
-                          "its callable (docs/extending.md)")
+                          "nothing of the motion (sensors, energy terms, graphics), mark its callable "
+                          "@rpdrill.extension(changes_motion=False) (docs/extending.md)")
     return None
 
 
 def records(extensions: Mapping[str, Extension] | None) -> dict[str, dict[str, Any]]:
     """Every extension's record (:func:`record`) and parameters, by name: what provenance keeps."""
-    return {name: {**record(extension.function), "parameters": dict(extension.parameters)}
+    found = {name: extension.found for name, extension in (extensions or {}).items()}
+    return {name: {**record(found[name].import_path, found[name]), "parameters": dict(extension.parameters)}
             for name, extension in (extensions or {}).items()}

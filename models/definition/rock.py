@@ -1,11 +1,14 @@
-"""The scene's ``rock`` section: a built-in law and its keys, or a law of one's own named by import path.
+"""The scene's ``rock`` section: a built-in law and its keys, or a law of one's own.
 
 ``law`` is a built-in name (``jenkins``, the paper's Eq. 1, 2; ``bilinear``) whose keys sit directly
-under ``rock``, or the import path ``module:Class`` of a class implementing the rock-law interface
-(rocklaw.base.RockLaw, docs/extending.md), whose keys go under ``rock.parameters`` and are checked
-against its constructor as strictly as a built-in law's (unknown and missing keys, the types of its
-annotations: models.definition.extensions.check_parameters). The class is imported by name wherever the
-scene runs (a worker process too).
+under ``rock``, or a law of one's own (models.definition.own_code: a scene runs no code unasked): the name
+an installed package registers under the entry point group ``rpdrill.rock_laws``, or the import path
+``module:Class`` of a module its reader allowed for the run. Its class must subclass rocklaw.base.RockLaw
+(docs/extending.md), checked before anything of it is constructed; its keys go under ``rock.parameters`` and
+are checked against its constructor as strictly as a built-in law's (unknown and missing keys, the types of
+its annotations: models.definition.extensions.check_parameters), then the law is built once to check it
+(its constructor's own refusals, the interface's members). The class is resolved by name wherever the scene
+runs (a worker process too, the scene carrying its allowance).
 """
 
 from __future__ import annotations
@@ -13,14 +16,15 @@ from __future__ import annotations
 import math
 from typing import Any, Literal
 
-from pydantic import BaseModel, Field, field_validator, model_validator
+from pydantic import BaseModel, Field, PrivateAttr, ValidationInfo, field_validator, model_validator
 from pydantic_core import ValidationError
 
-from ...rocklaw import LAWS, BilinearRock, JenkinsRock, RockLaw
-from ...rocklaw.base import missing_members
+from ...rocklaw import BilinearRock, JenkinsRock, RockLaw
+from ...rocklaw.base import is_rock_law_class, missing_members
 from ...rocklaw.catalog import TABLE_1
 from .drill_string import NonNegative, Positive, Strict, _key_error, _problem
-from .extensions import IMPORT_PATH, check_parameters, import_object
+from .extensions import check_parameters, record
+from .own_code import IMPORT_PATH, REGISTERED_NAME, ROCK_LAW, Found, allowance, failure, resolve
 
 JENKINS_VALUES = ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n")
 # the keys of each built-in rock law (``law`` itself is common)
@@ -44,11 +48,6 @@ def refuse_foreign_keys(model: BaseModel, what: str, chosen: str, keys: dict[str
         raise ValidationError.from_exception_data(title, foreign)
 
 
-def law_class(law: str) -> type:
-    """The class a ``rock.law`` names: a built-in law's, or the class at its import path."""
-    return LAWS[law] if law in LAWS else import_object(law)
-
-
 class Rock(Strict):
     """The rock under the bit: ``law`` and that law's keys (keys of another law are errors).
 
@@ -68,30 +67,37 @@ class Rock(Strict):
     unloading_stiffness_n_per_m: Positive | None = Field(None, description="bilinear: k_u > k_l")
     parameters: dict[str, Any] | None = Field(None, description="a law of one's own (law: module:Class): its keys")
 
+    _allowed: tuple[str, ...] = PrivateAttr(())  # the modules its reader allowed (models.definition.own_code)
+
     @field_validator("law")
     @classmethod
-    def _built_in_or_import_path(cls, law: str) -> str:
-        if law in BUILT_IN_LAWS:
+    def _built_in_or_named(cls, law: str) -> str:
+        """A built-in law, or the form of a law of one's own (resolved by :meth:`_complete`, nothing imported here)."""
+        if law in BUILT_IN_LAWS or IMPORT_PATH.fullmatch(law) or (":" not in law and REGISTERED_NAME.fullmatch(law)):
             return law
-        if not IMPORT_PATH.fullmatch(law):
-            raise ValueError(f"{law!r} is not a built-in law ({', '.join(BUILT_IN_LAWS)}); a law of one's own is named "
-                             "by its import path 'package.module:Class' (docs/extending.md)")
-        try:
-            target = import_object(law)
-        except ValueError as error:
-            raise ValueError(f"{law!r}: {error}") from None
-        if not isinstance(target, type):
-            # a ValueError: pydantic reports it as this key's problem
-            raise ValueError(f"{law!r} is not a class (a rock law is a class implementing rocklaw.base.RockLaw)")  # noqa: TRY004
-        return law
+        raise ValueError(f"{law!r} is not a built-in law ({', '.join(BUILT_IN_LAWS)}); a law of one's own is named by "
+                         "the name its package registers (entry point group 'rpdrill.rock_laws') or by its import path "
+                         "'package.module:Class' (docs/extending.md)")
 
     @property
     def own_law(self) -> bool:
         """Whether ``law`` is a law of one's own (an import path)."""
         return self.law not in BUILT_IN_LAWS
 
+    @property
+    def found(self) -> Found:
+        """The class of a law of one's own, resolved as the scene's reader allowed
+        (models.definition.own_code.resolve); ValueError where it may not run or does not resolve."""
+        return resolve(self.law, ROCK_LAW, self._allowed)
+
+    def code_record(self) -> dict[str, str]:
+        """What a run records of a law of one's own (models.definition.extensions.record)."""
+        found = self.found
+        return record(found.import_path, found)
+
     @model_validator(mode="after")
-    def _complete(self) -> Rock:
+    def _complete(self, info: ValidationInfo) -> Rock:
+        self._allowed = allowance(info)
         if self.own_law:
             return self._check_own_law()
         if self.parameters is not None:
@@ -119,17 +125,30 @@ class Rock(Strict):
         return self
 
     def _check_own_law(self) -> Rock:
+        try:
+            found = self.found
+        except ValueError as error:
+            raise _key_error("Rock", ("law",), self.law, "{why}", why=str(error)) from None
+        if not is_rock_law_class(found.target):
+            kind = "a class that does not subclass rocklaw.base.RockLaw" if isinstance(found.target, type) else \
+                f"a {type(found.target).__name__}, not a class"
+            raise _key_error("Rock", ("law",), self.law, "{kind}: a scene's rock law is a class written as one, "
+                             "class MyLaw(RockLaw), and nothing else is constructed (docs/extending.md)", kind=kind)
         given = [key for keys in ROCK_LAW_KEYS.values() for key in keys if getattr(self, key) is not None]
         if given:
             raise _key_error("Rock", (given[0],), getattr(self, given[0]), "a key of the built-in laws; the keys of a "
                              "law of one's own go under rock.parameters")
-        target = law_class(self.law)
+        target = found.target
         parameters = check_parameters(target, self.parameters or {}, ("parameters",), "Rock", path=self.law)
+        module = found.import_path.partition(":")[0]
         try:
             law = target(**parameters)
         except (TypeError, ValueError) as error:
             raise _key_error("Rock", ("parameters",), self.parameters, "{law} refuses these parameters: {why}",
-                             law=self.law, why=str(error)) from None
+                             law=self.law, why=failure(error, module)) from None
+        except (Exception, SystemExit) as error:  # noqa: BLE001 - the user's constructor: its error is the user's
+            raise _key_error("Rock", ("law",), self.law, "the law's constructor failed: {why}",
+                             why=failure(error, module)) from None
         missing = missing_members(law)
         if missing:
             raise _key_error("Rock", ("law",), self.law, "not a rock law: it lacks {missing} of the interface "
@@ -151,7 +170,7 @@ class Rock(Strict):
         model): a Jenkins rock with the blow's threshold as a state (rocklaw.jenkins). A law of one's own
         is built from its parameters as given (the scene refuses the effects that would change it)."""
         if self.own_law:
-            target = law_class(self.law)
+            target = self.found.target
             return target(**check_parameters(target, self.parameters or {}, ("parameters",), "Rock"))
         rock = self.completed()
         if rock.law == "bilinear":

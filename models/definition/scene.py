@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
 
 from .drill_string import (
     EVERY_BODY,
@@ -41,6 +41,7 @@ from .formulations import (
     STEADY_STATES,
 )
 from .outputs import BODY_METRICS, METRICS, SERIES, Need, body_metric, metric_need, needs
+from .own_code import ALLOW_CODE, allowance, allowed_modules
 from .rock import JENKINS_VALUES, ROCK_LAW_KEYS, Rock, refuse_foreign_keys
 from .validation import InputError, parse, short, with_changes
 
@@ -243,13 +244,32 @@ class Scene(Strict):
         "equilibrium under the feed (and torque) with the bit pressed on the rock")
     extensions: dict[Name, Extension] | None = Field(
         None, description="Python extensions of the Exudyn model by name (models.definition.extensions)")
+    # the modules of one's own its reader allowed (models.definition.own_code): kept by copies, with_ and pickles
+    _allowed_code: tuple[str, ...] = PrivateAttr(())
 
-    def with_(self, changes: dict[str, Any], source: str = "Scene.with_") -> Scene:
+    @model_validator(mode="after")
+    def _keep_allowance(self, info: ValidationInfo) -> Scene:
+        self._allowed_code = allowance(info)
+        return self
+
+    @property
+    def allowed_code(self) -> tuple[str, ...]:
+        """The modules of one's own this scene may run (given by who read it, never by its file)."""
+        return self._allowed_code
+
+    def with_(self, changes: dict[str, Any], source: str = "Scene.with_", allow_code: Any = ()) -> Scene:
         """A validated copy with ``changes``: dotted key paths of the scene file -> values
         (``{"impact.frequency_hz": 70.0, "solver.formulation": "exact"}``; None removes a key). A bad
         value raises :class:`~rpdrill.models.definition.validation.InputError` naming the key path, the value and
-        what is allowed, as the command line reports a scene file."""
-        return with_changes(self, changes, source)
+        what is allowed, as the command line reports a scene file. The copy may run the code of one's own
+        this scene may, and the modules ``allow_code`` names besides (models.definition.own_code)."""
+        return with_changes(self, changes, source, {ALLOW_CODE: self._allowance(source, allow_code)})
+
+    def _allowance(self, source: str, allow_code: Any) -> tuple[str, ...]:
+        try:
+            return allowed_modules((*self._allowed_code, *allowed_modules(allow_code)))
+        except ValueError as error:
+            raise InputError(f"{source}: allow_code: {error}") from None
 
     def with_solver(self, formulation: str | None = None, **options: object) -> Scene:
         """This scene with another formulation (:func:`switch_formulation`) and/or other solver
@@ -261,7 +281,8 @@ class Scene(Strict):
                                  f"allowed: {', '.join(FORMULATIONS)}")
             solver = switch_formulation(solver, formulation)
         data = self.model_dump(by_alias=True, exclude_none=True)
-        return parse(Scene, {**data, "solver": {**solver, **options}}, "Scene.with_solver")
+        return parse(Scene, {**data, "solver": {**solver, **options}}, "Scene.with_solver",
+                     context={ALLOW_CODE: self._allowed_code})
 
     @model_validator(mode="after")
     def _feed_body_exists(self) -> Scene:

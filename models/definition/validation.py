@@ -160,10 +160,12 @@ def describe_validation_error(source: str, error: ValidationError, model: type[B
     return "\n".join(lines)
 
 
-def parse(model: type[ModelT], data: Any, source: str, prefix: tuple[Any, ...] = ()) -> ModelT:
-    """Validate ``data`` as ``model``; InputError with the described problems otherwise."""
+def parse(model: type[ModelT], data: Any, source: str, prefix: tuple[Any, ...] = (),
+          context: Mapping[str, Any] | None = None) -> ModelT:
+    """Validate ``data`` as ``model`` (``context``: pydantic's validation context, what the reader allows:
+    models.definition.own_code); InputError with the described problems otherwise."""
     try:
-        return model.model_validate(data)
+        return model.model_validate(data, context=None if context is None else dict(context))
     except ValidationError as error:
         failure = InputError(describe_validation_error(source, error, model, prefix))
         failure.problems = tuple((".".join(str(p) for p in item["loc"] if p != "function-after"), problem(item))
@@ -213,9 +215,11 @@ def check_path(model: type[BaseModel], source: str, key: str, path: str, base: d
         node = node.get(part)
 
 
-def with_changes(model: ModelT, changes: dict[str, Any], source: str) -> ModelT:
+def with_changes(model: ModelT, changes: dict[str, Any], source: str,
+                 context: Mapping[str, Any] | None = None) -> ModelT:
     """A validated copy of ``model`` with ``changes`` (dotted key path -> value, the keys of its file
-    format, ``None`` removes a key), or InputError naming ``source``, the key path and the value."""
+    format, ``None`` removes a key), validated with ``context`` (:func:`parse`), or InputError naming
+    ``source``, the key path and the value."""
     if not isinstance(changes, Mapping):
         raise InputError(f"{source}: changes: {short(changes)}: give a mapping of key paths to values, e.g. "
                          "{'impact.frequency_hz': 70.0}")
@@ -232,5 +236,5 @@ def with_changes(model: ModelT, changes: dict[str, Any], source: str) -> ModelT:
             node.pop(leaf, None)
         else:
             set_path(data, path, value)
-    return parse(type(model), data, source)
+    return parse(type(model), data, source, context=context)
 

@@ -26,9 +26,12 @@ from typing import Any
 
 import numpy as np
 
+from ..definition.own_code import blame
+from ..definition.validation import InputError
 from ..evaluation.results import SimulationResult
 from ..evaluation.run_record import OrbitRecord, Regime, SteadyStateRecord
 from ..evaluation.run_result import Result
+from ..evaluation.stability import SimulationFailed
 from ..solvers.simulation import Simulation
 from ..solvers.time_run import time_run
 from ..steady.section import section_of
@@ -46,9 +49,17 @@ def run(simulation: Simulation, progress: Callable[[float], None] | None = None,
     and the period it repeats (a neighbour had no periodic orbit: models.steady.regimes, step 2).
     ``solution_file``: a time run of the Exudyn formulation writes Exudyn's coordinates solution file there.
     ``source``: where the scene came from, as the result records it. The warnings shown while it runs (as
-    the caller's filters let them through) are also kept in the result's ``warnings``."""
+    the caller's filters let them through) are also kept in the result's ``warnings``. An error raised in the
+    code of one's own the scene names (an extension, a rock law) is a SimulationFailed naming it and the user's
+    line (models.definition.own_code.blame)."""
     with kept_warnings() as kept:
-        raw = _raw(simulation, progress, guess, cold_newton, solution_file)
+        try:
+            raw = _raw(simulation, progress, guess, cold_newton, solution_file)
+        except Exception as error:
+            why = blame(error, simulation.scene)  # the user's code raised it: a failed run, not rpdrill's error
+            if why is None or isinstance(error, (InputError, SimulationFailed)):
+                raise
+            raise SimulationFailed(f"scene '{simulation.name}': {why}") from None
     return Result(simulation.scene, raw, source=source, code=simulation.code_records(),
                   warnings=tuple(dict.fromkeys(kept)))
 

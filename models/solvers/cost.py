@@ -37,7 +37,7 @@ from ..definition.formulations import DEFAULT_PRESET
 from ..drill.piston import PISTON
 from ..drill.pulse import phase_pieces
 from ..evaluation.solver_settings import EXUDYN_PRESETS
-from ..evaluation.stability import element_rates
+from ..evaluation.stability import SimulationFailed, element_rates
 from ..waves.steps import STEPS_PER_PULSE, STEPS_PER_TRANSIT
 from .exact_system import sub_step
 from .simulation import Simulation
@@ -127,12 +127,17 @@ Part = tuple[Cause, float, float | None]
 
 def _extended(simulation: Simulation) -> tuple[Simulation, Cause | None]:
     """The simulation as the Exudyn model of a scene with extensions sizes it (the step of the assembled
-    system, models.solvers.exudyn_model), and the extensions as the cause when they made it faster."""
-    if not simulation.scene.extensions:
+    system, models.solvers.exudyn_model), and the extensions as the cause when they made it faster. Where an
+    extension fails on the model, the drill's own (the run fails and says why: models.solvers.exudyn_messages).
+    A step the scene fixes (``solver.step_s``) or the wave rods' is the step whatever they add: no model is built."""
+    if not simulation.scene.extensions or simulation.scene.solver.step_s is not None or simulation.dynamic_chain.waves:
         return simulation, None
     from .exudyn_model import build_exudyn  # Exudyn only for a scene with extensions
 
-    sized = build_exudyn(simulation).simulation
+    try:
+        sized = build_exudyn(simulation, graphics=False).simulation
+    except SimulationFailed:
+        return simulation, None
     faster = sized.spectral_radius_per_s > simulation.spectral_radius_per_s * (1 + 1e-9)
     return sized, Cause("extensions", ", ".join(simulation.scene.extensions)) if faster else None
 

@@ -1,7 +1,18 @@
 """What surrounds an Exudyn solve: what Exudyn prints, as one warning a line (the command line shows
 each as ``rpdrill: warning: ...``), Python's cyclic garbage collector paused while it runs, and the
 per-step functions that watch it (the guard of an automatic step, progress reports), the one
-pre-step function that runs them all in order, and Exudyn's simulation settings of a run."""
+pre-step function that runs them all in order, and Exudyn's simulation settings of a run.
+
+And before and while it runs, the user's code kept the user's: the scene's extensions
+(models.definition.extensions) called on the built model, which is then prepared with what they added
+(models.solvers.exudyn_user_items). What the user's code does wrong there ends the run as a failed run,
+``SimulationFailed`` (exit status 1 on the command line, a study's point ``failed``), with one message naming
+the scene, the extension's key (``extensions.NAME``), its name in the scene and the user's exception with the
+file and line of the user's code (models.definition.own_code.failure): the function raises, or calls
+``sys.exit`` (which would end a command with status 0 and no word); what it added cannot be prepared (a
+spring of NaN stiffness) or solved (a mass Exudyn cannot invert: :func:`solver_errors`). A body or connector
+it names that the model lacks (``model.bodies["colar"]``) is a ``KeyError`` listing those there are
+(:class:`NamedItems`)."""
 
 from __future__ import annotations
 
@@ -15,7 +26,9 @@ from typing import TYPE_CHECKING, Any
 
 from ...rocklaw.exudyn_module import exu
 from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
+from ..definition.own_code import failure
 from ..evaluation.stability import SimulationFailed
+from .exudyn_user_items import follow_extension_coordinates
 
 if TYPE_CHECKING:
     from .simulation import Simulation
@@ -155,3 +168,66 @@ def set_step(settings: Any, solver: Any) -> None:
     integration = settings.timeIntegration
     integration.numberOfSteps = round(solver.end_time_s / solver.step_s)
     integration.initialStepSize = solver.step_s / 10
+
+
+class UnknownName(KeyError):
+    """A name a built model does not have; its message lists the names there are."""
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+class NamedItems(dict):
+    """A built model's bodies or connectors by name (``model.bodies[name]``); a name it does not have is a
+    :class:`UnknownName` that lists them."""
+
+    def __init__(self, kind: str, items: dict[str, Any]) -> None:
+        super().__init__(items)
+        self.kind = kind
+
+    def __missing__(self, name: object) -> Any:
+        raise UnknownName(f"the built model has no {self.kind} {name!r}; its {self.kind} names: {', '.join(self)}")
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return NamedItems, (self.kind, dict(self))
+
+
+def apply_extensions(model: Any) -> None:
+    """The scene's extensions applied to the built ``model`` in their order, which is then prepared (the
+    coordinates they add followed where a steady-state run asks); SimulationFailed naming the extension and
+    the user's error (module doc)."""
+    scene = model.simulation.scene
+    for name, extension in (scene.extensions or {}).items():
+        try:
+            extension.apply(model)
+        except (Exception, SystemExit) as error:  # noqa: BLE001 - the user's code: its error is the user's
+            path = extension.found.import_path
+            raise SimulationFailed(f"scene '{scene.name}': extensions.{name} ({extension.function}) failed on the "
+                                   f"built model: {failure(error, path.partition(':')[0])}") from None
+    if not scene.extensions:
+        follow_extension_coordinates(model)
+        return
+    try:
+        follow_extension_coordinates(model)  # model.prepare(), the coordinates a steady-state run follows with it
+    except (ValueError, exu.ExudynError) as error:
+        raise SimulationFailed(f"scene '{scene.name}': the model with {_named(scene)} cannot be prepared: "
+                               f"{type(error).__name__}: {error}") from None
+
+
+def _named(scene: Any) -> str:
+    return ", ".join(f"extensions.{name} ({extension.function})" for name, extension in scene.extensions.items())
+
+
+@contextlib.contextmanager
+def solver_errors(model: Any) -> Iterator[None]:
+    """Exudyn's solver refusing the system (a mass matrix it cannot invert, a constraint its solver does not
+    take) as a failed run: SimulationFailed naming the scene, and the extensions or items of one's own
+    that the system holds beside the drill."""
+    try:
+        yield
+    except exu.ExudynError as error:
+        scene = model.simulation.scene
+        own = _named(scene) if scene.extensions else \
+            "items added to the built model" if model.user_items().keys() - {"sensors"} else None
+        raise SimulationFailed(f"scene '{scene.name}': Exudyn's solver stopped: {type(error).__name__}: {error}"
+                               + (f" (the system holds {own})" if own else "")) from None

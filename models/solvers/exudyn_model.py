@@ -72,6 +72,8 @@ from .exudyn_graphics import DrillGraphics, body_graphics, chain_cylinders, tors
 from .exudyn_messages import (
     SOLVER_TYPES,
     MinimumStepGuard,
+    NamedItems,
+    apply_extensions,
     exudyn_messages_as_warnings,
     no_cyclic_gc,
     pre_step,
@@ -79,6 +81,7 @@ from .exudyn_messages import (
     replaced_pre_step,
     set_step,
     simulation_settings,
+    solver_errors,
 )
 from .exudyn_piston import ExudynPiston
 from .exudyn_user_items import (
@@ -88,7 +91,6 @@ from .exudyn_user_items import (
     UserAccount,
     add_body,
     assembled_scales,
-    follow_extension_coordinates,
     item_counts,
     link_force_function,
     time_runs_only,
@@ -142,6 +144,7 @@ class ExudynModel:
     extension_sensors: list[Any] = field(default_factory=list)  # models.solvers.exudyn_user_items
 
     def __post_init__(self) -> None:
+        self.bodies, self.connectors = NamedItems("body", self.bodies), NamedItems("connector", self.connectors)
         self._account = UserAccount(*(self._built_items[kind] for kind in ("objects", "loads", "sensors")))
         self._install()
 
@@ -273,7 +276,7 @@ class ExudynModel:
         if warning:
             warnings.warn(warning, StepLimitWarning, stacklevel=3)
         blas = self.waves.single_threaded() if self.waves is not None else contextlib.nullcontext()
-        with no_cyclic_gc(), exudyn_messages_as_warnings(self.simulation.name), blas:
+        with no_cyclic_gc(), exudyn_messages_as_warnings(self.simulation.name), blas, solver_errors(self):
             start = time.process_time()
             ok = self.mbs.SolveDynamic(settings, solverType=self.solver_type)
             cpu = time.process_time() - start
@@ -328,7 +331,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True, graphics: bool 
     if simulation.dynamic_chain.waves:  # the string's bodies with mass, the rods an element (models.waves)
         model = WaveExudyn(simulation, symbolic).model(ExudynModel, ExudynBody, ExudynConnector,
                                                        simulation_settings(simulation), named)
-        _apply_extensions(model)
+        apply_extensions(model)
         return model
     chain, impact, piston = simulation.dynamic_chain, simulation.impact, simulation.piston
     initial_positions = simulation.initial_positions_m if piston is None else piston.parked(simulation.initial_positions_m)
@@ -428,25 +431,8 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True, graphics: bool 
     model = ExudynModel(simulation, chain, container, mbs, {body.name: body for body in bodies}, connectors, rock,
                         torsion, drawn, sensors, simulation_settings(simulation), [impact_function, *user_functions],
                         blows, hook, named, symbolic, _built_items=item_counts(mbs), _prepared_items=item_counts(mbs))
-    _apply_extensions(model)
+    apply_extensions(model)
     return model
-
-
-def _apply_extensions(model: ExudynModel) -> None:
-    """The scene's extensions (models.definition.extensions) applied to the built model, which is then
-    prepared (the coordinates they add followed where a steady-state run asks)."""
-    simulation = model.simulation
-    for name, extension in (simulation.scene.extensions or {}).items():
-        try:
-            extension.apply(model)
-        except Exception as error:
-            raise ExtensionFailed(f"scene '{simulation.name}': extensions.{name} ({extension.function}) failed on the "
-                                  f"built model: {type(error).__name__}: {error}") from error
-    follow_extension_coordinates(model)  # model.prepare(), the coordinates a steady-state run follows with it
-
-
-class ExtensionFailed(RuntimeError):
-    """An extension of the scene (models.definition.extensions) raised while it was applied to the model."""
 
 
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None,

@@ -169,8 +169,9 @@ def assembled_scales(model: Any) -> StepScales:
     scales = scales_of(eigenvalues, model.simulation.impact.period_s,
                        law.damping_n_s_per_m / model.chain.bodies[model.chain.bit_body].mass_kg)
     if not np.isfinite(scales.spectral_radius_per_s):
-        raise ValueError(f"scene '{model.simulation.name}': the assembled system's fastest rate overflows: an item "
-                         "of one's own has a stiffness or damping beyond floating point over its mass")
+        raise ValueError(f"scene '{model.simulation.name}': the assembled system's fastest rate is "
+                         f"{scales.spectral_radius_per_s}: an item of one's own has a mass, stiffness or damping that "
+                         "is not a finite number, or a stiffness or damping beyond floating point over its mass")
     return scales
 
 

@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 
 from ...rocklaw import RockLaw, State
-from ..definition.extensions import record, refusal
 from ..definition.extensions import records as extension_records
+from ..definition.extensions import refusal
 from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
 from ..definition.outputs import needs
 from ..definition.scene import (
@@ -159,7 +159,7 @@ class Simulation:
         if self.scene.extensions:
             records["extensions"] = extension_records(self.scene.extensions)
         if self.scene.rock.own_law:
-            records["rock_law"] = record(self.scene.rock.law)
+            records["rock_law"] = self.scene.rock.code_record()
         return records
 
     def resolved_scene(self) -> dict[str, Any]:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -19,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from ...models.evaluation.workprecision import Signature
 from ..figures.workprecision_figure import plot_workprecision
 from ..inputs.arguments import (
+    allow_code_problem,
     check,
     either,
     file_problem,
@@ -90,16 +92,19 @@ def _reference(study: AccuracyStudy, setting: Setting | None, what: str, cpu: di
     return signature
 
 
-def accuracy(study: AccuracyStudy | str | Path, options: RunOptions | None = None, **run: Any) -> AccuracyResult:
+def accuracy(study: AccuracyStudy | str | Path, options: RunOptions | None = None, *,
+             allow_code: Sequence[str] | str = (), **run: Any) -> AccuracyResult:
     """Run a work-precision study (or file) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
     ``workers``, ``dask``, ``out``, ``budget``, ``quiet``): into ``out`` (resumable: module doc) or a scratch
-    folder. InputError or BudgetError before anything runs, ReferenceFailed when a reference run fails."""
+    folder; ``allow_code``: the modules of one's own its scene may run (models.definition.own_code).
+    InputError or BudgetError before anything runs, ReferenceFailed when a reference run fails."""
     check(WHERE, "study", study,
           either(file_problem, instance_problem(AccuracyStudy, "a work-precision study file's path or its loaded study")))
     options = RunOptions.of(WHERE, options, run, TAKES)
+    check(WHERE, "allow_code", allow_code, allow_code_problem)
     folder = None if options.out is None else check_out(options.out, None, RECORD)
     if not isinstance(study, AccuracyStudy):
-        study = load_accuracy_study(study, options.budget)
+        study = load_accuracy_study(study, options.budget, allow_code)
     quiet = options.quiet
     wall: dict[str, float] = {}
     reference = _reference(study, study.reference, "reference", wall)

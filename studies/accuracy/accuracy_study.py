@@ -41,7 +41,7 @@ import signal
 import statistics
 import time
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -196,13 +196,14 @@ def _checked(setting: Setting, scene: Scene, spec: AccuracySpec, source: str, ke
     return setting.repeats * min(cost.cpu_s, spec.time_limit_s), solver
 
 
-def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> AccuracyStudy:
-    """Read, validate and expand a work-precision study, every run checked against the ``budget``;
+def load_accuracy_study(path: str | Path, budget: Budget = DEFAULT_BUDGET, allow_code: Sequence[str] | str = ()) -> AccuracyStudy:
+    """Read, validate and expand a work-precision study (``allow_code``: the modules of one's own its scene
+    may run), every run checked against the ``budget``;
     InputError naming file and key, BudgetError naming the cost, otherwise."""
     path = Path(shipped_path(path, "accuracy", "rpdrill.load_accuracy_study"))
     source = str(path)
     spec = parse(AccuracySpec, read_yaml(path), source)
-    base = spec.base(path)
+    base = spec.base(path, allow_code)
     scene = windowed_scene(base, spec.blows, f"{path} (base scene over blows: {spec.blows})")
     pulse_s = scene.impact.duration_s
     if spec.grid_interval_s > pulse_s / GRID_POINTS_PER_PULSE:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import sys
 import time
+from collections.abc import Sequence
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -59,7 +60,7 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
                  rocks: list[str] | None = None, power_kw: float | None = None, max_thrust_ratio: float = 1.0,
                  search: AdviceSearch | None = None, markdown: str | Path | None = None, command: str | None = None,
                  max_rod_stress_pa: float | None = None, options: RunOptions | None = None,
-                 **run: Any) -> list[Advice]:
+                 allow_code: Sequence[str] | str = (), **run: Any) -> list[Advice]:
     """Maximise ``metric`` over ``bounds`` (``{"impact.frequency_hz": (45, 70), "feed.force_n": (35e3,
     60e3)}``, optionally ``"impact.amplitude_n"`` and an extension's ``"extensions.NAME.parameters.KEY"``; SI
     units) for the scene's rock, or for each Table 1
@@ -69,7 +70,8 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     doc; new, empty or an earlier advice's, or any folder with ``overwrite``, which starts afresh there);
     ``markdown``: a copy of advice.md; ``command``: the command the report names (default: this call);
     ``max_rod_stress_pa``: the best point whose rods stay below this stress (rod_stress_max_pa, a scene with rods).
-    InputError before anything runs when an input cannot be used."""
+    InputError before anything runs when an input cannot be used; ``allow_code``: the modules of one's own the
+    scene may run (models.definition.own_code)."""
     where = "rpdrill.advise"
     check(where, "bounds", bounds, bounds_problem)
     check(where, "metric", metric, choice_problem(METRICS, "metric"))
@@ -84,7 +86,7 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     folder = None if out is None else check_out(out, overwrite, CHECKPOINT)
     if markdown is not None:
         check_file_target("--markdown", markdown)
-    data, source = scene_and_source(scene, where)
+    data, source = scene_and_source(scene, where, allow_code)
     allowed = [entry.path for entry in PARAMETERS]
     own = [f"extensions.{name}.parameters.KEY" for name in data.extensions or {}]  # an extension's parameter
     for path in bounds:

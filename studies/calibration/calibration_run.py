@@ -13,6 +13,7 @@ import contextlib
 import shutil
 import sys
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -21,6 +22,7 @@ from tqdm import tqdm
 
 from ...models.definition.scene import Scene
 from ..inputs.arguments import (
+    allow_code_problem,
     check,
     either,
     file_problem,
@@ -67,20 +69,22 @@ class CalibrationResult:
         return {} if self.final is None else {r.label: r.optimum for r in self.final.results}
 
 
-def calibrate(calibration: Calibration | str | Path, options: RunOptions | None = None,
-              **run: Any) -> CalibrationResult:
+def calibrate(calibration: Calibration | str | Path, options: RunOptions | None = None, *,
+              allow_code: Sequence[str] | str = (), **run: Any) -> CalibrationResult:
     """Fit a calibration file's parameters (module doc) as ``options`` say (rpdrill.RunOptions, or its names as
     keywords: ``workers``, ``dask``, ``out``, ``overwrite``, ``budget``, ``quiet``): into ``out`` (resumable; a
     folder holding anything else, or another calibration, is refused unless ``overwrite``, which starts
     afresh there) or a scratch folder. InputError or BudgetError before anything runs. An ``out`` that was
-    new is removed again when no evaluation has a best (nothing to keep)."""
+    new is removed again when no evaluation has a best (nothing to keep). ``allow_code``: the modules of one's
+    own its scenes may run (models.definition.own_code), never read from the file."""
     check(WHERE, "calibration", calibration,
           either(file_problem, instance_problem(Calibration, "a calibration file's path or its loaded Calibration")))
     options = RunOptions.of(WHERE, options, run)
+    check(WHERE, "allow_code", allow_code, allow_code_problem)
     workers, dask, quiet, overwrite = options.workers, options.dask, options.quiet, options.overwrite
     folder = None if options.out is None else check_out(options.out, overwrite, CHECKPOINT)
     if not isinstance(calibration, Calibration):
-        calibration = load_calibration(calibration, options.budget)
+        calibration = load_calibration(calibration, options.budget, allow_code)
     spec = calibration.spec
     with tempfile.TemporaryDirectory(prefix="rpdrill-calibration-") as scratch:
         target = folder or Path(scratch) / "calibration"

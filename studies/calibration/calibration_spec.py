@@ -29,6 +29,7 @@ import hashlib
 import itertools
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from types import UnionType
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
@@ -354,13 +355,14 @@ def scans_per_evaluation(spec: CalibrationSpec) -> int:
     return len({json.dumps([t.overrides, t.metric or spec.metric], sort_keys=True) for t in spec.targets})
 
 
-def load_calibration(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> Calibration:
-    """Read and validate a calibration file, its runs checked against the ``budget``; InputError naming
+def load_calibration(path: str | Path, budget: Budget = DEFAULT_BUDGET, allow_code: Sequence[str] | str = ()) -> Calibration:
+    """Read and validate a calibration file (``allow_code``: the modules of one's own its scenes may run), its
+    runs checked against the ``budget``; InputError naming
     the file, key path and value, BudgetError naming the cost, otherwise."""
     path = Path(shipped_path(path, "calibration", "rpdrill.load_calibration"))
     source = str(path)
     spec = parse(CalibrationSpec, read_yaml(path), source)
-    base = spec.base(path)
+    base = spec.base(path, allow_code)
     _check_parameters(spec, base, source)
     evaluations = spec.search.evaluations(len(spec.parameters))
     scans, count = scans_per_evaluation(spec), spec.frequency_hz.count

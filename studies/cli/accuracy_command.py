@@ -34,7 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        result = accuracy(args.study, run_options(args, *TAKES))
+        result = accuracy(args.study, run_options(args, *TAKES), allow_code=args.allow_code)
     except ReferenceFailed as error:
         print(error, file=sys.stderr)
         return 1

@@ -19,7 +19,14 @@ from ..display.catalogue import parameter
 from ..inputs.arguments import choice_problem, cli_type
 from ..runtime.evaluation_log import CHECKPOINT, EVALUATIONS
 from ..runtime.output_files import check_file_target, check_out
-from .options import add_runner_arguments, positive_count, positive_number, run_options, seed
+from .options import (
+    add_allow_code_argument,
+    add_runner_arguments,
+    positive_count,
+    positive_number,
+    run_options,
+    seed,
+)
 
 FILES = f"""files written to DIR (an interrupted advice keeps its points there: the same command again
 replays them and runs the rest):
@@ -73,6 +80,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=seed, default=AdviceSearch.seed, help=f"random seed (default {AdviceSearch.seed})")
     parser.add_argument("--markdown", type=Path, help="also write advice.md to this file (e.g. docs/advice.md)")
     add_runner_arguments(parser)
+    add_allow_code_argument(parser)
 
 
 def command_line(args: argparse.Namespace) -> str:
@@ -99,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
                            AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed),
                            args.markdown, command_line(args),
                            max_rod_stress_pa=args.max_rod_stress_mpa * 1e6 if args.max_rod_stress_mpa else None,
-                           options=run_options(args, *ADVISE_OPTIONS))
+                           options=run_options(args, *ADVISE_OPTIONS), allow_code=args.allow_code)
     for advice in advices:
         print(advice_text(advice))
     print(best_table(advices))

@@ -29,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    result = calibrate(args.calibration, run_options(args, *FIELDS))
+    result = calibrate(args.calibration, run_options(args, *FIELDS), allow_code=args.allow_code)
     if result.best is None:
         which = f"targets {', '.join(result.failed_targets)}: every run" if result.failed_targets else "every simulation"
         print(f"{args.calibration}: {which} of all {len(result.records)} evaluations failed; first error: "

@@ -14,7 +14,7 @@ from ..figures.crosscheck_figure import plot_overlay
 from ..inputs.arguments import choice_problem, cli_type
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import check_out, staged_directory, write_json
-from .options import add_budget_arguments, budget, positive_count, positive_number
+from .options import add_allow_code_argument, add_budget_arguments, budget, positive_count, positive_number
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -28,13 +28,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar="{" + ",".join(ODE_METHODS) + "}", help="ODE method (default DOP853)")
     parser.add_argument("--rtol", type=positive_number, default=1e-10, help="ODE relative tolerance (default 1e-10)")
     add_budget_arguments(parser, many_runs=False)
+    add_allow_code_argument(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     if args.out:
         check_out(args.out, args.overwrite)
     try:
-        check = crosscheck(args.scene, args.blows, args.step, args.method, args.rtol, budget(args))
+        check = crosscheck(args.scene, args.blows, args.step, args.method, args.rtol, budget(args), args.allow_code)
     except SimulationFailed as err:
         raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
         print(f"{args.scene}: {err}", file=sys.stderr)

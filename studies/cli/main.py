@@ -4,7 +4,9 @@ Exit status: 0 success, 1 a run failed, a check did not pass or a budget was exc
 (studies.runtime.budgets), 2 bad input (also: another command writes into ``--out``, whose lock it
 holds: studies.runtime.out_lock), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM: stopped as for
 Ctrl-C, finished results kept). An unexpected exception is a bug: one line naming the input and
-where it was raised, exit status 1, no traceback. While a command runs, a warning prints as one
+where it was raised, exit status 1, no traceback; one that code of one's own a scene named raised is a run
+that failed: one line naming that code and the user's line (models.definition.own_code.blame_resolved).
+While a command runs, a warning prints as one
 line, ``rpdrill: warning: ...`` (warnings of worker processes come back to this process and print
 here, once each: studies.runtime.pools).
 
@@ -110,6 +112,7 @@ def _version() -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from ...models.definition.own_code import blame_resolved
     from ..inputs.reading import InputError
     from ..runtime.budgets import BudgetError
     from ..runtime.interrupts import Terminated, WorkerLost, raise_if_stopped, stops_handled
@@ -153,6 +156,10 @@ def main(argv: list[str] | None = None) -> int:
         where = traceback.extract_tb(err.__traceback__)[-1]
         source = next((getattr(args, key) for key in ("scene", "study", "calibration", "sensitivity", "reproduction", "runs")
                        if hasattr(args, key)), "")
+        own = blame_resolved(err)  # the code of one's own a scene named raised it: a run that failed, not a bug
+        if own is not None:
+            print(f"{source}: {own}", file=sys.stderr)
+            return 1
         print(f"{source}: rpdrill internal error: {type(err).__name__}: {err} (at {Path(where.filename).name}:"
               f"{where.lineno}); please report it with this input", file=sys.stderr)
         return 1

@@ -10,6 +10,7 @@ from ..inputs.arguments import (
     cli_type,
     count_problem,
     dask_problem,
+    module_problem,
     number,
     positive_problem,
     seed_problem,
@@ -25,8 +26,20 @@ positive_count = cli_type(count_problem, whole_number)  # a whole number of at l
 worker_count = cli_type(workers_problem, whole_number)  # 1 to WORKERS_PER_CORE x the machine's cores
 seed = cli_type(seed_problem, whole_number)  # 0 to 2^32 - 1
 dask_address = cli_type(dask_problem)  # tcp://host:port or host:port
+module_name = cli_type(module_problem)  # a Python module's dotted name
 
 __all__ = ["WORKERS_PER_CORE", "dask_address", "positive_count", "positive_number", "seed", "worker_count"]
+
+
+def add_allow_code_argument(parser: argparse.ArgumentParser) -> None:
+    """``--allow-code MODULE`` (repeated for several): the modules of one's own the command's scenes may run,
+    named by import path as an extension's function or a rock law (models.definition.own_code); a scene file
+    never allows any itself."""
+    parser.add_argument("--allow-code", action="append", default=[], type=module_name, metavar="MODULE",
+                        help="run the code of MODULE (and its submodules) that the scene names by import path "
+                             "(module:function), as an extension or a rock law; repeat for several. A scene runs no "
+                             "code of one's own otherwise, except what installed packages register "
+                             "(entry point groups rpdrill.extensions, rpdrill.rock_laws)")
 
 
 def add_budget_arguments(parser: argparse.ArgumentParser, many_runs: bool = True) -> None:
@@ -61,6 +74,7 @@ def add_resumable_arguments(parser: argparse.ArgumentParser, name: str, help: st
     parser.add_argument("--out", required=True, help="output directory: new, empty, or this command's own (to resume)")
     add_runner_arguments(parser)
     add_budget_arguments(parser)
+    add_allow_code_argument(parser)
 
 
 def add_runner_arguments(parser: argparse.ArgumentParser, dask: bool = True) -> None:

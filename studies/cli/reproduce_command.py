@@ -20,7 +20,7 @@ import sys
 from pathlib import Path
 
 from ..pages.reproduction_run import DEFAULT, reproduce
-from .options import add_runner_arguments, run_options
+from .options import add_allow_code_argument, add_runner_arguments, run_options
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -32,11 +32,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sensitivity", type=Path, help="output directory of `rpdrill sensitivity` for sensitivity.md")
     parser.add_argument("--docs", type=Path, help="also copy the pages and figures into this folder (e.g. docs)")
     add_runner_arguments(parser)
+    add_allow_code_argument(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     result = reproduce(args.reproduction, args.calibration, args.sensitivity, args.docs,
-                       options=run_options(args, "workers", "dask", "out", "overwrite"))
+                       options=run_options(args, "workers", "dask", "out", "overwrite"), allow_code=args.allow_code)
     trends = result.trends
     print(f"{result.reproduction.spec.name}: {sum(t['rises'] for t in trends)} of {len(trends)} trends hold; "
           f"{len(result.reached)} of {len(result.stated)} optima the paper states reached within "

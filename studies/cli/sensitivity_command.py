@@ -22,7 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    result = sensitivity(args.sensitivity, run_options(args, *TAKES))
+    result = sensitivity(args.sensitivity, run_options(args, *TAKES), allow_code=args.allow_code)
     name, summary = result.study.spec.name, result.summary
     for metric, figures_of in summary["metrics"].items():
         top = ", ".join(f"{p} {v:.1%}" for p, v in list(figures_of["parameters_by_peak_change"].items())[:4])

@@ -30,7 +30,7 @@ from ..runtime.output_files import (
     staged_directory,
 )
 from ..runtime.progress import time_progress
-from .options import add_budget_arguments, budget
+from .options import add_allow_code_argument, add_budget_arguments, budget
 
 HEADLINE = ("penetration_rate_m_per_s", "advance_per_blow_m", "energy_transfer_efficiency",
             "energy_balance_relative_error")
@@ -49,16 +49,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="also drill.gif (the last blows, displacements magnified) and, with the exudyn formulation, "
                              "Exudyn's solution file solution.txt for its SolutionViewer")
     add_budget_arguments(parser, many_runs=False)
+    add_allow_code_argument(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     check_out(args.out, args.overwrite)
-    scene = load_scene(args.scene)
+    scene = load_scene(args.scene, args.allow_code)
     with tempfile.TemporaryDirectory() as scratch:  # the solution file, kept until the animation is drawn
         try:
             with time_progress(scene.solver.end_time_s, scene.name, enabled=not args.quiet) as progress:
                 solution = Path(scratch) / SOLUTION_FILE if args.animate else None
-                result = simulate(args.scene, args.formulation, progress, budget(args), solution_file=solution)
+                result = simulate(args.scene, args.formulation, progress, budget(args), solution_file=solution,
+                                  allow_code=args.allow_code)
                 solution = solution if solution is not None and solution.exists() else None
         except SimulationFailed as err:
             raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
@@ -80,5 +82,5 @@ def run(args: argparse.Namespace) -> int:
     print(f"{result.scene.name} ({result.formulation}{regime}): {shown or 'no metrics asked for'}; wrote {args.out}")
     if solution is not None:
         print(f"Exudyn's viewer: python -c \"from rpdrill.studies.drawings.drill_animation import view_solution; "
-              f"view_solution('{args.out}')\"")
+              f"view_solution('{args.out}'{f', allow_code={args.allow_code!r}' if args.allow_code else ''})\"")
     return 0

@@ -64,7 +64,8 @@ def report(run: StudyRun) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    runs = run_study_files(args.study, run_options(args, *STUDY_OPTIONS), formulation=args.formulation)
+    runs = run_study_files(args.study, run_options(args, *STUDY_OPTIONS), formulation=args.formulation,
+                           allow_code=args.allow_code)
     for study_run in runs:
         report(study_run)
     useless = [study_run.study.source for study_run in runs if not study_run.table["status"].isin(USABLE).any()]

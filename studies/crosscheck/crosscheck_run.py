@@ -4,6 +4,7 @@ returns both runs with their comparison; ``rpdrill crosscheck`` is this function
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -43,17 +44,19 @@ class Crosscheck:
 
 
 def crosscheck(scene: Scene | str | Path, blows: int = 20, step_s: float = DEFAULT_STEP_S, method: str = "DOP853",
-               rtol: float = 1e-10, budget: Budget | None = DEFAULT_BUDGET) -> Crosscheck:
+               rtol: float = 1e-10, budget: Budget | None = DEFAULT_BUDGET,
+               allow_code: Sequence[str] | str = ()) -> Crosscheck:
     """The Exudyn model (the scene's solver type at ``step_s``) against the ODE (``method`` at relative
     tolerance ``rtol``) over the first ``blows`` impact periods. InputError or BudgetError before
-    anything runs; SimulationFailed when a run diverges."""
+    anything runs; SimulationFailed when a run diverges. ``allow_code``: the modules of one's own the scene may
+    run (models.definition.own_code)."""
     where = "rpdrill.crosscheck"
     check(where, "blows", blows, count_problem)
     check(where, "step_s", step_s, positive_problem)
     check(where, "method", method, choice_problem(ODE_METHODS, "method"))
     check(where, "rtol", rtol, positive_problem)
     check(where, "budget", budget, instance_problem(Budget, "a rpdrill Budget or None", optional=True))
-    scene, source = scene_and_source(scene, where)
+    scene, source = scene_and_source(scene, where, allow_code)  # (allow_code checked there)
     windows = window_scenes(scene, blows, step_s, method, rtol, source)
     simulations = [prepare_scene(window, source) for window in windows]
     if budget is not None:

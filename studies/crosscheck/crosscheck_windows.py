@@ -17,6 +17,7 @@ overlay plot DIR/crosscheck.png.
 
 from __future__ import annotations
 
+from ...models.definition.own_code import ALLOW_CODE
 from ...models.definition.scene import Scene
 from ..inputs.reading import parse
 
@@ -33,7 +34,8 @@ def window_scenes(scene: Scene, blows: int, step_s: float, method: str, rtol: fl
     solvers = ({"formulation": "exudyn", "type": scene.solver.type or "rk44", "step_s": step_s},
                {"formulation": "ode", "method": method, "relative_tolerance": rtol, "absolute_tolerance": rtol * 1e-3})
     where = f"{source} (cross-check: --blows {blows}, --step {step_s:g}, --rtol {rtol:g})"
-    return tuple(parse(Scene, {**data, "solver": {**window, **solver}}, where) for solver in solvers)
+    allowed = {ALLOW_CODE: scene.allowed_code}  # the code of one's own the scene may run
+    return tuple(parse(Scene, {**data, "solver": {**window, **solver}}, where, context=allowed) for solver in solvers)
 
 
 def comparison_table(report: dict, checks: dict) -> str:

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -129,9 +129,10 @@ def write_animation(result: SimulationResult | Result | ExudynModel, path: str |
     return factor
 
 
-def load_solution(run: str | Path | ExudynModel) -> tuple[ExudynModel, dict]:
+def load_solution(run: str | Path | ExudynModel, allow_code: Sequence[str] | str = ()) -> tuple[ExudynModel, dict]:
     """A run's Exudyn model and its solution file as Exudyn reads it: a run folder's scene rebuilt (its
-    extensions applied) and its ``solution.txt``, or a model that ran with ``model.write_solution(path)``.
+    extensions applied: ``allow_code``, the modules of one's own it may run, models.definition.own_code) and its
+    ``solution.txt``, or a model that ran with ``model.write_solution(path)``.
     InputError when the solution does not fit the model (a run with items added in Python that its scene
     does not name)."""
     from exudyn.utilities import LoadSolutionFile
@@ -140,7 +141,8 @@ def load_solution(run: str | Path | ExudynModel) -> tuple[ExudynModel, dict]:
 
     if isinstance(run, (str, Path)):
         check("rpdrill.view_solution", "run", run, folder_problem)
-        source, model = Path(run) / SOLUTION_FILE, build_exudyn(load_scene(Path(run) / RESOLVED_SCENE))
+        scene = load_scene(Path(run) / RESOLVED_SCENE, allow_code)
+        source, model = Path(run) / SOLUTION_FILE, build_exudyn(scene)
     elif built_model_problem(run) is not None:
         check("rpdrill.view_solution", "run", run, built_model_problem)
     elif run.solution_path is None:
@@ -156,13 +158,14 @@ def load_solution(run: str | Path | ExudynModel) -> tuple[ExudynModel, dict]:
     return model, solution
 
 
-def view_solution(run: str | Path | ExudynModel) -> None:
-    """Play a run folder's ``solution.txt`` on its scene's Exudyn model (its extensions applied), or a model's
+def view_solution(run: str | Path | ExudynModel, allow_code: Sequence[str] | str = ()) -> None:
+    """Play a run folder's ``solution.txt`` on its scene's Exudyn model (its extensions applied, their modules
+    allowed by ``allow_code``: :func:`load_solution`), or a model's
     own solution file, in Exudyn's SolutionViewer (module doc; it needs a display: without one Exudyn's
     renderer aborts the process)."""
     import exudyn.interactive
 
-    model, solution = load_solution(run)
+    model, solution = load_solution(run, allow_code)
     exudyn.interactive.SolutionViewer(model.mbs, solution)
 
 

@@ -19,6 +19,7 @@ from numbers import Real
 from typing import Any
 from urllib.parse import urlsplit
 
+from ...models.definition.own_code import allowed_modules, module_name_problem
 from ...models.definition.validation import InputError, short
 
 WORKERS_PER_CORE = 4  # more workers only share the cores, each holding its own copy of the model
@@ -155,6 +156,20 @@ def bounds_problem(value: Any) -> str | None:
         if not pair[0] < pair[1]:
             return f"{path}: {short(pair)}: the lower bound must be below the upper bound"
     return None
+
+
+def allow_code_problem(value: Any) -> str | None:
+    """The modules of one's own a call allows a scene to run (models.definition.own_code): a module name,
+    or a list or tuple of them (none: ``()``)."""
+    try:
+        allowed_modules(value)
+    except ValueError as error:
+        return str(error)
+    return None
+
+
+# the command line's --allow-code MODULE: one module name (the option repeats)
+module_problem = module_name_problem
 
 
 def rows_problem(value: Any) -> str | None:

@@ -12,13 +12,15 @@ YAML 1.2's section 5.2 does) is refused as such.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from ...models.definition.own_code import allowed_modules, context
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, parse, short
 from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
-from .arguments import check, scene_file_problem
+from .arguments import allow_code_problem, check, scene_file_problem
 from .shipped import shipped_path
 from .strict_yaml import MAX_DEPTH, MAX_VALUES, parse_yaml
 
@@ -96,21 +98,28 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
     return parse_yaml(read_text(path), str(path))
 
 
-def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file, or a shipped scene by its name (``"paper_base"``: studies.inputs.shipped)."""
+def load_scene(path: str | Path, allow_code: Sequence[str] | str = ()) -> Scene:
+    """Read and validate a scene file, or a shipped scene by its name (``"paper_base"``: studies.inputs.shipped);
+    ``allow_code``: the modules of one's own the scene may run (an extension's function, a rock law named by
+    import path: models.definition.own_code), never read from the file."""
     check("rpdrill.load_scene", "path", path, scene_file_problem)
+    check("rpdrill.load_scene", "allow_code", allow_code, allow_code_problem)
     path = shipped_path(path, "scene", "rpdrill.load_scene")
-    return parse(Scene, read_yaml(path), str(path))
+    return parse(Scene, read_yaml(path), str(path), context=context(allowed_modules(allow_code)))
 
 
-def scene_and_source(scene: Scene | str | Path, function: str = "rpdrill") -> tuple[Scene, str]:
+def scene_and_source(scene: Scene | str | Path, function: str = "rpdrill",
+                     allow_code: Sequence[str] | str = ()) -> tuple[Scene, str]:
     """A validated scene (given, or read from a file) and the name its messages use; ``function``: the
-    library call whose argument it is, for the message when it is neither."""
+    library call whose argument it is, for the message when it is neither; ``allow_code``: the modules of
+    one's own it may run besides those a given scene may (models.definition.own_code)."""
+    check(function, "allow_code", allow_code, allow_code_problem)
     if isinstance(scene, Scene):
-        return scene, f"scene {scene.name!r}"
+        allowed = scene if not allow_code else scene.with_({}, f"{function}: scene", allow_code)
+        return allowed, f"scene {scene.name!r}"
     check(function, "scene", scene, scene_file_problem)
     path = shipped_path(scene, "scene", function)
-    return load_scene(path), str(path)
+    return load_scene(path, allow_code), str(path)
 
 
 def prepare_scene(scene: Scene, source: str, where: str = "") -> Simulation:

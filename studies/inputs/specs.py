@@ -9,12 +9,14 @@ maps dotted scene paths to values, each replacing what is at that path (``solver
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ...models.definition.outputs import METRICS
+from ...models.definition.own_code import allowed_modules, context
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, check_path, parse
 from .reading import read_yaml
@@ -40,19 +42,21 @@ class SceneSpec(StrictSpec):
     base_scene: str | dict[str, Any]
     base_overrides: dict[str, Any] = Field(default_factory=dict)
 
-    def base(self, source: Path) -> Scene:
+    def base(self, source: Path, allow_code: Sequence[str] | str = ()) -> Scene:
         """The base scene, validated, with the overrides (``Scene.with_``: the scene keeps what its file
         gives, so that a scanned ``rock.name`` still supplies the rock's values); InputError naming
-        ``source`` (and the scene file, or ``base_overrides``) otherwise."""
+        ``source`` (and the scene file, or ``base_overrides``) otherwise. ``allow_code``: the modules of
+        one's own the scene may run (models.definition.own_code), the reader's, never the file's."""
+        allowed = context(allowed_modules(allow_code))
         if isinstance(self.base_scene, str):
             path = source.parent / self.base_scene
             try:
                 data = read_yaml(path)
             except InputError as error:
                 raise InputError(f"{source}: base_scene: {self.base_scene!r}: {error}") from None
-            scene = parse(Scene, data, str(path))
+            scene = parse(Scene, data, str(path), context=allowed)
         else:
-            scene = parse(Scene, self.base_scene, str(source), ("base_scene",))
+            scene = parse(Scene, self.base_scene, str(source), ("base_scene",), context=allowed)
         return scene.with_(dict(self.base_overrides), f"{source}: base_overrides") if self.base_overrides else scene
 
 

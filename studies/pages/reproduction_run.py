@@ -18,6 +18,7 @@ import importlib.metadata
 import shlex
 import shutil
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,7 @@ from typing import Any
 from ..calibration.calibration_spec import load_calibration
 from ..figures.paper_figures import draw_figure
 from ..inputs.arguments import (
+    allow_code_problem,
     check,
     file_problem,
     folder_problem,
@@ -118,17 +120,19 @@ def made_by(file: Path, reproduction: Reproduction, out: Path | None, calibratio
 
 def reproduce(reproduction: str | Path = DEFAULT, calibration: str | Path | None = None,
               sensitivity: str | Path | None = None, docs: str | Path | None = None, options: RunOptions | None = None,
-              **run: Any) -> ReproductionResult:
+              *, allow_code: Sequence[str] | str = (), **run: Any) -> ReproductionResult:
     """Reproduce the paper (module doc) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
     ``workers``, ``dask``, ``out``, ``overwrite``); ``calibration``, ``sensitivity``: the ``--out`` folders of
     ``rpdrill calibrate`` and ``rpdrill sensitivity`` for parameters.md and sensitivity.md. ``out`` must be
-    new, empty or an earlier reproduction's (``overwrite``: any folder). InputError before anything runs."""
+    new, empty or an earlier reproduction's (``overwrite``: any folder). ``allow_code``: the modules of one's own
+    its scenes may run (models.definition.own_code). InputError before anything runs."""
     where = "rpdrill.reproduce"
     check(where, "reproduction", reproduction, file_problem)
     for name, value in (("calibration", calibration), ("sensitivity", sensitivity), ("docs", docs)):
         check(where, name, value, optional(folder_problem))
     options = RunOptions.of(where, options, run, ("workers", "dask", "out", "overwrite"))
     out, workers, dask, overwrite = options.out, options.workers, options.dask, options.overwrite
+    check(where, "allow_code", allow_code, allow_code_problem)
     file = Path(reproduction)
     folder = None if out is None else check_out(out, overwrite, "reproduction.json")
     docs_folder = None if docs is None else check_out(docs, True, option="--docs")
@@ -137,10 +141,10 @@ def reproduce(reproduction: str | Path = DEFAULT, calibration: str | Path | None
     for option, command in (("calibration", "calibrate"), ("sensitivity", "sensitivity")):
         if runs[option] is not None and not runs[option].is_dir():
             raise InputError(f"--{option}: {runs[option]}: not a folder; give the --out of `rpdrill {command}`")
-    loaded = load_reproduction(file)
+    loaded = load_reproduction(file, allow_code)
     # only the calibration's bounds and reasons are read (its search is not run): no limit on its CPU estimate
     calibration_file = None if loaded.calibration_file is None else \
-        load_calibration(loaded.calibration_file, Budget(accept_long=True))
+        load_calibration(loaded.calibration_file, Budget(accept_long=True), allow_code)
     with pool(dask, workers) as (label, runner):
         print(f"{loaded.spec.name}: {len(loaded.spec.cases)} cases x {len(loaded.frequencies_hz)} "
               f"frequencies on {label}", file=sys.stderr)

@@ -16,6 +16,7 @@ the result depends on.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -153,11 +154,12 @@ class CaseResult:
     silent_from_hz: float | None
 
 
-def load_reproduction(path: str | Path) -> Reproduction:
-    """Read and validate a reproduction file; InputError naming the file and key otherwise."""
+def load_reproduction(path: str | Path, allow_code: Sequence[str] | str = ()) -> Reproduction:
+    """Read and validate a reproduction file (``allow_code``: the modules of one's own its scenes may run);
+    InputError naming the file and key otherwise."""
     path = Path(shipped_path(path, "reproduction", "rpdrill.load_reproduction"))
     spec = parse(ReproductionSpec, read_yaml(path), str(path))
-    base = spec.base(path)
+    base = spec.base(path, allow_code)
     for i, case in enumerate(spec.cases):
         for key in case.overrides:
             check_scene_path(str(path), f"cases.{i}.overrides", key, base)

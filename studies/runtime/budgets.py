@@ -93,9 +93,11 @@ DEFAULT_BUDGET = Budget()
 
 def base_estimate_s(source: str, base: Scene, changes: Mapping[str, Any] | None = None) -> float:
     """Estimated CPU seconds of a run of ``base`` with ``changes`` (0 when it does not prepare: its points
-    will say why)."""
+    will say why), before the points are expanded: the drill without its extensions (a lower bound; each
+    point's estimate sizes the model its extensions make, so that they run once a point here, not more)."""
+    plain = {**(changes or {}), "extensions": None} if base.extensions else changes
     try:
-        return run_cost(prepare_point(base, {}, source, changes)).cpu_s
+        return run_cost(prepare_point(base, {}, source, plain)).cpu_s
     except InputError:
         return 0.0
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -45,7 +46,14 @@ from ...models.definition.formulations import FORMULATIONS
 from ...models.definition.scene import Scene
 from ...models.definition.validation import short
 from ...models.solvers.simulation import Simulation
-from ..inputs.arguments import check, choice_problem, file_problem, instance_problem, optional
+from ..inputs.arguments import (
+    allow_code_problem,
+    check,
+    choice_problem,
+    file_problem,
+    instance_problem,
+    optional,
+)
 from ..inputs.reading import InputError, parse, read_yaml
 from ..inputs.shipped import shipped_path
 from ..inputs.specs import METRIC_NAMES, Axis, MetricName, SceneSpec, StrictSpec, check_scene_path
@@ -198,17 +206,20 @@ def _check_plots(spec: StudySpec, axes: dict[str, list[Any]], source: str) -> No
                                  f"metrics: {', '.join(spec.metrics)}")
 
 
-def load_study(path: str | Path, formulation: str | None = None, budget: Budget = DEFAULT_BUDGET) -> Study:
+def load_study(path: str | Path, formulation: str | None = None, budget: Budget = DEFAULT_BUDGET,
+               allow_code: Sequence[str] | str = ()) -> Study:
     """Read, validate and expand a study file, every point with ``formulation`` when given (the base
     scene's solver options of another formulation dropped) and checked against the ``budget`` before it
-    runs; InputError naming the file and key path, BudgetError naming the cost, otherwise."""
+    runs; ``allow_code``: the modules of one's own its scenes may run (models.definition.own_code), never
+    read from the file. InputError naming the file and key path, BudgetError naming the cost, otherwise."""
     check("rpdrill.load_study", "path", path, file_problem)
     check("rpdrill.load_study", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
     check("rpdrill.load_study", "budget", budget, instance_problem(Budget, "a rpdrill Budget"))
+    check("rpdrill.load_study", "allow_code", allow_code, allow_code_problem)
     path = Path(shipped_path(path, "study", "rpdrill.load_study"))
     source = str(path)
     spec = parse(StudySpec, read_yaml(path), source)
-    base = spec.base(path)
+    base = spec.base(path, allow_code)
     if formulation is not None:
         base = base.with_solver(formulation)
     for axis in spec.scan:

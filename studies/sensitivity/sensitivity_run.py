@@ -10,12 +10,14 @@ and SVG); without ``out`` the table lives in a scratch folder removed after, and
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..figures.tornado_figures import draw_tornados
 from ..inputs.arguments import (
+    allow_code_problem,
     check,
     either,
     file_problem,
@@ -71,17 +73,19 @@ class SensitivityResult:
         return self.table[self.table["status"] != "ok"]
 
 
-def sensitivity(study: SensitivityStudy | str | Path, options: RunOptions | None = None,
-                **run: Any) -> SensitivityResult:
+def sensitivity(study: SensitivityStudy | str | Path, options: RunOptions | None = None, *,
+                allow_code: Sequence[str] | str = (), **run: Any) -> SensitivityResult:
     """Run a sensitivity study (or file) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
     ``workers``, ``dask``, ``out``, ``budget``, ``quiet``): into ``out`` (resumable: module doc) or a scratch
-    folder. InputError or BudgetError before anything runs."""
+    folder; ``allow_code``: the modules of one's own its scenes may run (models.definition.own_code).
+    InputError or BudgetError before anything runs."""
     check(WHERE, "study", study,
           either(file_problem, instance_problem(SensitivityStudy, "a sensitivity file's path or its loaded study")))
     options = RunOptions.of(WHERE, options, run, TAKES)
+    check(WHERE, "allow_code", allow_code, allow_code_problem)
     folder = None if options.out is None else check_out(options.out, None, RECORD)
     if not isinstance(study, SensitivityStudy):
-        study = load_sensitivity(study, options.budget)
+        study = load_sensitivity(study, options.budget, allow_code)
     quiet = options.quiet
     with tempfile.TemporaryDirectory(prefix="rpdrill-sensitivity-") as scratch, \
             pool(options.dask, options.workers) as runner:

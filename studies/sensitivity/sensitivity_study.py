@@ -26,6 +26,7 @@ import hashlib
 import json
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -204,12 +205,12 @@ def _problem(spec: GlobalAnalysis) -> dict[str, Any]:
             "bounds": [[1 - spec.relative_span, 1 + spec.relative_span]] * len(spec.parameters)}
 
 
-def load_sensitivity(path: str | Path, budget: Budget = DEFAULT_BUDGET) -> SensitivityStudy:
-    """Read, validate and expand a sensitivity file; InputError naming the file and key otherwise,
-    BudgetError when its runs together are beyond ``budget``."""
+def load_sensitivity(path: str | Path, budget: Budget = DEFAULT_BUDGET, allow_code: Sequence[str] | str = ()) -> SensitivityStudy:
+    """Read, validate and expand a sensitivity file (``allow_code``: the modules of one's own its scenes may
+    run); InputError naming the file and key otherwise, BudgetError when its runs together are beyond ``budget``."""
     path = Path(shipped_path(path, "sensitivity", "rpdrill.load_sensitivity"))
     spec = parse(SensitivitySpec, read_yaml(path), str(path))
-    base = spec.base(path)
+    base = spec.base(path, allow_code)
     for i, scan in enumerate(spec.scans):
         for key in scan.overrides:
             check_scene_path(str(path), f"scans.{i}.overrides", key, base)
