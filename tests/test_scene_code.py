@@ -579,12 +579,12 @@ def test_registered_names_are_looked_up_per_sys_path_once(monkeypatch):
     assert reads == ["rpdrill.extensions", "rpdrill.extensions"]
 
 
-def test_any_command_says_whose_code_raised_where_a_run_path_does_not(code, tmp_path, capsys):
-    """A law of one's own that raises inside a command's own runs (crosscheck runs its windows itself) is a run
-    that failed naming the law and the user's line, not an internal error."""
+def test_any_command_says_whose_code_raised(code, tmp_path, capsys):
+    """A law of one's own that raises inside a command's runs (crosscheck's windows, through the one run path) is
+    a run that failed naming the key, the law and the user's line, not an internal error."""
     rig = code()
     scene = scene_file(tmp_path / "scene.yaml", rock={"law": "my_rig:BadForce", "parameters": JENKINS})
     status, message = run(capsys, "crosscheck", scene, "--blows", 4, "--allow-code", "my_rig")
     assert status == 1 and clean(message), message
-    assert f"{scene}: the rock law my_rig:BadForce raised NotImplementedError: my force ({rig}, line " \
-           f"{line_of(RIG, 'FORCE')})" in message
+    assert f"{scene}: scene 'test_drill': rock.law (my_rig:BadForce) raised NotImplementedError: my force ({rig}, " \
+           f"line {line_of(RIG, 'FORCE')})" in message

@@ -31,6 +31,7 @@ import inspect
 import sys
 import typing
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from typing import Any
 
 from pydantic import (
@@ -63,17 +64,53 @@ def _distributions() -> Mapping[str, list[str]]:
     return importlib.metadata.packages_distributions()
 
 
-def record(path: str, found: Found | None = None) -> dict[str, str]:
+@dataclass(frozen=True)
+class CodeRecord:
+    """What a run records of one piece of code of one's own it ran (an extension, a rock law): its import path,
+    the package and version that provide it (where one does), the file it was loaded from, the entry point it
+    is registered as, and an extension's parameters."""
+
+    import_path: str
+    package: str | None = None
+    version: str | None = None
+    file: str | None = None
+    entry_point: str | None = None
+    parameters: Mapping[str, Any] | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        """As provenance files hold it: the fields that have a value."""
+        return {name: value for name, value in vars(self).items() if value is not None}
+
+
+@dataclass(frozen=True)
+class CodeRecords:
+    """The code of one's own a run imports: every extension by name and a rock law of one's own."""
+
+    extensions: Mapping[str, CodeRecord] = field(default_factory=dict)
+    rock_law: CodeRecord | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        """As provenance files hold it (``extensions``, ``rock_law``: only those there are)."""
+        out: dict[str, Any] = {}
+        if self.extensions:
+            out["extensions"] = {name: record.as_dict() for name, record in self.extensions.items()}
+        if self.rock_law is not None:
+            out["rock_law"] = self.rock_law.as_dict()
+        return out
+
+
+def record(path: str, found: Found | None = None, parameters: Mapping[str, Any] | None = None) -> CodeRecord:
     """What a run records of the code an import path names: the path and, where it has one, its package and
     version; ``file`` where the module was loaded from; the entry point it is registered as (``found``)."""
     module = sys.modules.get(path.partition(":")[0])
-    where = {"file": str(module.__file__)} if module is not None and getattr(module, "__file__", None) else {}
+    file = str(module.__file__) if module is not None and getattr(module, "__file__", None) else None
     package = package_version(path)
-    registered = {}
+    entry_point = None
     if found is not None and found.entry_point:
-        registered = {"entry_point": found.entry_point}
+        entry_point = found.entry_point
         package = {"package": found.package, "version": found.version} if found.package else package
-    return {"import_path": path, **package, **where, **registered}
+    return CodeRecord(path, package.get("package"), package.get("version"), file, entry_point,
+                      None if parameters is None else dict(parameters))
 
 
 STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, arbitrary_types_allowed=True)
@@ -211,8 +248,7 @@ def refusal(extensions: Mapping[str, Extension] | None, formulation: str) -> tup
     return None
 
 
-def records(extensions: Mapping[str, Extension] | None) -> dict[str, dict[str, Any]]:
-    """Every extension's record (:func:`record`) and parameters, by name: what provenance keeps."""
-    found = {name: extension.found for name, extension in (extensions or {}).items()}
-    return {name: {**record(found[name].import_path, found[name]), "parameters": dict(extension.parameters)}
+def records(extensions: Mapping[str, Extension] | None) -> dict[str, CodeRecord]:
+    """Every extension's record (:func:`record`) with its parameters, by name: what provenance keeps."""
+    return {name: record(extension.found.import_path, extension.found, extension.parameters)
             for name, extension in (extensions or {}).items()}

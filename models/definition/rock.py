@@ -23,7 +23,7 @@ from ...rocklaw import BilinearRock, JenkinsRock, RockLaw
 from ...rocklaw.base import is_rock_law_class, missing_members
 from ...rocklaw.catalog import TABLE_1
 from .drill_string import NonNegative, Positive, Strict, _key_error, _problem
-from .extensions import check_parameters, record
+from .extensions import CodeRecord, check_parameters, record
 from .own_code import IMPORT_PATH, REGISTERED_NAME, ROCK_LAW, Found, allowance, failure, resolve
 
 JENKINS_VALUES = ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n")
@@ -90,7 +90,7 @@ class Rock(Strict):
         (models.definition.own_code.resolve); ValueError where it may not run or does not resolve."""
         return resolve(self.law, ROCK_LAW, self._allowed)
 
-    def code_record(self) -> dict[str, str]:
+    def code_record(self) -> CodeRecord:
         """What a run records of a law of one's own (models.definition.extensions.record)."""
         found = self.found
         return record(found.import_path, found)

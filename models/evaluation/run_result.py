@@ -3,11 +3,11 @@ pandas table, the formulation's raw result, its steady state and where the run c
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
+from ..definition.extensions import CodeRecords
 from ..definition.scene import Scene
 from .metrics import summary_metrics
 from .results import SimulationResult
@@ -32,7 +32,7 @@ class Result:
     scene: Scene
     raw: SimulationResult
     source: str = ""
-    code: Mapping[str, Any] = field(default_factory=dict)
+    code: CodeRecords = field(default_factory=CodeRecords)
     warnings: tuple[str, ...] = ()
 
     @cached_property
@@ -54,7 +54,7 @@ class Result:
     @property
     def provenance(self) -> dict[str, Any]:
         """Where the run came from, as ``summary.json`` records it: the source and the code records."""
-        return {"source": self.source, **self.code}
+        return {"source": self.source, **self.code.as_dict()}
 
     @cached_property
     def timeseries(self) -> pd.DataFrame:

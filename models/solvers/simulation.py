@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 
 from ...rocklaw import RockLaw, State
+from ..definition.extensions import CodeRecords, refusal
 from ..definition.extensions import records as extension_records
-from ..definition.extensions import refusal
 from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
 from ..definition.outputs import needs
 from ..definition.scene import (
@@ -152,15 +152,11 @@ class Simulation:
         """What must be recorded for the requested outputs: ``forces``, ``energy``."""
         return needs(self.outputs.metrics, self.outputs.timeseries).data
 
-    def code_records(self) -> dict[str, Any]:
+    def code_records(self) -> CodeRecords:
         """The code of one's own the run imports, as provenance keeps it: every extension (import path,
         package and version where it has one, the file, its parameters) and a rock law of one's own."""
-        records: dict[str, Any] = {}
-        if self.scene.extensions:
-            records["extensions"] = extension_records(self.scene.extensions)
-        if self.scene.rock.own_law:
-            records["rock_law"] = self.scene.rock.code_record()
-        return records
+        return CodeRecords(extension_records(self.scene.extensions),
+                           self.scene.rock.code_record() if self.scene.rock.own_law else None)
 
     def resolved_scene(self) -> dict[str, Any]:
         """The scene as run: rock values filled in, the effects built and why, the outputs, and the
@@ -170,8 +166,9 @@ class Simulation:
         data["effects"] = {**self.effects.as_dict(), "reasons": dict(self.effects.reasons)}
         data["outputs"] = self.outputs.model_dump(mode="json")
         data["solver"] = {key: value for key, value in vars(self.settings).items() if value is not None}
-        for name, recorded in self.code_records().get("extensions", {}).items():  # informational (Extension)
-            data["extensions"][name]["recorded"] = {key: value for key, value in recorded.items() if key != "parameters"}
+        for name, recorded in self.code_records().extensions.items():  # informational (Extension)
+            data["extensions"][name]["recorded"] = {key: value for key, value in recorded.as_dict().items()
+                                                    if key != "parameters"}
         data["solver"]["steady_state"] = self.scene.solver.steady_state
         if self.piston is not None:  # the coupling across the contact as run
             given = self.scene.impact.piston.contact_stiffness_n_per_m

@@ -117,7 +117,7 @@ def code_records(points: Sequence[Any]) -> dict[str, Any]:
     records: dict[str, Any] = {}
     for point in points:
         simulation = getattr(point, "simulation", None)
-        for kind, found in ({} if simulation is None else simulation.code_records()).items():
+        for kind, found in ({} if simulation is None else simulation.code_records().as_dict()).items():
             if kind == "extensions":
                 records.setdefault(kind, {}).update({name: {key: value for key, value in record.items()
                                                             if key != "parameters"} for name, record in found.items()})
