@@ -20,6 +20,7 @@ DEFAULT_PRESET = "standard"
 EXUDYN_SOLVERS = ("rk67", "rk44", "rk33", "explicit_midpoint", "explicit_euler", "generalized_alpha",
                   "trapezoidal_index2", "dopri5", "ode23")
 AUTOMATIC_STEP_SOLVERS = ("dopri5", "ode23")
+IMPLICIT_SOLVERS = ("generalized_alpha", "trapezoidal_index2")  # the types that integrate constraints
 ODE_METHODS = ("DOP853", "Radau", "LSODA")
 
 
