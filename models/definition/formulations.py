@@ -7,7 +7,7 @@ exponentials between located switches (the reference and the fast path for large
 A scene chooses one in ``solver.formulation`` and gives its options next to it (the keys listed
 here; a key of another formulation is an error). This registry is data: the names of each
 formulation's implementation module in models.solvers and of its lighter ``checks`` module;
-models.solvers.dispatch imports and runs them.
+models.solvers.simulation.implementation imports and runs them.
 """
 
 from __future__ import annotations

@@ -80,7 +80,7 @@ from .exudyn_messages import (
     simulation_settings,
 )
 from .exudyn_piston import ExudynPiston
-from .exudyn_start import check_constraints, preloaded_start, solve_preload
+from .exudyn_start import start_assembled
 from .exudyn_user_items import (
     EnergyTerm,
     ExudynBody,
@@ -141,9 +141,6 @@ class ExudynModel:
     solution_path: Path | None = None
     waves: WaveExudyn | None = None  # wave rods: the element updated before every step (models.waves.exudyn_waves)
     extension_sensors: list[Any] = field(default_factory=list)  # models.solvers.exudyn_user_items
-    impact_load: Any = None  # the prescribed blow's LoadCoordinate and its load function (switched off for statics)
-    impact_function: Any = None
-    extension_objects: dict[str, range] = field(default_factory=dict)  # the objects each extension added
 
     def __post_init__(self) -> None:
         self._account = UserAccount(*(self._built_items[kind] for kind in ("objects", "loads", "sensors")))
@@ -202,14 +199,8 @@ class ExudynModel:
         self.solution_path = Path(path)
 
     def coordinate_names(self) -> list[str]:
-        """The name of each ODE2 coordinate of the system as assembled now (:meth:`prepare`), in Exudyn's order:
-        the index of ``mbs.systemData.GetODE2Coordinates()`` and the column after the time of Exudyn's solution
-        file (:meth:`write_solution`). The drill's bodies come first, in the order the scene lists them (a rod's
-        segments ``rod1[0]``, ``rod1[1]``, ..., then a piston's), then ``torsion`` where it is built, then the
-        coordinates of items of one's own, in the order they were added, each by the name of the first object on
-        its node (``name[i]`` for a node of several coordinates)."""
-        self.prepare()
-        return coordinate_names(self)
+        """Each ODE2 coordinate's name in Exudyn's order, the solution file's columns (exudyn_user_items)."""
+        return self.prepare() or coordinate_names(self)
 
     def user_items(self) -> dict[str, int]:
         """The Exudyn items added to ``mbs`` since the model was built (by the scene's extensions too), by
@@ -223,10 +214,8 @@ class ExudynModel:
         if item_counts(self.mbs) == self._prepared_items:
             return
         self.mbs.Assemble()
-        if self.user_items().keys() - {"sensors"}:  # models.solvers.exudyn_start
-            check_constraints(self)
-            if preloaded_start(self):
-                solve_preload(self)
+        if self.user_items().keys() - {"sensors"}:
+            start_assembled(self)  # a preloaded start, the solver the constraints need (models.solvers.exudyn_start)
             self._size_step()
         self._account.watch(self.mbs, "energy" in self.simulation.needed_data)
         self.mbs.Assemble()
@@ -443,8 +432,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True, graphics: bool 
     hook = None if piston is None else ExudynPiston(piston, [body.node for body in bodies], mbs, impact.period_s)
     model = ExudynModel(simulation, chain, container, mbs, {body.name: body for body in bodies}, connectors, rock,
                         torsion, drawn, sensors, simulation_settings(simulation), [impact_function, *user_functions],
-                        blows, hook, named, symbolic, _built_items=item_counts(mbs), _prepared_items=item_counts(mbs),
-                        impact_load=impact_load, impact_function=impact_function)
+                        blows, hook, named, symbolic, _built_items=item_counts(mbs), _prepared_items=item_counts(mbs))
     _apply_extensions(model)
     return model
 
@@ -454,10 +442,8 @@ def _apply_extensions(model: ExudynModel) -> None:
     prepared (the coordinates they add followed where a steady-state run asks)."""
     simulation = model.simulation
     for name, extension in (simulation.scene.extensions or {}).items():
-        first = model.mbs.systemData.NumberOfObjects()
         try:
             extension.apply(model)
-            model.extension_objects[name] = range(first, model.mbs.systemData.NumberOfObjects())
         except Exception as error:
             raise ExtensionFailed(f"scene '{simulation.name}': extensions.{name} ({extension.function}) failed on the "
                                   f"built model: {type(error).__name__}: {error}") from error

@@ -55,11 +55,22 @@ def preloaded_start(model: Any) -> bool:
         and (followed is None or followed.start is None)
 
 
+def start_assembled(model: Any) -> None:
+    """A built model's start and solver once items of one's own were added (module doc): the constraints checked
+    against the solver type, the preloaded start solved on the assembled system."""
+    check_constraints(model)
+    if preloaded_start(model):
+        solve_preload(model)
+
+
 def item_origin(model: Any, index: int) -> str:
-    """What added object ``index``: ``extension 'NAME' (module:function)`` or ``an item added to model.mbs``."""
-    for name, objects in model.extension_objects.items():
-        if index in objects:
-            return f"extension {name!r} ({model.simulation.scene.extensions[name].function})"
+    """What added object ``index``: ``extension 'NAME' (module:function)`` (the scene's extensions are applied and
+    prepared at the build, before any item added by hand: models.solvers.exudyn_model), or ``an item added to
+    model.mbs``."""
+    extensions = model.simulation.scene.extensions or {}
+    prepared = model._prepared_items["objects"]
+    if extensions and (prepared == model.built_items["objects"] or index < prepared):
+        return " or ".join(f"extension {name!r} ({extension.function})" for name, extension in extensions.items())
     return "an item added to model.mbs"
 
 
@@ -99,14 +110,15 @@ def check_constraints(model: Any) -> None:
 @contextlib.contextmanager
 def _blow_switched_off(model: Any) -> Iterator[None]:
     """The prescribed blow's load function off for the statics (a rectangular pulse is on at t = 0)."""
-    mbs, load = model.mbs, model.impact_load
+    mbs = model.mbs  # the build's first load with a function: the blow's, whose function is the first the model keeps
+    load = next((i for i in range(model.built_items["loads"]) if mbs.GetLoad(i)["loadUserFunction"]), None)
     try:
         if load is not None:
             mbs.SetLoadParameter(load, "loadUserFunction", 0)
         yield
     finally:
         if load is not None:
-            mbs.SetLoadParameter(load, "loadUserFunction", model.impact_function)
+            mbs.SetLoadParameter(load, "loadUserFunction", model.symbolic_functions[0])
 
 
 def _held_coordinates(model: Any) -> set[int]:

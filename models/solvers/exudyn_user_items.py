@@ -188,9 +188,11 @@ def node_labels(model: Any, node: int, count: int) -> list[str]:
 
 
 def coordinate_names(model: Any) -> list[str]:
-    """The name of every ODE2 coordinate of an assembled model, in Exudyn's order: the drill's bodies by name (a
-    rod's segments ``rod[0]``..., a piston's), ``torsion``, the coordinates of items of one's own by
-    :func:`node_labels`."""
+    """The name of every ODE2 coordinate of an assembled model (ExudynModel.coordinate_names), in Exudyn's order:
+    the index of ``mbs.systemData.GetODE2Coordinates()`` and the column after the time of Exudyn's solution file
+    (``model.write_solution``). The drill's bodies come first, in the order the scene lists them (a rod's segments
+    ``rod1[0]``, ``rod1[1]``, ..., then a piston's), then ``torsion`` where it is built, then the coordinates of
+    items of one's own in the order they were added, each by :func:`node_labels`."""
     mbs = model.mbs
     names = [""] * mbs.systemData.ODE2Size()
     drill = {int(body.node): body.name for body in model.bodies.values()}
