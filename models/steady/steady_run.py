@@ -12,8 +12,11 @@ Every result's ``info`` then holds ``steady_state`` (what the scene asked for), 
 ``floquet_max_abs`` (max |mu| of the orbit; NaN without one), and with an orbit its ``floquet_multipliers``
 ([re, im] each), ``event_sequence`` (the modes entered over one orbit), ``orbit_state`` (its section state:
 a neighbour's Newton guess; an Exudyn scene's extension coordinates last) and ``orbit_state_labels`` (a name
-for each entry), ``newton_iterations``, ``map_runs``, ``jacobian`` and ``steady_state_note``
-(the unstable orbits met, or why none was found). :func:`regime_columns` gives the first four as a results
+for each entry), ``newton_iterations``, ``map_runs``, ``jacobian``, ``start_regime`` (where the drill goes from the scene's
+start: ``period-m`` or ``irregular``; models.steady.start_check) and ``start_reaches_orbit`` (whether that is
+the orbit found), and
+``steady_state_note`` (coexisting regimes where the start reaches another attractor, the unstable orbits met,
+or why none was found). :func:`regime_columns` gives the first four as a results
 table's columns.
 """
 
@@ -32,6 +35,7 @@ from ..solvers.simulation import Simulation
 from ..solvers.solution_file import solve_with_solution
 from .section import section_of
 from .shooting import Orbit, scales
+from .start_check import coexisting_note
 from .steady_state import NONE_FOUND, SteadyState
 
 OrbitGuess = tuple[np.ndarray, int]  # a section state and the orbit's blows
@@ -60,17 +64,22 @@ def orbit_info(state: SteadyState) -> dict[str, Any]:
     unstable = "; ".join(f"unstable period-{o.periods} orbit: |mu|max {o.floquet_max_abs:.4g}, advance per blow "
                          f"{o.advance_per_blow_m:.6g} m (not the drill's rate)" for o in state.unstable)
     info["steady_state_note"] = state.note if orbit is None else unstable
+    if orbit is not None and state.start is not None:  # models.steady.start_check
+        info["start_regime"], info["start_reaches_orbit"] = state.start.regime, state.start.reaches_orbit
+        info["steady_state_note"] = "; ".join(part for part in (coexisting_note(state.start, orbit), unstable) if part)
     return info
 
 
 def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
               progress: Callable[[float], None] | None = None, cold_newton: bool = True,
-              solution: Path | None = None) -> SimulationResult:
+              solution: Path | None = None, start_check: bool = True) -> SimulationResult:
     """The run ``simulation``'s scene asks for (module doc). ``guess``: the section state and period of
     an orbit to start Newton from (a neighbour's, predicted: models.steady.continuation); without one,
     ``cold_newton`` False goes straight to the time run and the period it repeats (a neighbour had no
     periodic orbit: models.steady.regimes, step 2). ``solution``: a time run of the Exudyn formulation
-    writes Exudyn's coordinates solution file there (models.solvers.solution_file)."""
+    writes Exudyn's coordinates solution file there (models.solvers.solution_file). ``start_check``: with an
+    orbit, where the drill goes from the scene's start too (models.steady.start_check: ``start_regime``, and a
+    note where it is another attractor); a scan that reads only its curve's optima leaves it out."""
     if simulation.scene.solver.steady_state != "periodic":
         result = solve_with_solution(simulation, progress, solution)
         result.info.update(steady_state="time", regime=TIME_RUN, period_blows=None, floquet_max_abs=math.nan)
@@ -89,6 +98,8 @@ def run_scene(simulation: Simulation, guess: OrbitGuess | None = None,
             if state.orbit is None:  # step 2: the period its time run repeats (models.steady.regimes)
                 time_run = finder.simulation.solve(progress)  # (an extension's coordinates recorded)
                 state = finder.settled(time_run, state)
+        if state.orbit is not None and start_check:  # where the drill goes from its start (models.steady.start_check)
+            state = finder.check_start(state)
     except SteadyStateUnavailable as why:
         state = SteadyState(NONE_FOUND, None, note=str(why))
     if state.orbit is not None and finder is not None:
