@@ -1,6 +1,6 @@
 """What an extended drill gives (docs/extending.md, "What the model's services see"): the figures of issue 35.
 
-Usage: python benchmarks/bench_extensions.py [--parts clamp,solve,energy,rate_law,study,cost,steady]
+Usage: python benchmarks/bench_extensions.py [--parts clamp,solve,energy,rate_law,study,cost,steady,start]
 Prints, on studies/scenes/paper_base.yaml over 0.5 s:
 
 * clamp: a 300 kg clamp on the collar (examples/clamp_extension.py: a Mass1D on its own Node1D and a
@@ -17,6 +17,11 @@ Prints, on studies/scenes/paper_base.yaml over 0.5 s:
   by one in this process (largest relative difference of the rate);
 * cost: CPU s of a run (median of 5, one BLAS thread; shared machine) of the plain scene and with the 1e9 N/m
   clamp (the same step), and the CPU of sizing the step from the assembled system;
+* start (not part of the default parts): ``start: preloaded`` with an extension's load of 16.6 kN on the pipe
+  (tests/user_rig.py: add_load) against the feed doubled: the pipe's start and the rates; a 300 kg clamp joined
+  rigidly to the collar (examples/clamp_extension.py: add_rigid_clamp, a constraint) on generalized-alpha at
+  the preset's step against the collar 300 kg heavier in the exact formulation, and the CPU of solving the start
+  of the assembled system (models/solvers/exudyn_start.py);
 * steady (on tests/pipe_drill.yaml at 65 Hz, not part of the default parts): the periodic steady state
   (Exudyn, standard preset) with a damped clamp (300 kg, 1e9 N/m, 2e4 N s/m) followed in the section
   (models/steady/extension_section.py), against the last 10 of 200 blows of its time run, the clamp as a
@@ -182,6 +187,34 @@ def steady() -> None:
     for label, other in (("time run, last 10 of 200 blows", time_run), ("the clamp as a scene body, exact orbit", exact),
                          ("the clamp left out of the section (restarted at rest every blow)", restarted)):
         print(f"{label}: {rate(other) * 1e3:.6f} mm/s (relative to the orbit {rate(other) / rate(orbit) - 1:+.2e})")
+
+
+def start() -> None:
+    from rpdrill.models.solvers.exudyn_start import solve_preload
+
+    sys.path[:0] = [str(ROOT / "tests"), str(ROOT)]  # the tests' user module (user_rig.py, which imports examples.)
+    feed = SCENE.feed.force_n
+    loaded = SCENE.with_({"extensions": {"load": {"function": "user_rig:add_load", "parameters": {"force_n": feed}}}})
+    doubled = SCENE.with_({"feed.force_n": 2 * feed})
+    extended, fed = rpdrill.simulate(loaded), rpdrill.simulate(doubled)
+    for label, result in (("the extension's load", extended), ("the feed doubled", fed)):
+        print(f"{label}: pipe starts at {result.timeseries['pipe_position_m'].iloc[0] * 1e3:.4f} mm, "
+              f"{rate(result) * 1e3:.6f} mm/s")
+    print(f"rates relative: {rate(extended) / rate(fed) - 1:+.2e}")
+    model = rpdrill.build_exudyn(loaded)
+    times = []
+    for _ in range(20):
+        begin = time.process_time()
+        solve_preload(model)
+        times.append(time.process_time() - begin)
+    print(f"solving the assembled system's start: {statistics.median(times) * 1e3:.2f} ms CPU (median of 20)")
+    rigid = SCENE.with_({"solver.type": "generalized_alpha", "extensions": {"clamp": {
+        "function": "clamp_extension:add_rigid_clamp", "parameters": {"mass_kg": 300.0}}}})
+    heavier = rate(rpdrill.simulate(SCENE.with_({"drill_string.bodies.collar.mass_kg": COLLAR + 300.0}),
+                                    formulation="exact"))
+    joined = rpdrill.simulate(rigid)
+    print(f"rigid clamp on generalized_alpha at {joined.raw.simulation.settings.step_s:.3g} s: {rate(joined) * 1e3:.6f} "
+          f"mm/s; collar 300 kg heavier (exact) {heavier * 1e3:.6f} mm/s ({rate(joined) / heavier - 1:+.2e})")
 
 
 def main() -> None:

@@ -140,7 +140,7 @@ SCENE_ROUTE = (
      "`solver.steady_state: periodic` asks for (`models.steady.regimes.RegimeFinder`, its runs by the same "
      "formulation)")),
     ("models.solvers.time_run", "time_run",
-     ("the formulation's run (`models.solvers.dispatch.implementation`: exact, Exudyn or ODE), its samples and "
+     ("the formulation's run (`models.solvers.simulation.implementation`: exact, Exudyn or ODE), its samples and "
      "a `SolverRecord` of what it did")),
     ("models.evaluation.run_result", "Result",
      ("the typed result: metrics (`models.evaluation.metrics.summary_metrics`, on first use), the time series as a "

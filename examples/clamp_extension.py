@@ -28,6 +28,7 @@ import numpy as np
 from exudyn.itemInterface import (
     MarkerNodeCoordinate,
     Node1D,
+    ObjectConnectorCoordinate,
     ObjectConnectorCoordinateSpringDamper,
     ObjectMass1D,
     SensorNode,
@@ -60,6 +61,16 @@ def add_clamp(model, mass_kg: float, stiffness_n_per_m: float, damping_n_s_per_m
         damping=damping_n_s_per_m, name="clamp_joint"))
     model.mbs.AddSensor(SensorNode(nodeNumber=node, storeInternal=True, name="clamp_velocity",
                                    outputVariableType=exudyn.OutputVariableType.Coordinates_t))
+
+
+@rpdrill.extension
+def add_rigid_clamp(model, mass_kg: float, body: str = "collar") -> None:
+    """A clamp of ``mass_kg`` joined rigidly to ``body`` by a coordinate constraint (``ObjectConnectorCoordinate``,
+    ``rigid_joint``): an algebraic equation, which only Exudyn's implicit solvers integrate (a scene names
+    ``solver.type: generalized_alpha`` with it; docs/extending.md)."""
+    _node, marker = _clamp_node(model, body, mass_kg, "rigid_clamp")
+    model.mbs.AddObject(ObjectConnectorCoordinate(markerNumbers=[model.bodies[body].marker_coordinate, marker],
+                                                  name="rigid_joint"))
 
 
 @rpdrill.extension

@@ -114,6 +114,13 @@ class ExudynRockContact:
         self.state = state
         self.state_history.append((time_s, state))
 
+    def start_at(self, state: State) -> None:
+        """Make ``state`` the law's initial state (before the run: a start solved after the build)."""
+        state = tuple(float(value) for value in state)
+        for variable, value in zip(self._variables, state):
+            variable.SetValue(value)
+        self.state, self.state_history = state, [(0.0, state)]
+
     def set_law(self, rock: RockLaw) -> None:
         """Go on with ``rock`` (the same law with another eta: models.drill.indexing), in the expression too."""
         if self._fresh_fraction is not None and rock.fresh_fraction != self.rock.fresh_fraction:

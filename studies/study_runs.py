@@ -16,7 +16,7 @@ from .runtime.point_runs import point_columns, run_point
 from .runtime.pools import Runner, pool, sequential
 from .runtime.resumable import RECORD, Table, run_tables
 from .runtime.run_options import RunOptions
-from .scan.continuation_runs import follow_study, given_row
+from .scan.continuation_runs import continuation_table, sort_files
 from .scan.curve_optima import Optimum
 from .scan.study import Study, StudyPoint, load_study
 from .scan.study_optima import csv_rows, study_optima
@@ -73,23 +73,24 @@ def run_studies(studies: list[Study], folders: list[Path], runner: tuple[str, Ru
     started: dict[int, tuple[list[Optimum], Callable[[], tuple[list[Path], list[str]]]]] = {}
 
     def finished(i: int, table: pd.DataFrame, record: dict[str, Any]) -> None:
+        if studies[i].spec.steady_state == "continuation":
+            sort_files(studies[i], folders[i])
         optima = write_optima(studies[i], folders[i], table, record)
         started[i] = optima, start_plots(studies[i], table, optima, folders[i],
                                          sequential if plots_here else runner[1])
 
-    tables = [_table(study, out, runner) for study, out in zip(studies, folders, strict=True)]
+    tables = [_table(study, out) for study, out in zip(studies, folders, strict=True)]
     frames = run_tables(tables, runner, quiet, finished)
     return [StudyRun(study, out, table, started[i][0], *started[i][1]())
             for i, (study, out, table) in enumerate(zip(studies, folders, frames, strict=True))]
 
 
-def _table(study: Study, out: Path, runner: tuple[str, Runner]) -> Table:
-    """The results table of a study: each point run by a worker, or, for a continuation study, its chains
-    followed first (studies.scan.continuation_runs) and each point's outcome taken from them."""
+def _table(study: Study, out: Path) -> Table:
+    """The results table of a study: each point run by a worker, or, for a continuation study, each chain
+    (studies.scan.continuation_runs), the rows of its points from its outcome."""
     columns = ["point", *study.axes, *point_columns(study.spec.metrics)]
     if study.spec.steady_state == "continuation":
-        followed = follow_study(study, out, runner)
-        return Table(study, out, "results.csv", columns, lambda p: followed[p.index], given_row)
+        return continuation_table(study, out, columns)
     return Table(study, out, "results.csv", columns, _task, run_point, scene_keys=study.scene_keys)
 
 

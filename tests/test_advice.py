@@ -210,3 +210,43 @@ def test_the_library_call_gives_the_commands_advice(tmp_path):
                                                  "impact.frequency_hz, feed.force_n, impact.amplitude_n"):
         rpdrill.advise(scene, {"impact.frequency_hz": (45, 70), "feed.force_n": (35e3, 60e3),
                                "rock.threshold_n": (1e5, 2e5)})
+
+
+def test_a_small_budget_reports_no_best_below_a_point_of_its_own_curves(tmp_path, capsys):
+    """Issue 47: on a budget of 2 x 2 members and one generation the search stopped at 5.36 mm/s while a point of
+    its own feed curve gave 7.25 mm/s. The best is now the best point run (the curves run again through it); the
+    search's own best is kept and said."""
+    scene, out = write_scene(tmp_path), tmp_path / "out"
+    assert main(["advise", scene, "--frequency-hz", "45", "70", "--feed-kn", "35", "60", "--popsize", "2",
+                 "--generations", "1", "--seed", "2", "--workers", "1", "--quiet", "--out", str(out)]) == 0
+    assert "a point of its curves or map beat the search's own best" in capsys.readouterr().out
+    (advice,) = json.loads((out / "advice.json").read_text())["results"]
+    run = [p["value"] for p in map(json.loads, (out / "evaluations.jsonl").read_text().splitlines())
+           if p["value"] is not None]
+    assert advice["best_value"] == max(run)  # no point run is better
+    assert advice["search_best_value"] < advice["best_value"]
+    for path, curve in advice["slices"].items():
+        assert np.nanmax(np.array(curve["metric"], dtype=float)) == advice["best_value"]
+        assert advice["best"][path] in curve["values"]
+
+
+def test_advise_where_no_point_meets_the_stress_bound_exits_1_without_a_best(tmp_path, capsys):
+    """Issue 47: ``--max-rod-stress-mpa 1e-6`` exited 0 with a best rate of -1.29e11 mm/s (the search's
+    penalty). No point run meets the bound: exit 1, the least stress run and where, the points run kept."""
+    path = tmp_path / "rod_drill.yaml"
+    path.write_text(yaml.safe_dump(scene_dict(solver=SHORT["solver"], metrics=SHORT["metrics"], **{
+        "drill_string.bodies.collar": {"length_m": 3.0, "diameter_m": 0.2}})))
+    out = tmp_path / "out"
+    assert main(["advise", str(path), "--frequency-hz", "45", "70", "--feed-kn", "35", "60", "--max-rod-stress-mpa",
+                 "1e-6", "--popsize", "2", "--generations", "1", "--workers", "1", "--quiet", "--out", str(out)]) == 1
+    printed = capsys.readouterr()
+    points = [json.loads(line) for line in (out / "evaluations.jsonl").read_text().splitlines()]
+    least = min(p["rod_stress_max_pa"] for p in points)
+    assert least > 1.0  # every point run exceeds the bound of 1 Pa
+    assert (f"no point run keeps the rods below the stress bound 1e-06 MPa (max_rod_stress_pa; {len(points)} of "
+            f"{len(points)} points run exceed it): the least stress run is {least / 1e6:.4g} MPa") in printed.err
+    assert "best" not in printed.out and "e+11" not in printed.out + printed.err
+    assert not (out / "advice.json").exists()
+    with pytest.raises(RuntimeError, match="no point run keeps the rods below the stress bound"):
+        rpdrill.advise(str(path), {FREQUENCY: (45, 70), FEED: (35e3, 60e3)}, max_rod_stress_pa=1.0, workers=1,
+                       search=rpdrill.AdviceSearch(popsize=2, max_generations=1))

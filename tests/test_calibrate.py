@@ -217,7 +217,7 @@ def test_nelder_mead_stays_within_its_budget(tmp_path):
 
 
 def test_every_simulation_failing_exits_1_without_a_scene(tmp_path, monkeypatch, capsys):
-    def failing(branch, value, simulation):
+    def failing(branch, value, simulation, start_check=True):
         return {"status": "failed", "error": "RuntimeError: diverged", "wall_time_s": 0.0}
     monkeypatch.setattr(curves, "run_followed", failing)  # runs in this process (--workers 1)
     path = write(tmp_path / "c.yaml", spec(search={"popsize": 2, "max_generations": 0, "seed": 3}))

@@ -192,6 +192,9 @@ BAD = [
     ("buttons do not fit", {"bit": {**BIT, "gauge_buttons": 40}, "rotation": {"speed_rpm": 45.0}},
      ["bit", "40 gauge buttons", "do not fit"]),
     ("negative speed", {"bit": BIT, "rotation": {"speed_rpm": -5.0}}, ["rotation.speed_rpm", "-5.0"]),
+    ("elastic rock", {"effects": {"indexing": True, "rock_plasticity": False}, "bit": BIT,
+                      "rotation": {"speed_rpm": 45.0}},  # was a raw ValueError of the rock law (issue 47)
+     ["effects.indexing", "needs the rock_plasticity effect", "set rock_plasticity true or indexing false"]),
 ]
 
 
@@ -211,6 +214,23 @@ def test_resolved_scene_says_why_indexing_was_built():
     resolved = simulation.resolved_scene()
     assert resolved["effects"]["indexing"] and "full model" in resolved["effects"]["reasons"]["indexing"]
     assert resolved["bit"] == BIT and resolved["rotation"] == {"speed_rpm": 45.0}
+
+
+def test_indexing_alone_builds_the_crushing_it_indexes(tmp_path, capsys):
+    """``effects: {indexing: true}`` leaves rock_plasticity out of the effects section: indexing pulls it in (a
+    blow meets craters only on a rock that crushes), says why, and runs as the section naming both (issue 47: a
+    raw ValueError of the rock law, exit 1)."""
+    both = crushing_scene(**SHORT, bit=BIT, rotation={"speed_rpm": 45.0},
+                          effects={"indexing": True, "rock_plasticity": True})
+    alone = both.with_({"effects": {"indexing": True}})
+    simulation = prepare(alone)
+    assert simulation.effects.indexing and simulation.effects.rock_plasticity
+    assert "needed by indexing" in simulation.effects.reasons["rock_plasticity"]
+    assert rate(simulate(alone, "exact")) == rate(simulate(both, "exact")) > 0
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(alone.model_dump(mode="json", by_alias=True, exclude_none=True)))
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet", "--formulation", "exact"]) == 0
+    assert "internal error" not in capsys.readouterr().err
 
 
 ROTATION_STUDIES = Path(__file__).resolve().parents[1] / "studies" / "rotation"

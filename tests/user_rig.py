@@ -2,9 +2,9 @@
 module, ``allow_code=["user_rig"]``: a scene runs no code unasked; each extension marked ``@rpdrill.extension``,
 each law a subclass of rocklaw.base.RockLaw, through the built-in law it derives from):
 extensions (the clamps of examples/clamp_extension.py: a mass on its own Node1D held on a body by a
-coordinate spring-damper, and one with a spring-force user function and its declared energy terms; sensors
-of one's own; an oscillator on ground; a loose mass, a step counter and an anchor to ground, which a steady
-state cannot follow) and
+coordinate spring-damper, one with a spring-force user function and its declared energy terms, one joined by a
+constraint; a constant load; sensors of one's own; an oscillator on ground; a loose mass, a step counter and an
+anchor to ground, which a steady state cannot follow) and
 rock laws of one's own (the paper's law under another name; one without a mode table)."""
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from typing import ClassVar
 
 import exudyn
 from exudyn.itemInterface import (
+    LoadCoordinate,
     MarkerNodeCoordinate,
     Node1D,
     NodePointGround,
@@ -23,11 +24,15 @@ from exudyn.itemInterface import (
 )
 
 import rpdrill
-from examples.clamp_extension import add_clamp, add_friction_clamp  # the checkout's examples: a user's module
+from examples.clamp_extension import (  # the checkout's examples: a user's module
+    add_clamp,
+    add_friction_clamp,
+    add_rigid_clamp,
+)
 from rpdrill.rocklaw import JenkinsRock
 
 __all__ = ["ForceOnlyRock", "RenamedJenkins", "add_anchor", "add_clamp", "add_friction_clamp", "add_ground_oscillator",
-           "add_loose_mass", "add_sensors", "add_step_counter"]
+           "add_load", "add_loose_mass", "add_rigid_clamp", "add_sensors", "add_step_counter"]
 
 
 @rpdrill.extension
@@ -38,6 +43,12 @@ def add_sensors(model, body: str = "bit") -> None:
 
 
 add_sensors.changes_motion = False  # rpdrill: the exact and ODE formulations may run a scene with it
+
+
+@rpdrill.extension
+def add_load(model, force_n: float, body: str = "pipe") -> None:
+    """A constant ``LoadCoordinate`` of ``force_n`` on ``body`` (on the pipe of paper_base: as much more feed)."""
+    model.mbs.AddLoad(LoadCoordinate(markerNumber=model.bodies[body].marker_coordinate, load=force_n))
 
 
 @rpdrill.extension

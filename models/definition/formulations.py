@@ -7,7 +7,7 @@ exponentials between located switches (the reference and the fast path for large
 A scene chooses one in ``solver.formulation`` and gives its options next to it (the keys listed
 here; a key of another formulation is an error). This registry is data: the names of each
 formulation's implementation module in models.solvers and of its lighter ``checks`` module;
-models.solvers.dispatch imports and runs them.
+models.solvers.simulation.implementation imports and runs them.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ DEFAULT_PRESET = "standard"
 EXUDYN_SOLVERS = ("rk67", "rk44", "rk33", "explicit_midpoint", "explicit_euler", "generalized_alpha",
                   "trapezoidal_index2", "dopri5", "ode23")
 AUTOMATIC_STEP_SOLVERS = ("dopri5", "ode23")
+IMPLICIT_SOLVERS = ("generalized_alpha", "trapezoidal_index2")  # the types that integrate constraints
 ODE_METHODS = ("DOP853", "Radau", "LSODA")
 
 

@@ -300,6 +300,11 @@ class Scene(Strict):
         if effects.indexing and self.bit is None:
             raise ValueError("the indexing effect needs a bit section (diameter_m, gauge_button_diameter_m, "
                              "gauge_buttons)")
+        if effects.indexing and not effects.rock_plasticity:
+            raise _key_error("Scene", ("effects", "indexing"), True,
+                             "needs the rock_plasticity effect, which is false here: an elastic rock never crushes, "
+                             "so it leaves no craters for the blows to index; set rock_plasticity true or indexing "
+                             "false")
         if effects.indexing and self.rotation is None and not effects.torsion:
             raise ValueError("the indexing effect needs the angle turned between blows: a rotation section "
                              "(speed_rpm) or the torsion effect")
@@ -407,6 +412,9 @@ def built_effects(scene: Scene) -> BuiltEffects:
             chosen[effect], reasons[effect] = True, f"needed by outputs: {', '.join(users)}"
         else:
             chosen[effect], reasons[effect] = False, "not asked for" if asked is None else "switched off"
+    if chosen["indexing"] and not chosen["rock_plasticity"] and scene.effects.rock_plasticity is None:
+        chosen["rock_plasticity"] = True  # blows meet craters only on a rock that crushes
+        reasons["rock_plasticity"] = "needed by indexing (an elastic rock leaves no craters for the blows to index)"
     return BuiltEffects(**chosen, reasons=reasons)
 
 

@@ -112,17 +112,31 @@ class OrbitRecord:
 
 
 @dataclass(frozen=True)
+class StartRecord:
+    """Where the drill goes from its scene's start beside the orbit found (models.steady.start_check): the
+    ``regime`` it reaches (``period-n`` or ``irregular``), whether that is the orbit (``reaches_orbit``; False:
+    coexisting attractors, and the start reaches the other one), after ``blows`` blows, and the other
+    attractor's advance per blow (NaN: none)."""
+
+    regime: str
+    reaches_orbit: bool
+    blows: int
+    advance_per_blow_m: float = float("nan")
+
+
+@dataclass(frozen=True)
 class SteadyStateRecord:
     """The steady state of a run (module doc): ``requested`` the scene's ``solver.steady_state``, the
     ``regime``, the stable ``orbit`` (None unless the regime is periodic), the ``unstable`` orbits met on the
-    way, the ``coexisting`` stable orbits known at the same parameters, the ``note`` (why none was found, why
-    the scene was refused) and what the search cost."""
+    way, where the drill goes from its scene's ``start`` (None: not checked; another attractor there: the orbit
+    coexists with it), the ``note`` (coexisting regimes, why none was found, why the scene was refused) and what
+    the search cost."""
 
     requested: Literal["time", "periodic"] = "time"
     regime: Regime = Regime.TIME_RUN
     orbit: OrbitRecord | None = None
     unstable: tuple[OrbitRecord, ...] = ()
-    coexisting: tuple[OrbitRecord, ...] = ()
+    start: StartRecord | None = None
     note: str = ""
     map_runs: int = 0
     cpu_time_s: float = 0.0

@@ -29,32 +29,37 @@ import numpy as np
 from ..definition.own_code import blame
 from ..definition.validation import InputError
 from ..evaluation.results import SimulationResult
-from ..evaluation.run_record import OrbitRecord, Regime, SteadyStateRecord
+from ..evaluation.run_record import OrbitRecord, Regime, StartRecord, SteadyStateRecord
 from ..evaluation.run_result import Result
 from ..evaluation.stability import SimulationFailed
 from ..solvers.simulation import Simulation
 from ..solvers.time_run import time_run
 from ..steady.section import section_of
 from ..steady.shooting import Orbit, scales
+from ..steady.start_check import coexisting_note
 from ..steady.steady_state import NONE_FOUND, SteadyState, SteadyStateUnavailable
 
 OrbitGuess = tuple[np.ndarray, int]  # a section state and the orbit's blows
 
 
 def run(simulation: Simulation, progress: Callable[[float], None] | None = None, *, guess: OrbitGuess | None = None,
-        cold_newton: bool = True, solution_file: Path | None = None, source: str = "") -> Result:
+        cold_newton: bool = True, solution_file: Path | None = None, source: str = "", start_check: bool = True
+        ) -> Result:
     """The run ``simulation``'s scene asks for (module doc), as ``rpdrill.Result``. ``progress(t)`` as simulated
     time advances. ``guess``: the section state and period of an orbit to start Newton from (a neighbour's,
     predicted: models.steady.continuation); without one, ``cold_newton`` False goes straight to the time run
     and the period it repeats (a neighbour had no periodic orbit: models.steady.regimes, step 2).
     ``solution_file``: a time run of the Exudyn formulation writes Exudyn's coordinates solution file there.
+    ``start_check``: with an orbit, where the drill goes from the scene's start too (models.steady.start_check:
+    the record's ``start``, and a note where it is another attractor); a scan that reads only its curve's optima
+    leaves it out.
     ``source``: where the scene came from, as the result records it. The warnings shown while it runs (as
     the caller's filters let them through) are also kept in the result's ``warnings``. An error raised in the
     code of one's own the scene names (an extension, a rock law) is a SimulationFailed naming it and the user's
     line (models.definition.own_code.blame)."""
     with kept_warnings() as kept:
         try:
-            raw = _raw(simulation, progress, guess, cold_newton, solution_file)
+            raw = _raw(simulation, progress, guess, cold_newton, solution_file, start_check)
         except Exception as error:
             why = blame(error, simulation.scene)  # the user's code raised it: a failed run, not rpdrill's error
             if why is None or isinstance(error, (InputError, SimulationFailed)):
@@ -84,7 +89,7 @@ def kept_warnings() -> Iterator[list[str]]:
 
 
 def _raw(simulation: Simulation, progress: Callable[[float], None] | None, guess: OrbitGuess | None,
-         cold_newton: bool, solution_file: Path | None) -> SimulationResult:
+         cold_newton: bool, solution_file: Path | None, start_check: bool) -> SimulationResult:
     if simulation.scene.solver.steady_state != "periodic":
         return time_run(simulation, progress, solution_file)
     from ..solvers.exact_model import BLAS  # numba's kernels: loaded for a periodic run only
@@ -102,6 +107,8 @@ def _raw(simulation: Simulation, progress: Callable[[float], None] | None, guess
             if state.orbit is None:  # step 2: the period its time run repeats (models.steady.regimes)
                 time_run_result = time_run(finder.simulation, progress)  # (an extension's coordinates recorded)
                 state = finder.settled(time_run_result, state)
+        if state.orbit is not None and start_check:  # where the drill goes from its start (models.steady.start_check)
+            state = finder.check_start(state)
     except SteadyStateUnavailable as why:
         state, regime = SteadyState(NONE_FOUND, None, note=str(why)), Regime.REFUSED
     orbit = None
@@ -119,8 +126,13 @@ def _raw(simulation: Simulation, progress: Callable[[float], None] | None, guess
     note = state.note if orbit is None else "; ".join(
         f"unstable period-{o.period_blows} orbit: |mu|max {o.floquet_max_abs:.4g}, advance per blow "
         f"{o.advance_per_blow_m:.6g} m (not the drill's rate)" for o in unstable)
-    result.steady_state = SteadyStateRecord("periodic", regime, orbit, unstable, note=note, map_runs=state.map_runs,
-                                            cpu_time_s=state.cpu_time_s)
+    start = None
+    if orbit is not None and state.start is not None:  # models.steady.start_check
+        check = state.start
+        start = StartRecord(check.regime, check.reaches_orbit, check.blows, check.advance_per_blow_m)
+        note = "; ".join(part for part in (coexisting_note(check, state.orbit), note) if part)
+    result.steady_state = SteadyStateRecord("periodic", regime, orbit, unstable, start, note=note,
+                                            map_runs=state.map_runs, cpu_time_s=state.cpu_time_s)
     return result
 
 

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 from ...rocklaw.exudyn_module import exu
 from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
 from ..definition.own_code import failure
+from ..definition.validation import InputError
 from ..evaluation.stability import SimulationFailed
 from .exudyn_user_items import follow_extension_coordinates
 
@@ -209,6 +210,8 @@ def apply_extensions(model: Any) -> None:
         return
     try:
         follow_extension_coordinates(model)  # model.prepare(), the coordinates a steady-state run follows with it
+    except InputError:  # a scene its extensions make that cannot run as given (a start, a solver): bad input
+        raise
     except (ValueError, exu.ExudynError) as error:
         raise SimulationFailed(f"scene '{scene.name}': the model with {_named(scene)} cannot be prepared: "
                                f"{type(error).__name__}: {error}") from None

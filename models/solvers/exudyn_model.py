@@ -84,6 +84,7 @@ from .exudyn_messages import (
     solver_errors,
 )
 from .exudyn_piston import ExudynPiston
+from .exudyn_start import start_assembled
 from .exudyn_user_items import (
     EnergyTerm,
     ExudynBody,
@@ -91,6 +92,7 @@ from .exudyn_user_items import (
     UserAccount,
     add_body,
     assembled_scales,
+    coordinate_names,
     item_counts,
     link_force_function,
     time_runs_only,
@@ -200,6 +202,10 @@ class ExudynModel:
         solution.export.velocities = solution.export.accelerations = False
         self.solution_path = Path(path)
 
+    def coordinate_names(self) -> list[str]:
+        """Each ODE2 coordinate's name in Exudyn's order, the solution file's columns (exudyn_user_items)."""
+        return self.prepare() or coordinate_names(self)
+
     def user_items(self) -> dict[str, int]:
         """The Exudyn items added to ``mbs`` since the model was built (by the scene's extensions too), by
         kind (none: empty); the sensors the energy account adds are not counted."""
@@ -213,6 +219,7 @@ class ExudynModel:
             return
         self.mbs.Assemble()
         if self.user_items().keys() - {"sensors"}:
+            start_assembled(self)  # a preloaded start, the solver the constraints need (models.solvers.exudyn_start)
             self._size_step()
         self._account.watch(self.mbs, "energy" in self.simulation.needed_data)
         self.mbs.Assemble()

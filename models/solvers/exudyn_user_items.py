@@ -175,6 +175,41 @@ def assembled_scales(model: Any) -> StepScales:
     return scales
 
 
+def node_labels(model: Any, node: int, count: int) -> list[str]:
+    """The name of the first object of one's own on ``node`` (else the node's), with [i] for a node of several
+    coordinates."""
+    mbs = model.mbs
+    name = mbs.GetNode(node)["name"]
+    for index in range(model.built_items["objects"], mbs.systemData.NumberOfObjects()):
+        item = mbs.GetObject(index)
+        numbers = item.get("nodeNumber", item.get("nodeNumbers", []))
+        if node in [int(number) for number in (numbers if isinstance(numbers, list | tuple) else [numbers])]:
+            name = item["name"]
+            break
+    return [name] if count == 1 else [f"{name}[{i}]" for i in range(count)]
+
+
+def coordinate_names(model: Any) -> list[str]:
+    """The name of every ODE2 coordinate of an assembled model (ExudynModel.coordinate_names), in Exudyn's order:
+    the index of ``mbs.systemData.GetODE2Coordinates()`` and the column after the time of Exudyn's solution file
+    (``model.write_solution``). The drill's bodies come first, in the order the scene lists them (a rod's segments
+    ``rod1[0]``, ``rod1[1]``, ..., then a piston's), then ``torsion`` where it is built, then the coordinates of
+    items of one's own in the order they were added, each by :func:`node_labels`."""
+    mbs = model.mbs
+    names = [""] * mbs.systemData.ODE2Size()
+    drill = {int(body.node): body.name for body in model.bodies.values()}
+    if model.torsion is not None:
+        drill[int(model.torsion.node)] = "torsion"
+    for node in range(mbs.systemData.NumberOfNodes()):
+        indices = [int(i) for i in mbs.systemData.GetNodeLTGODE2(node)]
+        if not indices or "Ground" in mbs.GetNode(node)["nodeType"]:
+            continue
+        labels = [drill[node]] if node in drill else node_labels(model, node, len(indices))
+        for index, label in zip(indices, labels, strict=True):
+            names[index] = label
+    return names
+
+
 def extension_nodes(model: Any) -> list[tuple[int, list[int]]]:
     """The nodes added to a built model after its build (by its extensions, or by a user) that have ODE2
     coordinates: (node, its coordinates' global ODE2 indices) in the order of the nodes."""

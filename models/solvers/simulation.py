@@ -6,14 +6,20 @@ as built, the solver settings of the scene's formulation (an accuracy preset res
 or tolerances), the initial state (rest, or the static preload), and the indexing model (the
 ``indexing`` effect: models.drill.indexing) whose blow starts every formulation applies. Every formulation, the metrics,
 the energy account and the stability checks read these fields; nothing derives them again.
-models.solvers.time_run runs it through the formulation registry (models.definition.formulations).
+models.solvers.time_run runs it through the formulation registry (models.definition.formulations):
+:func:`implementation` imports a formulation's module on first use (the exact and ODE formulations never import
+Exudyn); each provides ``simulate(simulation, progress=None)`` and, if it cannot run every scene,
+``unsupported(simulation) -> str | None``, there or in the lighter ``checks`` module the registry names (the
+exact formulation's exact_system: a study checks its points before any run without loading the compiled kernels).
 """
 
 from __future__ import annotations
 
+import importlib
 import math
 import sys
 from dataclasses import dataclass, replace
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -21,7 +27,7 @@ import numpy as np
 from ...rocklaw import RockLaw, State
 from ..definition.extensions import CodeRecords, refusal
 from ..definition.extensions import records as extension_records
-from ..definition.formulations import AUTOMATIC_STEP_SOLVERS
+from ..definition.formulations import AUTOMATIC_STEP_SOLVERS, FORMULATIONS
 from ..definition.outputs import needs
 from ..definition.scene import (
     BuiltEffects,
@@ -47,7 +53,6 @@ from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_setti
 from ..evaluation.stability import FastestElement, StepScales, fastest_element, spring_spread, step_scales
 from ..waves.statics import wave_preload_m
 from ..waves.steps import wave_settings
-from .dispatch import implementation
 
 
 class SceneError(ValueError):
@@ -177,6 +182,12 @@ class Simulation:
                 f"coupling {self.piston.contact_stiffness_n_per_m:.6g} N/m: {faces} in series with the "
                 "half-segments behind the faces")
         return data
+
+
+def implementation(name: str, checks: bool = False) -> ModuleType:
+    """The module of formulation ``name`` in this package (``checks``: its lighter checks module, if any)."""
+    formulation = FORMULATIONS[name]
+    return importlib.import_module(f".{(checks and formulation.checks) or formulation.module}", __package__)
 
 
 def unsupported(name: str, simulation: Simulation) -> str | None:

@@ -8,13 +8,12 @@ from pathlib import Path
 
 from ..definition.extensions import refusal
 from ..evaluation.results import SimulationResult
-from .dispatch import implementation
-from .simulation import SceneError, Simulation
+from .simulation import SceneError, Simulation, implementation
 
 
 def time_run(simulation: Simulation, progress: Callable[[float], None] | None = None,
              solution_file: Path | None = None) -> SimulationResult:
-    """The formulation's run of ``simulation`` from its start to its end time (models.solvers.dispatch);
+    """The formulation's run of ``simulation`` from its start to its end time (models.solvers.simulation.implementation);
     ``progress(t)`` as simulated time advances. The steady-state machinery's runs (models.steady) and the one
     run path (models.runs.scene_run.run, which honours ``solver.steady_state``) call it; nothing else does.
     ``solution_file``: with the Exudyn formulation, Exudyn's coordinates solution file written there during

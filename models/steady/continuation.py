@@ -19,7 +19,9 @@ Between two neighbouring orbits of a branch (:func:`changes`):
 * ``regime``: the attractor found changes (period n to m, or to no periodic orbit).
 
 Coexisting orbits (hysteresis) show when the same axis is followed from both ends (:func:`hysteresis`):
-where the two passes end on different orbits at one value, both are stable there.
+where the two passes end on different orbits at one value, both are stable there. And where an orbit a pass
+follows is not where the drill goes from the scene's start (models.steady.start_check: another orbit, or an
+irregular response), the two coexist too (:func:`coexisting`).
 """
 
 from __future__ import annotations
@@ -47,6 +49,8 @@ class BranchPoint:
     state: np.ndarray | None
     multipliers: np.ndarray
     events: tuple[str, ...]
+    start_regime: str = ""  # where the drill goes from the scene's start (models.steady.start_check; '': unchecked)
+    start_reaches_orbit: bool | None = None
 
     @property
     def floquet_max_abs(self) -> float:
@@ -59,8 +63,10 @@ def branch_point(value: float, steady: SteadyStateRecord | None, advance_per_blo
     if orbit is None:
         return BranchPoint(value, "" if steady is None else steady.regime_name, None, advance_per_blow_m, None,
                            np.array([], dtype=complex), ())
+    start = steady.start
     return BranchPoint(value, steady.regime_name, orbit.period_blows, advance_per_blow_m, orbit.state,
-                       np.array(orbit.multipliers, dtype=complex), orbit.event_sequence)
+                       np.array(orbit.multipliers, dtype=complex), orbit.event_sequence,
+                       "" if start is None else start.regime, None if start is None else start.reaches_orbit)
 
 
 @dataclass
@@ -148,3 +154,15 @@ def hysteresis(forward: list[BranchPoint], backward: list[BranchPoint], relative
             or abs(a.advance_per_blow_m - b.advance_per_blow_m)
             > relative * max(abs(a.advance_per_blow_m), abs(b.advance_per_blow_m), 1e-12)
             or (a.period_blows == 1 and not np.allclose(a.state, b.state, rtol=1e-6, atol=1e-9))]
+
+
+def coexisting(points: list[BranchPoint]) -> list[Change]:
+    """The points of a pass whose orbit the drill does not reach from the scene's start (module doc): what the
+    start reaches instead."""
+    def reached(p: BranchPoint) -> str:
+        if p.start_regime == "irregular":
+            return "an irregular response (no period up to 6 blows)"
+        return f"{'another' if p.start_regime == p.regime else 'a'} stable {p.start_regime} orbit"
+
+    return [Change("coexisting", p.value, p.value, f"{p.regime} orbit of the pass; from the scene's start the drill "
+                   f"reaches {reached(p)}") for p in points if p.state is not None and p.start_reaches_orbit is False]

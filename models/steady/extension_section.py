@@ -31,7 +31,13 @@ from dataclasses import replace
 import numpy as np
 
 from ..solvers.exudyn_model import ExudynModel, build_exudyn
-from ..solvers.exudyn_user_items import closed_chain, extension_nodes, initial_coordinates, linearised_system
+from ..solvers.exudyn_user_items import (
+    closed_chain,
+    extension_nodes,
+    initial_coordinates,
+    linearised_system,
+    node_labels,
+)
 from ..solvers.simulation import ExtensionCoordinates, Simulation
 from .steady_state import SteadyStateUnavailable
 
@@ -53,8 +59,11 @@ def with_extension_coordinates(simulation: Simulation) -> Simulation:
     _refuse_hidden_states(model)
     nodes = extension_nodes(model)
     indices = [i for _, node_indices in nodes for i in node_indices]
-    labels = [label for node, node_indices in nodes for label in _labels(model, node, len(node_indices))]
+    labels = [label for node, node_indices in nodes for label in node_labels(model, node, len(node_indices))]
     drift = _drift(model, indices, labels)  # also where they add no coordinates: a spring to ground
+    # the start the model solved (start: preloaded: the assembled system's equilibrium, models.solvers.exudyn_start)
+    simulation = replace(simulation, initial_positions_m=model.simulation.initial_positions_m,
+                         initial_rock_state=model.simulation.initial_rock_state)
     if not nodes:
         return simulation
     start = initial_coordinates(model, indices)
@@ -79,19 +88,6 @@ def _refuse_hidden_states(model: ExudynModel) -> None:
             f"{_extensions(model)} add {' and '.join(hidden)} to the Exudyn model: a state the Poincare section of "
             "the steady-state solver does not hold (it holds the ODE2 coordinates and velocities), so an orbit "
             "could not return it; use solver.steady_state: time")
-
-
-def _labels(model: ExudynModel, node: int, count: int) -> list[str]:
-    """The name of the first object on ``node`` (else the node's), with [i] for a node of several coordinates."""
-    mbs = model.mbs
-    name = mbs.GetNode(node)["name"]
-    for index in range(model.built_items["objects"], mbs.systemData.NumberOfObjects()):
-        item = mbs.GetObject(index)
-        numbers = item.get("nodeNumber", item.get("nodeNumbers", []))
-        if node in [int(number) for number in (numbers if isinstance(numbers, list | tuple) else [numbers])]:
-            name = item["name"]
-            break
-    return [name] if count == 1 else [f"{name}[{i}]" for i in range(count)]
 
 
 def _drift(model: ExudynModel, indices: list[int], labels: list[str]) -> np.ndarray:

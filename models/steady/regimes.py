@@ -19,7 +19,8 @@
 
 A guess from a neighbour follows the branch it is on: where two stable orbits coexist (hysteresis), a
 continuation stays on its branch while the time run from the scene's start may settle on the other
-(models.steady.continuation follows a scan from both ends).
+(models.steady.continuation follows a scan from both ends); :meth:`RegimeFinder.check_start` says where the
+start goes (models.steady.start_check).
 
 The exact formulation has the exact Jacobian. The ODE and Exudyn formulations shoot with their own time
 runs (models.steady.formulation_map); where the exact formulation can run the scene, its regime comes first
@@ -46,6 +47,7 @@ from .formulation_map import FormulationMap
 from .map_runs import end_state, started_at, states_at
 from .section import drift_problem, section_of
 from .shooting import TOLERANCE, NoConvergence, Orbit, PeriodMap, Shooter, scales
+from .start_check import check_start
 from .steady_state import NONE_FOUND, SteadyState, SteadyStateUnavailable, regime_name
 
 MAX_PERIOD_BLOWS = 6  # the longest orbit looked for, in blows
@@ -276,6 +278,23 @@ class RegimeFinder:
             return periodic.result(orbit.state, orbit.periods, cpu_start)
         result = time_run(started_at(self.simulation, orbit.state, orbit.periods))
         return result, end_state(result)
+
+    def check_start(self, state: SteadyState) -> SteadyState:
+        """``state`` with where the drill goes from the scene's start beside its orbit (models.steady.start_check),
+        by the exact model (the scene's, or the one guiding another formulation, against its orbit); unchanged
+        without an orbit or where the exact model does not run the scene."""
+        finder = self if self.exact else self.guide
+        orbit = state.orbit if self.exact else state.exact_guide or state.orbit
+        if finder is None or orbit is None:
+            return state
+        self.runs += 1
+        try:
+            checked = check_start(finder.map(1), finder.simulation, finder.section, start_state(finder.simulation),
+                                  orbit, lambda states: repeating_period(finder.simulation, states, MAX_PERIOD_BLOWS),
+                                  finder.shoot)
+        except SimulationFailed:
+            return state
+        return replace(state, start=checked)
 
     def _why_none(self) -> str:
         distance = getattr(self, "distance", None)

@@ -8,6 +8,20 @@ from dataclasses import dataclass, field
 from .shooting import Orbit
 
 PERIOD_1, NONE_FOUND = "period-1", "no periodic orbit found"
+IRREGULAR = "irregular"  # where the drill goes from its start when that is no period up to 6 blows
+
+
+@dataclass(frozen=True)
+class StartCheck:
+    """Where the drill goes from its scene's start (models.steady.start_check): ``regime`` the attractor it reaches
+    (``period-n``, or ``irregular``), ``reaches_orbit`` whether that is the orbit found, ``advance_per_blow_m``
+    the other orbit's (NaN: none), after ``blows`` blows, ``cpu_time_s`` the check's cost."""
+
+    regime: str
+    reaches_orbit: bool
+    blows: int
+    advance_per_blow_m: float
+    cpu_time_s: float
 
 
 class SteadyStateUnavailable(ValueError):
@@ -26,6 +40,8 @@ class SteadyState:
     map_runs: int = 0
     cpu_time_s: float = 0.0
     exact_guide: Orbit | None = field(default=None, compare=False)  # the exact model's orbit (other formulations)
+    # where the drill goes from its scene's start beside the orbit (models.steady.start_check; None: not checked)
+    start: StartCheck | None = field(default=None, compare=False)
 
     @property
     def period_blows(self) -> int | None:

@@ -46,6 +46,7 @@ from .advice_search import (
     Advice,
     AdviceEvaluation,
     AdviceSearch,
+    NoAllowedPoint,
     Request,
     advice_hash,
     planned_evaluations,
@@ -69,7 +70,8 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
     ``dask``, ``out``, ``overwrite``, ``quiet``): ``out`` the folder of the checkpoint and the report (module
     doc; new, empty or an earlier advice's, or any folder with ``overwrite``, which starts afresh there);
     ``markdown``: a copy of advice.md; ``command``: the command the report names (default: this call);
-    ``max_rod_stress_pa``: the best point whose rods stay below this stress (rod_stress_max_pa, a scene with rods).
+    ``max_rod_stress_pa``: the best point whose rods stay below this stress (rod_stress_max_pa, a scene with rods;
+    NoAllowedPoint, a RuntimeError, where no point run meets it: the points run are kept in ``out``).
     InputError before anything runs when an input cannot be used; ``allow_code``: the modules of one's own the
     scene may run (models.definition.own_code)."""
     where = "rpdrill.advise"
@@ -117,9 +119,10 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
         try:
             for rock, prepared in scenes:
                 advices.append(search_advice(prepared, rock, request, runner, bar.update, log))
-        except KeyboardInterrupt:  # the points run are kept (evaluations.jsonl); the session says where it stopped
-            if log:
-                log.add_session(_session(label, len(log.records) - earlier, advices, start, interrupted=True))
+        except (KeyboardInterrupt, NoAllowedPoint) as stop:  # the points run are kept (evaluations.jsonl); the
+            if log:                                             # session says where it stopped
+                log.add_session(_session(label, len(log.records) - earlier, advices, start,
+                                         interrupted=isinstance(stop, KeyboardInterrupt)))
             raise
         if log:
             log.add_session(_session(label, len(log.records) - earlier, advices, start, interrupted=False))

@@ -10,8 +10,12 @@ scene: the penetration rate per unit hammer power; models.evaluation.metrics).
   the frequency, E_blow = P / f (``impact.piston.energy_j``; the strike speed follows from it), so the
   search trades frequency against blow energy at the hammer's rated power P = E_blow f. A top
   hammer's rate is jagged along the frequency there (each blow meets the string's ringing from the
-  last at another phase), so the points of the curves and the map are candidates too: where one beats
-  the search's best it becomes the optimum, and the curves are run again through it.
+  last at another phase).
+
+* **The best is the best point run**: the points of the curves and the map are candidates too (a search on
+  a small budget may stop short of a point its own curves pass through): where one beats the search's best
+  it becomes the optimum (``Advice.search_best_value`` keeps the search's own), and the curves (and the map,
+  when a parameter beside feed and frequency moved) are run again through it, until none beats it.
 
 * **Runs**: the exact formulation where it can run the scene (models.definition.formulations.unsupported),
   the Exudyn model otherwise; the scene's end time, raised where needed so that the metrics'
@@ -21,7 +25,9 @@ scene: the penetration rate per unit hammer power; models.evaluation.metrics).
   ``max_thrust_ratio`` x F_th) is not run: there a Jenkins rock yields under the mean load and the
   bit sinks at a rate set only by the rock damper (runaway crushing, outside what the model
   describes). The search treats it as a constraint: such a point is worse than any point below the
-  limit, the more the further beyond.
+  limit, the more the further beyond. So is a point whose rods exceed a stress bound; where no point run
+  meets the bound there is no advice: :class:`NoAllowedPoint` (``rpdrill advise`` exits 1), never the
+  search's penalty as a rate.
 * **AdviceSearch**: SciPy's differential evolution over the box of the bounds (best1bin, a population
   of ``popsize`` x parameters, at most ``max_generations`` generations, seeded; no gradient
   polish: the metric has steps where crushing starts). Each generation's population is one batch
@@ -71,6 +77,7 @@ STRESS = "rod_stress_max_pa"  # the rods' largest stress (models.evaluation.rod_
 METRICS = ("penetration_rate_m_per_s", "penetration_per_impact_energy_m_per_j", "penetration_per_blow_energy_m_per_j")
 SLICE_POINTS = 15
 MAP_POINTS = 12
+MAX_PROMOTIONS = 5  # rounds of curves through a better point (module doc: the best is the best point run)
 IMPLAUSIBLE = 10  # a feed bound this many times every rock's threshold force is a unit mistake (N for kN)
 Bounds = dict[str, tuple[float, float]]  # scene path -> (low, high), SI
 Point = dict[str, float]  # scene path -> SI value
@@ -180,6 +187,11 @@ class Advice:
     max_rod_stress_pa: float | None = None  # the rods' stress bound, or None
     best_rod_stress_pa: float = math.nan  # the rods' largest stress at the best point (with a bound)
     beyond_stress: int = 0  # points run whose rods' stress exceeded the bound
+    search_best_value: float = math.nan  # the search's own best, where a point of its curves or map beat it
+
+
+class NoAllowedPoint(RuntimeError):
+    """No point run meets the rods' stress bound (``max_rod_stress_pa``): there is no advice (module doc)."""
 
 
 def at_point(scene: Scene, point: Point, power_w: float | None = None, source: str = "advise") -> Scene:
@@ -438,13 +450,24 @@ def search_advice(data: Scene, rock: str | None, request: Request, runner: Runne
                     metric=request.metric, formulation=data.solver.formulation, end_time_s=data.solver.end_time_s,
                     bounds=request.bounds, max_thrust_ratio=request.max_thrust_ratio, power_w=request.power_w)
     advice.best, advice.best_value, advice.generations, advice.converged = search_best(evaluate, request)
+    if request.max_rod_stress_pa is not None and evaluate.beyond_stress and not math.isfinite(evaluate.best_value):
+        raise NoAllowedPoint(_no_allowed_point(evaluate, request, rock or data.name))
     advice.best_thrust_ratio = thrust_ratio(at_point(data, advice.best, request.power_w))
     advice.slices = slices(evaluate, request.bounds, advice.best, advice.best_value)
     advice.feed_map = feed_map(evaluate, request, advice.best, data)
-    if request.power_w is not None and evaluate.best_value > advice.best_value:  # a curve or map point (module doc)
+    searched = advice.best_value
+    for _ in range(MAX_PROMOTIONS):  # a point of the curves or the map beats the search's best (module doc)
+        if not evaluate.best_value > advice.best_value:
+            break
+        moved = [path for path in request.bounds if path not in (FREQUENCY, FEED)
+                 and evaluate.best_point[path] != advice.best[path]]
         advice.best, advice.best_value = evaluate.best_point, evaluate.best_value
         advice.best_thrust_ratio = thrust_ratio(at_point(data, advice.best, request.power_w))
         advice.slices = slices(evaluate, request.bounds, advice.best, advice.best_value)
+        if moved:  # the map is at the other parameters of the best
+            advice.feed_map = feed_map(evaluate, request, advice.best, data)
+    if advice.best_value > searched:
+        advice.search_best_value = searched
     advice.feed_map["response"] = feed_response(advice.feed_map)
     advice.runs, advice.failed_runs, advice.beyond_limit = evaluate.runs, evaluate.failed, evaluate.beyond_limit
     advice.max_rod_stress_pa, advice.beyond_stress = request.max_rod_stress_pa, evaluate.beyond_stress
@@ -453,3 +476,16 @@ def search_advice(data: Scene, rock: str | None, request: Request, runner: Runne
     advice.first_error = evaluate.first_error
     advice.wall_time_s = time.perf_counter() - start
     return advice
+
+
+def _no_allowed_point(evaluate: AdviceEvaluator, request: Request, name: str) -> str:
+    """Why there is no advice under the stress bound: the least stress of the points run, and where."""
+    stresses = {key: value for key, value in evaluate.stress_at.items() if math.isfinite(value)}
+    bound = f"{request.max_rod_stress_pa / 1e6:g} MPa"
+    if not stresses:
+        return f"{name}: no point run gave the rods' stress to hold against the bound {bound}"
+    key = min(stresses, key=stresses.get)
+    where = ", ".join(f"{parameter(path).name} {parameter(path).show_with_unit(value)}" for path, value in key[1:])
+    return (f"{name}: no point run keeps the rods below the stress bound {bound} (max_rod_stress_pa; "
+            f"{evaluate.beyond_stress} of {evaluate.runs} points run exceed it): the least stress run is "
+            f"{stresses[key] / 1e6:.4g} MPa, at {where}; raise the bound above it or change the bounds")

@@ -14,7 +14,7 @@ from pathlib import Path
 from ...rocklaw.catalog import TABLE_1
 from ..advice.advice_report import advice_text, best_table
 from ..advice.advice_run import ADVISE_OPTIONS, advise_scene
-from ..advice.advice_search import METRICS, PARAMETERS, AdviceSearch, AdviseParameter
+from ..advice.advice_search import METRICS, PARAMETERS, AdviceSearch, AdviseParameter, NoAllowedPoint
 from ..display.catalogue import parameter
 from ..inputs.arguments import choice_problem, cli_type
 from ..runtime.evaluation_log import CHECKPOINT, EVALUATIONS
@@ -103,11 +103,15 @@ def run(args: argparse.Namespace) -> int:
     if args.markdown:
         check_file_target("--markdown", args.markdown)
     bounds = {e.path: e.si_bounds(_given(args, e)) for e in PARAMETERS if _given(args, e) is not None}
-    advices = advise_scene(args.scene, bounds, args.metric, args.rock, args.power_kw, args.max_thrust_ratio,
-                           AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed),
-                           args.markdown, command_line(args),
-                           max_rod_stress_pa=args.max_rod_stress_mpa * 1e6 if args.max_rod_stress_mpa else None,
-                           options=run_options(args, *ADVISE_OPTIONS), allow_code=args.allow_code)
+    try:
+        advices = advise_scene(args.scene, bounds, args.metric, args.rock, args.power_kw, args.max_thrust_ratio,
+                               AdviceSearch(popsize=args.popsize, max_generations=args.generations, seed=args.seed),
+                               args.markdown, command_line(args),
+                               max_rod_stress_pa=args.max_rod_stress_mpa * 1e6 if args.max_rod_stress_mpa else None,
+                               options=run_options(args, *ADVISE_OPTIONS), allow_code=args.allow_code)
+    except NoAllowedPoint as error:  # no advice: the points run are kept in --out (evaluations.jsonl)
+        print(f"advise: {error}; the points run are in {args.out}", file=sys.stderr)
+        return 1
     for advice in advices:
         print(advice_text(advice))
     print(best_table(advices))

@@ -5,7 +5,8 @@ kernel when the process ends, however it ends; the file is removed when it is re
 the pid and command line of its run. A second command on the same folder is refused (InputError,
 exit status 2) naming the running one. A lock file left by a run that was killed is taken over,
 which is said once. When the folder cannot take the lock (read-only, not writable, a full disk) the
-command is refused naming ``--out`` and why, before anything runs. ``--out`` is removed when the
+command is refused naming ``--out`` and why, before anything runs (a folder that takes no files, such as one
+in /proc, too: filelock reports it as a lock held by another run). So is an ``--out`` that cannot be made. ``--out`` is removed when the
 command ends if the command created it and left it empty (bad input leaves ``--out`` as it was).
 """
 
@@ -20,7 +21,7 @@ from pathlib import Path
 from filelock import FileLock, Timeout
 
 from ..inputs.reading import InputError
-from .output_files import check_name
+from .output_files import check_name, check_out
 
 LOCK = ".rpdrill.lock"
 
@@ -39,6 +40,16 @@ def _holder(path: Path) -> str:
         return ""
 
 
+def _unwritable(path: Path) -> OSError | None:
+    """Why the lock file ``path`` cannot be opened for writing (its folder takes no files: /proc), or None."""
+    try:
+        handle = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError as error:
+        return error
+    os.close(handle)
+    return None
+
+
 def _refusal(out: Path, error: OSError) -> InputError:
     return InputError(f"--out: {out}: cannot write there ({error.strerror or error}); give a folder you can write")
 
@@ -55,9 +66,13 @@ def out_locked(out: str | Path | None, command: str) -> Iterator[None]:
     try:
         created = [p for p in (out, *out.parents) if not p.exists() and not p.is_symlink()]
         out.mkdir(parents=True, exist_ok=True)
-    except (OSError, ValueError):  # (ValueError: a NUL in the name) the command's check of --out says why
+    except ValueError:  # (a NUL in the name) the command's check of --out says why
         yield
         return
+    except OSError as error:  # the command's check of --out says why where it can (a file on the path), else this
+        check_out(out, overwrite=True)
+        raise InputError(f"--out: {out}: cannot be made ({error.strerror or error}); give a folder you can "
+                         "write") from None
     before: list[str] = []
 
     def take(handle: int) -> None:
@@ -81,6 +96,10 @@ def out_locked(out: str | Path | None, command: str) -> Iterator[None]:
                 lock.acquire()
                 break
     except Timeout:
+        refused = _unwritable(out / LOCK)  # filelock reports a folder that takes no files (/proc) as a lock held
+        if refused is not None:
+            _remove(created)
+            raise _refusal(out, refused) from None
         holder = _holder(out / LOCK) or "a run that is starting"
         raise InputError(f"--out: {out}: another rpdrill run writes there ({holder}); wait until it ends, or give "
                          "another folder") from None

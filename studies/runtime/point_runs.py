@@ -80,17 +80,18 @@ def point_columns(metrics: Sequence[str]) -> list[str]:
     return [*STATUS_COLUMNS, *metrics]
 
 
-def run_prepared(simulation: Simulation, guess: OrbitGuess | None = None, cold_newton: bool = True
-                 ) -> tuple[dict[str, Any], Result | None]:
+def run_prepared(simulation: Simulation, guess: OrbitGuess | None = None, cold_newton: bool = True,
+                 start_check: bool = True) -> tuple[dict[str, Any], Result | None]:
     """Run one prepared point as its scene asks (models.runs.scene_run.run: a time run, or its
     steady state from ``guess``, a neighbour's orbit; ``cold_newton``: as there) into its row
     (:func:`point_columns`): status (models.evaluation.run_status: ok, unstable, unsettled, not_finite or
-    unbalanced, the reason in ``error``; a steady state's note where the run is ok), the steady state's
+    unbalanced, the reason in ``error``; a steady state's note where the run is ok; ``start_check``: as
+    models.runs.scene_run.run's), the steady state's
     columns, wall time and every metric of its outputs; a failure is returned (status ``failed``, the
     exception in ``error``, no metrics), not raised. The row and the run (None if it failed)."""
     start = time.perf_counter()
     try:
-        result = run(simulation, guess=guess, cold_newton=cold_newton)
+        result = run(simulation, guess=guess, cold_newton=cold_newton, start_check=start_check)
         metrics = result.metrics
         status, why = run_status(result.raw, metrics)
     except Exception as err:  # noqa: BLE001 - one bad point is recorded and the analysis goes on
@@ -108,11 +109,12 @@ def run_point(simulation: Simulation) -> dict[str, Any]:
     return run_prepared(simulation)[0]
 
 
-def run_followed(branch: Continuation, value: float, simulation: Simulation) -> dict[str, Any]:
+def run_followed(branch: Continuation, value: float, simulation: Simulation, start_check: bool = True
+                 ) -> dict[str, Any]:
     """One point of a sequence along an axis at ``value``, run after the points before it (module doc):
     Newton from ``branch``'s prediction, which then takes this point's orbit (every point's, a failed
     one's too, so that the passes of a chain align: models.steady.continuation). Its row."""
-    row, result = run_prepared(simulation, branch.guess(value), branch.cold_newton)
+    row, result = run_prepared(simulation, branch.guess(value), branch.cold_newton, start_check)
     branch.add(branch_point(value, None if result is None else result.steady_state,
                             row.get("advance_per_blow_m", math.nan)))
     return row

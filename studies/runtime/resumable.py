@@ -172,6 +172,15 @@ def finished_rows(path: Path, columns: list[str], points: Sequence[TablePoint], 
     return set(rows)
 
 
+def _keep_rows(path: Path, columns: list[str], kept: set[int]) -> set[int]:
+    """The rows of ``kept`` points of a table's file (rewritten by :func:`finished_rows`), the rest dropped."""
+    _, lines = read_text(path)
+    rows = [cells for _, cells in lines if int(cells[0]) in kept]
+    with atomic_file(path) as handle:
+        write_rows(handle, columns, [dict(zip(columns, cells, strict=True)) for cells in rows], {}, header=True)
+    return {int(cells[0]) for cells in rows}
+
+
 def point_row(point: TablePoint, outcome: Mapping[str, Any]) -> dict[str, Any]:
     """A table row: the point's index, its values, then what its run returned."""
     return {"point": point.index, **point.values, **outcome}
@@ -184,7 +193,11 @@ class Table:
     into the point's row by ``row(point, outcome)`` (default :func:`point_row`). ``formats``: number
     formats of columns in the file (wall time: 4 digits); ``text``: columns that hold text even where
     they read as numbers or are empty (studies.runtime.tables.typed). ``scene_keys``: each point's scene,
-    when points of equal keys give equal results (module doc)."""
+    when points of equal keys give equal results (module doc); a task's outcome then gives the rows of every
+    point of its key (a continuation's chain: studies.scan.continuation_runs). ``resumed(done)``: told the points
+    with a finished row before any runs, it gives back those to keep (the others run again: their files beside
+    the table do not hold them); ``taken(outcome)``: each outcome before its rows are appended (files of
+    the study's own beside the table, written first so that a table's row means they hold its point)."""
 
     study: ResumableStudy
     out: Path
@@ -196,6 +209,9 @@ class Table:
     formats: dict[str, str] = field(default_factory=dict)
     text: Sequence[str] = ()
     scene_keys: Sequence[str] | None = None
+    resumed: Callable[[set[int]], set[int]] | None = None
+    taken: Callable[[Any], None] | None = None
+    task_name: str | None = None  # a task's name when one task runs every point of its key ("chain"), not copies
 
     def number_formats(self) -> dict[str, str]:
         return {"wall_time_s": WALL_TIME_FORMAT, **self.formats}
@@ -227,20 +243,29 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
         records.append(provenance(job.study, job.out, job.table))
         write_json(job.out / RECORD, records[-1])
         done = finished_rows(job.out / job.table, job.columns, job.study.points, job.text, job.number_formats())
+        if job.resumed is not None:
+            kept = job.resumed(done)
+            if kept != done:  # rows whose files beside the table do not hold their points: run again
+                done = _keep_rows(job.out / job.table, job.columns, kept)
         todo = [p for p in job.study.points if p.index not in done]
-        runs = []
+        runs, keys = [], set()
         for point in todo:
             key = job.scene_keys[point.index] if job.scene_keys is not None else (i, point.index)
+            keys.add(key)
             if key not in task_of:
                 task_of[key] = len(tasks)
                 tasks.append((job.worker, len(tasks), job.task(point)))
                 targets.append([])
                 runs.append(point)
+            elif job.task_name is not None:  # run by its key's task, not copied
+                runs.append(point)
             targets[task_of[key]].append((i, point.index))
         remaining.append(len(todo))
         same = f"{len(todo) - len(runs)} the same as another point (run once), " if len(runs) < len(todo) else ""
+        grouped = f" in {len(keys)} {job.task_name}(s)" if job.task_name is not None else ""
         print(f"{job.study.spec.name}: {len(job.study.points)} points, {len(done)} finished earlier, {same}running "
-              f"{len(runs)} on {label} (estimated {duration(sum(p.cpu_s for p in runs))} of CPU)", file=sys.stderr)
+              f"{len(runs)}{grouped} on {label} (estimated {duration(sum(p.cpu_s for p in runs))} of CPU)",
+              file=sys.stderr)
     frames: list[pd.DataFrame | None] = [None] * len(tables)
     ran, copied = [0] * len(tables), [0] * len(tables)  # points written: run for the table, or copied to it
     start = time.perf_counter()
@@ -260,13 +285,18 @@ def run_tables(tables: Sequence[Table], runner: tuple[str, Runner], quiet: bool,
                 """Append a batch's rows to their tables."""
                 by_table: dict[int, list[dict[str, Any]]] = {}
                 first: dict[int, int] = {}  # per table: the outcomes of points run for it (the others copied)
+                outcomes: dict[int, list[Any]] = {}  # per table: the outcomes its rows come from, once each
                 for tag, outcome in batch:
                     for n, (i, index) in enumerate(targets[tag]):
                         job = tables[i]
                         by_table.setdefault(i, []).append(job.row(job.study.points[index], outcome))
-                        first[i] = first.get(i, 0) + (n == 0)
+                        first[i] = first.get(i, 0) + (n == 0 or job.task_name is not None)
+                        if not any(taken is outcome for taken in outcomes.setdefault(i, [])):
+                            outcomes[i].append(outcome)
                 for i, rows in by_table.items():  # a batch's rows, then one flush per table
                     job = tables[i]
+                    for outcome in outcomes[i] if job.taken is not None else ():
+                        job.taken(outcome)
                     append_rows(job.out / job.table, job.columns, rows, job.number_formats())
                     ran[i] += first.get(i, 0)
                     copied[i] += len(rows) - first.get(i, 0)

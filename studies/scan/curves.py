@@ -130,7 +130,8 @@ def run_curve(curve: Curve) -> CurveRun:
             continue
         if curve.axis == FREQUENCY:
             resonance = resonance or rock_mode_frequency_hz(simulation.chain, simulation.rock) or None
-        rows[index] = {curve.axis: value, **run_followed(branch, value, simulation)}
+        # (a curve is read for its optima: where each orbit's start goes is a study's and a run's to say)
+        rows[index] = {curve.axis: value, **run_followed(branch, value, simulation, start_check=False)}
     table = pd.DataFrame([rows[i] for i in sorted(rows)], columns=[curve.axis, *point_columns(curve.metrics)])
     return CurveRun(curve.key, curve.axis, table, resonance, time.process_time() - start)
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -237,6 +238,8 @@ def load_study(path: str | Path, formulation: str | None = None, budget: Budget 
     check_size(budget, source, what, count, base_estimate_s(source, base, outputs))
     axes = {name: axis.expand() for name, axis in spec.scan.items()}
     _check_distinct(axes, source)
+    if spec.steady_state == "continuation":
+        axes = _continuation_order(spec, axes, groups, source)
     points, problems, bad_input = [], [], False
     for index, values in enumerate(_combine(groups, axes)):
         try:
@@ -262,6 +265,25 @@ def _check_continuation(spec: StudySpec, source: str) -> None:
     values = spec.scan[axis].expand()
     if len(values) < 2 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
         raise InputError(f"{source}: scan.{axis}: a continuation follows an axis of at least two numbers")
+
+
+def _continuation_order(spec: StudySpec, axes: dict[str, list[Any]], groups: list[list[str]], source: str
+                        ) -> dict[str, list[Any]]:
+    """The axes with the continuation axis in increasing order (its zipped axes along with it) where it was
+    given in neither increasing nor decreasing order, said in a warning: a continuation follows its axis from
+    one end to the other, and the tables and plots show the points in that order."""
+    axis = spec.continuation_axis or next(iter(spec.scan))
+    values = axes[axis]
+    steps = [b - a for a, b in itertools.pairwise(values)]
+    if all(step > 0 for step in steps) or all(step < 0 for step in steps):
+        return axes
+    order = sorted(range(len(values)), key=values.__getitem__)
+    group = next(g for g in groups if axis in g)
+    warnings.warn(f"{source}: scan.{axis}: {short(values)} is not in order; a continuation follows it from one end "
+                  f"to the other: the points run in increasing order, {short(sorted(values))}"
+                  + (f" (the zipped axes {', '.join(n for n in group if n != axis)} along with it)" if len(group) > 1
+                     else ""), UserWarning, stacklevel=3)
+    return {name: [values_[i] for i in order] if name in group else values_ for name, values_ in axes.items()}
 
 
 def _check_rock_name_axis(spec: StudySpec, base: Scene, source: str) -> None:
