@@ -109,12 +109,36 @@ AXIS_X_FROM_Z = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]  # a rotati
 class ExudynModel:
     """The drill as an assembled Exudyn system, not yet run (:func:`build_exudyn`).
 
-    ``mbs`` is open to any Exudyn item of a user's own: join it to ``bodies[name].marker_position``
-    (spatial connectors) or ``.marker_coordinate`` (coordinate connectors, loads); ``run()`` assembles
-    what was added and runs it with the scene's solver settings, its step sized for the assembled system.
-    ``add_pre_step(function)`` adds a per-step function; a function set with ``mbs.SetPreStepUserFunction``
-    replaces the model's own (the rock would never crush), so ``run()`` runs it after them and
-    :meth:`result` refuses a solve it replaced. ``add_energy_term`` declares an energy of one's own.
+    ``mbs`` is open to any Exudyn item of a user's own: join it to ``bodies[name].marker_position`` (spatial
+    connectors) or ``.marker_coordinate`` (coordinate connectors, loads); :meth:`run` assembles what was added
+    and runs it with the scene's solver settings, its step sized for the assembled system.
+    :meth:`add_pre_step` adds a per-step function; a function set with ``mbs.SetPreStepUserFunction`` replaces
+    the model's own (the rock would never crush), so :meth:`run` runs it after them and :meth:`result` refuses a
+    solve it replaced. :meth:`add_energy_term` declares an energy of one's own (docs/extending.md).
+
+    Attributes
+    ----------
+    SC, mbs : exudyn.SystemContainer, exudyn.MainSystem
+        Exudyn's system container and system.
+    bodies : mapping of str to ExudynBody
+        Each body by its scene name: ``.node``, ``.object``, ``.marker_coordinate``, ``.marker_position``.
+    connectors : mapping of str to ExudynConnector
+        Each connector by its scene name: ``.object``.
+    simulation : Simulation
+        The prepared scene it was built from.
+    solution_path : pathlib.Path or None
+        Where the run writes Exudyn's solution file (:meth:`write_solution`).
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> from exudyn.itemInterface import LoadCoordinate
+    >>> model = rpdrill.build_exudyn(rpdrill.load_scene("paper_base").with_({"solver.end_time_s": 0.3}))
+    >>> load = model.mbs.AddLoad(LoadCoordinate(markerNumber=model.bodies["collar"].marker_coordinate, load=5e3))
+    >>> model.user_items()
+    {'loads': 1}
+    >>> model.run().metrics["penetration_rate_m_per_s"] > 0
+    True
     """
 
     simulation: Simulation
@@ -322,14 +346,41 @@ def _exudyn_simulation(run: Scene | Simulation) -> tuple[Simulation, str]:
 
 
 def build_exudyn(run: Scene | Simulation, symbolic: bool = True, graphics: bool = True) -> ExudynModel:
-    """The drill of a scene (or prepared simulation) as an assembled Exudyn system, not yet run
-    (:class:`ExudynModel`); ``model.run()`` runs it. A scene of another formulation is built for Exudyn.
+    """The drill of a scene as an assembled Exudyn system, not yet run: add Exudyn items of one's own, then run.
 
-    ``symbolic=False`` uses Python callbacks for the impact and rock forces (same law, slower:
-    kept for the benchmark that measures what the symbolic functions save). ``graphics=False`` leaves out
-    the bodies' cylinders (models.solvers.exudyn_graphics), which only a renderer shows: a system no one
-    can see (:func:`simulate`'s) is built without them (the paper drill's build: 16.3 ms with them, 1.2 ms
-    without; ``python benchmarks/bench_core.py``).
+    A scene of another formulation is built for Exudyn (its common solver keys kept). The scene's extensions
+    are applied to the model before it is returned.
+
+    Parameters
+    ----------
+    run : Scene or Simulation
+        The scene (:func:`load_scene`), or a prepared simulation.
+    symbolic : bool, default True
+        False: Python callbacks for the impact and rock forces (the same law, slower; kept for the benchmark
+        that measures what the symbolic functions save).
+    graphics : bool, default True
+        False leaves out the bodies' cylinders (models.solvers.exudyn_graphics), which only a renderer shows
+        (the paper drill's build: 16.3 ms with them, 1.2 ms without; ``python benchmarks/bench_core.py``).
+
+    Returns
+    -------
+    ExudynModel
+        ``SC``, ``mbs``, ``bodies``, ``connectors``; ``run()`` runs it.
+
+    Raises
+    ------
+    InputError
+        When ``run`` is not a scene, or the scene cannot be built.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> model = rpdrill.build_exudyn(rpdrill.load_scene("paper_base").with_({"solver.end_time_s": 0.3}))
+    >>> sorted(model.bodies), model.solver_type.name
+    (['bit', 'collar', 'pipe', 'shank'], 'RK44')
+    >>> result = model.run()  # an rpdrill.Result, as rpdrill.simulate returns
+    >>> result.formulation, result.metrics["penetration_rate_m_per_s"] > 0
+    ('exudyn', True)
     """
     if not isinstance(run, (Scene, Simulation)):
         raise InputError(f"rpdrill.build_exudyn: run: {short(run)}: give a rpdrill.Scene (rpdrill.load_scene) or a "

@@ -125,8 +125,30 @@ PARAMETERS = (AdviseParameter("frequency", FREQUENCY, True), AdviseParameter("fe
 
 @dataclass(frozen=True)
 class AdviceSearch:
-    """Differential evolution's budget: population ``popsize`` x parameters, ``max_generations``
-    after the first population, convergence at ``tolerance`` (SciPy's tol), ``seed``."""
+    """Differential evolution's budget for :func:`advise` (SciPy's ``differential_evolution``).
+
+    Parameters
+    ----------
+    popsize : int, default 10
+        The population: ``popsize`` x the number of parameters.
+    max_generations : int, default 30
+        Generations after the first population.
+    tolerance : float, default 0.01
+        Convergence at this relative spread of the population (SciPy's ``tol``).
+    seed : int, default 1
+        The random seed: the same seed, the same search.
+
+    Raises
+    ------
+    InputError
+        For a count below 1, a tolerance that is not positive, a seed that is not a whole number.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> rpdrill.AdviceSearch(popsize=6, max_generations=10)
+    AdviceSearch(popsize=6, max_generations=10, tolerance=0.01, seed=1)
+    """
 
     popsize: int = 10
     max_generations: int = 30
@@ -158,8 +180,60 @@ class Request:
 
 @dataclass
 class Advice:
-    """The result for one scene (one rock): the best point, its value and how it was found, the
-    curves around it, the feed x frequency map. SI units."""
+    """The advice for one scene and rock (:func:`advise`): the best point, its value, how it was found. SI units.
+
+    Parameters
+    ----------
+    scene, description, scene_description : str
+        The scene's name; the scene, rock and impact in one line; the same without the rock.
+    rock : str or None
+        The Table 1 rock advised for (None: the scene's).
+    metric, formulation : str
+        What was maximised, by which formulation.
+    end_time_s : float
+        The simulated time of each run.
+    bounds : dict of str to (float, float)
+        The bounds searched, SI units by key path.
+    max_thrust_ratio : float
+        The thrust limit as a share of F_th.
+    best : dict of str to float
+        The best point found (key path to value).
+    best_value : float
+        The metric there.
+    best_thrust_ratio : float
+        The mean thrust over F_th there.
+    runs, replayed, failed_runs, beyond_limit : int
+        The points run, of them replayed from an earlier session, failed; the points not run (thrust limit).
+    first_error : str
+        The first failed run's error.
+    generations : int
+        Differential evolution's generations.
+    converged : bool
+        Whether it converged within its budget.
+    slices : dict
+        The metric along each parameter through the best point.
+    feed_map : dict
+        The feed x frequency map.
+    wall_time_s : float
+        The wall time of the search.
+    power_w, max_rod_stress_pa : float or None
+        The fixed hammer power and the rods' stress bound, where given.
+    best_rod_stress_pa : float
+        The rods' largest stress at the best point (with a bound).
+    beyond_stress : int
+        Points run whose rods' stress exceeded the bound.
+    search_best_value : float
+        The search's own best, where a point of its curves or map beat it.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base").with_({"solver.formulation": "exact"})
+    >>> advice = rpdrill.advise(scene, {"impact.frequency_hz": (45, 75), "feed.force_n": (10e3, 30e3)},
+    ...                         search=rpdrill.AdviceSearch(popsize=3, max_generations=2))  # doctest: +SKIP
+    >>> advice[0].best, advice[0].rock, advice[0].metric  # doctest: +SKIP
+    ({'impact.frequency_hz': 75.0, 'feed.force_n': 30000.0}, None, 'penetration_rate_m_per_s')
+    """
 
     scene: str
     description: str  # the scene, rock and impact in one line (studies.display.catalogue.describe_scene)
