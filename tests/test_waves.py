@@ -310,7 +310,10 @@ def test_an_item_of_ones_own_on_a_body_acts_through_the_wave_element(both):
 
     from rpdrill.models.solvers.exudyn_model import build_exudyn
 
-    model = build_exudyn(Scene.model_validate(bit_on_rods("exudyn")))
+    # from rest: a preloaded start of a wave drill with items of one's own is refused (its statics would miss the
+    # rods: tests/test_extension_start.py), so both runs compared here start at rest
+    at_rest = Scene.model_validate({**bit_on_rods("exudyn"), "start": "rest"})
+    model = build_exudyn(at_rest)
     assert sorted(model.bodies) == ["bit", "carriage"] and model.waves is not None
     node = model.mbs.AddNode(NodePoint(referenceCoordinates=[1.0, 0.0, 0.0]))
     model.mbs.AddObject(ObjectMassPoint(mass=50.0, nodeNumber=node))
@@ -320,7 +323,8 @@ def test_an_item_of_ones_own_on_a_body_acts_through_the_wave_element(both):
         stiffness=k, damping=0.2 * math.sqrt(k * 50.0), referenceLength=1.0))
     result = model.run()
     assert result.exudyn_model.user_items == {"nodes": 1, "objects": 2, "markers": 1}
-    assert result.metrics["advance_per_blow_m"] < 0.5 * summary_metrics(both["exudyn"])["advance_per_blow_m"]
+    plain = build_exudyn(at_rest).run()
+    assert result.metrics["advance_per_blow_m"] < 0.5 * plain.metrics["advance_per_blow_m"]
 
 
 @pytest.mark.parametrize("formulation", FORMULATIONS)

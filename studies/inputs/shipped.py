@@ -87,7 +87,11 @@ def shipped_path(value: str | Path, kind: str, where: str) -> str | Path:
     """``value`` itself where it is a file that exists (or names no shipped file), else the path of the
     shipped file of ``kind`` it names; InputError naming ``where`` for a shipped name of another kind."""
     text = str(value)
-    if Path(text).exists() or text.endswith((".yaml", ".yml")) or not text:
+    try:
+        exists = Path(text).exists()
+    except (OSError, ValueError):  # a name the system cannot take (too long, a NUL byte): read_text says why
+        return value
+    if exists or text.endswith((".yaml", ".yml")) or not text:
         return value
     named = [f for f in shipped_files() if f.name == text or f.path.relative_to(_root()).with_suffix("").as_posix() == text]
     if not named:
