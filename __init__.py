@@ -1,6 +1,7 @@
 """rpdrill: multibody simulation of rotary-percussive rock drilling on Exudyn.
 
-The public API (every name documented with an example in ``docs/api.md``)::
+The public API (every name with an example in ``docs/api.md``; each name's docstring, in numpydoc style, is
+the API reference of the documentation site, ``docs/reference/index.md``)::
 
     import rpdrill
     scene = rpdrill.load_scene("studies/scenes/paper_base.yaml")

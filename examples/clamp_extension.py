@@ -1,29 +1,33 @@
-"""Extensions of one's own: a clamp on the collar, its sensor and an energy term, named by a scene.
+"""
+Extensions of one's own: a clamp on the collar, its sensor and an energy term
+=============================================================================
 
-Shows: a Python extension is a function ``f(model, **parameters)`` marked ``@rpdrill.extension`` that adds
-Exudyn items to the built model (rpdrill.build_exudyn); a scene names it by import path with its parameters
+A Python extension is a function ``f(model, **parameters)`` marked ``@rpdrill.extension`` that adds Exudyn
+items to the built model (``rpdrill.build_exudyn``); a scene names it by import path with its parameters
 and runs it where its reader allows the module (``allow_code=["clamp_extension"]``, ``--allow-code
 clamp_extension``: a scene is data, docs/extending.md "Security"), so every run builds it, a worker process
-too, and a study can scan its parameters (``extensions.clamp.parameters.mass_kg``). The
-clamp (a Mass1D on its own Node1D and a coordinate spring-damper to the collar) is stepped as the assembled
-system needs, enters the energy account by itself, and its sensor comes back in the time series. The
-friction clamp has a spring-force user function the energy account cannot see into, so it declares its own
-energy terms. Printed: the step each run got, the penetration rate of the clamped collar against the
-collar made heavier by the clamp's mass (the exact formulation), the energy balance and the sensor.
+too, and a study can scan its parameters (``extensions.clamp.parameters.mass_kg``). The clamp (a Mass1D on
+its own Node1D and a coordinate spring-damper to the collar) is stepped as the assembled system needs,
+enters the energy account by itself, and its sensor comes back in the time series. The friction clamp has a
+spring-force user function the energy account cannot see into, so it declares its own energy terms.
+Printed: the step each run got, the penetration rate of the clamped collar against the collar made heavier
+by the clamp's mass (the exact formulation), the energy balance and the sensor; drawn: the collar of both
+and the clamp's sensor over the last blows. ::
 
-    python examples/clamp_extension.py [--end-time-s 0.3] [--stiffness-n-per-m 1e12]
+    python examples/clamp_extension.py [--end-time-s 0.3] [--stiffness-n-per-m 1e12] [--figure clamp_extension.png]
 
-The extensions are importable as ``clamp_extension:add_clamp`` with this folder on PYTHONPATH (as this
-script puts it), or as ``examples.clamp_extension:add_clamp`` from the root of the checkout (docs/extending.md).
+The extensions are importable as ``clamp_extension:add_clamp`` with this folder on ``sys.path`` (the
+script's folder is, when it runs), or as ``examples.clamp_extension:add_clamp`` from the root of the
+checkout (docs/extending.md).
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 import exudyn
+import matplotlib.pyplot as plt
 import numpy as np
 from exudyn.itemInterface import (
     MarkerNodeCoordinate,
@@ -36,8 +40,6 @@ from exudyn.itemInterface import (
 )
 
 import rpdrill
-
-SCENE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
 
 
 def _clamp_node(model, body: str, mass_kg: float, name: str) -> tuple:
@@ -109,20 +111,21 @@ def add_friction_clamp(model, mass_kg: float, stiffness_n_per_m: float, damping_
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description="Extensions of one's own: a clamp on the collar, its sensor and "
+                                                 "an energy term")
     parser.add_argument("--end-time-s", type=float, default=0.3)
     parser.add_argument("--stiffness-n-per-m", type=float, default=1e12)
+    parser.add_argument("--figure", type=Path, default=Path("clamp_extension.png"))
     args = parser.parse_args()
-    sys.path.insert(0, str(Path(__file__).resolve().parent))  # this folder: the extensions importable by name
     allowed = ["clamp_extension"]  # the module of one's own the scenes below may run (this script's)
-    base = rpdrill.load_scene(SCENE).with_({"solver.end_time_s": args.end_time_s})
+    base = rpdrill.load_scene("paper_base").with_({"solver.end_time_s": args.end_time_s})  # a shipped scene
     clamped = base.with_({"extensions": {"clamp": {"function": "clamp_extension:add_clamp", "parameters": {
         "mass_kg": 300.0, "stiffness_n_per_m": args.stiffness_n_per_m, "damping_n_s_per_m": 1e3}}}}, allow_code=allowed)
     result = rpdrill.simulate(clamped)
     heavier = rpdrill.simulate(base.with_({"drill_string.bodies.collar.mass_kg":
                                            base.drill_string.bodies["collar"].mass_kg + 300.0}), formulation="exact")
     rate, reference = result.metrics["penetration_rate_m_per_s"], heavier.metrics["penetration_rate_m_per_s"]
-    print(f"step: {rpdrill.simulate(base).raw.simulation.settings.step_s:.3g} s without the clamp, "
+    print(f"step: {rpdrill.build_exudyn(base).simulation.settings.step_s:.3g} s without the clamp, "
           f"{result.raw.simulation.settings.step_s:.3g} s with it")
     print(f"clamped collar (Exudyn): {rate * 1e3:.4f} mm/s; collar 300 kg heavier (exact): {reference * 1e3:.4f} mm/s "
           f"(relative difference {abs(rate / reference - 1):.2e})")
@@ -134,6 +137,20 @@ def main() -> None:
     declared = rpdrill.simulate(friction)
     print(f"energy balance with the friction clamp and its declared terms: "
           f"{declared.metrics['energy_balance_relative_error']:.2e} ({', '.join(declared.user_energy.declared)})")
+    figure, axes = plt.subplots(figsize=(7, 3.5), layout="constrained")
+    start = args.end_time_s - 3 * base.impact.period_s  # the last three blows
+    for label, series, column, style in (
+            ("collar with the clamp (Exudyn)", result.timeseries, "collar_velocity_m_per_s", "-"),
+            ("clamp_velocity sensor (Exudyn)", result.timeseries, "clamp_velocity", ":"),
+            ("collar 300 kg heavier (exact)", heavier.timeseries, "collar_velocity_m_per_s", "--")):
+        shown = series[series["time_s"] >= start]
+        axes.plot(shown["time_s"], shown[column], style, label=label)
+    axes.set_xlabel("time (s)")
+    axes.set_ylabel("velocity (m/s)")
+    axes.set_title(f"{base.name}: a 300 kg clamp on the collar, k {args.stiffness_n_per_m:g} N/m")
+    axes.legend()
+    figure.savefig(args.figure)
+    print(f"wrote {args.figure}")
 
 
 if __name__ == "__main__":

@@ -1,33 +1,36 @@
-"""A rock law of one's own: a crushing threshold that rises with the crushing speed, named in a scene by its
-import path and run in the Exudyn and the exact formulations.
+"""
+A rock law of one's own: a crushing threshold that rises with the crushing speed
+================================================================================
 
-The law (written against the documented interface, docs/extending.md "A rock law of one's own"): the rock
-spring k_n in series with a slider whose threshold rises with its speed, F_th = F_0 + c_r x_n' (a
-Bingham slider; c_r = 0 is the paper's Eq. 1, 2). Off the bottom there is no force; in contact
-F = k_n (x - x_n); the bottom advances only while the spring force exceeds F_0, at the rate
-x_n' = (k_n (x - x_n) - F_0) / c_r. It is linear between switches, so it declares its modes (free,
-contact, crushing) and the exact and ODE formulations run it; the Exudyn formulation records its force
-symbolically and advances the slider once per step (``step_update``: backward Euler over the step).
+A law named in a scene by its import path and run in the Exudyn and the exact formulations. The law
+(written against the documented interface, docs/extending.md "A rock law of one's own"): the rock spring
+k_n in series with a slider whose threshold rises with its speed, F_th = F_0 + c_r x_n' (a Bingham slider;
+c_r = 0 is the paper's Eq. 1, 2). Off the bottom there is no force; in contact F = k_n (x - x_n); the
+bottom advances only while the spring force exceeds F_0, at the rate x_n' = (k_n (x - x_n) - F_0) / c_r.
+It is linear between switches, so it declares its modes (free, contact, crushing) and the exact and ODE
+formulations run it; the Exudyn formulation records its force symbolically and advances the slider once per
+step (``step_update``: backward Euler over the step).
 
-The class subclasses rocklaw.base.RockLaw (a scene names no other class as its law). The scene names it by
+The class subclasses ``rpdrill.RockLaw`` (a scene names no other class as its law). The scene names it by
 import path, its keys under ``rock.parameters``::
 
     rock: {law: "rate_dependent_rock:RateDependentRock",
            parameters: {stiffness_n_per_m: 5.0e8, threshold_n: 138.0e3, rate_n_s_per_m: 1.0e5}}
 
 and runs it only where its reader allows the module (a scene is data: ``allow_code=["rate_dependent_rock"]``,
-``--allow-code rate_dependent_rock``), or, installed as a package that registers it under the entry point group
-``rpdrill.rock_laws`` as ``rate_dependent``, by that name (docs/extending.md, "Security"). The module must be
-importable where the scene runs (this folder on PYTHONPATH, or the module in an installed package). Printed: the penetration rate on the paper's base scene of the Exudyn
-and the exact formulations with this law, and of the paper's law at the same static threshold F_0.
+``--allow-code rate_dependent_rock``), or, installed as a package that registers it under the entry point
+group ``rpdrill.rock_laws`` as ``rate_dependent``, by that name (docs/extending.md, "Security"). The module
+must be importable where the scene runs (this folder, the script's, on ``sys.path``; or the module in an
+installed package). Printed: the penetration rate on the paper's base scene of the Exudyn and the exact
+formulations with this law, and of the paper's law at the same static threshold F_0; drawn: the borehole
+bottom of the three runs. ::
 
-    python examples/rate_dependent_rock.py [--end-time-s 0.5] [--rate-n-s-per-m 1e5]
+    python examples/rate_dependent_rock.py [--end-time-s 0.5] [--rate-n-s-per-m 1e5] [--figure rate_dependent_rock.png]
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,7 +43,6 @@ from rpdrill.rocklaw.base import POSITION, RockLaw, State, trapezoidal_plastic_w
 from rpdrill.rocklaw.modes import ONE, Mode, ModeTable, Switch
 
 BOTTOM = "bottom_m"
-SCENE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
 
 
 @dataclass(frozen=True)
@@ -130,25 +132,39 @@ class RateDependentRock(RockLaw):
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description="A rock law of one's own: a crushing threshold that rises "
+                                                 "with the crushing speed")
     parser.add_argument("--end-time-s", type=float, default=0.5)
     parser.add_argument("--rate-n-s-per-m", type=float, default=1e5)
+    parser.add_argument("--figure", type=Path, default=Path("rate_dependent_rock.png"))
     args = parser.parse_args()
-    sys.path.insert(0, str(Path(__file__).resolve().parent))  # this folder: the law's module importable by name
+    import matplotlib.pyplot as plt
+
     import rpdrill
 
-    base = rpdrill.load_scene(SCENE).with_({"solver.end_time_s": args.end_time_s})
+    base = rpdrill.load_scene("paper_base").with_({"solver.end_time_s": args.end_time_s})  # a shipped scene
     rock = base.rock.completed()
     own = base.with_({"rock": {"law": "rate_dependent_rock:RateDependentRock", "parameters": {
         "stiffness_n_per_m": rock.stiffness_n_per_m, "threshold_n": rock.threshold_n,
         "rate_n_s_per_m": args.rate_n_s_per_m}}}, allow_code=["rate_dependent_rock"])  # the module this script allows
-    rates = {name: rpdrill.simulate(own, formulation=name).metrics["penetration_rate_m_per_s"]
-             for name in ("exudyn", "exact")}
-    paper = rpdrill.simulate(base, formulation="exact").metrics["penetration_rate_m_per_s"]
+    runs = {name: rpdrill.simulate(own, formulation=name) for name in ("exudyn", "exact")}
+    rates = {name: result.metrics["penetration_rate_m_per_s"] for name, result in runs.items()}
+    paper = rpdrill.simulate(base, formulation="exact")
     print(f"rate-dependent threshold (c_r {args.rate_n_s_per_m:g} N s/m), Exudyn: {rates['exudyn'] * 1e3:.4f} mm/s")
     print(f"rate-dependent threshold (c_r {args.rate_n_s_per_m:g} N s/m), exact: {rates['exact'] * 1e3:.4f} mm/s "
           f"(relative difference {abs(rates['exudyn'] / rates['exact'] - 1):.2e})")
-    print(f"the paper's law at the same F_0, exact: {paper * 1e3:.4f} mm/s")
+    print(f"the paper's law at the same F_0, exact: {paper.metrics['penetration_rate_m_per_s'] * 1e3:.4f} mm/s")
+    figure, axes = plt.subplots(figsize=(7, 3.5), layout="constrained")
+    for label, result, style in ((f"c_r {args.rate_n_s_per_m:g} N s/m, Exudyn", runs["exudyn"], "-"),
+                                 (f"c_r {args.rate_n_s_per_m:g} N s/m, exact", runs["exact"], "--"),
+                                 ("the paper's law (c_r = 0), exact", paper, "-")):
+        axes.plot(result.timeseries["time_s"], 1e3 * result.timeseries["borehole_bottom_m"], style, label=label)
+    axes.set_xlabel("time (s)")
+    axes.set_ylabel("borehole bottom x_n (mm)")
+    axes.set_title(f"{base.name}: the bottom under a rate-dependent crushing threshold")
+    axes.legend()
+    figure.savefig(args.figure)
+    print(f"wrote {args.figure}")
 
 
 if __name__ == "__main__":

@@ -46,18 +46,59 @@ import numpy as np
 from .backends import NUMERIC, Backend
 from .modes import ModeTable
 
+#: The internal state of a rock law: a tuple of floats, one per name of ``state_names``.
 State = tuple[float, ...]
 POSITION, VELOCITY = "position", "velocity"  # the bit's local variables in a law's mode table
 
 
 @runtime_checkable
 class RockLaw(Protocol):
-    """A bit-rock contact law (module docstring). Lengths in m, forces in N.
+    """The interface of a bit-rock contact law (module doc), which every formulation codes against.
 
-    A law's class subclasses it (``class MyLaw(RockLaw)``; the built-in laws do): a scene names no other class
-    as its ``rock.law`` (models.definition.rock). Its values are declared as attributes, so that a
-    dataclass's fields, a class attribute or a property of the law give them; a method a law does not
-    define stays this protocol's stub, which :func:`missing_members` counts as missing."""
+    Lengths in m, forces in N. A law's class subclasses it (``class MyLaw(RockLaw)``; the built-in laws do): a
+    scene names no other class as its ``rock.law`` (models.definition.rock). Its values are declared as
+    attributes, so that a dataclass's fields, a class attribute or a property of the law give them; a method a
+    law does not define stays this protocol's stub, which :func:`missing_members` counts as missing. A worked
+    law of one's own: ``examples/rate_dependent_rock.py`` (docs/extending.md, "A rock law of one's own").
+
+    Attributes
+    ----------
+    name : str
+        The law's name (``rock.law``).
+    state_names : tuple of str
+        Its internal states; ``bottom_index`` is the one of the borehole bottom x_n, never decreasing.
+    bottom_index : int
+        The index of x_n in ``state_names``.
+    crushes : bool
+        Whether the rock ever gives way (False: elastic).
+    loading_stiffness_n_per_m, unloading_stiffness_n_per_m : float
+        k_l and k_u (equal for the Jenkins law): the energy the rock stores is F_spring^2 / (2 k_u).
+    threshold_n : float
+        F_th, the force at which the rock crushes (inf where it does not apply).
+    damping_n_s_per_m : float
+        c_n, the rock's damping (0 for none).
+    crushing_penetration_m : float
+        The penetration from the bottom at which crushing starts (Jenkins F_th / k_n; 0 for a law that
+        indents from the first contact; inf if elastic).
+    fresh_fraction : float
+        eta, the share of a blow's footprint on fresh rock (1 without an indexing model).
+    modes_follow_fresh_fraction, resets_at_blows : bool
+        Whether the mode rows carry eta; whether :meth:`start_blow` changes the state.
+
+    See Also
+    --------
+    rpdrill.rocklaw.JenkinsRock, rpdrill.rocklaw.BilinearRock : the built-in laws.
+
+    Examples
+    --------
+    >>> from rpdrill import RockLaw
+    >>> from rpdrill.rocklaw import JenkinsRock
+    >>> law = JenkinsRock(stiffness_n_per_m=5.1e8, damping_n_s_per_m=4.9e3, threshold_n=210e3)
+    >>> isinstance(law, RockLaw), law.state_names, law.initial_state()
+    (True, ('bottom_m',), (0.0,))
+    >>> law.force(1e-4, 0.0, law.initial_state())  # k_n x below the threshold [N]
+    51000.0
+    """
 
     name: str
     state_names: tuple[str, ...]
@@ -152,7 +193,37 @@ def local_values(law: RockLaw, bit_position_m: float, bit_velocity_m_per_s: floa
 
 def force_and_state(law: RockLaw, bit_position_m: float, bit_velocity_m_per_s: float,
                     state: State, backend: Backend = NUMERIC) -> tuple[float, State]:
-    """One step of the time-discrete law: state <- return_map(x, state), then F(x, v, state)."""
+    """One step of the time-discrete law, as the Exudyn element takes it: the state, then the force.
+
+    state <- ``law.return_map(x, state)``, then F = ``law.force(x, v, state)``.
+
+    Parameters
+    ----------
+    law : RockLaw
+        The rock law.
+    bit_position_m : float
+        The bit position x, positive into the rock from the untouched surface.
+    bit_velocity_m_per_s : float
+        The bit velocity v.
+    state : State
+        The law's state before the step.
+    backend : Backend, default NUMERIC
+        How the force is evaluated (floats by default; rocklaw.backends).
+
+    Returns
+    -------
+    tuple of (float, State)
+        The force on the bit [N], positive pushing the bit out of the hole, and the new state.
+
+    Examples
+    --------
+    >>> from rpdrill.rocklaw import TABLE_1, JenkinsRock, force_and_state
+    >>> rock = TABLE_1["sandstone"]
+    >>> law = JenkinsRock(rock.stiffness_n_per_m, rock.damping_n_s_per_m, rock.threshold_n)
+    >>> force_n, (bottom_m,) = force_and_state(law, 1e-3, 0.0, law.initial_state())
+    >>> force_n, round(bottom_m * 1e3, 4)  # crushing: F = F_th, the bottom 1 mm - F_th / k_n
+    (210000.0, 0.5882)
+    """
     new_state = law.return_map(bit_position_m, state)
     return law.force(bit_position_m, bit_velocity_m_per_s, new_state, backend), new_state
 

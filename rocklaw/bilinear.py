@@ -67,7 +67,33 @@ SURFACE, BOTTOM = "surface_m", "bottom_m"
 
 @dataclass(frozen=True)
 class BilinearRock(RockLaw):
-    """Loading stiffness k_l, unloading stiffness k_u >= k_l; a :class:`rocklaw.base.RockLaw`."""
+    """The bilinear loading/unloading rock: F = max(0, min(k_l (x - s), k_u (x - p))) (module doc).
+
+    Loading along k_l pushes the bottom p so that the unloading line k_u passes through the current point;
+    a load to u_max and full unloading leave the indentation u_max (1 - k_l / k_u). A :class:`RockLaw`.
+
+    Parameters
+    ----------
+    loading_stiffness_n_per_m : float
+        k_l, positive.
+    unloading_stiffness_n_per_m : float
+        k_u >= k_l (equal: an elastic rock).
+    fresh_fraction : float, default 1.0
+        eta in (0, 1], the share of the next blow on fresh rock (models.drill.indexing).
+
+    Raises
+    ------
+    ValueError
+        Unless 0 < k_l <= k_u < inf and 0 < eta <= 1.
+
+    Examples
+    --------
+    >>> from rpdrill.rocklaw import BilinearRock, force_and_state
+    >>> law = BilinearRock(loading_stiffness_n_per_m=2e8, unloading_stiffness_n_per_m=8e8)
+    >>> force_n, (surface_m, bottom_m) = force_and_state(law, 1e-3, 0.1, law.initial_state())
+    >>> force_n, bottom_m  # k_l x; the bottom at x (1 - k_l / k_u)
+    (200000.0, 0.00075)
+    """
 
     loading_stiffness_n_per_m: float
     unloading_stiffness_n_per_m: float

@@ -68,7 +68,38 @@ BOTTOM, THRESHOLD = "bottom_m", "threshold_n"
 
 @dataclass(frozen=True)
 class JenkinsRock(RockLaw):
-    """Parameters of the paper's visco-elastic-plastic rock (Eq. 1, 2); a :class:`rocklaw.base.RockLaw`."""
+    """The paper's visco-elastic-plastic rock (Eq. 1, 2): a spring k_n in series with a dry-friction slider.
+
+    With penetration d = x_bit - x_n: no force off the bottom; F = k_n d (+ rock damping) in contact; F = F_th
+    while crushing, the bottom x_n advancing with the bit (module doc). A :class:`RockLaw`.
+
+    Parameters
+    ----------
+    stiffness_n_per_m : float
+        k_n, positive.
+    damping_n_s_per_m : float
+        c_n, at least 0.
+    threshold_n : float
+        F_th, positive (inf: an elastic rock).
+    damping_mode : {"contact", "always"}, default "contact"
+        c_n only while the bit touches the rock, the total force clipped at zero; or Eq. 4 literally.
+    indexed : bool, default False
+        Under an indexing model: the blow's threshold a state (module doc).
+    fresh_fraction : float, default 1.0
+        eta in (0, 1], the share of the blow on fresh rock (below 1 only when ``indexed``).
+
+    Raises
+    ------
+    ValueError
+        For parameters out of their ranges.
+
+    Examples
+    --------
+    >>> from rpdrill.rocklaw import JenkinsRock
+    >>> law = JenkinsRock(stiffness_n_per_m=5.1e8, damping_n_s_per_m=4.9e3, threshold_n=210e3)
+    >>> law.name, round(law.crushing_penetration_m * 1e3, 4)  # F_th / k_n in mm
+    ('jenkins', 0.4118)
+    """
 
     stiffness_n_per_m: float
     damping_n_s_per_m: float

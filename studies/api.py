@@ -49,11 +49,40 @@ __all__ = ["InputError", "Result", "load_scene", "load_study", "run_study", "run
 
 
 def save_result(result: Result, folder: str | Path, animate: bool = False) -> list[Path]:
-    """What ``rpdrill simulate`` writes into ``folder`` (made if missing): ``timeseries.csv``,
-    ``summary.json``, ``scene.resolved.yaml``, the ``timeseries.png``/``.svg`` figure, the drawing of the
-    drill ``drill.png``; ``animate``: ``drill.gif``, the last blows magnified. A scene with extensions is drawn
-    (and, from a run with a solution file, animated) as its built Exudyn model, every item of the extensions
-    included (studies.drawings.system_drawing). The files written."""
+    """Write what ``rpdrill simulate`` writes into ``folder`` (made if missing).
+
+    The files: ``timeseries.csv``, ``summary.json``, ``scene.resolved.yaml``, the ``timeseries.png`` and
+    ``.svg`` figure, the drawing of the drill ``drill.png``; with ``animate`` also ``drill.gif``, the last blows
+    magnified. A scene with extensions is drawn (and, from a run with a solution file, animated) as its built
+    Exudyn model, every item of the extensions included (studies.drawings.system_drawing).
+
+    Parameters
+    ----------
+    result : Result
+        A run of :func:`simulate`.
+    folder : str or pathlib.Path
+        Where the files go; files of the same names there are replaced.
+    animate : bool, default False
+        Also write ``drill.gif``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+
+    Raises
+    ------
+    InputError
+        When ``result`` is not a Result or ``folder`` cannot be written, before anything is written.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base").with_({"solver.end_time_s": 0.3})
+    >>> files = rpdrill.save_result(rpdrill.simulate(scene, formulation="exact"), "out/first_run")
+    >>> sorted(path.name for path in files)
+    ['drill.png', 'scene.resolved.yaml', 'summary.json', 'timeseries.csv', 'timeseries.png', 'timeseries.svg']
+    """
     from .drawings.drill_animation import write_animation  # matplotlib only when saving
     from .drawings.drill_drawing import draw
     from .figures.timeseries_figure import plot_timeseries
@@ -105,16 +134,54 @@ def _animated(result: Result) -> Any:
 def simulate(scene: Scene | str | Path, formulation: str | None = None,
              progress: Callable[[float], None] | None = None, budget: Budget | None = DEFAULT_BUDGET,
              solution_file: Path | None = None, allow_code: Sequence[str] | str = ()) -> Result:
-    """Run a scene (or a scene file) with its formulation, or ``formulation`` (``exudyn``, ``exact``,
-    ``ode``; the scene's options of another formulation dropped). InputError when it cannot run as
-    given, BudgetError when one run's steps or memory exceed ``budget`` (None: unchecked), both before
-    it starts; ``allow_code``: the modules of one's own the scene may run (models.definition.own_code; never
-    a scene file's own); models.evaluation.stability.SimulationFailed when the run diverges (or the user's
-    code fails in it). ``solution_file``:
-    with the Exudyn formulation, Exudyn's coordinates solution file written there during the run
-    (for its SolutionViewer: studies.drawings.drill_animation.view_solution). Loads no figure module:
-    the caller's matplotlib is left as it is. A scene with ``solver.steady_state: periodic`` gives its
-    steady state (models.runs.scene_run.run)."""
+    """Run a scene with its formulation, or with ``formulation``: one run into a :class:`Result`.
+
+    A scene with ``solver.steady_state: periodic`` gives its steady state (models.runs.scene_run.run). Loads no
+    figure module: the caller's matplotlib is left as it is.
+
+    Parameters
+    ----------
+    scene : Scene, str or pathlib.Path
+        The scene, a scene file, or a shipped scene's name (``"paper_base"``; ``rpdrill shipped``).
+    formulation : {"exudyn", "exact", "ode"}, optional
+        Run with this formulation instead of the scene's (its solver options of another formulation dropped).
+    progress : callable, optional
+        Called with the simulated time in seconds as the run advances.
+    budget : Budget or None, default Budget()
+        The steps and memory one run may take, checked before it starts; None: unchecked.
+    solution_file : pathlib.Path, optional
+        With the Exudyn formulation, Exudyn's coordinates solution file written there during the run (for
+        :func:`view_solution`).
+    allow_code : sequence of str or str, default ()
+        The modules of one's own the scene may run (an extension's function, a rock law named by import path);
+        never read from a scene file (models.definition.own_code).
+
+    Returns
+    -------
+    Result
+        The run's metrics, time series and records.
+
+    Raises
+    ------
+    InputError
+        When the scene cannot run as given, before it starts.
+    BudgetError
+        When the run's steps or memory exceed ``budget``, before it starts.
+    SimulationFailed
+        When the run diverges, or the user's code fails in it.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base").with_({"solver.end_time_s": 0.5})
+    >>> result = rpdrill.simulate(scene, formulation="exact")
+    >>> result.formulation
+    'exact'
+    >>> result.metrics["penetration_rate_m_per_s"] > 0
+    True
+    >>> list(result.timeseries.columns[:3])
+    ['time_s', 'pipe_position_m', 'pipe_velocity_m_per_s']
+    """
     from ..models.runs.scene_run import run
 
     check("rpdrill.simulate", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
@@ -133,9 +200,33 @@ def simulate(scene: Scene | str | Path, formulation: str | None = None,
 
 
 def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
-    """A results table (rows as read from ``results.csv``: text cells) as the typed DataFrame
-    :func:`run_study` returns: numbers as numbers, text (status, error, a rock's name) as text; one row
-    a point, in point order, indexed by the point (studies.runtime.tables)."""
+    """A results table's rows (text cells, as read from ``results.csv``) as the typed DataFrame :func:`run_study` returns.
+
+    Numbers become numbers, text (status, error, a rock's name) stays text; one row a point, in point order,
+    indexed by the point (studies.runtime.tables).
+
+    Parameters
+    ----------
+    rows : sequence of dict of str to str
+        The rows, each a mapping of column name to cell text (``csv.DictReader`` gives them).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The typed table.
+
+    Raises
+    ------
+    InputError
+        When ``rows`` is not a sequence of mappings of text.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> table = rpdrill.table_frame([{"point": "0", "impact.frequency_hz": "65.0", "status": "ok"}])
+    >>> table["impact.frequency_hz"].dtype.kind, table["status"].iloc[0]
+    ('f', 'ok')
+    """
     check("rpdrill.table_frame", "rows", rows, rows_problem)
     rows = list(rows)
     return table_of(list(rows[0]) if rows else [], [list(row.values()) for row in rows])
@@ -143,11 +234,45 @@ def table_frame(rows: Sequence[dict[str, str]]) -> pd.DataFrame:
 
 def run_study(study: Study | str | Path, options: RunOptions | None = None, *,
               allow_code: Sequence[str] | str = (), **run: Any) -> pd.DataFrame:
-    """Run a study (or a study file) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
-    ``workers``, ``dask``, ``out``, ``budget``, ``quiet``): into ``out`` (results.csv, study.json, optima.csv,
-    plots; resumable as the command's) or, without ``out``, a scratch folder that is removed after (no plots);
-    ``allow_code``: the modules of one's own a study file's scenes may run (models.definition.own_code). The
-    results table as a DataFrame, one row a point."""
+    """Run a study's points, on all cores or a Dask cluster, into a pandas table.
+
+    With ``out`` the run writes what ``rpdrill study`` writes there (``results.csv``, ``study.json``,
+    ``optima.csv``, plots) and resumes as the command does; without, it runs in a scratch folder that is
+    removed after (no plots).
+
+    Parameters
+    ----------
+    study : Study, str or pathlib.Path
+        A study of :func:`load_study`, a study file, or a shipped study's name (``"paper/frequency_scan"``).
+    options : RunOptions, optional
+        How the points run and where they are written; or its names as keywords (``workers``, ``dask``,
+        ``out``, ``budget``, ``quiet``).
+    allow_code : sequence of str or str, default ()
+        The modules of one's own a study file's scenes may run (a loaded Study keeps what :func:`load_study`
+        allowed).
+    **run
+        :class:`RunOptions` names.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The results table: one row a point, its axis values, metrics and status.
+
+    Raises
+    ------
+    InputError
+        When the study or an option cannot be used, before anything runs.
+    BudgetError
+        When the study's runs exceed the budget, before anything runs.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> study = rpdrill.load_study("paper/frequency_scan", formulation="exact")
+    >>> table = rpdrill.run_study(study, workers=1)  # in this process; None: one worker per core
+    >>> len(table), list(table["impact.frequency_hz"][:3]), set(table["status"])
+    (23, [10.0, 15.0, 20.0], {'ok'})
+    """
     from .runtime.pools import pool
 
     where = "rpdrill.run_study"

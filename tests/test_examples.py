@@ -1,5 +1,5 @@
-"""Every example in examples/ runs as a user runs it (a new process, from another folder) and shows
-what its header says."""
+"""Every example in examples/ runs as a user runs it (a new process, from another folder), shows what its
+header says and draws its figure (the gallery of the documentation site shows it: docs/conf.py)."""
 
 import re
 import subprocess
@@ -16,6 +16,8 @@ def run(name: str, *args: str, cwd: Path) -> str:
                           check=False, timeout=600)
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr and "Warning" not in done.stderr, done.stderr
+    figure = re.search(r"^wrote (.+\.png)$", done.stdout, re.MULTILINE)
+    assert figure and (cwd / figure.group(1)).stat().st_size > 10_000, done.stdout
     return done.stdout
 
 
@@ -40,7 +42,7 @@ def test_a_changed_geometry_agrees_between_exudyn_and_the_exact_formulation(tmp_
 
 
 def test_a_study_from_python_into_pandas_and_a_plot(tmp_path):
-    out = run("study_to_pandas.py", "--out", "scan.png", "--workers", "2", cwd=tmp_path)
+    out = run("study_to_pandas.py", "--figure", "scan.png", "--workers", "2", cwd=tmp_path)
     best = float(re.search(r"best grid point: ([0-9.]+) Hz", out).group(1))
     assert 50 <= best <= 70, out  # the paper's 3.1 a) band
     assert (tmp_path / "scan.png").stat().st_size > 10_000

@@ -209,10 +209,39 @@ CallableT = TypeVar("CallableT", bound=Callable[..., Any])
 
 
 def extension(function: CallableT | None = None, *, changes_motion: bool = True) -> Any:
-    """Mark a function as an extension of the Exudyn model that a scene may name (``@rpdrill.extension``;
-    ``@rpdrill.extension(changes_motion=False)`` for one that only adds sensors, energy terms or graphics,
-    which the exact and ODE formulations may then run without). rpdrill calls no callable a scene names
-    that is not marked: not ``os:system``, not a function written for something else."""
+    """Mark a function as an extension of the Exudyn model that a scene may name.
+
+    rpdrill calls no callable a scene names that is not marked: not ``os:system``, not a function written for
+    something else. The function is called as ``function(model, **parameters)`` on every built model
+    (:class:`ExudynModel`), where its module is registered by an installed package (entry point group
+    ``rpdrill.extensions``) or allowed by the reader (``allow_code``, ``--allow-code``; docs/extending.md).
+
+    Parameters
+    ----------
+    function : callable, optional
+        The function (``@rpdrill.extension``); without it, the decorator with its options
+        (``@rpdrill.extension(changes_motion=False)``).
+    changes_motion : bool, default True
+        False for an extension that only adds sensors, energy terms or graphics, which the exact and ODE
+        formulations may then run without.
+
+    Returns
+    -------
+    callable
+        The function itself, marked; or the decorator.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> @rpdrill.extension
+    ... def add_sensor(model, name: str = "collar"):
+    ...     '''A sensor of the collar's velocity (parameters as the scene gives them).'''
+    >>> @rpdrill.extension(changes_motion=False)
+    ... def add_graphics(model):
+    ...     '''Graphics only: the exact formulation may run without it.'''
+    >>> add_graphics.changes_motion
+    False
+    """
     def mark(target: CallableT) -> CallableT:
         setattr(target, EXTENSION_MARK, True)
         if not changes_motion:

@@ -224,7 +224,25 @@ class Metrics(Strict):
 
 
 class Scene(Strict):
-    """One drill on one rock with one solver setting (data only: module doc)."""
+    """One drill on one rock with one solver setting: the typed content of a scene file (data only, immutable).
+
+    Its fields are the file's sections, each key with its unit in its name (docs/scenes.md): ``name``,
+    ``description``, ``drill_string``, ``torsion``, ``bit``, ``rotation``, ``feed``, ``impact``, ``rock``,
+    ``solver``, ``metrics``, ``effects``, ``outputs``, ``start``, ``extensions``; :meth:`with_` makes a validated copy.
+
+    Parameters
+    ----------
+    **sections
+        The sections; :func:`load_scene` reads them from a file (InputError naming the key path), and
+        ``Scene.model_validate(mapping)`` from a mapping (pydantic's ValidationError).
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base")
+    >>> scene.name, scene.impact.frequency_hz, sorted(scene.drill_string.bodies)
+    ('paper_base', 65.0, ['bit', 'collar', 'pipe', 'shank'])
+    """
 
     name: str
     description: str = ""
@@ -258,11 +276,34 @@ class Scene(Strict):
         return self._allowed_code
 
     def with_(self, changes: dict[str, Any], source: str = "Scene.with_", allow_code: Any = ()) -> Scene:
-        """A validated copy with ``changes``: dotted key paths of the scene file -> values
-        (``{"impact.frequency_hz": 70.0, "solver.formulation": "exact"}``; None removes a key). A bad
-        value raises :class:`~rpdrill.models.definition.validation.InputError` naming the key path, the value and
-        what is allowed, as the command line reports a scene file. The copy may run the code of one's own
-        this scene may, and the modules ``allow_code`` names besides (models.definition.own_code)."""
+        """A validated copy with ``changes``: key paths of the scene file to values (None removes a key).
+
+        Parameters
+        ----------
+        changes : dict of str to object
+            ``{"impact.frequency_hz": 70.0}``; a whole section as a mapping.
+        source : str, optional
+            How messages name the scene (default ``Scene.with_``).
+        allow_code : sequence of str or str, default ()
+            Modules of one's own the copy may run besides this scene's (models.definition.own_code).
+
+        Returns
+        -------
+        Scene
+            The copy; this scene is unchanged.
+
+        Raises
+        ------
+        InputError
+            Naming the key path, the value and what is allowed, as the command line reports a scene file.
+
+        Examples
+        --------
+        >>> import rpdrill
+        >>> scene = rpdrill.load_scene("paper_base")
+        >>> scene.with_({"impact.frequency_hz": 70.0}).impact.frequency_hz, scene.impact.frequency_hz
+        (70.0, 65.0)
+        """
         return with_changes(self, changes, source, {ALLOW_CODE: self._allowance(source, allow_code)})
 
     def _allowance(self, source: str, allow_code: Any) -> tuple[str, ...]:
@@ -272,8 +313,10 @@ class Scene(Strict):
             raise InputError(f"{source}: allow_code: {error}") from None
 
     def with_solver(self, formulation: str | None = None, **options: object) -> Scene:
-        """This scene with another formulation (:func:`switch_formulation`) and/or other solver
-        options (a new, validated scene)."""
+        """This scene with another formulation (:func:`switch_formulation`: the former one's options dropped) and/or
+        other solver options (``scene.with_solver("exact", end_time_s=0.5)``): a new, validated scene; InputError for
+        a formulation that is not one, or an option it does not take.
+        """
         solver = self.solver.model_dump(exclude_none=True)
         if formulation is not None:
             if not isinstance(formulation, str) or formulation not in FORMULATIONS:

@@ -27,10 +27,31 @@ LONG_QUOTED = re.compile(r"(?<!\w)(['\"])([^'\"\n]{78})[^'\"\n]{3,}\1(?!\w)")  #
 
 
 class InputError(ValueError):
-    """Bad user input; the message is complete and meant for the user (a quoted value in it beyond 80
-    characters is shortened, :func:`shortened`). ``problems``: when a validation found it (:func:`parse`),
-    each problem as (key path, what is wrong), so that a caller can tie it to the change that caused it
-    (a scan axis: studies.runtime.point_runs)."""
+    """Bad user input, refused before anything runs (a ``ValueError``; exit status 2 on the command line).
+
+    The message is complete and meant for the user: the file (or the call), the key path, the value and what is
+    allowed; a quoted value beyond 80 characters is shortened (:func:`shortened`).
+
+    Parameters
+    ----------
+    *args
+        The message, as for any exception.
+
+    Attributes
+    ----------
+    problems : tuple of (str, str)
+        When a validation found it (:func:`parse`), each problem as (key path, what is wrong), so that a caller
+        can tie it to the change that caused it (a scan axis: studies.runtime.point_runs).
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> try:
+    ...     rpdrill.load_scene("paper_base").with_({"impact.frequency_hz": -1})
+    ... except rpdrill.InputError as error:
+    ...     print(error)
+    Scene.with_: impact.frequency_hz: -1: Input should be greater than 0
+    """
 
     problems: tuple[tuple[str, str], ...] = ()
 

@@ -73,9 +73,27 @@ class WaveSolverRecord(SolverRecord):
 
 
 class Regime(Enum):
-    """What a run's steady state is: the time run itself (``steady_state: time``), a stable periodic orbit
-    of ``period_blows`` blows, none found (the result is then the time run, the reason in the note), or a
-    scene that cannot have one (refused: the result is the time run, the reason in the note)."""
+    """What a run's steady state is (``Result.steady_state.regime``).
+
+    Attributes
+    ----------
+    TIME_RUN
+        The time run itself (``solver.steady_state: time``): averaged after the transient blows.
+    PERIODIC
+        A stable periodic orbit of ``period_blows`` blows (``solver.steady_state: periodic``).
+    NOT_FOUND
+        No periodic orbit found: the result is the time run, the reason in the note.
+    REFUSED
+        A scene that cannot have an orbit relative to the bottom: the time run, the reason in the note.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> rpdrill.Regime("periodic") is rpdrill.Regime.PERIODIC
+    True
+    >>> [regime.value for regime in rpdrill.Regime]
+    ['time run', 'periodic', 'no periodic orbit found', 'periodic orbit refused']
+    """
 
     TIME_RUN = "time run"
     PERIODIC = "periodic"

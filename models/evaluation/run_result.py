@@ -19,15 +19,51 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Result:
-    """One run: ``metrics`` (the scene's outputs' metrics, SI units in the names), ``timeseries`` (a
-    DataFrame every ``solver.output_interval_s``, columns with units in their names, as
-    ``timeseries.csv``), ``raw`` (the formulation's result: every sample, the chain), ``steady_state`` (the
-    regime: a time run, or the periodic orbit with its Floquet multipliers), ``solver`` (what the
-    formulation's solver did), ``exudyn_model`` (the items of one's own an Exudyn model ran with, or None),
-    ``source`` (the scene's file, or how it was made), ``code`` (the code of one's own the run imported:
-    every extension and a rock law of one's own, by import path, package, version and file) and
-    ``warnings`` (what the run warned of). The raw result's histories read through (``result.time_s``,
-    ``result.position_m``)."""
+    """One run of a scene (:func:`simulate`): its metrics, its time series, its steady state and its records.
+
+    The raw result's histories read through (``result.time_s``, ``result.position_m``).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene that ran.
+    raw : SimulationResult
+        The formulation's result: every sample, the chain (models.evaluation.results).
+    source : str, default ""
+        The scene's file, or how it was made.
+    code : CodeRecords
+        The code of one's own the run imported: every extension and a rock law of one's own, by import path,
+        package, version and file.
+    warnings : tuple of str, default ()
+        What the run warned of.
+
+    Attributes
+    ----------
+    metrics : dict of str to float
+        The scene's metrics, SI units in the names (``penetration_rate_m_per_s``, ``bit_velocity_peak_m_per_s``).
+    timeseries : pandas.DataFrame
+        Every ``solver.output_interval_s``: ``time_s`` a column on a plain index, every body's position and
+        velocity, every connector's force and compression, units in the column names (as ``timeseries.csv``).
+    steady_state : SteadyStateRecord
+        The ``regime`` (:class:`Regime`), the periodic ``orbit`` with its Floquet ``multipliers``, the ``note``.
+    solver : SolverRecord
+        What the formulation's solver did: samples, mode switches, its step.
+    exudyn_model : ExudynModelRecord or None
+        The items of one's own an Exudyn model ran with.
+    provenance : dict
+        The source and the code records, as ``summary.json`` holds them.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base").with_({"solver.formulation": "exact",
+    ...                                                  "solver.steady_state": "periodic"})
+    >>> result = rpdrill.simulate(scene)
+    >>> result.steady_state.regime, result.steady_state.orbit.period_blows
+    (<Regime.PERIODIC: 'periodic'>, 1)
+    >>> result.metrics["advance_per_blow_m"] > 0, result.timeseries.columns[0]
+    (True, 'time_s')
+    """
 
     scene: Scene
     raw: SimulationResult

@@ -45,7 +45,26 @@ SUGGESTED = "rk44"
 
 
 class SimulationFailed(RuntimeError):
-    """A run that diverged or did not reach its end time."""
+    """A run that diverged or did not reach its end time (a ``RuntimeError``; exit status 1 on the command line).
+
+    The message names the scene, the time reached and why: the explicit step beyond its stability limit, a
+    state that is not a number, or the error a piece of code of one's own raised in the run (its file and line).
+
+    Parameters
+    ----------
+    *args
+        The message, as for any exception.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> issubclass(rpdrill.SimulationFailed, RuntimeError)
+    True
+    >>> try:
+    ...     rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
+    ... except rpdrill.SimulationFailed as error:
+    ...     print(f"the run failed: {error}")
+    """
 
 
 class StepLimitWarning(UserWarning):

@@ -9,16 +9,10 @@ torque. Only what the scene's effects and outputs need is built: no torsion node
 damping term, no per-step hook for an elastic rock, no force sensors and no per-step storage
 unless an output asks for them. Every body carries its graphics to scale (models.solvers.exudyn_graphics).
 
-:func:`build_exudyn` returns the assembled system before it runs (:class:`ExudynModel`: ``SC``,
-``mbs``, ``bodies[name]`` with their node, object and markers, ``connectors[name]``) for a user to
-add Exudyn items of their own, after the scene's extensions (models.definition.extensions) have added
-theirs; ``model.run()`` runs it, and so does Exudyn's own ``exu.SolveDynamic(mbs, model.settings,
-solverType=model.solver_type)``: the model's per-step functions (the rock's state, the piston's strikes,
-``add_pre_step``) are part of the built system. What a user adds is seen by the model's services
-(models.solvers.exudyn_user_items): the step rule and the stability bounds take the assembled system,
-the energy account its masses, spring-dampers and loads, the result's time series its sensors. A
-normal run is the same build and run (:func:`simulate`). A scene with wave rods builds the string's bodies
-with mass only, the rods an element of their own updated before every step (models.waves.exudyn_waves).
+:func:`build_exudyn` returns the assembled system before it runs for a user to add Exudyn items of their own
+(:class:`ExudynModel`; both docstrings say how); a normal run is the same build and run (:func:`simulate`).
+A scene with wave rods builds the string's bodies with mass only, the rods an element of their own updated
+before every step (models.waves.exudyn_waves).
 """
 
 from __future__ import annotations
@@ -98,7 +92,7 @@ from .exudyn_user_items import (
     time_runs_only,
     user_outcome,
 )
-from .simulation import Simulation, as_simulation, prepare, solver_settings
+from .simulation import Simulation, exudyn_simulation, solver_settings
 
 COORDINATE = exu.OutputVariableType.Coordinates
 RATE = exu.OutputVariableType.Coordinates_t
@@ -109,12 +103,26 @@ AXIS_X_FROM_Z = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]  # a rotati
 class ExudynModel:
     """The drill as an assembled Exudyn system, not yet run (:func:`build_exudyn`).
 
-    ``mbs`` is open to any Exudyn item of a user's own: join it to ``bodies[name].marker_position``
-    (spatial connectors) or ``.marker_coordinate`` (coordinate connectors, loads); ``run()`` assembles
-    what was added and runs it with the scene's solver settings, its step sized for the assembled system.
-    ``add_pre_step(function)`` adds a per-step function; a function set with ``mbs.SetPreStepUserFunction``
-    replaces the model's own (the rock would never crush), so ``run()`` runs it after them and
-    :meth:`result` refuses a solve it replaced. ``add_energy_term`` declares an energy of one's own.
+    :meth:`add_pre_step` adds a per-step function; one set with ``mbs.SetPreStepUserFunction`` replaces the model's
+    own (the rock would never crush), so :meth:`run` runs it after them and :meth:`result` refuses a solve it
+    replaced. :meth:`add_energy_term` declares an energy of one's own.
+
+    Attributes
+    ----------
+    SC, mbs : exudyn.SystemContainer, exudyn.MainSystem
+        Open to any Exudyn item of one's own: :meth:`run` (or ``exu.SolveDynamic(model.mbs, model.settings,
+        solverType=model.solver_type)``, then :meth:`result`) runs it with the scene's solver settings, the step
+        sized for the system as assembled; the energy account takes its masses, springs, loads, the series its sensors.
+    bodies, connectors : mapping of str to ExudynBody, ExudynConnector
+        By scene name: a body's ``.node``, ``.object``, ``.marker_position`` (spatial connectors),
+        ``.marker_coordinate`` (coordinate connectors, loads); a connector's ``.object``.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> model = rpdrill.build_exudyn(rpdrill.load_scene("paper_base"))
+    >>> sorted(model.connectors), model.user_items()  # items of one's own: none yet
+    (['collar_bit_joint', 'shank_collar_joint', 'shock_sub'], {})
     """
 
     simulation: Simulation
@@ -311,30 +319,37 @@ class ExudynModel:
                       code=self.simulation.code_records())
 
 
-def _exudyn_simulation(run: Scene | Simulation) -> tuple[Simulation, str]:
-    """The prepared simulation to build, and the formulation the scene named: a scene of another
-    formulation is run by Exudyn with its common solver keys (end time, preset, output interval)."""
-    simulation = as_simulation(run)
-    named = simulation.settings.formulation
-    if named != "exudyn":
-        simulation = prepare(simulation.scene.with_solver("exudyn"))
-    return simulation, named
-
-
 def build_exudyn(run: Scene | Simulation, symbolic: bool = True, graphics: bool = True) -> ExudynModel:
-    """The drill of a scene (or prepared simulation) as an assembled Exudyn system, not yet run
-    (:class:`ExudynModel`); ``model.run()`` runs it. A scene of another formulation is built for Exudyn.
+    """The drill of a scene as an assembled Exudyn system, not yet run, its extensions applied; ``run()`` runs it.
 
-    ``symbolic=False`` uses Python callbacks for the impact and rock forces (same law, slower:
-    kept for the benchmark that measures what the symbolic functions save). ``graphics=False`` leaves out
-    the bodies' cylinders (models.solvers.exudyn_graphics), which only a renderer shows: a system no one
-    can see (:func:`simulate`'s) is built without them (the paper drill's build: 16.3 ms with them, 1.2 ms
-    without; ``python benchmarks/bench_core.py``).
+    Parameters
+    ----------
+    run : Scene or Simulation
+        The scene (built for Exudyn whatever its formulation), or a prepared simulation.
+    symbolic, graphics : bool, default True
+        False: Python callbacks for the impact and rock forces (the same law, slower); no bodies' cylinders,
+        which only a renderer shows (a build of 1.2 ms, not 16.3 ms: ``python benchmarks/bench_core.py``).
+
+    Returns
+    -------
+    ExudynModel
+
+    Raises
+    ------
+    InputError
+        When ``run`` is not a scene, or the scene cannot be built.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> model = rpdrill.build_exudyn(rpdrill.load_scene("paper_base").with_({"solver.end_time_s": 0.3}))
+    >>> sorted(model.bodies), model.solver_type.name, model.run().formulation
+    (['bit', 'collar', 'pipe', 'shank'], 'RK44', 'exudyn')
     """
     if not isinstance(run, (Scene, Simulation)):
         raise InputError(f"rpdrill.build_exudyn: run: {short(run)}: give a rpdrill.Scene (rpdrill.load_scene) or a "
                          "prepared simulation")
-    simulation, named = _exudyn_simulation(run)
+    simulation, named = exudyn_simulation(run)
     if simulation.dynamic_chain.waves:  # the string's bodies with mass, the rods an element (models.waves)
         model = WaveExudyn(simulation, symbolic).model(ExudynModel, ExudynBody, ExudynConnector,
                                                        simulation_settings(simulation), named)
@@ -445,7 +460,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True, graphics: bool 
 def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None = None,
              symbolic: bool = True) -> SimulationResult:
     """Build and run the Exudyn model (:func:`build_exudyn`, without the bodies' graphics: the system
-    is not returned, no renderer sees it; :meth:`ExudynModel.solve`)."""
+    is not returned, no renderer sees it; :meth:`ExudynModel.run_raw`)."""
     return build_exudyn(run, symbolic, graphics=False).run_raw(progress)
 
 

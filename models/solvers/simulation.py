@@ -268,3 +268,14 @@ def prepare(scene: Scene) -> Simulation:
 def as_simulation(run: Scene | Simulation) -> Simulation:
     """A prepared simulation (a scene is prepared here)."""
     return run if isinstance(run, Simulation) else prepare(run)
+
+
+def exudyn_simulation(run: Scene | Simulation) -> tuple[Simulation, str]:
+    """The prepared simulation the Exudyn model builds (models.solvers.exudyn_model.build_exudyn), and the
+    formulation the scene named: a scene of another formulation is run by Exudyn with its common solver keys
+    (end time, preset, output interval)."""
+    simulation = as_simulation(run)
+    named = simulation.settings.formulation
+    if named != "exudyn":
+        simulation = prepare(simulation.scene.with_solver("exudyn"))
+    return simulation, named

@@ -60,10 +60,36 @@ class ReferenceFailed(RuntimeError):
 
 @dataclass(frozen=True)
 class AccuracyResult:
-    """A work-precision study's outcome: its ``table`` (one row a setting: median CPU time, every
-    repeat's, the errors against the reference), the Pareto front of each error measure, the
-    references' ``report`` (their agreement and whether it is below the smallest error plotted), the
-    references' CPU seconds, and the figures written (none without ``out``)."""
+    """A work-precision study's outcome (:func:`accuracy`).
+
+    Parameters
+    ----------
+    study : AccuracyStudy
+        The study, loaded.
+    table : pandas.DataFrame
+        One row a solver setting: its median CPU time, every repeat's, the errors against the reference.
+    pareto : pandas.DataFrame
+        The Pareto front of each error measure.
+    report : dict
+        The references' agreement, and whether it is below the smallest error plotted.
+    reference_cpu_s : dict of str to float
+        The references' CPU seconds.
+    figures : list of pathlib.Path
+        The figures written (none without ``out``).
+    out : pathlib.Path or None
+        The folder written.
+
+    Attributes
+    ----------
+    references_agree : bool
+        Whether the references agree better than the smallest error plotted, in every measure.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> study = rpdrill.accuracy("accuracy_studies/paper_base")  # doctest: +SKIP
+    >>> study.table.head()  # doctest: +SKIP
+    """
 
     study: AccuracyStudy
     table: pd.DataFrame
@@ -94,10 +120,44 @@ def _reference(study: AccuracyStudy, setting: Setting | None, what: str, cpu: di
 
 def accuracy(study: AccuracyStudy | str | Path, options: RunOptions | None = None, *,
              allow_code: Sequence[str] | str = (), **run: Any) -> AccuracyResult:
-    """Run a work-precision study (or file) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
-    ``workers``, ``dask``, ``out``, ``budget``, ``quiet``): into ``out`` (resumable: module doc) or a scratch
-    folder; ``allow_code``: the modules of one's own its scene may run (models.definition.own_code).
-    InputError or BudgetError before anything runs, ReferenceFailed when a reference run fails."""
+    """A work-precision study: the error against CPU time of every solver setting, and its Pareto front.
+
+    ``rpdrill accuracy`` as a library call (module doc; docs/accuracy.md): the study's reference and reference
+    check run in this process, then every setting ``repeats`` times; resumable in ``out``.
+
+    Parameters
+    ----------
+    study : AccuracyStudy, str or pathlib.Path
+        A work-precision study file, its loaded study, or a shipped one's name
+        (``"accuracy_studies/paper_base"``).
+    options : RunOptions, optional
+        ``workers``, ``dask``, ``out``, ``budget``, ``quiet``; or these names as keywords. Without ``out``, a
+        scratch folder removed after, and nothing drawn.
+    allow_code : sequence of str or str, default ()
+        The modules of one's own its scene may run (models.definition.own_code).
+    **run
+        :class:`RunOptions` names.
+
+    Returns
+    -------
+    AccuracyResult
+        The table, the Pareto front, the references' report.
+
+    Raises
+    ------
+    InputError
+        When the file or an option cannot be used, before anything runs.
+    BudgetError
+        When its runs exceed the budget, before anything runs.
+    ReferenceFailed
+        When a reference run fails.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> study = rpdrill.accuracy("accuracy_studies/paper_base", out="runs/accuracy")  # doctest: +SKIP
+    >>> study.references_agree, study.pareto  # doctest: +SKIP
+    """
     check(WHERE, "study", study,
           either(file_problem, instance_problem(AccuracyStudy, "a work-precision study file's path or its loaded study")))
     options = RunOptions.of(WHERE, options, run, TAKES)

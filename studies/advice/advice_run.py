@@ -62,18 +62,66 @@ def advise_scene(scene: Scene | str | Path, bounds: dict[str, tuple[float, float
                  search: AdviceSearch | None = None, markdown: str | Path | None = None, command: str | None = None,
                  max_rod_stress_pa: float | None = None, options: RunOptions | None = None,
                  allow_code: Sequence[str] | str = (), **run: Any) -> list[Advice]:
-    """Maximise ``metric`` over ``bounds`` (``{"impact.frequency_hz": (45, 70), "feed.force_n": (35e3,
-    60e3)}``, optionally ``"impact.amplitude_n"`` and an extension's ``"extensions.NAME.parameters.KEY"``; SI
-    units) for the scene's rock, or for each Table 1
-    rock of ``rocks``; ``power_kw``: a fixed hammer power (a piston scene, the blow energy P / f). One
-    :class:`Advice` per rock (SI units). ``options`` (rpdrill.RunOptions, or its names as keywords: ``workers``,
-    ``dask``, ``out``, ``overwrite``, ``quiet``): ``out`` the folder of the checkpoint and the report (module
-    doc; new, empty or an earlier advice's, or any folder with ``overwrite``, which starts afresh there);
-    ``markdown``: a copy of advice.md; ``command``: the command the report names (default: this call);
-    ``max_rod_stress_pa``: the best point whose rods stay below this stress (rod_stress_max_pa, a scene with rods;
-    NoAllowedPoint, a RuntimeError, where no point run meets it: the points run are kept in ``out``).
-    InputError before anything runs when an input cannot be used; ``allow_code``: the modules of one's own the
-    scene may run (models.definition.own_code)."""
+    """The operating point that maximises a metric within bounds: ``rpdrill advise`` as a library call.
+
+    Differential evolution (on the exact formulation where the scene allows it), then the metric along each
+    parameter through the optimum and a feed x frequency map (module doc). Points whose mean thrust (feed +
+    frequency x impulse per blow) reaches ``max_thrust_ratio`` of the rock's threshold are not run.
+
+    Parameters
+    ----------
+    scene : Scene, str or pathlib.Path
+        The scene, a scene file or a shipped scene's name.
+    bounds : dict of str to (float, float)
+        Key path to (low, high), SI units: ``impact.frequency_hz``, ``feed.force_n``, optionally
+        ``impact.amplitude_n`` and an extension's ``extensions.NAME.parameters.KEY``.
+    metric : {"penetration_rate_m_per_s", "penetration_per_impact_energy_m_per_j"}, optional
+        What is maximised (default the penetration rate).
+    rocks : list of str, optional
+        Table 1 rocks (``conglomerate``, ``sandstone``, ``soft_limestone``) to advise for, each in turn;
+        default the scene's rock.
+    power_kw : float, optional
+        A fixed hammer power (a piston scene): the blow energy P / f at every frequency.
+    max_thrust_ratio : float, default 1.0
+        The largest mean thrust run, as a share of the rock's threshold F_th.
+    search : AdviceSearch, optional
+        Differential evolution's budget (default ``AdviceSearch()``).
+    markdown : str or pathlib.Path, optional
+        Where a copy of ``advice.md`` goes.
+    command : str, optional
+        The command the report names (default: this call).
+    max_rod_stress_pa : float, optional
+        The best point whose rods stay below this stress, tension or compression (a scene with rods).
+    options : RunOptions, optional
+        ``workers``, ``dask``, ``out`` (the checkpoint ``evaluations.jsonl`` and the report: resumable),
+        ``overwrite``, ``quiet``; or these names as keywords.
+    allow_code : sequence of str or str, default ()
+        The modules of one's own the scene may run (models.definition.own_code).
+    **run
+        :class:`RunOptions` names.
+
+    Returns
+    -------
+    list of Advice
+        One per rock: the best point, its value, the curves around it, the feed x frequency map.
+
+    Raises
+    ------
+    InputError
+        When an input cannot be used, before anything runs.
+    NoAllowedPoint
+        A ``RuntimeError``: no point run keeps its rods below ``max_rod_stress_pa`` (the points run are kept in
+        ``out``).
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base").with_({"solver.formulation": "exact"})
+    >>> advice = rpdrill.advise(scene, {"impact.frequency_hz": (45, 75), "feed.force_n": (10e3, 30e3)},
+    ...                         search=rpdrill.AdviceSearch(popsize=3, max_generations=2))  # doctest: +SKIP
+    >>> advice[0].best  # doctest: +SKIP
+    {'impact.frequency_hz': 75.0, 'feed.force_n': 30000.0}
+    """
     where = "rpdrill.advise"
     check(where, "bounds", bounds, bounds_problem)
     check(where, "metric", metric, choice_problem(METRICS, "metric"))

@@ -66,11 +66,11 @@ from ...models.definition.validation import InputError
 from ...models.solvers.simulation import SceneError, Simulation, prepare, unsupported
 from ...rocklaw.catalog import TABLE_1
 from ..display.catalogue import describe_scene, parameter
-from ..inputs.arguments import check, count_problem, positive_problem, seed_problem
 from ..runtime.evaluation_log import EvaluationLog
 from ..runtime.pools import Runner
 from ..scan.curve_optima import band
 from ..scan.curves import Curve, run_curve
+from .advice_records import Advice, AdviceSearch, Bounds, Point
 
 FREQUENCY, FEED = "impact.frequency_hz", "feed.force_n"
 STRESS = "rod_stress_max_pa"  # the rods' largest stress (models.evaluation.rod_outputs), a --max-rod-stress-mpa bound's
@@ -79,8 +79,6 @@ SLICE_POINTS = 15
 MAP_POINTS = 12
 MAX_PROMOTIONS = 5  # rounds of curves through a better point (module doc: the best is the best point run)
 IMPLAUSIBLE = 10  # a feed bound this many times every rock's threshold force is a unit mistake (N for kN)
-Bounds = dict[str, tuple[float, float]]  # scene path -> (low, high), SI
-Point = dict[str, float]  # scene path -> SI value
 
 
 @dataclass(frozen=True)
@@ -124,29 +122,13 @@ PARAMETERS = (AdviseParameter("frequency", FREQUENCY, True), AdviseParameter("fe
 
 
 @dataclass(frozen=True)
-class AdviceSearch:
-    """Differential evolution's budget: population ``popsize`` x parameters, ``max_generations``
-    after the first population, convergence at ``tolerance`` (SciPy's tol), ``seed``."""
-
-    popsize: int = 10
-    max_generations: int = 30
-    tolerance: float = 0.01
-    seed: int = 1
-
-    def __post_init__(self) -> None:
-        for name, problem in (("popsize", count_problem), ("max_generations", count_problem),
-                              ("tolerance", positive_problem), ("seed", seed_problem)):
-            check("rpdrill.AdviceSearch", name, getattr(self, name), problem)
-
-
-@dataclass(frozen=True)
 class Request:
     """What to maximise, over which bounds, below which thrust ratio, with which search budget."""
 
     metric: str
     bounds: Bounds
     max_thrust_ratio: float = 1.0
-    search: AdviceSearch = AdviceSearch()
+    search: AdviceSearch = field(default_factory=AdviceSearch)
     power_w: float | None = None  # a fixed hammer power: E_blow = P / f at every point (module doc)
     max_rod_stress_pa: float | None = None  # a bound on the rods' stress (rod_stress_max_pa, module doc)
 
@@ -154,40 +136,6 @@ class Request:
     def metrics(self) -> list[str]:
         """What each run computes: the metric, and the rods' largest stress under a stress bound."""
         return [self.metric] + ([STRESS] if self.max_rod_stress_pa is not None else [])
-
-
-@dataclass
-class Advice:
-    """The result for one scene (one rock): the best point, its value and how it was found, the
-    curves around it, the feed x frequency map. SI units."""
-
-    scene: str
-    description: str  # the scene, rock and impact in one line (studies.display.catalogue.describe_scene)
-    scene_description: str  # the same without the rock
-    rock: str | None
-    metric: str
-    formulation: str
-    end_time_s: float
-    bounds: Bounds
-    max_thrust_ratio: float
-    best: Point = field(default_factory=dict)
-    best_value: float = math.nan
-    best_thrust_ratio: float = math.nan  # mean thrust / F_th at the best point
-    runs: int = 0
-    replayed: int = 0  # of the runs, points recorded by an earlier session (module doc)
-    failed_runs: int = 0
-    beyond_limit: int = 0  # points not run: beyond the thrust limit
-    first_error: str = ""
-    generations: int = 0
-    converged: bool = False
-    slices: dict[str, dict[str, Any]] = field(default_factory=dict)
-    feed_map: dict[str, Any] = field(default_factory=dict)
-    wall_time_s: float = 0.0
-    power_w: float | None = None  # the fixed hammer power (module doc), or None
-    max_rod_stress_pa: float | None = None  # the rods' stress bound, or None
-    best_rod_stress_pa: float = math.nan  # the rods' largest stress at the best point (with a bound)
-    beyond_stress: int = 0  # points run whose rods' stress exceeded the bound
-    search_best_value: float = math.nan  # the search's own best, where a point of its curves or map beat it
 
 
 class NoAllowedPoint(RuntimeError):

@@ -42,10 +42,40 @@ WHERE = "rpdrill.calibrate"
 
 @dataclass(frozen=True)
 class CalibrationResult:
-    """A calibration's outcome: every recorded evaluation (``records``: parameters, per-target optima as
-    studies.scan.curve_optima.Optimum records, objective), the ``best`` one and its refined ``final`` scan
-    (None when every simulation failed, or every run of a target did: ``failed_targets``), the
-    calibrated ``scene``, what this session cost (``session``) and the folder written (``out``, or None)."""
+    """A calibration's outcome (:func:`calibrate`).
+
+    Parameters
+    ----------
+    calibration : Calibration
+        The calibration file, loaded.
+    records : list of CalibrationEvaluation
+        Every recorded evaluation: its parameters, each target's optimum, the objective.
+    best : CalibrationEvaluation or None
+        The best evaluation (None when every simulation failed, or every run of a target did).
+    final : FinalScan or None
+        The best set scanned again around its optima.
+    session : dict
+        What this session cost.
+    failed_targets : list of str
+        The targets every run of which failed.
+    scene : Scene or None
+        The calibrated scene.
+    out : pathlib.Path or None
+        The folder written.
+
+    Attributes
+    ----------
+    optima_hz : dict of str to float or None
+        Each target's main-lobe optimum of the final scan.
+    first_error : str
+        The first error of a failed target's runs.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> fit = rpdrill.calibrate("paper/calibration", out="runs/calibration")  # doctest: +SKIP
+    >>> fit.scene.drill_string.bodies["collar"].mass_kg  # doctest: +SKIP
+    """
 
     calibration: Calibration
     records: list[CalibrationEvaluation]
@@ -71,12 +101,44 @@ class CalibrationResult:
 
 def calibrate(calibration: Calibration | str | Path, options: RunOptions | None = None, *,
               allow_code: Sequence[str] | str = (), **run: Any) -> CalibrationResult:
-    """Fit a calibration file's parameters (module doc) as ``options`` say (rpdrill.RunOptions, or its names as
-    keywords: ``workers``, ``dask``, ``out``, ``overwrite``, ``budget``, ``quiet``): into ``out`` (resumable; a
-    folder holding anything else, or another calibration, is refused unless ``overwrite``, which starts
-    afresh there) or a scratch folder. InputError or BudgetError before anything runs. An ``out`` that was
-    new is removed again when no evaluation has a best (nothing to keep). ``allow_code``: the modules of one's
-    own its scenes may run (models.definition.own_code), never read from the file."""
+    """Fit a calibration file's scene parameters so that frequency scans put their optima where the targets say.
+
+    ``rpdrill calibrate`` as a library call (module doc): a global search (SciPy's differential evolution, a
+    whole population's scans at once), every evaluation checkpointed as it finishes, a rerun into the same
+    ``out`` replays them and continues; the best set scanned again around its optima. The file's format:
+    docs/calibration.md.
+
+    Parameters
+    ----------
+    calibration : Calibration, str or pathlib.Path
+        A calibration file, its loaded Calibration, or a shipped calibration's name (``"paper/calibration"``).
+    options : RunOptions, optional
+        ``workers``, ``dask``, ``out`` (resumable; a folder holding anything else, or another calibration, is
+        refused unless ``overwrite``, which starts afresh there), ``overwrite``, ``budget``, ``quiet``; or these
+        names as keywords. Without ``out``, a scratch folder removed after.
+    allow_code : sequence of str or str, default ()
+        The modules of one's own its scenes may run (models.definition.own_code); never read from the file.
+    **run
+        :class:`RunOptions` names.
+
+    Returns
+    -------
+    CalibrationResult
+        Every evaluation, the best, its refined scan and the calibrated scene.
+
+    Raises
+    ------
+    InputError
+        When the file or an option cannot be used, before anything runs.
+    BudgetError
+        When the search's runs exceed the budget, before anything runs.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> fit = rpdrill.calibrate("paper/calibration", out="runs/calibration", workers=2)  # doctest: +SKIP
+    >>> fit.best.objective, fit.optima_hz, fit.scene  # doctest: +SKIP
+    """
     check(WHERE, "calibration", calibration,
           either(file_problem, instance_problem(Calibration, "a calibration file's path or its loaded Calibration")))
     options = RunOptions.of(WHERE, options, run)

@@ -83,9 +83,41 @@ def save_frames(fig: Figure, frame: Callable[[int], None], count: int, path: Pat
 
 def write_animation(result: SimulationResult | Result | ExudynModel, path: str | Path, blows: int = 3,
                     magnification: float | None = None) -> float:
-    """Write the last ``blows`` blows of ``result`` (a run's raw result, or its rpdrill.Result) to ``path``
-    (module doc); the magnification drawn. A built Exudyn model is drawn from its own graphics, every item of
-    one's own included (:func:`model_animation`)."""
+    """Animate the last blows of a run into ``path`` (``.gif`` with Pillow; ``.mp4`` needs ffmpeg; module doc).
+
+    Every body moves by its displacement since the window's start, the rock face by the borehole bottom's, all
+    magnified by one factor stated in the title. A built Exudyn model is drawn from its own graphics, every item
+    of one's own included, at the coordinates of its solution file (:func:`model_animation`).
+
+    Parameters
+    ----------
+    result : Result, SimulationResult or ExudynModel
+        A run of :func:`simulate` (or its raw result), or a built model that ran with a solution file.
+    path : str or pathlib.Path
+        The animation file.
+    blows : int, default 3
+        The blows drawn, the last ones of the run.
+    magnification : float, optional
+        The factor displacements are drawn with (default: the largest motion drawn as half a connector's space,
+        rounded down to 1, 2 or 5 x a power of ten).
+
+    Returns
+    -------
+    float
+        The magnification drawn.
+
+    Raises
+    ------
+    InputError
+        When an argument cannot be used.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base").with_({"solver.end_time_s": 0.3})
+    >>> rpdrill.write_animation(rpdrill.simulate(scene, formulation="exact"), "drill.gif")  # doctest: +SKIP
+    200.0
+    """
     where = "rpdrill.write_animation"
     result = result.raw if isinstance(result, Result) else result
     check(where, "result", result, either(built_model_problem, instance_problem(
@@ -159,10 +191,33 @@ def load_solution(run: str | Path | ExudynModel, allow_code: Sequence[str] | str
 
 
 def view_solution(run: str | Path | ExudynModel, allow_code: Sequence[str] | str = ()) -> None:
-    """Play a run folder's ``solution.txt`` on its scene's Exudyn model (its extensions applied, their modules
-    allowed by ``allow_code``: :func:`load_solution`), or a model's
-    own solution file, in Exudyn's SolutionViewer (module doc; it needs a display: without one Exudyn's
-    renderer aborts the process)."""
+    """Play a run in Exudyn's SolutionViewer (module doc; it needs a display: without one Exudyn's renderer aborts
+    the process).
+
+    Parameters
+    ----------
+    run : str, pathlib.Path or ExudynModel
+        A folder of ``rpdrill simulate --animate`` (its ``scene.resolved.yaml`` and ``solution.txt``: the scene's
+        model built again, its extensions applied), or a model that ran with ``model.write_solution(path)``.
+    allow_code : sequence of str or str, default ()
+        The modules of one's own the run's scene may run (its extensions; models.definition.own_code).
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    InputError
+        When the folder holds no run, or the solution does not fit the model (a run with items added in Python
+        that its scene does not name).
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> # a folder of `rpdrill simulate paper_base --out out/run --animate`
+    >>> rpdrill.view_solution("out/run")  # doctest: +SKIP
+    """
     import exudyn.interactive
 
     model, solution = load_solution(run, allow_code)

@@ -323,9 +323,35 @@ def figure_title(scene: Scene, drawing: DrawnLayout) -> str:
 
 
 def draw(scene: Scene | ExudynModel, path: str | Path) -> Path:
-    """Write the drawing of ``scene``'s drill string to ``path`` (PNG or SVG by its suffix; module doc). A built
-    Exudyn model (``rpdrill.build_exudyn``), or a scene with extensions (drawn as its built model), is drawn
-    from the system's own graphics with every item of one's own (studies.drawings.system_drawing)."""
+    """Draw the scene's drill string to scale, every part labelled, into ``path`` (PNG or SVG by its suffix).
+
+    A built Exudyn model (:func:`build_exudyn`), or a scene with extensions (drawn as its built model), is
+    drawn from the system's own graphics with every item of one's own (studies.drawings.system_drawing).
+    Drawn without pyplot: the caller's matplotlib is left as it is.
+
+    Parameters
+    ----------
+    scene : Scene or ExudynModel
+        The scene, or a built model.
+    path : str or pathlib.Path
+        The image file; its folder must exist.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    InputError
+        When ``scene`` is neither a scene nor a built model, or ``path`` cannot be written.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> rpdrill.draw(rpdrill.load_scene("paper_base"), "drill.svg")
+    PosixPath('drill.svg')
+    """
     check("rpdrill.draw", "scene", scene, either(built_model_problem, instance_problem(
         Scene, "a rpdrill.Scene (rpdrill.load_scene) or a built model (rpdrill.build_exudyn)")))
     check("rpdrill.draw", "path", path, file_problem)

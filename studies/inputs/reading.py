@@ -99,9 +99,40 @@ def read_yaml(path: str | Path) -> dict[str, Any]:
 
 
 def load_scene(path: str | Path, allow_code: Sequence[str] | str = ()) -> Scene:
-    """Read and validate a scene file, or a shipped scene by its name (``"paper_base"``: studies.inputs.shipped);
-    ``allow_code``: the modules of one's own the scene may run (an extension's function, a rock law named by
-    import path: models.definition.own_code), never read from the file."""
+    """Read and validate a scene file, or a shipped scene by its name.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A scene file (YAML; its keys: the scene reference, docs/scenes.md), or the name of a shipped scene
+        (``"paper_base"``; :func:`shipped_files`, ``rpdrill shipped``). A file that exists wins over a name.
+    allow_code : sequence of str or str, default ()
+        The modules of one's own the scene may run (an extension's function, a rock law named by import path:
+        models.definition.own_code); never read from the file.
+
+    Returns
+    -------
+    Scene
+        The validated scene, every key typed.
+
+    Raises
+    ------
+    InputError
+        Naming the file, the key path, the value and what is allowed: a missing file, YAML that YAML 1.2
+        reads otherwise than YAML 1.1, an unknown key, a value out of range, code of one's own not allowed.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base")
+    >>> scene.impact.frequency_hz, scene.drill_string.bodies["collar"].mass_kg
+    (65.0, 1830.0)
+    >>> try:
+    ...     rpdrill.load_scene("paper_bas")
+    ... except rpdrill.InputError as error:
+    ...     print(error)
+    paper_bas: no such file; nor a shipped file's name (rpdrill shipped lists them)
+    """
     check("rpdrill.load_scene", "path", path, scene_file_problem)
     check("rpdrill.load_scene", "allow_code", allow_code, allow_code_problem)
     path = shipped_path(path, "scene", "rpdrill.load_scene")

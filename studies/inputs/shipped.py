@@ -26,8 +26,26 @@ _KEYS = (("drill_string", "scene"), ("scan", "study"), ("scans", "sensitivity"),
 
 @dataclass(frozen=True)
 class ShippedFile:
-    """One shipped file: its ``kind`` (:data:`KINDS`), the ``name`` it is opened by, its ``path`` and its
-    ``description``."""
+    """One file that ships with rpdrill (:func:`shipped_files`).
+
+    Parameters
+    ----------
+    kind : {"scene", "study", "calibration", "sensitivity", "accuracy", "reproduction"}
+        What it holds (:data:`KINDS`).
+    name : str
+        The name that opens it anywhere (``load_scene("paper_base")``, ``rpdrill study paper/frequency_scan``).
+    path : pathlib.Path
+        The installed file.
+    description : str
+        Its own ``description``.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = next(f for f in rpdrill.shipped_files() if f.name == "paper_base")
+    >>> scene.kind, scene.path.name
+    ('scene', 'paper_base.yaml')
+    """
 
     kind: str
     name: str
@@ -42,7 +60,19 @@ def _root() -> Path:
 
 @functools.cache
 def shipped_files() -> tuple[ShippedFile, ...]:
-    """Every shipped file, scenes first, each kind by name (module doc)."""
+    """Every shipped scene, study and analysis, scenes first, each kind by name (module doc; ``rpdrill shipped``).
+
+    Returns
+    -------
+    tuple of ShippedFile
+        The files with their kind, name, path and description.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> [f.name for f in rpdrill.shipped_files() if f.kind == "study"][:3]
+    ['paper/frequency_scan', 'paper/impulse_scan', 'paper/rock_table']
+    """
     root = _root()
     found = []
     for path in sorted(root.glob("*/*.yaml")):

@@ -45,7 +45,7 @@ from ..runtime.budgets import Budget
 from ..runtime.output_files import check_out, staged_directory, write_json, write_rows_csv
 from ..runtime.pools import pool
 from ..runtime.run_options import RunOptions
-from .paper_pages import figures_page, parameters_page, reproduction_page, sensitivity_page
+from .paper_pages import figures_page, parameters_page, reproduction_page, sensitivity_page, site_prefix
 
 PAPER = Path(__file__).resolve().parents[1] / "paper"
 DEFAULT = PAPER / "reproduction.yaml"
@@ -53,9 +53,38 @@ DEFAULT = PAPER / "reproduction.yaml"
 
 @dataclass(frozen=True)
 class ReproductionResult:
-    """The paper reproduced: every case on the shipped scene and on each variant (``by_variant``, the
-    shipped scene's under None), the trends, the pages (file name -> Markdown), what the scans cost
-    (``provenance``) and the folder written (``out``, or None)."""
+    """The paper reproduced (:func:`reproduce`).
+
+    Parameters
+    ----------
+    reproduction : Reproduction
+        The reproduction file, loaded.
+    by_variant : dict of (str or None) to list of CaseResult
+        Every case on the shipped scene (under None) and on each variant: its curves and optimum.
+    pages : dict of str to str
+        The pages made, file name to Markdown.
+    provenance : dict
+        What the scans cost, the versions.
+    out : pathlib.Path or None
+        The folder written.
+
+    Attributes
+    ----------
+    results : list of CaseResult
+        The cases on the shipped scene.
+    trends : list of dict
+        Whether each trend of the paper holds.
+    stated, reached : list of CaseResult
+        The cases whose optimum the paper states; of them, those reached within the file's tolerance.
+    passed : bool
+        Every optimum the paper states reached and every trend holding.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> paper = rpdrill.reproduce()  # doctest: +SKIP
+    >>> [case.case.label for case in paper.reached]  # doctest: +SKIP
+    """
 
     reproduction: Reproduction
     by_variant: dict[str | None, list[CaseResult]]
@@ -121,11 +150,48 @@ def made_by(file: Path, reproduction: Reproduction, out: Path | None, calibratio
 def reproduce(reproduction: str | Path = DEFAULT, calibration: str | Path | None = None,
               sensitivity: str | Path | None = None, docs: str | Path | None = None, options: RunOptions | None = None,
               *, allow_code: Sequence[str] | str = (), **run: Any) -> ReproductionResult:
-    """Reproduce the paper (module doc) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
-    ``workers``, ``dask``, ``out``, ``overwrite``); ``calibration``, ``sensitivity``: the ``--out`` folders of
-    ``rpdrill calibrate`` and ``rpdrill sensitivity`` for parameters.md and sensitivity.md. ``out`` must be
-    new, empty or an earlier reproduction's (``overwrite``: any folder). ``allow_code``: the modules of one's own
-    its scenes may run (models.definition.own_code). InputError before anything runs."""
+    """Reproduce the paper on the shipped scene and make its pages: ``rpdrill reproduce`` as a library call.
+
+    Every case of the reproduction file on a 1 Hz grid (exact formulation), on the shipped scene and on each
+    variant; its optima against the paper's, the trends, the sub-harmonic lobes, the paper's Figs. 2-6 redrawn
+    (module doc). The pages: ``reproduction.md``, ``parameters.md``, ``figures.md``, and ``sensitivity.md`` when a
+    sensitivity run is given; their links to other pages of the documentation site are made relative to the site's
+    root (the nearest folder at or above ``docs`` holding ``conf.py``).
+
+    Parameters
+    ----------
+    reproduction : str or pathlib.Path, optional
+        The reproduction file (default ``studies/paper/reproduction.yaml``).
+    calibration : str or pathlib.Path, optional
+        The ``--out`` folder of ``rpdrill calibrate``, for parameters.md.
+    sensitivity : str or pathlib.Path, optional
+        The ``--out`` folder of ``rpdrill sensitivity``, for sensitivity.md.
+    docs : str or pathlib.Path, optional
+        Where the pages and figures are also copied (with ``out``).
+    options : RunOptions, optional
+        ``workers``, ``dask``, ``out`` (new, empty or an earlier reproduction's), ``overwrite`` (any folder); or
+        these names as keywords.
+    allow_code : sequence of str or str, default ()
+        The modules of one's own its scenes may run (models.definition.own_code).
+    **run
+        :class:`RunOptions` names.
+
+    Returns
+    -------
+    ReproductionResult
+        Every case, the trends, the pages.
+
+    Raises
+    ------
+    InputError
+        When a file, a folder or an option cannot be used, before anything runs.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> paper = rpdrill.reproduce(out="runs/reproduction", workers=2)  # doctest: +SKIP
+    >>> len(paper.reached), len(paper.stated), paper.passed  # doctest: +SKIP
+    """
     where = "rpdrill.reproduce"
     check(where, "reproduction", reproduction, file_problem)
     for name, value in (("calibration", calibration), ("sensitivity", sensitivity), ("docs", docs)):
@@ -153,8 +219,10 @@ def reproduce(reproduction: str | Path = DEFAULT, calibration: str | Path | None
     provenance = {"cases": len(results), **cost, "rpdrill_version": importlib.metadata.version("rpdrill"),
                   "exudyn_version": importlib.metadata.version("exudyn")}
     stated = made_by(file, loaded, folder, runs["calibration"], runs["sensitivity"], docs_folder)
-    pages = {"reproduction.md": reproduction_page(loaded, by_variant, provenance, stated),
-             "parameters.md": parameters_page(loaded, results, calibration_file, runs["calibration"], stated),
+    site = site_prefix(docs_folder)
+    pages = {"reproduction.md": reproduction_page(loaded, by_variant, provenance, stated, site,
+                                                  sensitivity_here=runs["sensitivity"] is not None),
+             "parameters.md": parameters_page(loaded, results, calibration_file, runs["calibration"], stated, site),
              "figures.md": figures_page([(f.number, f.title, f"figures/fig{f.number}.svg") for f in loaded.spec.figures],
                                         stated)}
     tornados = sorted(runs["sensitivity"].glob("tornado_*.svg")) if runs["sensitivity"] is not None else []

@@ -218,9 +218,27 @@ def write_report(runs: Path, out: Path, rock: str, made_by: str) -> list[Path]:
 
 @dataclass(frozen=True)
 class RotationReport:
-    """The rotation-speed note: its Markdown ``text``, the files written into ``out`` (the note and the
-    map, PNG and SVG; none without ``out``), and the ``ridge`` of the map: per rock and drilled frequency the
-    best scanned speed, the rate there and the model's best speed 60 f w / (pi D)."""
+    """The rotation-speed note (:func:`rotation_report`).
+
+    Parameters
+    ----------
+    text : str
+        The note in Markdown.
+    files : list of pathlib.Path
+        The files written into ``out`` (the note and the map, PNG and SVG; none without ``out``).
+    ridge : pandas.DataFrame
+        Per rock and drilled frequency the best scanned speed, the rate there and the model's best speed
+        60 f w / (pi D) (columns ``rock``, ``frequency_hz``, ``best_speed_rpm``, ``penetration_rate_m_per_s``,
+        ``model_speed_rpm``).
+    out : pathlib.Path or None
+        The folder written.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> note = rpdrill.rotation_report("runs/rotation")  # doctest: +SKIP
+    >>> print(note.text)  # doctest: +SKIP
+    """
 
     text: str
     files: list[Path]
@@ -230,10 +248,40 @@ class RotationReport:
 
 def rotation_report(runs: str | Path, out: str | Path | None = None, rock: str = "sandstone",
                     docs: str | Path | None = None, overwrite: bool = False) -> RotationReport:
-    """``rpdrill rotation-report`` as a library call: the note (module doc) from the two rotation studies'
-    results in ``runs``, written into ``out`` (new, empty or an earlier report's; ``overwrite``: any
-    folder) and copied into ``docs``; without ``out``, into a scratch folder removed after. InputError
-    before anything is written when a study's results or the rock are missing."""
+    """The rotation-speed note (docs/rotation.md) from the two rotation studies' results: ``rpdrill
+    rotation-report`` as a library call (module doc).
+
+    Parameters
+    ----------
+    runs : str or pathlib.Path
+        The folder holding ``rpm_frequency_map/`` and ``dth_example/``, as written by ``rpdrill study
+        studies/rotation/<name>.yaml --out RUNS/<name>``.
+    out : str or pathlib.Path, optional
+        Where the note and its map go (new, empty or an earlier report's); without, a scratch folder removed
+        after.
+    rock : str, default "sandstone"
+        The rock of the map.
+    docs : str or pathlib.Path, optional
+        Where the note and map are also copied (with ``out``).
+    overwrite : bool, default False
+        Write ``out`` whatever it holds.
+
+    Returns
+    -------
+    RotationReport
+        The note, the files written and the map's ridge.
+
+    Raises
+    ------
+    InputError
+        When a study's results or the rock are missing, before anything is written.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> note = rpdrill.rotation_report("runs/rotation", out="runs/rotation_note")  # doctest: +SKIP
+    >>> note.ridge.head()  # doctest: +SKIP
+    """
     import pandas as pd
 
     where = "rpdrill.rotation_report"

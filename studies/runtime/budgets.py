@@ -39,7 +39,26 @@ AXIS_VALUE_BYTES = 32
 
 
 class BudgetError(Exception):
-    """A run or a command beyond a budget; the message is complete (exit status 1)."""
+    """A run or a call beyond its :class:`Budget`, refused before it starts (exit status 1 on the command line).
+
+    The message is complete: the source, the key that causes the cost, its value, the estimate and the option
+    that allows it.
+
+    Parameters
+    ----------
+    *args
+        The message, as for any exception.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base").with_({"solver.end_time_s": 100.0})
+    >>> try:
+    ...     rpdrill.simulate(scene, budget=rpdrill.Budget(max_steps=1e5))
+    ... except rpdrill.BudgetError as error:
+    ...     print(error.__class__.__name__)
+    BudgetError
+    """
 
 
 def duration(seconds: float) -> str:
@@ -51,7 +70,29 @@ def duration(seconds: float) -> str:
 
 @dataclass(frozen=True)
 class Budget:
-    """The limits of one command (module doc); ``accept_long``: ``--yes`` was given."""
+    """The limits a call checks its runs against before they start (module doc; the command line's ``--max-steps``,
+    ``--max-memory-gb``, ``--yes``).
+
+    Parameters
+    ----------
+    max_steps : float, default 1e7
+        The steps one run may take.
+    max_memory_gb : float, default 2.0
+        The memory one run may hold, and a study's prepared points together, in GB.
+    accept_long : bool, default False
+        Allow more than 1 h of CPU for a call's runs together.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> scene = rpdrill.load_scene("paper_base").with_({"solver.end_time_s": 100.0, "solver.step_s": 1e-7})
+    >>> try:
+    ...     rpdrill.simulate(scene, budget=rpdrill.Budget(max_steps=1e8))
+    ... except rpdrill.BudgetError as error:
+    ...     print(error)
+    scene 'paper_base': solver.step_s: 1e-07: the run would take 1e+09 steps of 1e-07 s over solver.end_time_s 100
+    (about ... of CPU); at most 1e+08 steps per run (--max-steps)
+    """
 
     max_steps: float = DEFAULT_MAX_STEPS
     max_memory_gb: float = DEFAULT_MAX_MEMORY_GB

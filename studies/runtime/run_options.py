@@ -34,7 +34,42 @@ FIELDS = ("workers", "dask", "out", "overwrite", "budget", "quiet")
 
 @dataclass(frozen=True)
 class RunOptions:
-    """How an analysis runs its points and where it writes (module doc)."""
+    """How an analysis runs its points and where it writes; every analysis call takes it (module doc).
+
+    A call takes ``options=RunOptions(...)`` or the same names as keywords (``rpdrill.run_study(study,
+    workers=2)``), and refuses the ones it has no use for.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Processes (None: one per core; 1: in the caller's process).
+    dask : str, optional
+        A Dask scheduler's address, or "" for a LocalCluster, instead of processes.
+    out : str or pathlib.Path, optional
+        The folder written (None: a scratch folder removed afterwards).
+    overwrite : bool, default False
+        Write into a folder that holds other files, or start a search afresh there.
+    budget : Budget, default Budget()
+        What the runs are checked against before anything runs.
+    quiet : bool, default True
+        No progress bar.
+
+    Raises
+    ------
+    InputError
+        ``RunOptions: <option>: <problem>`` for a value an option does not allow.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> rpdrill.RunOptions(workers=2, out="runs/scan").workers
+    2
+    >>> try:
+    ...     rpdrill.RunOptions(workers=0)
+    ... except rpdrill.InputError as error:
+    ...     print(error)
+    RunOptions: workers: 0: must be a whole number of at least 1
+    """
 
     workers: int | None = None
     dask: str | None = None

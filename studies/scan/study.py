@@ -122,7 +122,30 @@ class StudyPoint:
 
 @dataclass(frozen=True)
 class Study:
-    """A validated study with its base scene and its expanded points."""
+    """A validated study: its base scene and its points, expanded from the scan axes (:func:`load_study`).
+
+    Parameters
+    ----------
+    source : pathlib.Path
+        The study file.
+    spec : StudySpec
+        The file's content, typed (the keys: docs/studies.md).
+    base : Scene
+        The base scene, ``base_overrides`` applied.
+    axes : dict of str to list
+        Each scan axis (a scene key path) and its values.
+    points : list of StudyPoint
+        Every point: its index, its axis values, its prepared simulation and its estimated CPU seconds.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> study = rpdrill.load_study("paper/frequency_scan")
+    >>> len(study.points), study.axes["impact.frequency_hz"][:3]
+    (23, [10.0, 15.0, 20.0])
+    >>> study.points[0].scene.impact.frequency_hz
+    10.0
+    """
 
     source: Path
     spec: StudySpec
@@ -209,10 +232,41 @@ def _check_plots(spec: StudySpec, axes: dict[str, list[Any]], source: str) -> No
 
 def load_study(path: str | Path, formulation: str | None = None, budget: Budget = DEFAULT_BUDGET,
                allow_code: Sequence[str] | str = ()) -> Study:
-    """Read, validate and expand a study file, every point with ``formulation`` when given (the base
-    scene's solver options of another formulation dropped) and checked against the ``budget`` before it
-    runs; ``allow_code``: the modules of one's own its scenes may run (models.definition.own_code), never
-    read from the file. InputError naming the file and key path, BudgetError naming the cost, otherwise."""
+    """Read, validate and expand a study file, or a shipped study by its name.
+
+    Every point is validated and prepared here, so a point that cannot run is refused now, naming the scan
+    axis that made it so; the study's runs are checked against ``budget`` before anything runs.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A study file (its keys: docs/studies.md), or a shipped study's name (``"paper/frequency_scan"``).
+    formulation : {"exudyn", "exact", "ode"}, optional
+        Every point with this formulation (the base scene's solver options of another formulation dropped).
+    budget : Budget, default Budget()
+        The steps and memory per run, and the CPU time of all runs, the study may take.
+    allow_code : sequence of str or str, default ()
+        The modules of one's own its scenes may run (models.definition.own_code); never read from the file.
+
+    Returns
+    -------
+    Study
+        The study with its base scene and points, ready for :func:`run_study`.
+
+    Raises
+    ------
+    InputError
+        Naming the file, the key path, the value and what is allowed.
+    BudgetError
+        Naming the cost and the option that allows it.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> study = rpdrill.load_study("paper/frequency_scan", formulation="exact")
+    >>> study.spec.name, len(study.points), study.base.solver.formulation
+    ('frequency_scan', 23, 'exact')
+    """
     check("rpdrill.load_study", "path", path, file_problem)
     check("rpdrill.load_study", "formulation", formulation, optional(choice_problem(FORMULATIONS, "formulation")))
     check("rpdrill.load_study", "budget", budget, instance_problem(Budget, "a rpdrill Budget"))

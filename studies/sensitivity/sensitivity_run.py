@@ -53,10 +53,38 @@ TAKES = ("workers", "dask", "out", "budget", "quiet")  # the run options it has 
 
 @dataclass(frozen=True)
 class SensitivityResult:
-    """A sensitivity study's outcome: its results ``table`` (one row per scanned variation: optimum and peak
-    of every metric), the one-at-a-time changes against the nominal scans, whether each variation keeps
-    the trends, the global indices (empty without a ``global`` analysis), the ``summary`` (the paper's
-    3.3 claim measured) and the figures written (none without ``out``)."""
+    """A sensitivity study's outcome (:func:`sensitivity`).
+
+    Parameters
+    ----------
+    study : SensitivityStudy
+        The study, loaded.
+    table : pandas.DataFrame
+        One row per scanned variation: the optimum and peak of every metric.
+    one_at_a_time : pandas.DataFrame
+        Each variation's change of the optima and peaks against the nominal scans.
+    trends : pandas.DataFrame
+        Whether each variation keeps the paper's trends.
+    global_indices : pandas.DataFrame
+        SALib's indices (empty without a ``global`` analysis).
+    summary : dict
+        The paper's 3.3 claim measured.
+    figures : list of pathlib.Path
+        The tornado figures written (none without ``out``).
+    out : pathlib.Path or None
+        The folder written.
+
+    Attributes
+    ----------
+    failed : pandas.DataFrame
+        The rows of the variations whose every run failed.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> found = rpdrill.sensitivity("paper/sensitivity")  # doctest: +SKIP
+    >>> found.one_at_a_time.head()  # doctest: +SKIP
+    """
 
     study: SensitivityStudy
     table: pd.DataFrame
@@ -75,10 +103,42 @@ class SensitivityResult:
 
 def sensitivity(study: SensitivityStudy | str | Path, options: RunOptions | None = None, *,
                 allow_code: Sequence[str] | str = (), **run: Any) -> SensitivityResult:
-    """Run a sensitivity study (or file) as ``options`` say (rpdrill.RunOptions, or its names as keywords:
-    ``workers``, ``dask``, ``out``, ``budget``, ``quiet``): into ``out`` (resumable: module doc) or a scratch
-    folder; ``allow_code``: the modules of one's own its scenes may run (models.definition.own_code).
-    InputError or BudgetError before anything runs."""
+    """How the frequency optima move with each scene parameter: the paper's section 3.3 (``rpdrill sensitivity``).
+
+    Every listed scene number changed by a step one at a time (and, with a ``global`` analysis, SALib's Morris
+    or Sobol indices), each variation's frequency scans against the unchanged scene's; resumable in ``out``
+    (module doc).
+
+    Parameters
+    ----------
+    study : SensitivityStudy, str or pathlib.Path
+        A sensitivity file, its loaded study, or a shipped one's name (``"paper/sensitivity"``).
+    options : RunOptions, optional
+        ``workers``, ``dask``, ``out``, ``budget``, ``quiet``; or these names as keywords. Without ``out``, a
+        scratch folder removed after, and nothing drawn.
+    allow_code : sequence of str or str, default ()
+        The modules of one's own its scenes may run (models.definition.own_code).
+    **run
+        :class:`RunOptions` names.
+
+    Returns
+    -------
+    SensitivityResult
+        The table, the one-at-a-time changes, the trends, the global indices, the summary.
+
+    Raises
+    ------
+    InputError
+        When the file or an option cannot be used, before anything runs.
+    BudgetError
+        When its runs exceed the budget, before anything runs.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> found = rpdrill.sensitivity("paper/sensitivity", out="runs/sensitivity")  # doctest: +SKIP
+    >>> found.summary  # doctest: +SKIP
+    """
     check(WHERE, "study", study,
           either(file_problem, instance_problem(SensitivityStudy, "a sensitivity file's path or its loaded study")))
     options = RunOptions.of(WHERE, options, run, TAKES)
