@@ -86,3 +86,13 @@ def test_simulate_draws_the_drill_and_with_animate_writes_what_exudyns_viewer_op
     assert {"drill.png", "drill.gif"} <= {p.name for p in exact.iterdir()}
     assert not (exact / "solution.txt").exists()  # only an Exudyn run writes Exudyn's solution file
     assert json.loads((exact / "summary.json").read_text())["formulation"] == "exact"
+
+
+def test_a_drawing_into_a_folder_that_is_not_there_is_refused_before_anything_is_drawn(tmp_path):
+    import rpdrill
+
+    scene = rpdrill.load_scene("paper_base")
+    with pytest.raises(rpdrill.InputError, match=r"rpdrill.draw: path: .*x.svg: no folder .*missing"):
+        rpdrill.draw(scene, tmp_path / "missing" / "x.svg")
+    with pytest.raises(rpdrill.InputError, match=r"rpdrill.write_animation: path: .*x.gif: no folder"):
+        rpdrill.write_animation(rpdrill.build_exudyn(scene), tmp_path / "missing" / "x.gif")

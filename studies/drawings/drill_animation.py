@@ -45,6 +45,7 @@ from ..inputs.arguments import (
     positive_problem,
 )
 from ..inputs.reading import InputError, load_scene
+from ..runtime.output_files import check_file_target
 from .drill_drawing import BODY_HEIGHT, draw_string, drawn_layout, figure_title
 from .system_drawing import SystemPicture
 
@@ -125,9 +126,9 @@ def write_animation(result: SimulationResult | Result | ExudynModel, path: str |
     check(where, "path", path, file_problem)
     check(where, "blows", blows, count_problem)
     check(where, "magnification", magnification, optional(positive_problem))
+    path = check_file_target(f"{where}: path", path)  # its folder must exist: refused now, not at the end
     if not isinstance(result, SimulationResult):
         return model_animation(result, path, blows, magnification)
-    path = Path(path)
     writer = movie_writer(path)
     scene, drawing = result.scene, drawn_layout(result.scene)
     period = scene.impact.period_s

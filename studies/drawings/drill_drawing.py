@@ -31,6 +31,7 @@ from ...models.definition.scene import Scene
 from ...models.drill.shapes import DEFAULT_DIAMETER_M, Layout, axial_order, layout
 from ..figures.figure_style import OKABE_ITO, figure
 from ..inputs.arguments import built_model_problem, check, either, file_problem, instance_problem
+from ..runtime.output_files import check_file_target
 from .system_drawing import draw_model
 
 if TYPE_CHECKING:
@@ -355,7 +356,7 @@ def draw(scene: Scene | ExudynModel, path: str | Path) -> Path:
     check("rpdrill.draw", "scene", scene, either(built_model_problem, instance_problem(
         Scene, "a rpdrill.Scene (rpdrill.load_scene) or a built model (rpdrill.build_exudyn)")))
     check("rpdrill.draw", "path", path, file_problem)
-    path = Path(path)
+    path = check_file_target("rpdrill.draw: path", path)  # its folder must exist: refused now, not at the end
     if not isinstance(scene, Scene) or scene.extensions:
         from ...models.solvers.exudyn_model import build_exudyn  # Exudyn only for a model
 
