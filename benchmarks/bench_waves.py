@@ -20,6 +20,8 @@ the scenes at these segments per rod in the exact formulation (the convergence o
 the waves).
 ``--lumped-lundberg``: Lundberg's check on lumped rods of 64 to 512 segments (Exudyn, reference preset),
 the dispersion the wave element removes.
+``--cost [--repeat N]``: the CPU per blow of studies/scenes/top_hammer_waves.yaml as shipped (20 blows) in each
+formulation, the median of N runs (default 3) after a warm-up, the process's CPU.
 """
 
 from __future__ import annotations
@@ -199,11 +201,26 @@ def lumped_lundberg() -> None:
             print(f"| {segments} | {alpha:g} | {efficiency - closed:+.4f} | {cpu:.1f} |", flush=True)
 
 
+def cost(repeat: int = 3) -> None:
+    print("| scene | formulation | CPU s per blow (median of runs) | runs |")
+    print("|---|---|---|---|")
+    data = read_yaml("studies/scenes/top_hammer_waves.yaml")
+    blows = round(data["solver"]["end_time_s"] * data["impact"]["frequency_hz"])
+    for formulation in ("exact", "exudyn"):
+        scene = Scene.model_validate({**data, "solver": {**data["solver"], "formulation": formulation}})
+        timed(scene.with_({"solver.end_time_s": 0.02, "metrics.transient_blows": 0, "metrics.block_blows": 1}))
+        times = sorted(timed(scene)[1] for _ in range(repeat))
+        print(f"| top_hammer_waves | {formulation} | {times[len(times) // 2] / blows:.4f} | "
+              f"{', '.join(f'{t:.2f}' for t in times)} |", flush=True)
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--checks", action="store_true")
     parser.add_argument("--strings", action="store_true")
     parser.add_argument("--lumped-lundberg", action="store_true")
+    parser.add_argument("--cost", action="store_true", help="CPU per blow of the shipped top-hammer wave scene")
+    parser.add_argument("--repeat", type=int, default=3, help="--cost: runs per formulation (the median)")
     parser.add_argument("--fine", action="store_true", help="--strings: lumped rods refined (--segments), exact")
     parser.add_argument("--segments", type=lambda text: tuple(int(n) for n in text.split(",")), default=(16, 32, 64),
                         help="--fine: segments per rod (default 16,32,64)")
@@ -211,8 +228,10 @@ def main(argv: list[str] | None = None) -> None:
                         default=("top_hammer_piston", "four_rod_string"), help="--fine: these scenes only")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")  # Exudyn's printed notes
-    if args.checks or not (args.strings or args.lumped_lundberg):
+    if args.checks or not (args.strings or args.lumped_lundberg or args.cost):
         checks()
+    if args.cost:
+        cost(args.repeat)
     if args.strings:
         strings(args.fine, args.segments, args.scenes)
     if args.lumped_lundberg:

@@ -86,10 +86,10 @@ class Wave:
 
     def function(self, start: float, end: float):
         """A vectorised function of the wave on [start, end] (one stretch between hard breaks)."""
-        first = max(bisect.bisect_right(self.starts, start) - 1, 0)
-        last = bisect.bisect_left(self.starts, end)
+        first = max(bisect.bisect_right(self.starts, start + MERGE_S) - 1, 0)  # a break at the start: after it
+        last = bisect.bisect_left(self.starts, end - MERGE_S)
         pieces = self.pieces[first:last] if self.pieces else []
-        if not pieces or pieces[0].start > start + 1e-18:
+        if not pieces or pieces[0].start > start + MERGE_S:
             initial = self.initial
             lead = [Piece(-math.inf, pieces[0].start if pieces else math.inf, np.array([initial]), False)]
             pieces = lead + pieces

@@ -9,6 +9,7 @@ import numpy as np
 from ..definition.links import CLOSED, OPEN
 from .kernels import CATCH, PISTON_CLOSED, PISTON_NONE, PISTON_OPEN, SWITCH, run_steps
 from .levels import key_levels
+from .outgoing import Segment
 from .system import Key
 
 
@@ -51,7 +52,8 @@ def run_fast(stepper, stop: int) -> tuple[int, int]:
     status, reached = run_steps(
         stepper.w, stepper.step_index, stop, stepper.step_s, stepper.layout.inputs, propagator, grams, rows, slopes,
         stepper.port_nodes, velocity, lines.port_delays, stepper.port_signs, stepper.port_impedances,
-        stepper.port_down, own, lines.left, lines.right, lines.square, lines.mean, lines.square_sum, lines.mean_sum,
+        stepper.port_down, own, lines.left, lines.right, lines.start, lines.broken, lines.square, lines.mean,
+        lines.square_sum, lines.mean_sum,
         lines.ring, stepper.works, rock, stats.compression_n[-1], stats.tension_n[-1], stats.energy_j[-1], integral,
         forces, loads, mode, pistons, impact, momentum_tolerance, force_tolerance, impedance)
     stats.rock_work_j[-1] += rock[0]
@@ -59,7 +61,10 @@ def run_fast(stepper, stop: int) -> tuple[int, int]:
         stepper.body_loads = loads
     stepper.step_index = reached
     if reached > 0 and len(stepper.ports):  # the last step's arriving waves (the Exudyn bodies' ports close with them)
-        stepper.last_inputs = (lines.incoming(reached - 1)[0], stepper.w[stepper.layout.inputs::2].copy())
+        a0, a1 = lines.incoming(reached - 1)[0], stepper.w[stepper.layout.inputs::2].copy()
+        stepper.last_inputs = (a0, a1)
+        nothing = np.zeros(len(stepper.ports))
+        stepper.last_segments = [Segment(0.0, 1.0, nothing, nothing, nothing, nothing, a0, a1, nothing, nothing, False)]
     if status == CATCH:
         stepper.catch_wave_piston(reached)
     return status, reached

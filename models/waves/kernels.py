@@ -2,12 +2,14 @@
 no element switches, on plain float arrays (numba, cached on disk).
 
 A step is what :meth:`models.waves.stepping.Stepper.advance` does without events: the arriving waves
-set as (a, b) of every port, w <- expm(A h) w, the works w^T G w, the outgoing waves stored (end value
-and mean-keeping start) with the running sums of the waves in flight, the blow's section figures of the
-ports the element closes itself, and, for kinematic bodies, the impulse and end value of their loads.
-The kernel returns before committing a step in which an exit function crosses (or crosses and returns:
-the slopes), and after a step whose end a wave piston's catch condition holds; the stepper handles
-those in Python. Status: STEPS_DONE (reached ``stop``), SWITCH, CATCH.
+set as (a, b) of every port, w <- expm(A h) w, the works w^T G w, the outgoing waves stored (end value,
+mean-keeping start and exact start value) with the running sums of the waves in flight, the blow's section
+figures of the ports the element closes itself (from the exact values at the step's ends), and, for
+kinematic bodies, the impulse and end value of their loads. The kernel returns before committing a step
+into which a wave arrives with a break (models.waves.history), in which an exit function is on its
+crossed side at the start or the end or crosses and returns (the slopes), and after a step whose end a
+wave piston's catch condition holds; the stepper handles those in Python. Status: STEPS_DONE (reached
+``stop``), SWITCH, CATCH.
 """
 
 from __future__ import annotations
@@ -21,16 +23,20 @@ PISTON_NONE, PISTON_OPEN, PISTON_CLOSED = 0, 1, 2
 
 @njit(cache=True)
 def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_nodes, port_velocity, port_delays,
-              port_signs, port_impedances, port_down, own, left, right, square, mean, square_sum, mean_sum, ring,
-              works, rock_work, compression, tension, energy, integral, body_forces, loads,
+              port_signs, port_impedances, port_down, own, left, right, start, broken, square, mean, square_sum,
+              mean_sum, ring, works, rock_work, compression, tension, energy, integral, body_forces, loads,
               piston_mode, piston_ports, impact_row, momentum_tolerance, force_tolerance, rod_impedance):
     """Advance ``w`` from ``step`` up to ``stop`` (module doc); returns (status, the step reached)."""
     m = w.shape[0]
     ports = port_nodes.shape[0]
     a0 = np.empty(ports)
     x0 = np.empty(ports)
+    s0 = np.empty(ports)
     w1 = np.empty(m)
     while step < stop:
+        for p in range(ports):
+            if broken[p ^ 1, (step - port_delays[p]) % ring]:
+                return SWITCH, step
         for p in range(ports):
             j = (step - port_delays[p]) % ring
             source = p ^ 1
@@ -39,6 +45,11 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
             w[inputs + 2 * p] = a
             w[inputs + 2 * p + 1] = (right[source, j] - a) / h
             x0[p] = w[port_nodes[p]]
+        for p in range(ports):  # the exact outgoing wave at the step's start
+            velocity = 0.0
+            for j in range(m):
+                velocity += port_velocity[p, j] * w[j]
+            s0[p] = velocity - a0[p]
         for i in range(m):
             total = 0.0
             for j in range(m):
@@ -47,14 +58,14 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
         for e in range(exits.shape[0]):
             g0 = 0.0
             g1 = 0.0
-            s0 = 0.0
-            s1 = 0.0
+            r0 = 0.0
+            r1 = 0.0
             for j in range(m):
                 g0 += exits[e, j] * w[j]
                 g1 += exits[e, j] * w1[j]
-                s0 += slopes[e, j] * w[j]
-                s1 += slopes[e, j] * w1[j]
-            if g1 > 0.0 or (g0 < 0.0 and s0 > 0.0 and s1 < 0.0):
+                r0 += slopes[e, j] * w[j]
+                r1 += slopes[e, j] * w1[j]
+            if g0 > 0.0 or g1 > 0.0 or (g0 < 0.0 and r0 > 0.0 and r1 < 0.0):
                 return SWITCH, step
         for q in range(3):
             total = 0.0
@@ -95,10 +106,12 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
             mean_sum[p] += mn - mean[p, old]
             left[p, k] = out_left
             right[p, k] = out_right
+            start[p, k] = s0[p]
+            broken[p, k] = 0
             square[p, k] = sq
             mean[p, k] = mn
             if own[p]:
-                start_c = port_signs[p] * (out_left - a0[p])
+                start_c = port_signs[p] * (s0[p] - a0[p])
                 end_c = port_signs[p] * (out_right - a1)
                 compression[p] = max(compression[p], max(start_c, end_c))
                 tension[p] = max(tension[p], -min(start_c, end_c))

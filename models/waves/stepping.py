@@ -34,9 +34,11 @@ from .fast_path import SWITCH, run_fast
 from .history import WaveLines
 from .kernels import CATCH
 from .levels import key_levels
+from .outgoing import Segment, StepWaves, outgoing, readings
 from .system import Key, Modes, WaveSystem
 
 MAX_SWITCHES_PER_STEP = 64
+SWITCH_AT_START = 1e-9  # a switch this soon (a fraction of the step) after a jump is at the jump
 
 
 @dataclass
@@ -105,6 +107,9 @@ class Stepper:
             self.jumps.blow_energy_j = 0.5 * rod.impedance_n_s_per_m * self.lines.delays[self.piston_rod] * step_s \
                 * self.setup.strike_velocity_m_per_s**2
         self.ports = self.system.ports
+        impact = simulation.impact  # the wave scale: the strike velocity, or the pulse over the smallest impedance
+        self.wave_scale_m_per_s = self.setup.strike_velocity_m_per_s if self.setup is not None else \
+            impact.amplitude_n / min((rod.impedance_n_s_per_m for rod in chain.waves), default=1.0)
         self.port_nodes = np.array([port.node for port in self.ports], dtype=int)
         self.port_impedances = np.array([port.impedance_n_s_per_m for port in self.ports])
         self.port_signs = np.array([SIGMA[port.end] for port in self.ports]) * self.port_impedances
@@ -124,10 +129,10 @@ class Stepper:
         self.step_index = 0
         self.kinematic = tuple(sorted(kinematic))
         self.record_steps = record_steps  # False: the Exudyn model records at its step starts
-        self.record_inputs = False  # True: a sample after the arriving waves are set at every step start
         self.caught_at_end = False  # the last step ended with a wave piston's catch
         self._set_inputs(0)  # the waves arriving at the start (a preload's), for the first sample
-        self._step_flux = np.zeros(2)  # energy into the string's rods and a wave piston since the step's start
+        # energy into the string's rods, into a wave piston and through the Exudyn bodies' ports since the step's start
+        self._step_flux = np.zeros(3)
         self.body_loads = np.zeros((2, len(self.kinematic)))  # (start, end) of the force on each over the step
 
     # -- state ----------------------------------------------------------------------------------------
@@ -164,9 +169,6 @@ class Stepper:
         """Step ``step_index`` (module doc): in the compiled kernel when nothing happens in it (no blow
         start, pulse phase change or switch), else here."""
         if self._quiet(self.step_index):
-            if self.record_inputs:
-                self._set_inputs(self.step_index)
-                self._record(self.step_index * self.step_s, self.w, self.key(), after=True)
             status, _ = run_fast(self, self.step_index + 1)
             if status != SWITCH:
                 self._after(status == CATCH)
@@ -174,7 +176,8 @@ class Stepper:
         self._step()
 
     def _quiet(self, k: int) -> bool:
-        """Whether step k has no blow start and no pulse phase change (the kernel's steps)."""
+        """Whether step k has no blow start and no pulse phase change (the kernel's steps; it returns itself
+        before a step into which a wave arrives with a break)."""
         if k % self.period_steps == 0:
             return False
         t0, t1 = k * self.step_s, (k + 1) * self.step_s
@@ -189,58 +192,89 @@ class Stepper:
             self._record(k * self.step_s, self.w, self.key(), after=caught)
 
     def _step(self) -> None:
-        """Step ``step_index`` here (module doc)."""
+        """Step ``step_index`` here (module doc): pieces between the switches, the pulse's phase changes and the
+        breaks of the arriving waves (models.waves.history), each integrated exactly; the step's outgoing waves
+        from its segments (models.waves.outgoing)."""
         k, h, layout = self.step_index, self.step_s, self.layout
         t0 = k * h
         w = self.w
+        strike = k % self.period_steps == 0 and self.setup is not None
         if k % self.period_steps == 0:
             self._start_blow(k, t0)
-            if self.setup is not None:  # the strike: a jump, recorded on both sides
-                self._set_inputs(k)
-                self._record(t0, w, self.key(), after=True)
         self._set_inputs(k)
-        if self.record_inputs:  # the arriving waves jump at t0: a sample on this side too (an energy account)
-            self._record(t0, w, self.key(), after=True)
-        x0, a0 = w[:layout.n].copy(), w[layout.inputs::2].copy()
+        arrivals = self.lines.arriving_breaks(k)
         t, t1, switches = t0, t0 + h, 0
-        key = self.key()
+        jumped = strike  # a jump just now whose other side is still to be sampled (the strike's, a front's)
         self._step_impulse = np.zeros(len(self.kinematic))
+        segments: list[Segment] = []
+        begin = (t0, w.copy(), self.key())
         while t < t1 - 1e-12 * h:
             later = np.flatnonzero(self.phase_changes > t + 1e-12 * h)
-            boundary = min(t1, self.phase_changes[later[0]]) if len(later) else t1
+            phase = self.phase_changes[later[0]] if len(later) else np.inf
+            arrival = t0 + arrivals[0][0] * h if arrivals else np.inf
+            boundary = min(t1, phase, arrival)
             key = self.key()
             span = boundary - t
             w1 = key_levels(self, key).propagate(w, span)
             hit = self._first_switch(key, w, w1, span)
+            at_jump = hit is not None and hit[0] <= SWITCH_AT_START * h and (jumped or t == t0)
+            if jumped and not at_jump:  # the jump's other side (a switch at the jump: the state after it)
+                self._record(t, w, key, after=True)
             if hit is None:
                 w, t = self._piece(key, w, span), boundary
-                if len(later) and boundary >= self.phase_changes[later[0]] - 1e-12 * h:
-                    if self.record_inputs:  # the pulse may jump here: both sides (the trapezoidal account)
-                        self._record(t, w, key)
+                jumped = False
+                if boundary >= t1 - 1e-12 * h:  # the step's end (a phase change there: the next step's start)
+                    if phase <= boundary + 1e-12 * h:
+                        self.phase_index = int(later[0])
+                        self._start_phase(w, t)
+                    break
+                segments.append(self._segment(begin, t, w, key))
+                self._record(t, w, key)  # a phase change or a front: both sides of it
+                if phase <= boundary + 1e-12 * h:
                     self.phase_index = int(later[0])
                     self._start_phase(w, t)
-                    if self.record_inputs:
-                        self._record(t, w, self.key())
+                while arrivals and t0 + arrivals[0][0] * h <= boundary + 1e-12 * h:
+                    _, port, value, slope = arrivals.pop(0)
+                    w[self.ports[port].input], w[self.ports[port].input + 1] = value, slope / h
+                begin, jumped = (t, w.copy(), self.key()), True
                 continue
             s, exit_ = hit
             w_s = self._piece(key, w, s)
             t += s
-            self._record(t, w_s, key)
+            if not at_jump:  # a switch at a jump is at the jump: no sample between
+                self._record(t, w_s, key)
+            segments.append(self._segment(begin, t, w_s, key))
             w = self._switch(t, w_s, key, exit_)
             self._record(t, w, self.key(), after=True)
+            begin, jumped = (t, w.copy(), self.key()), False
             switches += 1
             if switches > MAX_SWITCHES_PER_STEP:
                 raise SimulationFailed(f"scene '{self.simulation.name}': more than {MAX_SWITCHES_PER_STEP} switches "
                                        f"within one wave step at t = {t:.6g} s (a chattering contact)")
+        if t1 - begin[0] > 1e-12 * h or not segments:
+            segments.append(self._segment(begin, t1, w, key))
         self.w = w
         if not np.all(np.isfinite(w)) or np.max(np.abs(w[:layout.n])) > POSITION_LIMIT_M:
             raise SimulationFailed(f"scene '{self.simulation.name}': the wave solution diverged at t = {t1:.6g} s")
-        caught = self._close_step(k, x0, a0, key)
+        caught = self._close_step(k, segments, key)
         if self.kinematic:  # the loads on the Exudyn bodies over the step: its end value and its mean
             end = key.body_forces @ w
             self.body_loads = np.array([2.0 * self._step_impulse / h - end, end])
         self.step_index += 1
         self._after(caught)
+
+    def _segment(self, begin: tuple[float, np.ndarray, Key], t: float, w: np.ndarray, key: Key) -> Segment:
+        """The segment from ``begin`` (time, state, key) to the state ``w`` at ``t`` (models.waves.outgoing)."""
+        t_begin, w_begin, key_begin = begin
+        t0, h, nodes, inputs = self.step_index * self.step_s, self.step_s, self.port_nodes, self.layout.inputs
+        if "accelerations" not in key.cache:  # the ports' nodes' accelerations: d/dt (V w) = V A w
+            key.cache["accelerations"] = key.velocity[nodes] @ key.matrix
+        if "accelerations" not in key_begin.cache:
+            key_begin.cache["accelerations"] = key_begin.velocity[nodes] @ key_begin.matrix
+        return Segment((t_begin - t0) / h, (t - t0) / h, w_begin[nodes], w[nodes], key_begin.velocity[nodes] @ w_begin,
+                       key.velocity[nodes] @ w, w_begin[inputs::2].copy(), w[inputs::2].copy(),
+                       key_begin.cache["accelerations"] @ w_begin - w_begin[inputs + 1::2],
+                       key.cache["accelerations"] @ w - w[inputs + 1::2])
 
     def _start_phase(self, w: np.ndarray, t: float) -> None:
         """The pulse generator's states (u1, u2) at the start of the phase piece beginning at ``t``."""
@@ -250,19 +284,19 @@ class Stepper:
         w[one + 1:one + 3] = generator_states(self.simulation.impact, np.array([max(local, 0.0)]))[0]
 
     def _set_inputs(self, k: int) -> None:
-        """The arriving waves of step k as (a, b) of every port."""
+        """The arriving waves of step k as (a, b) of every port (the first piece of a wave with breaks)."""
         if not self.ports:
             return
-        left, right = self.lines.incoming(k)
+        value, slope = self.lines.first_pieces(k)
         inputs = self.layout.inputs
-        self.w[inputs::2], self.w[inputs + 1::2] = left, (right - left) / self.step_s
+        self.w[inputs::2], self.w[inputs + 1::2] = value, slope / self.step_s
 
     def run(self) -> None:
         """Every step, runs of quiet steps in the kernel up to the next blow start, phase change or sample."""
         self._record(0.0, self.w, self.key())
         while self.step_index < self.steps:
             k = self.step_index
-            if not self._quiet(k) or self.record_inputs:
+            if not self._quiet(k):
                 self.advance()
                 continue
             stop = min(self.steps, (k // self.period_steps + 1) * self.period_steps,
@@ -280,37 +314,43 @@ class Stepper:
             return self.steps
         return max(k + 1, int(np.floor(later[0] / self.step_s - 1e-9)))
 
-    def _close_step(self, k: int, x0: np.ndarray, a0: np.ndarray, key: Key) -> bool:
-        """The outgoing waves of step k (at its end before any change there: ``key`` that of its last
-        piece), the blow's section statistics, a wave piston's catch (True then)."""
+    def _close_step(self, k: int, segments: list[Segment], key: Key) -> bool:
+        """The outgoing waves of step k from its segments (``key`` that of its last piece), the blow's section
+        figures, a wave piston's catch (True then)."""
         self._step_flux[:] = 0.0  # in the waves in flight from now on
         if self.ports:
-            w, nodes = self.w, self.port_nodes
-            a1 = w[self.layout.inputs::2].copy()
-            self.last_inputs = (a0, a1)
-            self.close_ports(k, self.own_ports, w[nodes] - x0[nodes], key.velocity[nodes] @ w, a0, a1,
-                             provisional=True)
+            self.last_segments = segments
+            self.last_inputs = (segments[0].a0, segments[-1].a1)
+            self.close_ports(k, self.own_ports, segments, provisional=True)
         if self.piston_rod is not None and self._wave_piston_done(key):
             self.catch_wave_piston(k + 1)
             return True
         return False
 
-    def close_ports(self, k: int, ports: np.ndarray, moved_m: np.ndarray, velocity: np.ndarray, a0: np.ndarray,
-                    a1: np.ndarray, again: bool = False, provisional: bool = False) -> None:
-        """Store the outgoing waves over step k from the ports' nodes' displacement over the step and velocity
-        at its end (arrays over every port) and add the step to the blow's section figures of ``ports``;
-        ``provisional``: store every port (the others are stored ``again`` later, from the Exudyn bodies)."""
-        h = self.step_s
-        right = velocity - a1
-        left = 2.0 * (moved_m / h - 0.5 * (a0 + a1)) - right
-        self.lines.store(k, left, right, None if provisional else ports, again)
-        left, right, a0, a1 = left[ports], right[ports], a0[ports], a1[ports]
-        stats, signs = self.statistics, self.port_signs[ports]
-        start, end = signs * (left - a0), signs * (right - a1)  # compression: sigma Z (outgoing - incoming)
-        stats.compression_n[-1][ports] = np.maximum(stats.compression_n[-1][ports], np.maximum(start, end))
-        stats.tension_n[-1][ports] = np.maximum(stats.tension_n[-1][ports], -np.minimum(start, end))
-        flux = self.port_impedances[ports] * h * ((left**2 + left * right + right**2) - (a0**2 + a0 * a1 + a1**2)) / 3
-        stats.energy_j[-1][ports] += self.port_down[ports] * flux
+    def close_ports(self, k: int, ports: np.ndarray, segments: list[Segment], again: bool = False,
+                    provisional: bool = False) -> None:
+        """Store the outgoing waves over step k from its segments (models.waves.outgoing) and add the step to
+        the blow's section figures of ``ports``; ``provisional``: store every port (the others are stored
+        ``again`` later, from the Exudyn bodies)."""
+        stored = np.arange(len(self.ports)) if provisional else ports
+        waves = outgoing(segments, self.step_s, stored, self.wave_scale_m_per_s)
+        size = len(self.ports)
+        left, right, start = np.zeros(size), np.zeros(size), np.zeros(size)
+        left[stored], right[stored], start[stored] = waves.left, waves.right, waves.start
+        self.lines.store(k, left, right, start, stored, again)
+        for j, rows in waves.pieces.items():
+            self.lines.store_pieces(k, int(stored[j]), rows, again=True)
+        if not provisional:
+            read = readings(segments, waves, self.step_s, ports, self.port_signs, self.port_impedances, self.port_down)
+        else:  # every port stored (``stored`` is every index): the readings of ``ports``
+            position = {int(port): i for i, port in enumerate(ports)}
+            mine = StepWaves(waves.left[ports], waves.right[ports], waves.start[ports],
+                             {position[j]: rows for j, rows in waves.pieces.items() if j in position})
+            read = readings(segments, mine, self.step_s, ports, self.port_signs, self.port_impedances, self.port_down)
+        stats = self.statistics
+        stats.compression_n[-1][ports] = np.maximum(stats.compression_n[-1][ports], read.compression_n)
+        stats.tension_n[-1][ports] = np.maximum(stats.tension_n[-1][ports], read.tension_n)
+        stats.energy_j[-1][ports] += read.energy_j
 
     def _wave_piston_done(self, key: Key) -> bool:
         """A wave piston is caught when its contact is open and its momentum not forward, or when it rests
@@ -437,7 +477,7 @@ class Stepper:
         samples.velocity.append(values[:n])
         samples.forces.append(values[n:n + forces])
         samples.compression.append(values[n + forces:])
-        samples.works.append(self.works.copy())
+        samples.works.append(self.works + np.array([0.0, self._step_flux[2]]))  # the bodies' ports: provisional
         energies = self.lines.energies_j()
         piston = 0.0 if self.piston_rod is None else energies[self.piston_rod]
         samples.piston_j.append(piston + self._step_flux[1])
