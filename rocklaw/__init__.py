@@ -6,8 +6,10 @@
 from .base import RockLaw, State, force_and_state
 from .bilinear import BilinearRock
 from .catalog import TABLE_1, RockProperties
+from .free import NoRock
 from .jenkins import JenkinsRock
 
-LAWS: dict[str, type[RockLaw]] = {JenkinsRock.name: JenkinsRock, BilinearRock.name: BilinearRock}
+LAWS: dict[str, type[RockLaw]] = {JenkinsRock.name: JenkinsRock, BilinearRock.name: BilinearRock, NoRock.name: NoRock}
 
-__all__ = ["LAWS", "TABLE_1", "BilinearRock", "JenkinsRock", "RockLaw", "RockProperties", "State", "force_and_state"]
+__all__ = ["LAWS", "TABLE_1", "BilinearRock", "JenkinsRock", "NoRock", "RockLaw", "RockProperties", "State",
+           "force_and_state"]

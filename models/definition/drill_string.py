@@ -167,12 +167,19 @@ class Connector(Strict):
 
 
 class DrillString(Strict):
-    """The axial chain: bodies and connectors by name, in order from the hammer to the rock."""
+    """The axial chain: bodies and connectors by name, in order from the hammer to the rock. Without a
+    ``rock_body`` the string ends free below its last body (the scene's rock is then ``law: none``)."""
 
     bodies: Annotated[dict[Name, Body], Field(min_length=1)]
     connectors: dict[Name, Connector] = Field(default_factory=dict)
     impact_body: Name = Field(description="the body the piston strikes")
-    rock_body: Name = Field(description="the body that touches the rock (the bit)")
+    rock_body: Name | None = Field(None, description="the body that touches the rock (the bit); none: the string "
+                                   "ends free")
+
+    @property
+    def foot(self) -> str:
+        """The body at the string's lower end: the rock body, or the last body of a string that ends free."""
+        return self.rock_body if self.rock_body is not None else list(self.bodies)[-1]
 
     @model_validator(mode="after")
     def _consistent(self) -> DrillString:
@@ -182,7 +189,7 @@ class DrillString(Strict):
                 raise _key_error("DrillString", ("bodies", reserved), reserved, "a reserved word, not a body name "
                                  "('{ground}' and '{every}' name the ground and every body)", ground=GROUND, every=EVERY_BODY)
         for role in ("impact_body", "rock_body"):
-            if getattr(self, role) not in names:
+            if getattr(self, role) not in names and (role == "impact_body" or self.rock_body is not None):
                 raise ValueError(f"{role} {getattr(self, role)!r} is not a body; bodies: {', '.join(names)}")
         for name, connector in self.connectors.items():
             taken = [column for column in (f"{name}{suffix}" for suffix in LINK_SERIES) if column in SERIES]
@@ -230,16 +237,16 @@ class DrillString(Strict):
             joined[ends[1]].append((name, ends[0]))
         for part in _parts(joined):
             bodies = [b for b in self.bodies if b in part]
-            if self.rock_body in part or not bodies:
+            if self.foot in part or not bodies:
                 continue
             if len(bodies) == 1 and not joined[bodies[0]]:
                 problems.append(_problem(("bodies", bodies[0]), bodies[0], "no connector joins this body to the drill "
-                                         "string; every body is joined to rock_body '{rock}'", rock=self.rock_body))
+                                         "string; every body is joined to rock_body '{rock}'", rock=self.foot))
             else:
                 to = " and ".join(["each other"] * (len(bodies) > 1) + [GROUND] * (GROUND in part))
                 problems.append(_problem(("bodies", bodies[0]), bodies, "a separate part: joined to {to} but not to "
                                          "rock_body '{rock}'; every body is joined to the rock body through connectors",
-                                         to=to, rock=self.rock_body))
+                                         to=to, rock=self.foot))
         if problems:
             raise ValidationError.from_exception_data("DrillString", problems)
 

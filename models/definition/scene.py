@@ -263,6 +263,23 @@ class Scene(Strict):
         data = self.model_dump(by_alias=True, exclude_none=True)
         return parse(Scene, {**data, "solver": {**solver, **options}}, "Scene.with_solver")
 
+    @model_validator(mode="before")
+    @classmethod
+    def _free_string_without_rock(cls, data: Any) -> Any:
+        """A string without a rock body ends free: its rock is ``law: none`` when the scene gives none."""
+        if isinstance(data, Mapping) and "rock" not in data and isinstance(data.get("drill_string"), Mapping) \
+                and data["drill_string"].get("rock_body") is None:
+            return {**data, "rock": {"law": "none"}}
+        return data
+
+    @model_validator(mode="after")
+    def _rock_on_a_rock_body(self) -> Scene:
+        if self.drill_string.rock_body is None and self.rock.law != "none":
+            raise _key_error("Scene", ("drill_string", "rock_body"), None, "missing: rock law '{law}' acts on the "
+                             "rock body; leave out the rock section (or give rock: {{law: none}}) for a string that "
+                             "ends free", law=self.rock.law)
+        return self
+
     @model_validator(mode="after")
     def _feed_body_exists(self) -> Scene:
         bodies = self.drill_string.bodies
@@ -312,7 +329,7 @@ class Scene(Strict):
     @model_validator(mode="after")
     def _end_time_and_step_fit_the_blows(self) -> Scene:
         period = self.impact.period_s
-        if self.solver.end_time_s < period:
+        if self.solver.end_time_s < period * (1 - 1e-12):  # a period of the run's end time, to its rounding
             raise ValueError(
                 f"solver.end_time_s {self.solver.end_time_s} is shorter than one impact period ({period:.6g} s)"
             )

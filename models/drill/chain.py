@@ -197,7 +197,7 @@ def axial_chain(scene: Scene, joint_damping: bool = True) -> AxialChain:
     for name, connector in string.connectors.items():
         links.append(_connector_link(scene, name, connector, groups, joint_damping))
     return AxialChain(tuple(bodies), tuple(links), impact_body=groups[string.impact_body][0],
-                      bit_body=groups[string.rock_body][1], groups=groups, waves=tuple(waves))
+                      bit_body=groups[string.foot][1], groups=groups, waves=tuple(waves))
 
 
 def _connector_link(scene: Scene, name: str, connector: Connector, groups: dict[str, tuple[int, int]],
