@@ -93,6 +93,12 @@ def test_the_shipped_wave_scene_runs_ok_on_exudyn_without_warnings(tmp_path, cap
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["status"] == "ok"
     assert "warning" not in capsys.readouterr().err
+    # its rigid couplings per blow: what came, what passed, what was lost (nothing: a rigid joint stores none)
+    couplings = json.loads((tmp_path / "out" / "wave_readings.json").read_text())["couplings"]
+    assert set(couplings) == {"shank_coupling", "coupling1", "coupling2", "coupling3"}
+    for coupling in couplings.values():
+        assert len(coupling["energy_out_j"]) == 2 and coupling["energy_out_j"][1] > 100.0
+        assert np.allclose(coupling["lost_j"], 0.0, atol=1e-9 * coupling["energy_in_j"][1])
 
 
 def test_the_period_check_tolerates_rounding():

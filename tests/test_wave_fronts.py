@@ -270,3 +270,152 @@ def test_a_stiff_spring_between_a_face_and_an_exudyn_body_keeps_the_energy_balan
     blow = 0.5 * PISTON_MASS * PISTON_SPEED**2
     assert np.allclose(exudyn.raw.waves.blow_rock_work_j, exact.raw.waves.blow_rock_work_j, atol=1e-3 * blow, rtol=0)
     assert np.allclose(exudyn.piston.rebounds[:, 1], exact.piston.rebounds[:, 1], atol=1e-3 * blow, rtol=0)
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_the_time_series_shows_every_front_and_every_peak(formulation):
+    """``Result.timeseries`` (``timeseries.csv``) keeps, beside its uniform grid, the samples on both sides of every
+    front and at every blow's peaks: its largest compression and tension at each rod end over the window equal the
+    metrics (before: -12.5 % and -29 % on a rod with an 8 kg bit, where a front is followed by a fast decay)."""
+    data = rigid_piston_scene(formulation, 356, bit_kg=8.0)
+    data["solver"] = {"formulation": formulation, "end_time_s": data["solver"]["end_time_s"],
+                      "output_interval_s": 2e-5}  # the preset's step, a coarse grid of samples
+    result = simulate(data)
+    table, metrics = result.timeseries, result.metrics
+    inside = (table.time_s >= metrics["window_start_s"] - 1e-12) & (table.time_s <= metrics["window_end_s"] + 1e-12)
+    stresses = table[["rod_top_stress_pa", "rod_bottom_stress_pa"]][inside].to_numpy()
+    # exact: the same values; Exudyn: a peak at a front within a step on the bit (a body with mass) is read from the
+    # bit's motion corrected to Exudyn's (models.waves.outgoing) and sampled at the element's prediction of it
+    # (measured 3.6e-4 apart; the issue asks 1e-3)
+    tolerance = 1e-9 if formulation == "exact" else 1e-3
+    assert stresses.max() == pytest.approx(metrics["rod_compressive_stress_max_pa"], rel=tolerance)
+    assert -stresses.min() == pytest.approx(metrics["rod_tensile_stress_max_pa"], rel=tolerance)
+    times = table.time_s.to_numpy()
+    jumps = (np.diff(times) == 0) & (np.abs(np.diff(table.rod_bottom_stress_pa.to_numpy())) > 1e7)
+    assert jumps.any()  # a front at the bit: two rows at its time, one on each side
+
+
+def coupled_rods(formulation: str, coupling: dict, speed: float = 6.0) -> tuple[dict, ref.Solution, ref.Joint]:
+    """An equal-impedance 45 mm rod piston (0.3 m: a 116 us rectangle) on a 1.2 m rod joined by ``coupling`` to a 3 m
+    rod that ends free; one blow, until the free end's reflection is back at the coupling. The scene and the
+    reference (the coupling a spring-damper, compression only, as the scene's)."""
+    z, tp, t1, t2 = impedance(0.045), 0.3 / C, 1.2 / C, 3.0 / C
+    step = tp / 60
+    end = step * math.floor((t1 + 2 * t2) / step - 10)  # a whole number of steps: no transit time rounded
+    solver = {"wave_step_s": step} if formulation == "exact" else {"step_s": step}
+    data = {"name": "coupled", "drill_string": {"bodies": {"rod": steel_rod(1.2, 0.045), "lower": steel_rod(3.0, 0.045)},
+                                                "connectors": {"thread": {"from": "rod", "to": "lower", "type": "coupling",
+                                                                          **coupling}},
+                                                "impact_body": "rod"},
+            "feed": {"force_n": 0.0}, "impact": {"frequency_hz": 1 / end, "piston": {**steel_rod(0.3, 0.045),
+                                                                                   "velocity_m_per_s": speed}},
+            "solver": {"formulation": formulation, "end_time_s": end, "output_interval_s": step, **solver},
+            "metrics": {"transient_blows": 0, "block_blows": 1}}
+    stiffness = coupling.get("stiffness_n_per_m")
+    if stiffness is None:  # the sleeve's: E pi (D_s^2 - D^2) / (4 L_s)
+        stiffness = E_PA * math.pi * (coupling["sleeve_outer_diameter_m"] ** 2 - 0.045**2) / 4 / coupling["sleeve_length_m"]
+    joint = ref.Joint(3, 4, (z, z), stiffness, coupling.get("damping_n_s_per_m", 0.0), coupling.get("gap_m", 0.0))
+    solution = ref.Solution([ref.Rod(z, tp), ref.Rod(z, t1), ref.Rod(z, t2)],
+                            [ref.FreeEnd(0, z), ref.RodPistonContact(1, 2, (z, z), z * tp, speed), joint,
+                             ref.FreeEnd(5, z)], 2 * end, end, [np.zeros(0), np.zeros(3), np.zeros(3), np.zeros(0)],
+                            z * speed).run()
+    return data, solution, joint
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+@pytest.mark.parametrize("coupling", [{"sleeve_length_m": 0.19, "sleeve_outer_diameter_m": 0.06},
+                                      {"stiffness_n_per_m": 4e9, "damping_n_s_per_m": 3e4, "gap_m": 2e-6}])
+def test_a_coupling_is_a_spring_with_its_gap_and_damper(formulation, coupling):
+    """A threaded coupling between two wave rods: the force it passes is the reference's (the closed form of a
+    spring between two rods for the sleeve's stiffness alone, checked in the reference's own test), and per blow
+    the result reads what came to it, what it passed on, what it lost and its transmission (out / incident), as the
+    reference integrates them: a sleeve loses nothing, a damper what it dissipates."""
+    data, solution, _ = coupled_rods(formulation, coupling)
+    result = simulate(data)
+    z, speed, force = impedance(0.045), 6.0, impedance(0.045) * 6.0 / 2
+    t = result.time_s
+    got = result.raw.waves.compression_n[:, result.raw.waves.port("lower", "top")]
+    assert history_error(solution, 4, t, got, 1e-3 * (0.3 / C / 60)) < 1e-3 * force
+    reading = result.wave_readings.couplings["thread"]
+    passed = ref.energy_through(solution, 4, 0.0, t[-1])
+    blow = 0.5 * z * (0.3 / C) * speed**2
+    assert reading.energy_out_j[0] == pytest.approx(passed, abs=1e-3 * blow)
+    assert reading.lost_j[0] == pytest.approx(solution.states[2][2], abs=1e-3 * blow)  # the damper's work
+    incident = ref.arriving_energy(solution, 3, 0.0, t[-1])  # the rectangle and what comes back down rod 1
+    assert reading.incident_j[0] == pytest.approx(incident, abs=1e-3 * blow)
+    assert reading.transmission[0] == pytest.approx(passed / incident, abs=1e-3)
+
+
+def along(solution: ref.Solution, fraction: float, t: np.ndarray) -> np.ndarray:
+    """The reference's force inside its rod, ``fraction`` of the way down: Z (d(t - x / c) - u(t - (L - x) / c))."""
+    rod = solution.rods[0]
+    down = solution.waves[0](t - fraction * rod.transit)
+    up = solution.waves[1](t - (1 - fraction) * rod.transit)
+    return rod.impedance * (down - up)
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS)
+def test_the_stress_envelope_and_a_gauge_inside_the_rod(restrike, formulation):
+    """Inside the rod of the re-strike case: every blow's largest compression and tension at sections along it, and
+    a gauge at 0.45 m (force, Z v, the down- and up-going waves, the energy passing it per blow with its incident and
+    reflected parts), against the reference's superposition of its two waves there, within 1e-3 of Z v_p and of
+    the blow energy. The sections are read at every step's ends: where a front crosses one within a step (the
+    re-strike's) the peak behind it is read up to a step late (measured 4.0e-3, 1.4e-3 and 3.3e-5 of Z v_p at
+    T / 356, T / 1424 and T / 5696 at 0.6 m), hence T / 5696 here."""
+    solution, _, _ = restrike
+    steps = 5696
+    data = rigid_piston_scene(formulation, steps)
+    data["outputs"] = {"metrics": ["rod_stress_max_pa"], "gauges": {"mid": {"rod": "rod", "position_m": 0.45}}}
+    readings = simulate(data).raw.wave_readings
+    scale, blow, period = PISTON_Z * PISTON_SPEED, 0.5 * PISTON_MASS * PISTON_SPEED**2, 5 * PISTON_T
+    area = math.pi * PISTON_D**2 / 4
+    envelope = readings.envelopes["rod"]
+    for b in range(3):
+        grid = np.arange(b * period, (b + 1) * period, PISTON_T / 4000)
+        for s, position in enumerate(envelope.position_m):
+            fraction = position / PISTON_L  # the waves' fronts there, on both sides
+            fronts = np.concatenate([[p.start + fraction * PISTON_T for p in solution.waves[0].pieces],
+                                     [p.start + (1 - fraction) * PISTON_T for p in solution.waves[1].pieces]])
+            fronts = fronts[(fronts >= b * period) & (fronts < (b + 1) * period)]
+            t = np.concatenate([grid, fronts - 1e-12, fronts + 1e-12])
+            force = along(solution, fraction, t)
+            assert envelope.compression_pa[b, s] * area == pytest.approx(max(force.max(), 0), abs=1e-3 * scale)
+            assert envelope.tension_pa[b, s] * area == pytest.approx(max(-force.min(), 0), abs=1e-3 * scale)
+    gauge = readings.gauges["mid"]
+    cell = round(0.45 / PISTON_L * steps) / steps  # the gauge reads the cell's end nearest it
+    sides = [np.abs(gauge.force_n - along(solution, cell, gauge.time_s + d)) for d in (-1e-10, 0.0, 1e-10)]
+    assert np.max(np.min(sides, axis=0)) < 1e-3 * scale  # two rows at a front at a grid time, one each side
+    assert np.allclose(gauge.down_n + gauge.up_n, gauge.force_n) and np.allclose(gauge.down_n - gauge.up_n,
+                                                                                  gauge.impedance_velocity_n)
+    for b in range(3):
+        t = np.linspace(b * period, (b + 1) * period, 200001)
+        down = solution.waves[0](t - cell * PISTON_T)
+        up = solution.waves[1](t - (1 - cell) * PISTON_T)
+        incident = PISTON_Z * np.trapezoid(down**2, t)
+        reflected = PISTON_Z * np.trapezoid(up**2, t)
+        assert gauge.incident_j[b] == pytest.approx(incident, abs=1e-3 * blow)
+        assert gauge.reflected_j[b] == pytest.approx(reflected, abs=1e-3 * blow)
+        assert gauge.energy_j[b] == pytest.approx(incident - reflected, abs=1e-3 * blow)
+
+
+def test_miners_damage_of_a_pulse_passing_a_gauge():
+    """A rectangular pulse of 100 kN passing a gauge in the middle of a 45 mm x 3 m rod that ends free, one blow ended
+    before its reflection is back: the gauge's stress goes 0 -> sigma -> 0, one cycle of range sigma (two halves,
+    ASTM E1049-85); with the S-N curve N = 1e6 (200 MPa / S_a)^5 the blow's damage is 1 / N(sigma / 2)."""
+    import rpdrill
+
+    area = math.pi * 0.045**2 / 4
+    transit = 3.0 / C
+    data = {"name": "pulse", "drill_string": {"bodies": {"rod": {**steel_rod(3.0, 0.045), "sn_curve": {
+        "stress_amplitude_pa": 200e6, "cycles": 1e6, "exponent": 5.0}}}, "impact_body": "rod"},
+            "feed": {"force_n": 0.0}, "impact": {"frequency_hz": 1 / (1.4 * transit), "amplitude_n": 1e5,
+                                                 "duration_s": 1e-4, "shape": "rectangular"},
+            "solver": {"formulation": "exact", "end_time_s": 1.4 * transit},
+            "metrics": {"transient_blows": 0, "block_blows": 1},
+            "outputs": {"metrics": ["rod_stress_max_pa"], "gauges": {"mid": {"rod": "rod", "position_m": 1.5}}}}
+    gauge = rpdrill.simulate(rpdrill.Scene.model_validate(data)).raw.wave_readings.gauges["mid"]
+    sigma = 1e5 / area
+    assert gauge.cycles[0] == [pytest.approx((sigma, 1.0), rel=1e-9)]
+    expected = 1.0 / (1e6 * (200e6 / (sigma / 2)) ** 5)
+    assert gauge.damage[0] == pytest.approx(expected, rel=1e-9)
+    assert gauge.blows_to_failure == pytest.approx(1 / expected, rel=1e-9)

@@ -358,7 +358,8 @@ class RodPistonContact(Junction):
     """A rod piston's front face (port ``piston``) on a rod's top face (port ``struck``), a rigid
     compression-only contact, a feed F on the struck face. y = (x_piston_face, x_struck_face, impulse
     int C dt since the strike); caught when the contact opens with the piston's momentum (m v_p - int C dt,
-    constant while free) not forward. Blows: the piston rod at v_p, unstressed (its waves v_p / 2)."""
+    constant while free) not forward, or when it rests on the face without pushing (rpdrill's rule for a wave
+    piston: both nil to 1e-9). Blows: the piston rod at v_p, unstressed (its waves v_p / 2)."""
 
     def __init__(self, piston: int, struck: int, impedances: tuple[float, float], mass: float, speed: float,
                  feed: float = 0.0) -> None:
@@ -404,6 +405,11 @@ class RodPistonContact(Junction):
     def settle(self, t, y, ins):
         if self.mode == "closed" and self.contact(y, ins) < -TOLERANCE["force"]:
             return self._open(t, y)
+        momentum = self.mass * self.speed - y[2]
+        if self.mode == "closed" and abs(momentum) <= 1e-9 * self.mass * self.speed and \
+                abs(self.contact(y, ins)) <= 1e-9 * self.impedances[0] * self.speed:  # at rest, not pushing
+            self.mode = "caught"
+            self.catches.append((t, momentum))
         return y
 
     def blow(self, t, y, ins, solution):
@@ -621,6 +627,19 @@ def extremes(solution: Solution, port: int, start: float, end: float, spacing: f
     times = times[(times >= start) & (times < end)]
     values = np.concatenate([compression(solution, port, times, 1), compression(solution, port, times, -1)])
     return float(values.max()), float(max(-values.min(), 0.0))
+
+
+def arriving_energy(solution: Solution, port: int, start: float, end: float) -> float:
+    """Z int w_in^2 dt at a rod end over [start, end]: the energy the waves arriving there bring."""
+    rod = solution.rods[port // 2]
+    cuts = np.concatenate([[start], breaks(solution, port, start, end), [end]])
+    x, weights = np.polynomial.legendre.leggauss(40)
+    total = 0.0
+    for a, b in itertools.pairwise(cuts):
+        if b - a > 0:
+            t = 0.5 * (a + b) + 0.5 * (b - a) * x
+            total += 0.5 * (b - a) * float(np.sum(weights * rod.impedance * solution.incoming(port, t) ** 2))
+    return total
 
 
 def energy_through(solution: Solution, port: int, start: float, end: float) -> float:

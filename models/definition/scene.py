@@ -195,8 +195,17 @@ class Effects(Strict):
     reasons: dict[str, str] = Field(default_factory=dict)
 
 
+class Gauge(Strict):
+    """A strain gauge and accelerometer pair on a wave rod, ``position_m`` from its top (pile-driving analyser
+    style: force, velocity, the down- and up-going waves, the energy that passes it per blow)."""
+
+    rod: Name
+    position_m: Annotated[float, Field(ge=0)]
+
+
 class Outputs(Strict):
-    """Requested metrics and time histories (time, positions and velocities always come).
+    """Requested metrics and time histories (time, positions and velocities always come), and gauges on wave rods
+    (``gauges: {NAME: {rod: ROD, position_m: X}}``: models.evaluation.wave_readings).
 
     No ``outputs`` section: every metric and history of the effects that are built. A list left
     out of a given section is empty.
@@ -204,6 +213,7 @@ class Outputs(Strict):
 
     metrics: list[str] = Field(default_factory=list)
     timeseries: list[Literal[tuple(SERIES)]] = Field(default_factory=list)  # type: ignore[valid-type]
+    gauges: dict[Name, Gauge] = Field(default_factory=dict)
 
     @field_validator("metrics")
     @classmethod
@@ -278,6 +288,19 @@ class Scene(Strict):
             raise _key_error("Scene", ("drill_string", "rock_body"), None, "missing: rock law '{law}' acts on the "
                              "rock body; leave out the rock section (or give rock: {{law: none}}) for a string that "
                              "ends free", law=self.rock.law)
+        return self
+
+    @model_validator(mode="after")
+    def _gauges_on_wave_rods(self) -> Scene:
+        for name, gauge in (self.outputs.gauges if self.outputs else {}).items():
+            body = self.drill_string.bodies.get(gauge.rod)
+            if body is None or not body.is_wave:
+                waves = [b for b, value in self.drill_string.bodies.items() if value.is_wave]
+                raise _key_error("Scene", ("outputs", "gauges", name, "rod"), gauge.rod, "a gauge sits on a wave rod "
+                                 "(model: waves); the scene's: {rods}", rods=", ".join(waves) or "none")
+            if gauge.position_m > body.length_m:
+                raise _key_error("Scene", ("outputs", "gauges", name, "position_m"), gauge.position_m, "beyond the "
+                                 "rod's length {length} m (the distance from its top)", length=body.length_m)
         return self
 
     @model_validator(mode="after")
@@ -410,8 +433,9 @@ def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
     """The scene's outputs, or without an outputs section every metric and history of the effects
     built and the bodies present (a scene with rods: each rod's figures too, ``<rod>_compressive_stress_max_pa``
     ...: models.definition.outputs.BODY_METRICS of the rods' data)."""
-    if scene.outputs is not None:
+    if scene.outputs is not None and not scene.outputs.model_fields_set <= {"gauges"}:
         return scene.outputs
+    gauges = scene.outputs.gauges if scene.outputs is not None else {}  # gauges alone: the default outputs besides
     built = {effect for effect, on in effects.as_dict().items() if on}
     bodies = set(scene.drill_string.bodies)
     rods = any(body.is_rod for body in scene.drill_string.bodies.values())
@@ -421,4 +445,4 @@ def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
     per_rod = [f"{name}{suffix}" for name, body in scene.drill_string.bodies.items() if body.is_rod
                for suffix, need in BODY_METRICS.items() if "rods" in need.data]
     return Outputs(metrics=[m for m, n in METRICS.items() if available(n)] + per_rod,
-                   timeseries=[s for s, n in SERIES.items() if available(n)])
+                   timeseries=[s for s, n in SERIES.items() if available(n)], gauges=gauges)

@@ -131,6 +131,7 @@ class WaveExudyn:
         self.previous_velocity = np.zeros(self.stepper.layout.n)
         self.last_velocity: np.ndarray | None = None  # the bodies' velocities at the last step's start
         self.last_positions = np.zeros(len(self.bodies))
+        self.step_start = None  # the snapshot of the step in progress at its start (models.waves.recording)
         self.masses = np.array([chain.bodies[i].mass_kg for i in sorted(self.bodies)])
         self.failed_at_s: float | None = None
 
@@ -201,7 +202,9 @@ class WaveExudyn:
             nodes = stepper.port_nodes
             motion = BodyMotion(self.previous[nodes], w[nodes], self.previous_velocity[nodes], velocity[nodes],
                                 stepper.step_s)
-            stepper.close_ports(k - 1, self.body_ports, body_segments(stepper.last_segments, motion), again=True)
+            end = stepper._snapshot(k * stepper.step_s, w, stepper.key(), after=False)  # Exudyn's state: exact
+            stepper.close_ports(k - 1, self.body_ports, body_segments(stepper.last_segments, motion), again=True,
+                                ends=(self.step_start, end))
             stepper.works[1] += port_work_j(stepper.last_segments, motion, self.body_ports, stepper.port_impedances)
             self.closed = k
         if k >= self.closed:
@@ -230,7 +233,11 @@ class WaveExudyn:
         self.last_velocity, self.last_positions = velocity, positions
         self._add_works(k * stepper.step_s)
         if k % stepper.sample_every == 0 or stepper.caught_at_end:
-            stepper._record(k * stepper.step_s, stepper.w, stepper.key(), after=stepper.caught_at_end)
+            stepper._record(k * stepper.step_s, stepper.w, stepper.key(), after=stepper.caught_at_end,
+                            kept=stepper.caught_at_end)
+        if len(self.body_ports):  # the step's start after its arriving jumps: a body port's peak may be there
+            stepper._set_inputs(k)
+            self.step_start = stepper._snapshot(k * stepper.step_s, stepper.w, stepper.key(), after=True)
         stepper.advance()
         # the dashpots are Exudyn's: their force at the predicted velocity, a straight line, taken out
         start = stepper.body_loads[0] + self.dashpots * velocity
@@ -299,7 +306,9 @@ class WaveExudyn:
         simulation, mbs, stepper = self.simulation, self.mbs, self.stepper
         self._sync()
         self._add_works(stepper.step_index * stepper.step_s)
-        stepper._record(stepper.step_index * stepper.step_s, stepper.w, stepper.key())
+        stepper._record(stepper.step_index * stepper.step_s, stepper.w, stepper.key(), kept=False)
+        stepper.record_peaks()
+        stepper.read_envelopes(stepper.step_index)
         if not ok or self.failed_at_s is not None or stepper.step_index < stepper.steps:
             at = self.failed_at_s if self.failed_at_s is not None else stepper.step_index * stepper.step_s
             raise SimulationFailed(f"scene '{simulation.name}': solver {simulation.settings.type} with the wave step "

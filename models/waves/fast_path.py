@@ -10,6 +10,7 @@ from ..definition.links import CLOSED, OPEN
 from .kernels import CATCH, PISTON_CLOSED, PISTON_NONE, PISTON_OPEN, SWITCH, run_steps
 from .levels import key_levels
 from .outgoing import Segment
+from .recording import Snapshot
 from .system import Key
 
 
@@ -54,8 +55,16 @@ def run_fast(stepper, stop: int) -> tuple[int, int]:
         stepper.port_nodes, velocity, lines.port_delays, stepper.port_signs, stepper.port_impedances,
         stepper.port_down, own, lines.left, lines.right, lines.start, lines.broken, lines.square, lines.mean,
         lines.square_sum, lines.mean_sum,
-        lines.ring, stepper.works, rock, stats.compression_n[-1], stats.tension_n[-1], stats.energy_j[-1], integral,
-        forces, loads, mode, pistons, impact, momentum_tolerance, force_tolerance, impedance)
+        lines.ring, stepper.works, rock, stats.compression_n[-1], stats.tension_n[-1], stats.energy_j[-1],
+        stats.arriving_j[-1], integral,
+        forces, loads, mode, pistons, impact, momentum_tolerance, force_tolerance, impedance, stepper.energy_weights,
+        stepper.peak_states, stepper.peak_extras, stepper.peak_sides)
+    for port, kind in zip(*np.nonzero(stepper.peak_sides), strict=True):  # the blow's peaks raised in these steps
+        extras = stepper.peak_extras[port, kind]
+        stepper.peaks.offer(int(port), int(kind), Snapshot(
+            float(extras[0]), stepper.peak_states[port, kind].copy(), key, bool(stepper.peak_sides[port, kind] == 1),
+            np.array([extras[1], extras[2]]), float(extras[3]), float(extras[4])))
+    stepper.peak_sides[:] = 0
     stats.rock_work_j[-1] += rock[0]
     if reached > stepper.step_index and len(forces):
         stepper.body_loads = loads

@@ -73,10 +73,11 @@ class WaveLines:
     pieces in ``pieces`` (port, slot) and ``broken`` set; ``left``, ``right`` and ``start`` then hold its
     first piece's left and start and its last piece's right."""
 
-    def __init__(self, rods: Sequence[WaveRod], step_s: float, initial_outgoing: np.ndarray) -> None:
+    def __init__(self, rods: Sequence[WaveRod], step_s: float, initial_outgoing: np.ndarray, kept_steps: int = 0) -> None:
         self.rods, self.step_s = tuple(rods), step_s
         self.delays = np.array(delays(rods, step_s), dtype=int)
-        self.ring = int(self.delays.max(initial=1)) + 1
+        # the waves in flight, and ``kept_steps`` more (a blow's, for the readings along the rods)
+        self.ring = int(self.delays.max(initial=1)) + 1 + kept_steps
         ports = len(initial_outgoing)
         self.left = np.zeros((ports, self.ring))
         self.right = np.zeros((ports, self.ring))

@@ -24,15 +24,22 @@ PISTON_NONE, PISTON_OPEN, PISTON_CLOSED = 0, 1, 2
 @njit(cache=True)
 def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_nodes, port_velocity, port_delays,
               port_signs, port_impedances, port_down, own, left, right, start, broken, square, mean, square_sum,
-              mean_sum, ring, works, rock_work, compression, tension, energy, integral, body_forces, loads,
-              piston_mode, piston_ports, impact_row, momentum_tolerance, force_tolerance, rod_impedance):
-    """Advance ``w`` from ``step`` up to ``stop`` (module doc); returns (status, the step reached)."""
+              mean_sum, ring, works, rock_work, compression, tension, energy, arriving_energy, integral, body_forces, loads,
+              piston_mode, piston_ports, impact_row, momentum_tolerance, force_tolerance, rod_impedance,
+              energy_weights, peak_states, peak_extras, peak_sides):
+    """Advance ``w`` from ``step`` up to ``stop`` (module doc); returns (status, the step reached). Where a port's
+    largest compression or tension of the blow is raised, the state there is kept: ``peak_states`` (port, kind,
+    state), ``peak_extras`` (port, kind: time, the two works, the string's and a wave piston's waves' energy,
+    by ``energy_weights`` (2, ports)), ``peak_sides`` 1 at a step's start (after its arriving jump), 2 at its end."""
     m = w.shape[0]
     ports = port_nodes.shape[0]
     a0 = np.empty(ports)
     x0 = np.empty(ports)
     s0 = np.empty(ports)
     w1 = np.empty(m)
+    w0 = np.empty(m)
+    start_extra = np.empty(5)
+    end_raised = np.zeros((ports, 2), dtype=np.bool_)
     while step < stop:
         for p in range(ports):
             if broken[p ^ 1, (step - port_delays[p]) % ring]:
@@ -50,6 +57,13 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
             for j in range(m):
                 velocity += port_velocity[p, j] * w[j]
             s0[p] = velocity - a0[p]
+        for i in range(m):
+            w0[i] = w[i]
+        start_extra[0], start_extra[1], start_extra[2] = step * h, works[0], works[1]
+        start_extra[3], start_extra[4] = 0.0, 0.0
+        for p in range(ports):
+            start_extra[3] += energy_weights[0, p] * square_sum[p]
+            start_extra[4] += energy_weights[1, p] * square_sum[p]
         for i in range(m):
             total = 0.0
             for j in range(m):
@@ -92,6 +106,8 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
         for i in range(m):
             w[i] = w1[i]
         k = step % ring
+        raised_end = False
+        end_raised[:, :] = False
         for p in range(ports):
             velocity = 0.0
             for j in range(m):
@@ -113,11 +129,41 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
             if own[p]:
                 start_c = port_signs[p] * (s0[p] - a0[p])
                 end_c = port_signs[p] * (out_right - a1)
-                compression[p] = max(compression[p], max(start_c, end_c))
-                tension[p] = max(tension[p], -min(start_c, end_c))
+                for kind in range(2):
+                    sign = 1.0 if kind == 0 else -1.0
+                    best = compression[p] if kind == 0 else tension[p]
+                    if sign * start_c > best or sign * end_c > best:
+                        side = 1 if sign * start_c >= sign * end_c else 2
+                        if kind == 0:
+                            compression[p] = max(start_c, end_c)
+                        else:
+                            tension[p] = -min(start_c, end_c)
+                        peak_sides[p, kind] = side
+                        if side == 1:
+                            for i in range(m):
+                                peak_states[p, kind, i] = w0[i]
+                            for i in range(5):
+                                peak_extras[p, kind, i] = start_extra[i]
+                        else:
+                            raised_end = True
+                            end_raised[p, kind] = True
+                            for i in range(m):
+                                peak_states[p, kind, i] = w[i]
                 incoming = a0[p] * a0[p] + a0[p] * a1 + a1 * a1
                 outgoing = out_left * out_left + out_left * out_right + out_right * out_right
                 energy[p] += port_down[p] * port_impedances[p] * h * (outgoing - incoming) / 3.0
+                arriving_energy[p] += port_impedances[p] * h * incoming / 3.0
+        if raised_end:  # the works and the waves' energy at the step's end, where a peak was raised there
+            string_energy, piston_energy = 0.0, 0.0
+            for p in range(ports):
+                string_energy += energy_weights[0, p] * square_sum[p]
+                piston_energy += energy_weights[1, p] * square_sum[p]
+            for p in range(ports):
+                for kind in range(2):
+                    if end_raised[p, kind]:
+                        peak_extras[p, kind, 0] = (step + 1) * h
+                        peak_extras[p, kind, 1], peak_extras[p, kind, 2] = works[0], works[1]
+                        peak_extras[p, kind, 3], peak_extras[p, kind, 4] = string_energy, piston_energy
         step += 1
         if piston_mode != PISTON_NONE:
             momentum = rod_impedance * h * (mean_sum[piston_ports[0]] + mean_sum[piston_ports[1]])
@@ -191,3 +237,27 @@ def first_crossing(steps, rows, slopes, w0, span, levels):
                 w = steps[j] @ w
         reached = limit
     return 0, -1
+
+
+@njit(cache=True)
+def envelope(start, right, top, bottom, ring, first, stop, delay, stations, impedance):
+    """The largest compression and tension (a positive number) at each station j (steps from the top) of one rod
+    over steps ``first`` .. ``stop`` - 1, and the steps where: P(x_j, t) = Z (d(t - j h) - u(t - (N - j) h)), d the
+    wave leaving its top, u its bottom's, at each step's start (exact values ``start``) and end (``right``)."""
+    count = stations.shape[0]
+    largest = np.zeros(count)
+    lowest = np.zeros(count)
+    at_largest = np.full(count, -1)
+    at_lowest = np.full(count, -1)
+    for s in range(count):
+        j = stations[s]
+        for k in range(first, stop):
+            down = (k - j) % ring
+            up = (k - delay + j) % ring
+            for value in (impedance * (start[top, down] - start[bottom, up]),
+                          impedance * (right[top, down] - right[bottom, up])):
+                if value > largest[s]:
+                    largest[s], at_largest[s] = value, k
+                if -value > lowest[s]:
+                    lowest[s], at_lowest[s] = -value, k
+    return largest, at_largest, lowest, at_lowest

@@ -52,6 +52,7 @@ class Segment:
     d0: np.ndarray  # the outgoing wave's slope (1/s) at both ends (a kink between segments is a break too)
     d1: np.ndarray
     solved: bool = True  # False: a step of the compiled kernel, whose nodes' values are not kept (only its waves)
+    samples: tuple[int, int] = (-1, -1)  # the samples recorded at its start and end (-1: none)
 
 
 @dataclass
@@ -130,6 +131,9 @@ class PortReadings:
     compression_n: np.ndarray
     tension_n: np.ndarray
     energy_j: np.ndarray
+    arriving_j: np.ndarray  # the energy the arriving wave brings, Z int w_in^2 dt
+    compression_at: list[tuple[Segment, int]]  # per port, the segment and its end (0 start, 1 end) of the value
+    tension_at: list[tuple[Segment, int]]
 
 
 def readings(segments: list[Segment], waves: StepWaves, step_s: float, ports: np.ndarray,
@@ -143,7 +147,12 @@ def readings(segments: list[Segment], waves: StepWaves, step_s: float, ports: np
     arriving = sum((s.end - s.begin) * (s.a0[ports] ** 2 + s.a0[ports] * s.a1[ports] + s.a1[ports] ** 2) / 3.0
                    for s in segments)
     energy = down[ports] * impedances[ports] * step_s * (waves.leaving_square() - arriving)
-    return PortReadings(values.max(axis=0), np.maximum(-values.min(axis=0), 0.0), energy)
+    count = len(kept)
+
+    def where(index: np.ndarray) -> list[tuple[Segment, int]]:
+        return [(kept[i % count], i // count) for i in index]
+    return PortReadings(values.max(axis=0), np.maximum(-values.min(axis=0), 0.0), energy,
+                        impedances[ports] * step_s * arriving, where(values.argmax(axis=0)), where(values.argmin(axis=0)))
 
 
 @dataclass(frozen=True)
@@ -188,7 +197,8 @@ def body_segments(segments: list[Segment], motion: BodyMotion) -> list[Segment]:
                             motion.v0 - first.v0, motion.v1 - last.v1, motion.step_s)
     return [Segment(s.begin, s.end, s.x0 + correction.position(s.begin), s.x1 + correction.position(s.end),
                     s.v0 + correction.velocity(s.begin), s.v1 + correction.velocity(s.end), s.a0, s.a1,
-                    s.d0 + correction.acceleration(s.begin), s.d1 + correction.acceleration(s.end)) for s in segments]
+                    s.d0 + correction.acceleration(s.begin), s.d1 + correction.acceleration(s.end), True, s.samples)
+            for s in segments]
 
 
 def _moved(s: Segment, position, velocity, acceleration) -> Segment:

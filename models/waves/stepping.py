@@ -35,10 +35,12 @@ from .history import WaveLines
 from .kernels import CATCH
 from .levels import key_levels
 from .outgoing import Segment, StepWaves, outgoing, readings
+from .recording import BlowPeaks, Recorder, Samples, Snapshot
 from .system import Key, Modes, WaveSystem
 
 MAX_SWITCHES_PER_STEP = 64
 SWITCH_AT_START = 1e-9  # a switch this soon (a fraction of the step) after a jump is at the jump
+
 
 
 @dataclass
@@ -50,35 +52,30 @@ class BlowStatistics:
     compression_n: list[np.ndarray] = field(default_factory=list)
     tension_n: list[np.ndarray] = field(default_factory=list)
     energy_j: list[np.ndarray] = field(default_factory=list)
+    arriving_j: list[np.ndarray] = field(default_factory=list)  # the energy the arriving wave brings, Z int w_in^2
+    # per blow and string rod: (stations' positions from its top, largest compression there, its time, largest
+    # tension, its time) (Stepper.read_envelopes)
+    envelopes: list[dict[str, tuple[np.ndarray, ...]]] = field(default_factory=list)
+    # per blow and gauge: (every step's start time, the down-going wave at its start and end, the up-going's)
+    gauges: list[dict[str, tuple[np.ndarray, ...]]] = field(default_factory=list)
     rock_work_j: list[float] = field(default_factory=list)
 
     def open_blow(self, ports: int) -> None:
         self.compression_n.append(np.zeros(ports))
         self.tension_n.append(np.zeros(ports))
         self.energy_j.append(np.zeros(ports))
+        self.arriving_j.append(np.zeros(ports))
         self.rock_work_j.append(0.0)
 
     def arrays(self, ports: int) -> dict[str, np.ndarray]:
         shape = (len(self.energy_j), ports)
         return {"compression_n": np.array(self.compression_n).reshape(shape),
                 "tension_n": np.array(self.tension_n).reshape(shape),
-                "energy_j": np.array(self.energy_j).reshape(shape), "rock_work_j": np.array(self.rock_work_j)}
+                "energy_j": np.array(self.energy_j).reshape(shape),
+                "arriving_j": np.array(self.arriving_j).reshape(shape), "rock_work_j": np.array(self.rock_work_j)}
 
 
-@dataclass
-class Samples:
-    time_s: list[float] = field(default_factory=list)
-    states: list[np.ndarray] = field(default_factory=list)
-    velocity: list[np.ndarray] = field(default_factory=list)
-    forces: list[np.ndarray] = field(default_factory=list)  # rock, impact, then each rigid joint's
-    works: list[np.ndarray] = field(default_factory=list)  # cumulative impact, internal (string) work
-    waves_j: list[float] = field(default_factory=list)  # energy of the string's rods' waves in flight
-    piston_j: list[float] = field(default_factory=list)  # a wave piston's energy
-    compression: list[np.ndarray] = field(default_factory=list)  # every port's compression
-    after: list[bool] = field(default_factory=list)  # recorded after a jump at its own time (a catch)
-
-
-class Stepper:
+class Stepper(Recorder):
     """One run on the grid of the characteristics (module doc). ``kinematic`` nodes move at their
     velocity over each step (the Exudyn formulation's bodies, set before each step)."""
 
@@ -93,10 +90,10 @@ class Stepper:
         self.system = WaveSystem(chain, simulation.rock, simulation.torsion, simulation.impact, kinematic,
                                  catch_by_row=self.piston_rod is None)
         self.layout = self.system.layout
-        self.lines = WaveLines(chain.waves, step_s, initial_outgoing(simulation, chain))
         end = simulation.settings.end_time_s
         self.steps = max(1, round(end / step_s))
         self.period_steps = round(simulation.impact.period_s / step_s)
+        self.lines = WaveLines(chain.waves, step_s, initial_outgoing(simulation, chain), self.period_steps + 1)
         times, phases = phase_pieces(simulation.impact, end)
         self.phase_changes, self.phases = times[:, 0], phases
         self.blows = simulation.blow_starts()
@@ -122,7 +119,15 @@ class Stepper:
         self.w = self._initial_state()
         self.modes = self.system.initial_modes(self.w)
         self.phase_index = 0
-        self.samples, self.statistics = Samples(), BlowStatistics()
+        self.samples, self.statistics, self.peaks = Samples(), BlowStatistics(), BlowPeaks()
+        self.step_start: Snapshot | None = None  # the state at the start of the step in progress (a peak's sample)
+        weights = np.zeros((2, len(self.ports)))  # the string's and a wave piston's waves' energy: Z h square sums
+        for p, port in enumerate(self.ports):
+            weights[int(port.rod == self.piston_rod), p] = port.impedance_n_s_per_m * step_s
+        self.energy_weights = weights
+        self.peak_states = np.zeros((len(self.ports), 2, self.layout.size))
+        self.peak_extras = np.zeros((len(self.ports), 2, 5))
+        self.peak_sides = np.zeros((len(self.ports), 2), dtype=np.int64)
         self.works = np.zeros(2)
         self.switch_times: list[float] = []
         self.switch_modes: list[Modes] = []
@@ -189,7 +194,7 @@ class Stepper:
         self.caught_at_end = caught
         k = self.step_index
         if self.record_steps and (caught or k % self.sample_every == 0 or k == self.steps):
-            self._record(k * self.step_s, self.w, self.key(), after=caught)
+            self._record(k * self.step_s, self.w, self.key(), after=caught, kept=caught)
 
     def _step(self) -> None:
         """Step ``step_index`` here (module doc): pieces between the switches, the pulse's phase changes and the
@@ -207,7 +212,8 @@ class Stepper:
         jumped = strike  # a jump just now whose other side is still to be sampled (the strike's, a front's)
         self._step_impulse = np.zeros(len(self.kinematic))
         segments: list[Segment] = []
-        begin = (t0, w.copy(), self.key())
+        begin = (t0, w.copy(), self.key(), -1)
+        self.step_start = self._snapshot(t0, w, self.key(), after=True)  # a peak there: after the step's jumps
         while t < t1 - 1e-12 * h:
             later = np.flatnonzero(self.phase_changes > t + 1e-12 * h)
             phase = self.phase_changes[later[0]] if len(later) else np.inf
@@ -219,7 +225,7 @@ class Stepper:
             hit = self._first_switch(key, w, w1, span)
             at_jump = hit is not None and hit[0] <= SWITCH_AT_START * h and (jumped or t == t0)
             if jumped and not at_jump:  # the jump's other side (a switch at the jump: the state after it)
-                self._record(t, w, key, after=True)
+                begin = (*begin[:3], self._record(t, w, key, after=True))
             if hit is None:
                 w, t = self._piece(key, w, span), boundary
                 jumped = False
@@ -228,25 +234,22 @@ class Stepper:
                         self.phase_index = int(later[0])
                         self._start_phase(w, t)
                     break
-                segments.append(self._segment(begin, t, w, key))
-                self._record(t, w, key)  # a phase change or a front: both sides of it
+                segments.append(self._segment(begin, t, w, key, self._record(t, w, key)))  # a front: both sides
                 if phase <= boundary + 1e-12 * h:
                     self.phase_index = int(later[0])
                     self._start_phase(w, t)
                 while arrivals and t0 + arrivals[0][0] * h <= boundary + 1e-12 * h:
                     _, port, value, slope = arrivals.pop(0)
                     w[self.ports[port].input], w[self.ports[port].input + 1] = value, slope / h
-                begin, jumped = (t, w.copy(), self.key()), True
+                begin, jumped = (t, w.copy(), self.key(), -1), True
                 continue
             s, exit_ = hit
             w_s = self._piece(key, w, s)
             t += s
-            if not at_jump:  # a switch at a jump is at the jump: no sample between
-                self._record(t, w_s, key)
-            segments.append(self._segment(begin, t, w_s, key))
+            before = -1 if at_jump else self._record(t, w_s, key)  # a switch at a jump is at the jump: no sample between
+            segments.append(self._segment(begin, t, w_s, key, before))
             w = self._switch(t, w_s, key, exit_)
-            self._record(t, w, self.key(), after=True)
-            begin, jumped = (t, w.copy(), self.key()), False
+            begin, jumped = (t, w.copy(), self.key(), self._record(t, w, self.key(), after=True)), False
             switches += 1
             if switches > MAX_SWITCHES_PER_STEP:
                 raise SimulationFailed(f"scene '{self.simulation.name}': more than {MAX_SWITCHES_PER_STEP} switches "
@@ -263,9 +266,11 @@ class Stepper:
         self.step_index += 1
         self._after(caught)
 
-    def _segment(self, begin: tuple[float, np.ndarray, Key], t: float, w: np.ndarray, key: Key) -> Segment:
-        """The segment from ``begin`` (time, state, key) to the state ``w`` at ``t`` (models.waves.outgoing)."""
-        t_begin, w_begin, key_begin = begin
+    def _segment(self, begin: tuple[float, np.ndarray, Key, int], t: float, w: np.ndarray, key: Key,
+                 sample: int = -1) -> Segment:
+        """The segment from ``begin`` (time, state, key, its sample or -1) to the state ``w`` at ``t`` (its sample
+        ``sample``) (models.waves.outgoing)."""
+        t_begin, w_begin, key_begin, first = begin
         t0, h, nodes, inputs = self.step_index * self.step_s, self.step_s, self.port_nodes, self.layout.inputs
         if "accelerations" not in key.cache:  # the ports' nodes' accelerations: d/dt (V w) = V A w
             key.cache["accelerations"] = key.velocity[nodes] @ key.matrix
@@ -274,7 +279,7 @@ class Stepper:
         return Segment((t_begin - t0) / h, (t - t0) / h, w_begin[nodes], w[nodes], key_begin.velocity[nodes] @ w_begin,
                        key.velocity[nodes] @ w, w_begin[inputs::2].copy(), w[inputs::2].copy(),
                        key_begin.cache["accelerations"] @ w_begin - w_begin[inputs + 1::2],
-                       key.cache["accelerations"] @ w - w[inputs + 1::2])
+                       key.cache["accelerations"] @ w - w[inputs + 1::2], True, (first, sample))
 
     def _start_phase(self, w: np.ndarray, t: float) -> None:
         """The pulse generator's states (u1, u2) at the start of the phase piece beginning at ``t``."""
@@ -292,8 +297,9 @@ class Stepper:
         self.w[inputs::2], self.w[inputs + 1::2] = value, slope / self.step_s
 
     def run(self) -> None:
-        """Every step, runs of quiet steps in the kernel up to the next blow start, phase change or sample."""
-        self._record(0.0, self.w, self.key())
+        """Every step, runs of quiet steps in the kernel up to the next blow start, phase change or sample; the
+        last blow's peaks recorded at the end."""
+        self._record(0.0, self.w, self.key(), kept=False)
         while self.step_index < self.steps:
             k = self.step_index
             if not self._quiet(k):
@@ -306,6 +312,8 @@ class Stepper:
                 self._step()
             elif self.step_index == stop or status == CATCH:
                 self._after(status == CATCH)
+        self.record_peaks()
+        self.read_envelopes(self.step_index)
 
     def _phase_step(self, k: int) -> int:
         """The first step from k on that holds the next pulse phase change (the kernel stops before it)."""
@@ -328,7 +336,7 @@ class Stepper:
         return False
 
     def close_ports(self, k: int, ports: np.ndarray, segments: list[Segment], again: bool = False,
-                    provisional: bool = False) -> None:
+                    provisional: bool = False, ends: tuple[Snapshot | None, Snapshot | None] | None = None) -> None:
         """Store the outgoing waves over step k from its segments (models.waves.outgoing) and add the step to
         the blow's section figures of ``ports``; ``provisional``: store every port (the others are stored
         ``again`` later, from the Exudyn bodies)."""
@@ -348,9 +356,15 @@ class Stepper:
                              {position[j]: rows for j, rows in waves.pieces.items() if j in position})
             read = readings(segments, mine, self.step_s, ports, self.port_signs, self.port_impedances, self.port_down)
         stats = self.statistics
+        raised = (read.compression_n > stats.compression_n[-1][ports], read.tension_n > stats.tension_n[-1][ports])
+        if raised[0].any() or raised[1].any():
+            if ends is None:  # the step just done by the stepper: its start, and its end now
+                ends = (self.step_start, self._snapshot((k + 1) * self.step_s, self.w, self.key(), after=False))
+            self.offer_peaks(read, raised, ports, ends)
         stats.compression_n[-1][ports] = np.maximum(stats.compression_n[-1][ports], read.compression_n)
         stats.tension_n[-1][ports] = np.maximum(stats.tension_n[-1][ports], read.tension_n)
         stats.energy_j[-1][ports] += read.energy_j
+        stats.arriving_j[-1][ports] += read.arriving_j
 
     def _wave_piston_done(self, key: Key) -> bool:
         """A wave piston is caught when its contact is open and its momentum not forward, or when it rests
@@ -417,7 +431,10 @@ class Stepper:
     # -- blows ----------------------------------------------------------------------------------------
 
     def _start_blow(self, k: int, t: float) -> None:
-        """The rock state the blow meets (indexing) and the piston's strike."""
+        """The rock state the blow meets (indexing) and the piston's strike; the last blow's peaks recorded and its
+        stresses along the rods read."""
+        self.record_peaks()
+        self.read_envelopes(k)
         self.statistics.open_blow(len(self.ports))
         layout, w = self.layout, self.w
         if self.blows:
@@ -458,31 +475,6 @@ class Stepper:
         return np.concatenate([w, self.key().velocity @ w])
 
     # -- records --------------------------------------------------------------------------------------
-
-    def _record(self, t: float, w: np.ndarray, key: Key, after: bool = False) -> None:
-        """A sample: the state, every node's velocity, the forces (rock, impact, rigid joints), the works,
-        the energy in the string's rods and in a wave piston, every port's compression."""
-        samples, layout, n = self.samples, self.layout, self.layout.n
-        if "record" not in key.cache:  # velocities, forces and compressions as one matrix over w
-            ports = self.port_signs[:, None] * key.velocity[self.port_nodes]
-            ports[np.arange(len(self.ports)), layout.inputs + 2 * np.arange(len(self.ports))] -= 2.0 * self.port_signs
-            rows = [key.velocity, key.rock_force[None], self.impact_row(key)[None],
-                    np.array([key.constraints[name] for name in self.rigid_names]).reshape(-1, layout.size), ports]
-            key.cache["record"] = np.vstack(rows)
-        values = key.cache["record"] @ w
-        forces = 2 + len(self.rigid_names)
-        samples.time_s.append(t)
-        samples.after.append(after)
-        samples.states.append(w.copy())
-        samples.velocity.append(values[:n])
-        samples.forces.append(values[n:n + forces])
-        samples.compression.append(values[n + forces:])
-        samples.works.append(self.works + np.array([0.0, self._step_flux[2]]))  # the bodies' ports: provisional
-        energies = self.lines.energies_j()
-        piston = 0.0 if self.piston_rod is None else energies[self.piston_rod]
-        samples.piston_j.append(piston + self._step_flux[1])
-        samples.waves_j.append(float(np.sum(energies)) - piston + self._step_flux[0])
-
 
 def initial_outgoing(simulation, chain) -> np.ndarray:
     """Every port's outgoing wave before the start: at rest, P / (2 Z) at the top and -P / (2 Z) at the
