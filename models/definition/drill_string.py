@@ -163,10 +163,11 @@ class Connector(Strict):
     """A link from body ``from`` (nearer the hammer, or ``ground``) to body ``to``, of a ``type`` of
     :data:`models.definition.links.LINK_TYPES`: ``spring_damper`` (bonded, F = k delta + c delta') or
     ``coupling`` (compression only once its ``gap_m`` has closed). Without ``stiffness_n_per_m`` the
-    stiffness follows from the rods it joins (:class:`Body`), or for a coupling with a sleeve
+    stiffness follows from the rods it joins (:class:`Body`), or for a threaded coupling with a sleeve
     (``sleeve_length_m``, ``sleeve_outer_diameter_m``) from the sleeve: k = E pi (D_s^2 - D^2) / (4 L_s), D the
-    larger of the joined rods' diameters (the threads' diameter), E the upper rod's (models.drill.chain). A
-    coupling between two wave rods without a stiffness or a sleeve is a rigid contact: compression only.
+    larger of the joined rods' diameters (the threads' diameter), E the upper rod's (models.drill.chain): bonded
+    (``spring_damper``: the threads carry tension) or compression only once a gap has closed (``coupling``). A
+    ``coupling`` between two wave rods without a stiffness or a sleeve is a rigid contact: compression only.
     """
 
     model_config = ConfigDict(populate_by_name=True)
@@ -177,7 +178,7 @@ class Connector(Strict):
     stiffness_n_per_m: Positive | None = None
     damping_n_s_per_m: NonNegative = 0.0
     gap_m: NonNegative | None = Field(None, description="coupling gap, m (type coupling; default 0)")
-    sleeve_length_m: Positive | None = Field(None, description="a coupling's sleeve: its length (type coupling)")
+    sleeve_length_m: Positive | None = Field(None, description="a threaded coupling's sleeve: its length")
     sleeve_outer_diameter_m: Positive | None = Field(None, description="a coupling's sleeve: its outer diameter")
 
     @model_validator(mode="after")
@@ -185,9 +186,6 @@ class Connector(Strict):
         if self.type not in LINK_TYPES:
             raise ValueError(f"type {self.type!r} is not one of {', '.join(LINK_TYPES)}")
         sleeve = [key for key in ("sleeve_length_m", "sleeve_outer_diameter_m") if getattr(self, key) is not None]
-        if sleeve and self.type != "coupling":
-            raise _key_error("Connector", (sleeve[0],), getattr(self, sleeve[0]), "a coupling's sleeve: only type "
-                             "coupling has one")
         if len(sleeve) == 1:
             missing = ({"sleeve_length_m", "sleeve_outer_diameter_m"} - set(sleeve)).pop()
             raise _key_error("Connector", (missing,), None, "missing: a sleeve is its length and its outer diameter "

@@ -205,7 +205,8 @@ class Gauge(Strict):
 
 class Outputs(Strict):
     """Requested metrics and time histories (time, positions and velocities always come), and gauges on wave rods
-    (``gauges: {NAME: {rod: ROD, position_m: X}}``: models.evaluation.wave_readings).
+    (``gauges: {NAME: {rod: ROD, position_m: X}}``: models.evaluation.wave_readings; gauges alone: the default
+    metrics and histories besides).
 
     No ``outputs`` section: every metric and history of the effects that are built. A list left
     out of a given section is empty.
@@ -433,7 +434,7 @@ def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
     """The scene's outputs, or without an outputs section every metric and history of the effects
     built and the bodies present (a scene with rods: each rod's figures too, ``<rod>_compressive_stress_max_pa``
     ...: models.definition.outputs.BODY_METRICS of the rods' data)."""
-    if scene.outputs is not None and not scene.outputs.model_fields_set <= {"gauges"}:
+    if scene.outputs is not None and (scene.outputs.metrics or scene.outputs.timeseries or not scene.outputs.gauges):
         return scene.outputs
     gauges = scene.outputs.gauges if scene.outputs is not None else {}  # gauges alone: the default outputs besides
     built = {effect for effect, on in effects.as_dict().items() if on}

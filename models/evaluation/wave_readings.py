@@ -2,7 +2,7 @@
 coupling (a connector joining two wave rods) and blow the energy the waves arriving from the upper rod bring
 (``incident_j``), the net energy that crosses the upper rod's lower end (``energy_in_j``: incident less
 reflected), the energy it passes into the lower rod, what it loses (its damper: in - out - the change of the
-spring's energy over the blow) and its transmission, out / incident; per rod and blow the largest compression and
+spring's energy over the blow) and its transmission, out / in; per rod and blow the largest compression and
 tension at sections along it and when (its stress envelope: models.waves.stepping.Stepper.read_envelopes, from the
 exact wave values at every step's ends), with their depth along the string.
 
@@ -38,9 +38,10 @@ class CouplingBlows:
 
     @property
     def transmission(self) -> np.ndarray:
-        """out / incident per blow (nan where nothing came)."""
+        """out / in per blow, the share of the net energy reaching it that it passes on (nan where none came): the
+        energy delivered through couplings in a row is the product of theirs."""
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(self.incident_j > 0, self.energy_out_j / self.incident_j, np.nan)
+            return np.where(self.energy_in_j > 0, self.energy_out_j / self.energy_in_j, np.nan)
 
 
 @dataclass(frozen=True)

@@ -62,6 +62,7 @@ def wave_step_s(durations_s: Sequence[float], target_s: float, period_s: float, 
     return float(steps[good[0]] if len(good) else steps[np.argmin(error)])
 
 
+EDGE = 1e-9  # a break within this fraction of a step's end is at its end
 # a step's pieces: rows (end, as a fraction of the step in (0, 1]; left; right; exact start value)
 PIECE_END, PIECE_LEFT, PIECE_RIGHT, PIECE_START = range(4)
 
@@ -116,6 +117,8 @@ class WaveLines:
             rows = self.pieces[(int(self.sources[port]), int(k[port]))]
             for i in range(1, len(rows)):
                 begin, end = rows[i - 1, PIECE_END], rows[i, PIECE_END]
+                if begin >= 1.0 - EDGE:  # a break a round-off before the step's end is the next step's start
+                    continue
                 out.append((float(begin), int(port), float(rows[i, PIECE_LEFT]),
                             float((rows[i, PIECE_RIGHT] - rows[i, PIECE_LEFT]) / (end - begin))))
         return sorted(out)

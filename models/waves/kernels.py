@@ -22,7 +22,8 @@ PISTON_NONE, PISTON_OPEN, PISTON_CLOSED = 0, 1, 2
 
 
 @njit(cache=True)
-def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_nodes, port_velocity, port_delays,
+def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_nodes, port_velocity, velocity_columns,
+              velocity_counts, port_delays,
               port_signs, port_impedances, port_down, own, left, right, start, broken, square, mean, square_sum,
               mean_sum, ring, works, rock_work, compression, tension, energy, arriving_energy, integral, body_forces, loads,
               piston_mode, piston_ports, impact_row, momentum_tolerance, force_tolerance, rod_impedance,
@@ -52,10 +53,10 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
             w[inputs + 2 * p] = a
             w[inputs + 2 * p + 1] = (right[source, j] - a) / h
             x0[p] = w[port_nodes[p]]
-        for p in range(ports):  # the exact outgoing wave at the step's start
+        for p in range(ports):  # the exact outgoing wave at the step's start (a port's velocity row is sparse)
             velocity = 0.0
-            for j in range(m):
-                velocity += port_velocity[p, j] * w[j]
+            for q in range(velocity_counts[p]):
+                velocity += port_velocity[p, velocity_columns[p, q]] * w[velocity_columns[p, q]]
             s0[p] = velocity - a0[p]
         for i in range(m):
             w0[i] = w[i]
@@ -110,8 +111,8 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
         end_raised[:, :] = False
         for p in range(ports):
             velocity = 0.0
-            for j in range(m):
-                velocity += port_velocity[p, j] * w[j]
+            for q in range(velocity_counts[p]):
+                velocity += port_velocity[p, velocity_columns[p, q]] * w[velocity_columns[p, q]]
             a1 = w[inputs + 2 * p]
             out_right = velocity - a1
             out_left = 2.0 * ((w[port_nodes[p]] - x0[p]) / h - 0.5 * (a0[p] + a1)) - out_right
@@ -251,13 +252,24 @@ def envelope(start, right, top, bottom, ring, first, stop, delay, stations, impe
     at_lowest = np.full(count, -1)
     for s in range(count):
         j = stations[s]
+        down = (first - j) % ring
+        up = (first - delay + j) % ring
+        high, low, at_high, at_low = 0.0, 0.0, -1, -1
         for k in range(first, stop):
-            down = (k - j) % ring
-            up = (k - delay + j) % ring
-            for value in (impedance * (start[top, down] - start[bottom, up]),
-                          impedance * (right[top, down] - right[bottom, up])):
-                if value > largest[s]:
-                    largest[s], at_largest[s] = value, k
-                if -value > lowest[s]:
-                    lowest[s], at_lowest[s] = -value, k
+            value = start[top, down] - start[bottom, up]
+            other = right[top, down] - right[bottom, up]
+            if other > value:
+                value, other = other, value
+            if value > high:  # value the larger of the two, other the smaller
+                high, at_high = value, k
+            if -other > low:
+                low, at_low = -other, k
+            down += 1
+            up += 1
+            if down == ring:
+                down = 0
+            if up == ring:
+                up = 0
+        largest[s], at_largest[s] = impedance * high, at_high
+        lowest[s], at_lowest[s] = impedance * low, at_low
     return largest, at_largest, lowest, at_lowest

@@ -68,7 +68,7 @@ class BlowPeaks:
 
 
 TINY_FRACTION = 1e-9
-ENVELOPE_STATIONS = 64  # sections along a rod where its blow's largest stresses are read
+ENVELOPE_STATIONS = 32  # sections along a rod where its blow's largest stresses are read
 
 
 class Recorder:

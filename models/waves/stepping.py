@@ -163,7 +163,7 @@ class Stepper(Recorder):
         w, works, moved = key_levels(self, key).advance(w0, span_s)
         self.works += works[:2]
         self.statistics.rock_work_j[-1] += works[2]
-        self._step_flux += works[3:]  # into the rods since the step's start (not in their waves in flight yet)
+        self._step_flux[:len(works) - 3] += works[3:]  # into the rods since the step's start (not in their waves in flight yet)
         if moved is not None:
             self._step_impulse += key.body_forces @ moved
         return w
@@ -219,6 +219,8 @@ class Stepper(Recorder):
             phase = self.phase_changes[later[0]] if len(later) else np.inf
             arrival = t0 + arrivals[0][0] * h if arrivals else np.inf
             boundary = min(t1, phase, arrival)
+            if boundary >= t1 - 1e-9 * h:  # a phase change a round-off before the step's end: at its end
+                boundary = t1
             key = self.key()
             span = boundary - t
             w1 = key_levels(self, key).propagate(w, span)
@@ -229,8 +231,8 @@ class Stepper(Recorder):
             if hit is None:
                 w, t = self._piece(key, w, span), boundary
                 jumped = False
-                if boundary >= t1 - 1e-12 * h:  # the step's end (a phase change there: the next step's start)
-                    if phase <= boundary + 1e-12 * h:
+                if boundary >= t1 - 1e-9 * h:  # the step's end (a phase change there: the next step's start)
+                    if phase <= boundary + 1e-9 * h:
                         self.phase_index = int(later[0])
                         self._start_phase(w, t)
                     break
@@ -330,7 +332,8 @@ class Stepper(Recorder):
             self.last_segments = segments
             self.last_inputs = (segments[0].a0, segments[-1].a1)
             self.close_ports(k, self.own_ports, segments, provisional=True)
-        if self.piston_rod is not None and self._wave_piston_done(key):
+        if self.piston_rod is not None and (k + 1) % self.period_steps and self._wave_piston_done(key):
+            # (a catch at a blow start: the strike there resets the piston, its energy counted as rebound)
             self.catch_wave_piston(k + 1)
             return True
         return False
