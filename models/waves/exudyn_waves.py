@@ -52,6 +52,7 @@ from ..evaluation.results import SimulationResult
 from ..evaluation.stability import SimulationFailed
 from .exact_waves import BLAS, result
 from .outgoing import BodyMotion, body_segments, port_work_j
+from .recording import Snapshot
 from .stepping import Stepper
 
 
@@ -202,7 +203,8 @@ class WaveExudyn:
             nodes = stepper.port_nodes
             motion = BodyMotion(self.previous[nodes], w[nodes], self.previous_velocity[nodes], velocity[nodes],
                                 stepper.step_s)
-            end = stepper._snapshot(k * stepper.step_s, w, stepper.key(), after=False)  # Exudyn's state: exact
+            def end() -> Snapshot:  # Exudyn's state at the step's end: exact (taken only for a peak there)
+                return stepper._snapshot(k * stepper.step_s, w, stepper.key(), after=False)
             stepper.close_ports(k - 1, self.body_ports, body_segments(stepper.last_segments, motion), again=True,
                                 ends=(self.step_start, end))
             stepper.works[1] += port_work_j(stepper.last_segments, motion, self.body_ports, stepper.port_impedances)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -167,11 +168,11 @@ class BodyMotion:
     v1: np.ndarray
     step_s: float
 
-    @property
+    @cached_property
     def gamma(self) -> np.ndarray:
         return 3.0 * (self.v1 - self.v0) - 6.0 * ((self.x1 - self.x0) / self.step_s - self.v0)
 
-    @property
+    @cached_property
     def beta(self) -> np.ndarray:
         return self.v1 - self.v0 - self.gamma
 

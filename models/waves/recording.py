@@ -129,6 +129,8 @@ class Recorder:
                 if index < 0:
                     index = ends[end] if (segment.begin <= TINY_FRACTION if end == 0 else segment.end >= 1 - TINY_FRACTION) \
                         else None
+                if callable(index):  # a snapshot taken only now that it is wanted
+                    index = index()
                 if index is not None:
                     self.peaks.offer(int(ports[j]), kind, index)
 
