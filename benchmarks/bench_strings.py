@@ -25,7 +25,7 @@ import numpy as np
 
 from rpdrill.models.definition.scene import Scene
 from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.models.evaluation.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.models.evaluation.rod_outputs import transmitted_pulse_n, travel_time_s
 from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import load_scene, read_yaml

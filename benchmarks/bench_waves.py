@@ -20,6 +20,13 @@ the scenes at these segments per rod in the exact formulation (the convergence o
 the waves).
 ``--lumped-lundberg``: Lundberg's check on lumped rods of 64 to 512 segments (Exudyn, reference preset),
 the dispersion the wave element removes.
+``--cost [--repeat N]``: the CPU per blow of studies/scenes/top_hammer_waves.yaml as shipped (20 blows) in each
+formulation, the median of N runs (default 3) after a warm-up, the process's CPU.
+``--fronts``: tests/test_wave_fronts.py's cases against its independent characteristics solution
+(tests/wave_reference.py): the rigid piston's re-strike within a step (the largest error of the blows' peaks,
+tension, rebound and rock energy, as shares of Z v_p and of the blow energy) at T / 356 and T / 1424 in each
+formulation, and the energy balance of a stiff spring (8e9 N/m) between the rod's foot and an 8 kg bit at each
+Exudyn preset.
 """
 
 from __future__ import annotations
@@ -200,11 +207,61 @@ def lumped_lundberg() -> None:
             print(f"| {segments} | {alpha:g} | {efficiency - closed:+.4f} | {cpu:.1f} |", flush=True)
 
 
+def cost(repeat: int = 3) -> None:
+    print("| scene | formulation | CPU s per blow (median of runs) | runs |")
+    print("|---|---|---|---|")
+    data = read_yaml("studies/scenes/top_hammer_waves.yaml")
+    blows = round(data["solver"]["end_time_s"] * data["impact"]["frequency_hz"])
+    for formulation in ("exact", "exudyn"):
+        scene = Scene.model_validate({**data, "solver": {**data["solver"], "formulation": formulation}})
+        timed(scene.with_({"solver.end_time_s": 0.02, "metrics.transient_blows": 0, "metrics.block_blows": 1}))
+        times = sorted(timed(scene)[1] for _ in range(repeat))
+        print(f"| top_hammer_waves | {formulation} | {times[len(times) // 2] / blows:.4f} | "
+              f"{', '.join(f'{t:.2f}' for t in times)} |", flush=True)
+
+
+def fronts() -> None:
+    sys.path.insert(0, "tests")
+    import test_wave_fronts as cases  # the tests' scenes and their reference (tests/wave_reference.py)
+
+    solution, top, foot = cases.rigid_piston_reference()
+    scale, blow = cases.PISTON_Z * cases.PISTON_SPEED, 0.5 * cases.PISTON_MASS * cases.PISTON_SPEED**2
+    print("| case | formulation | step | peaks (Z v_p) | tension (Z v_p) | rebound (blow) | rock energy (blow) | "
+          "largest contact pull (Z v_p) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for formulation in ("exact", "exudyn"):
+        for steps in (356, 1424):
+            result = cases.simulate(cases.rigid_piston_scene(formulation, steps))
+            checks = cases.rod_end_checks(result, solution, scale, 1e-2 * cases.PISTON_T / steps)
+            peaks = max(abs(v) for k, v in checks.items() if "compression" in k)
+            tension = max(abs(v) for k, v in checks.items() if "tension" in k)
+            rebound = np.max(np.abs(result.piston.rebounds[:, 1] - [e for _, e in top.rebounds])) / blow
+            rock = np.max(np.abs(result.raw.waves.blow_rock_work_j - foot.blow_works(solution.states[1]))) / blow
+            pull = max(-result.piston.contact_force_n.min(), 0.0) / scale
+            print(f"| re-strike within a step | {formulation} | T / {steps} | {peaks:.1e} | {tension:.1e} | "
+                  f"{rebound:.1e} | {rock:.1e} | {pull:.1e} |", flush=True)
+    print()
+    print("| stiff spring face - 8 kg bit (8e9 N/m) | preset | energy balance | stated error |")
+    print("|---|---|---|---|")
+    for preset in ("fast", "standard", "reference"):
+        data = cases.rigid_piston_scene("exudyn", 356)
+        data["drill_string"]["bodies"]["bit"] = {"mass_kg": 8.0}
+        data["drill_string"]["connectors"] = {"spring": {"from": "rod", "to": "bit", "stiffness_n_per_m": 8e9}}
+        data["drill_string"]["rock_body"] = "bit"
+        data["solver"] = {"formulation": "exudyn", "preset": preset, "end_time_s": data["solver"]["end_time_s"]}
+        result = cases.simulate(data)
+        stated = {"fast": 5e-2, "standard": 3e-3, "reference": 3e-4}[preset]
+        print(f"| exudyn | {preset} | {result.metrics['energy_balance_relative_error']:.1e} | {stated:g} |", flush=True)
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--checks", action="store_true")
     parser.add_argument("--strings", action="store_true")
     parser.add_argument("--lumped-lundberg", action="store_true")
+    parser.add_argument("--cost", action="store_true", help="CPU per blow of the shipped top-hammer wave scene")
+    parser.add_argument("--repeat", type=int, default=3, help="--cost: runs per formulation (the median)")
+    parser.add_argument("--fronts", action="store_true", help="the model against the tests' characteristics solution")
     parser.add_argument("--fine", action="store_true", help="--strings: lumped rods refined (--segments), exact")
     parser.add_argument("--segments", type=lambda text: tuple(int(n) for n in text.split(",")), default=(16, 32, 64),
                         help="--fine: segments per rod (default 16,32,64)")
@@ -212,8 +269,12 @@ def main(argv: list[str] | None = None) -> None:
                         default=("top_hammer_piston", "four_rod_string"), help="--fine: these scenes only")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")  # Exudyn's printed notes
-    if args.checks or not (args.strings or args.lumped_lundberg):
+    if args.checks or not (args.strings or args.lumped_lundberg or args.cost or args.fronts):
         checks()
+    if args.fronts:
+        fronts()
+    if args.cost:
+        cost(args.repeat)
     if args.strings:
         strings(args.fine, args.segments, args.scenes)
     if args.lumped_lundberg:

@@ -100,7 +100,7 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     write_resolved(folder / "scene.resolved.yaml", result.raw.simulation.resolved_scene())
     written = [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml",
                *plot_timeseries(columns, result.scene, folder / "timeseries.png"),
-               draw(result.scene, folder / "drill.png")]
+               draw(result.scene, folder / "drill.png"), *_wave_readings(result, folder)]
     if animate:
         write_animation(_animated(result), folder / "drill.gif")
         written.append(folder / "drill.gif")
@@ -115,6 +115,23 @@ def run_record(result: Result) -> dict[str, Any]:
             "energy_account": None if energy is None else {"accounted": energy.accounted, "declared": energy.declared,
                                                            "unaccounted": energy.unaccounted, "note": energy.note},
             "warnings": result.warnings}
+
+
+def _wave_readings(result: Result, folder: Path) -> list[Path]:
+    """A string of wave rods' readings (models.evaluation.wave_readings): ``wave_readings.json``, the stress
+    envelope over the window's blows and a figure per gauge."""
+    readings = result.raw.wave_readings
+    if readings is None:
+        return []
+    from .figures.wave_figures import plot_envelope, plot_gauge
+
+    write_json(folder / "wave_readings.json", readings.as_dict())
+    first = result.scene.metrics.transient_blows
+    written = [folder / "wave_readings.json",
+               *plot_envelope(readings, result.scene.name, folder / "stress_envelope.png", slice(first, None))]
+    for name, gauge in readings.gauges.items():
+        written += plot_gauge(gauge, result.scene.name, folder / f"gauge_{name}.png", result.scene.impact.period_s)
+    return written
 
 
 def _animated(result: Result) -> Any:

@@ -18,7 +18,7 @@ from rpdrill.models.definition.links import RATE, STRETCH, Coupling, Link
 from rpdrill.models.drill.chain import axial_chain, link_load_n
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.models.evaluation.waves import transmitted_pulse_n, travel_time_s
+from rpdrill.models.evaluation.rod_outputs import transmitted_pulse_n, travel_time_s
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw.modes import check_mode_forces
 

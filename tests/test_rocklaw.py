@@ -41,7 +41,7 @@ def blows(amplitude_m: float, count: int = 6, points: int = 4001) -> np.ndarray:
 
 
 def test_registry_and_interface():
-    assert set(LAWS) == {"jenkins", "bilinear"}
+    assert set(LAWS) == {"jenkins", "bilinear", "none"}  # none: no rock, a string that ends free (rocklaw.free)
     for name, law in LAW_CASES.items():
         assert isinstance(law, RockLaw), name
         assert law.name in LAWS and isinstance(law, LAWS[law.name])

@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError, ValidationError
 
@@ -51,6 +52,23 @@ GROUND = "ground"
 EVERY_BODY = "every_body"
 
 
+class SnCurve(Strict):
+    """A rod's S-N curve (Basquin): N = cycles (stress_amplitude_pa / S_a)^exponent cycles to failure at a stress
+    amplitude S_a; below ``endurance_limit_pa`` (when given) a cycle does no damage."""
+
+    stress_amplitude_pa: Positive = Field(description="S_ref, the amplitude at the reference cycles")
+    cycles: Positive = Field(description="N_ref, the cycles to failure at S_ref")
+    exponent: Positive = Field(description="m, the slope of log N against log S_a")
+    endurance_limit_pa: NonNegative = 0.0
+
+    def cycles_to_failure(self, amplitude_pa: Any) -> Any:
+        """N(S_a) (infinite below the endurance limit)."""
+        amplitude = np.asarray(amplitude_pa, dtype=float)
+        with np.errstate(divide="ignore"):
+            cycles = self.cycles * (self.stress_amplitude_pa / amplitude) ** self.exponent
+        return np.where(amplitude > self.endurance_limit_pa, cycles, np.inf)
+
+
 class Body(Strict):
     """One body of the drill string: a rigid ``mass_kg``, a rod given by its geometry, or a pipe
     given by its length and weight per metre.
@@ -80,6 +98,7 @@ class Body(Strict):
     density_kg_per_m3: Positive = STEEL_DENSITY_KG_PER_M3
     segments: Annotated[int, Field(ge=1, le=MAX_CHAIN_BODIES)] = 1
     model: Literal["lumped", "waves"] = Field("lumped", description="a rod as lumped segments or as waves")
+    sn_curve: SnCurve | None = Field(None, description="a wave rod's S-N curve: Miner's damage per blow at its gauges")
 
     @model_validator(mode="after")
     def _mass_or_geometry(self) -> Body:
@@ -96,6 +115,8 @@ class Body(Strict):
             raise ValueError("segments > 1 needs a rod geometry (length_m, diameter_m)")
         if self.model == "waves" and not self.is_rod:
             raise _key_error("Body", ("model",), self.model, "a wave rod needs a rod geometry (length_m, diameter_m)")
+        if self.sn_curve is not None and self.model != "waves":
+            raise _key_error("Body", ("sn_curve",), None, "a wave rod's (model: waves): its gauges' stresses are counted")
         if self.model == "waves" and self.segments > 1:
             raise _key_error("Body", ("segments",), self.segments, "segments are the lumped model's; a rod with "
                              "model: waves carries its waves exactly and has none (leave segments out)")
@@ -142,7 +163,11 @@ class Connector(Strict):
     """A link from body ``from`` (nearer the hammer, or ``ground``) to body ``to``, of a ``type`` of
     :data:`models.definition.links.LINK_TYPES`: ``spring_damper`` (bonded, F = k delta + c delta') or
     ``coupling`` (compression only once its ``gap_m`` has closed). Without ``stiffness_n_per_m`` the
-    stiffness follows from the rods it joins (:class:`Body`).
+    stiffness follows from the rods it joins (:class:`Body`), or for a threaded coupling with a sleeve
+    (``sleeve_length_m``, ``sleeve_outer_diameter_m``) from the sleeve: k = E pi (D_s^2 - D^2) / (4 L_s), D the
+    larger of the joined rods' diameters (the threads' diameter), E the upper rod's (models.drill.chain): bonded
+    (``spring_damper``: the threads carry tension) or compression only once a gap has closed (``coupling``). A
+    ``coupling`` between two wave rods without a stiffness or a sleeve is a rigid contact: compression only.
     """
 
     model_config = ConfigDict(populate_by_name=True)
@@ -153,11 +178,21 @@ class Connector(Strict):
     stiffness_n_per_m: Positive | None = None
     damping_n_s_per_m: NonNegative = 0.0
     gap_m: NonNegative | None = Field(None, description="coupling gap, m (type coupling; default 0)")
+    sleeve_length_m: Positive | None = Field(None, description="a threaded coupling's sleeve: its length")
+    sleeve_outer_diameter_m: Positive | None = Field(None, description="a coupling's sleeve: its outer diameter")
 
     @model_validator(mode="after")
     def _known_type_and_parameters(self) -> Connector:
         if self.type not in LINK_TYPES:
             raise ValueError(f"type {self.type!r} is not one of {', '.join(LINK_TYPES)}")
+        sleeve = [key for key in ("sleeve_length_m", "sleeve_outer_diameter_m") if getattr(self, key) is not None]
+        if len(sleeve) == 1:
+            missing = ({"sleeve_length_m", "sleeve_outer_diameter_m"} - set(sleeve)).pop()
+            raise _key_error("Connector", (missing,), None, "missing: a sleeve is its length and its outer diameter "
+                             "(its stiffness E A / L, A over the rods' diameter)")
+        if sleeve and self.stiffness_n_per_m is not None:
+            raise _key_error("Connector", ("stiffness_n_per_m",), self.stiffness_n_per_m, "give the stiffness or the "
+                             "sleeve it follows from, not both")
         taken = LINK_TYPES[self.type].parameters()
         given = [key for key in ("gap_m",) if getattr(self, key) is not None and key not in taken]
         if given:
@@ -167,12 +202,19 @@ class Connector(Strict):
 
 
 class DrillString(Strict):
-    """The axial chain: bodies and connectors by name, in order from the hammer to the rock."""
+    """The axial chain: bodies and connectors by name, in order from the hammer to the rock. Without a
+    ``rock_body`` the string ends free below its last body (the scene's rock is then ``law: none``)."""
 
     bodies: Annotated[dict[Name, Body], Field(min_length=1)]
     connectors: dict[Name, Connector] = Field(default_factory=dict)
     impact_body: Name = Field(description="the body the piston strikes")
-    rock_body: Name = Field(description="the body that touches the rock (the bit)")
+    rock_body: Name | None = Field(None, description="the body that touches the rock (the bit); none: the string "
+                                   "ends free")
+
+    @property
+    def foot(self) -> str:
+        """The body at the string's lower end: the rock body, or the last body of a string that ends free."""
+        return self.rock_body if self.rock_body is not None else list(self.bodies)[-1]
 
     @model_validator(mode="after")
     def _consistent(self) -> DrillString:
@@ -182,7 +224,7 @@ class DrillString(Strict):
                 raise _key_error("DrillString", ("bodies", reserved), reserved, "a reserved word, not a body name "
                                  "('{ground}' and '{every}' name the ground and every body)", ground=GROUND, every=EVERY_BODY)
         for role in ("impact_body", "rock_body"):
-            if getattr(self, role) not in names:
+            if getattr(self, role) not in names and (role == "impact_body" or self.rock_body is not None):
                 raise ValueError(f"{role} {getattr(self, role)!r} is not a body; bodies: {', '.join(names)}")
         for name, connector in self.connectors.items():
             taken = [column for column in (f"{name}{suffix}" for suffix in LINK_SERIES) if column in SERIES]
@@ -196,7 +238,13 @@ class DrillString(Strict):
             if connector.from_body == connector.to_body:
                 raise ValueError(f"connectors.{name} joins {connector.to_body!r} to itself")
             ends = [self.bodies[b] for b in (connector.from_body, connector.to_body) if b != GROUND]
-            if connector.stiffness_n_per_m is None and not any(b.is_rod for b in ends):
+            bore = max((b.diameter_m or 0.0 for b in ends), default=0.0)
+            if connector.sleeve_outer_diameter_m is not None and connector.sleeve_outer_diameter_m <= bore:
+                raise _key_error("DrillString", ("connectors", name, "sleeve_outer_diameter_m"),
+                                 connector.sleeve_outer_diameter_m, "must exceed the joined rods' diameter {bore} m",
+                                 bore=bore)
+            if connector.stiffness_n_per_m is None and connector.sleeve_length_m is None and \
+                    not any(b.is_rod for b in ends):
                 raise ValueError(f"connectors.{name} needs stiffness_n_per_m: neither end is a rod with a geometry")
             if connector.stiffness_n_per_m is None and all(b.half_segment_compliance_m_per_n() == 0 for b in ends) \
                     and connector.from_body == GROUND:
@@ -230,16 +278,16 @@ class DrillString(Strict):
             joined[ends[1]].append((name, ends[0]))
         for part in _parts(joined):
             bodies = [b for b in self.bodies if b in part]
-            if self.rock_body in part or not bodies:
+            if self.foot in part or not bodies:
                 continue
             if len(bodies) == 1 and not joined[bodies[0]]:
                 problems.append(_problem(("bodies", bodies[0]), bodies[0], "no connector joins this body to the drill "
-                                         "string; every body is joined to rock_body '{rock}'", rock=self.rock_body))
+                                         "string; every body is joined to rock_body '{rock}'", rock=self.foot))
             else:
                 to = " and ".join(["each other"] * (len(bodies) > 1) + [GROUND] * (GROUND in part))
                 problems.append(_problem(("bodies", bodies[0]), bodies, "a separate part: joined to {to} but not to "
                                          "rock_body '{rock}'; every body is joined to the rock body through connectors",
-                                         to=to, rock=self.rock_body))
+                                         to=to, rock=self.foot))
         if problems:
             raise ValidationError.from_exception_data("DrillString", problems)
 

@@ -19,7 +19,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, Field, PrivateAttr, ValidationInfo, field_validator, model_validator
 from pydantic_core import ValidationError
 
-from ...rocklaw import BilinearRock, JenkinsRock, RockLaw
+from ...rocklaw import BilinearRock, JenkinsRock, NoRock, RockLaw
 from ...rocklaw.base import is_rock_law_class, missing_members
 from ...rocklaw.catalog import TABLE_1
 from .drill_string import NonNegative, Positive, Strict, _key_error, _problem
@@ -31,6 +31,7 @@ JENKINS_VALUES = ("stiffness_n_per_m", "damping_n_s_per_m", "threshold_n")
 ROCK_LAW_KEYS = {
     "jenkins": ("name", "stiffness_n_per_m", "damping_n_s_per_m", "threshold_n", "damping_mode"),
     "bilinear": ("loading_stiffness_n_per_m", "unloading_stiffness_n_per_m"),
+    "none": (),  # no rock: the string ends free (rocklaw.free)
 }
 BUILT_IN_LAWS = tuple(ROCK_LAW_KEYS)
 
@@ -53,8 +54,8 @@ class Rock(Strict):
 
     ``jenkins`` (default; the paper's Eq. 1, 2): a Table 1 ``name``, explicit values, or a name
     with overrides; ``damping_mode`` ``contact`` (default) or ``always``. ``bilinear``: loading
-    stiffness k_l and unloading stiffness k_u > k_l (rocklaw.bilinear). ``module:Class``: a law of
-    one's own with its keys in ``parameters`` (module doc).
+    stiffness k_l and unloading stiffness k_u > k_l (rocklaw.bilinear). ``none``: no rock, the string ends
+    free (rocklaw.free). ``module:Class``: a law of one's own with its keys in ``parameters`` (module doc).
     """
 
     law: str = "jenkins"
@@ -108,6 +109,8 @@ class Rock(Strict):
                             "Rock")
         if self.law == "bilinear":
             return self._check_bilinear()
+        if self.law == "none":
+            return self
         if self.name is None:
             missing = [k for k in JENKINS_VALUES if getattr(self, k) is None]
             if missing:
@@ -173,6 +176,8 @@ class Rock(Strict):
             target = self.found.target
             return target(**check_parameters(target, self.parameters or {}, ("parameters",), "Rock"))
         rock = self.completed()
+        if rock.law == "none":
+            return NoRock()
         if rock.law == "bilinear":
             loading = rock.loading_stiffness_n_per_m
             return BilinearRock(loading, rock.unloading_stiffness_n_per_m if plasticity else loading)

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
-from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
+from pydantic import Field, PrivateAttr, ValidationInfo, model_validator
 
 from .drill_string import (
     EVERY_BODY,
@@ -40,9 +40,10 @@ from .formulations import (
     PRESETS,
     STEADY_STATES,
 )
-from .outputs import BODY_METRICS, METRICS, SERIES, Need, body_metric, metric_need, needs
+from .outputs import BODY_METRICS, METRICS, SERIES, Need, metric_need, needs
 from .own_code import ALLOW_CODE, allowance, allowed_modules
 from .rock import JENKINS_VALUES, ROCK_LAW_KEYS, Rock, refuse_foreign_keys
+from .sections import EFFECTS, Effects, Metrics, Outputs
 from .validation import InputError, parse, short, with_changes
 
 __all__ = ["JENKINS_VALUES", "ROCK_LAW_KEYS", "Rock", "Scene"]
@@ -173,56 +174,6 @@ def switch_formulation(solver: dict[str, Any], formulation: str) -> dict[str, An
     return {**{key: value for key, value in solver.items() if key in COMMON_SOLVER_KEYS}, "formulation": formulation}
 
 
-EFFECTS = ("torsion", "rock_damping", "rock_plasticity", "joint_damping", "indexing")
-
-
-class Effects(Strict):
-    """Which parts of the model are built (the axial impact chain always is).
-
-    In a scene: ``true`` builds an effect, ``false`` leaves it out, a key absent leaves it out
-    unless a requested output needs it; no ``effects`` section at all builds every effect the
-    scene gives parameters for (the full model); :func:`built_effects` resolves them for a run.
-    ``reasons`` is informational (a resolved scene file says there why each effect was built).
-    ``rock_plasticity`` off gives an elastic rock that never crushes. ``indexing`` couples rotation
-    to penetration (models.drill.indexing): the angle the bit turned between two blows (``rotation`` or the
-    torsion line) and the ``bit`` geometry set how each blow meets the rock.
-    """
-
-    torsion: bool | None = None
-    rock_damping: bool | None = None
-    rock_plasticity: bool | None = None
-    joint_damping: bool | None = None
-    indexing: bool | None = None
-    reasons: dict[str, str] = Field(default_factory=dict)
-
-
-class Outputs(Strict):
-    """Requested metrics and time histories (time, positions and velocities always come).
-
-    No ``outputs`` section: every metric and history of the effects that are built. A list left
-    out of a given section is empty.
-    """
-
-    metrics: list[str] = Field(default_factory=list)
-    timeseries: list[Literal[tuple(SERIES)]] = Field(default_factory=list)  # type: ignore[valid-type]
-
-    @field_validator("metrics")
-    @classmethod
-    def _known_metrics(cls, names: list[str]) -> list[str]:
-        for name in names:
-            if name not in METRICS and body_metric(name) is None:
-                raise ValueError(f"{name!r} is not a metric: one of {', '.join(METRICS)}, or a body's "
-                                 f"<body>{', <body>'.join(BODY_METRICS)}")
-        return names
-
-
-class Metrics(Strict):
-    """Averaging window: skip ``transient_blows`` blows, then whole blocks of ``block_blows`` blows."""
-
-    transient_blows: Annotated[int, Field(ge=0, le=MAX_COUNT)] = 10
-    block_blows: Annotated[int, Field(ge=1, le=MAX_COUNT)] = 5
-
-
 class Scene(Strict):
     """One drill on one rock with one solver setting: the typed content of a scene file (data only, immutable).
 
@@ -327,6 +278,36 @@ class Scene(Strict):
         return parse(Scene, {**data, "solver": {**solver, **options}}, "Scene.with_solver",
                      context={ALLOW_CODE: self._allowed_code})
 
+    @model_validator(mode="before")
+    @classmethod
+    def _free_string_without_rock(cls, data: Any) -> Any:
+        """A string without a rock body ends free: its rock is ``law: none`` when the scene gives none."""
+        if isinstance(data, Mapping) and "rock" not in data and isinstance(data.get("drill_string"), Mapping) \
+                and data["drill_string"].get("rock_body") is None:
+            return {**data, "rock": {"law": "none"}}
+        return data
+
+    @model_validator(mode="after")
+    def _rock_on_a_rock_body(self) -> Scene:
+        if self.drill_string.rock_body is None and self.rock.law != "none":
+            raise _key_error("Scene", ("drill_string", "rock_body"), None, "missing: rock law '{law}' acts on the "
+                             "rock body; leave out the rock section (or give rock: {{law: none}}) for a string that "
+                             "ends free", law=self.rock.law)
+        return self
+
+    @model_validator(mode="after")
+    def _gauges_on_wave_rods(self) -> Scene:
+        for name, gauge in (self.outputs.gauges if self.outputs else {}).items():
+            body = self.drill_string.bodies.get(gauge.rod)
+            if body is None or not body.is_wave:
+                waves = [b for b, value in self.drill_string.bodies.items() if value.is_wave]
+                raise _key_error("Scene", ("outputs", "gauges", name, "rod"), gauge.rod, "a gauge sits on a wave rod "
+                                 "(model: waves); the scene's: {rods}", rods=", ".join(waves) or "none")
+            if gauge.position_m > body.length_m:
+                raise _key_error("Scene", ("outputs", "gauges", name, "position_m"), gauge.position_m, "beyond the "
+                                 "rod's length {length} m (the distance from its top)", length=body.length_m)
+        return self
+
     @model_validator(mode="after")
     def _feed_body_exists(self) -> Scene:
         bodies = self.drill_string.bodies
@@ -381,7 +362,7 @@ class Scene(Strict):
     @model_validator(mode="after")
     def _end_time_and_step_fit_the_blows(self) -> Scene:
         period = self.impact.period_s
-        if self.solver.end_time_s < period:
+        if self.solver.end_time_s < period * (1 - 1e-12):  # a period of the run's end time, to its rounding
             raise ValueError(
                 f"solver.end_time_s {self.solver.end_time_s} is shorter than one impact period ({period:.6g} s)"
             )
@@ -465,8 +446,9 @@ def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
     """The scene's outputs, or without an outputs section every metric and history of the effects
     built and the bodies present (a scene with rods: each rod's figures too, ``<rod>_compressive_stress_max_pa``
     ...: models.definition.outputs.BODY_METRICS of the rods' data)."""
-    if scene.outputs is not None:
+    if scene.outputs is not None and (scene.outputs.metrics or scene.outputs.timeseries or not scene.outputs.gauges):
         return scene.outputs
+    gauges = scene.outputs.gauges if scene.outputs is not None else {}  # gauges alone: the default outputs besides
     built = {effect for effect, on in effects.as_dict().items() if on}
     bodies = set(scene.drill_string.bodies)
     rods = any(body.is_rod for body in scene.drill_string.bodies.values())
@@ -476,4 +458,4 @@ def requested_outputs(scene: Scene, effects: BuiltEffects) -> Outputs:
     per_rod = [f"{name}{suffix}" for name, body in scene.drill_string.bodies.items() if body.is_rod
                for suffix, need in BODY_METRICS.items() if "rods" in need.data]
     return Outputs(metrics=[m for m, n in METRICS.items() if available(n)] + per_rod,
-                   timeseries=[s for s, n in SERIES.items() if available(n)])
+                   timeseries=[s for s, n in SERIES.items() if available(n)], gauges=gauges)

@@ -197,7 +197,7 @@ def axial_chain(scene: Scene, joint_damping: bool = True) -> AxialChain:
     for name, connector in string.connectors.items():
         links.append(_connector_link(scene, name, connector, groups, joint_damping))
     return AxialChain(tuple(bodies), tuple(links), impact_body=groups[string.impact_body][0],
-                      bit_body=groups[string.rock_body][1], groups=groups, waves=tuple(waves))
+                      bit_body=groups[string.foot][1], groups=groups, waves=tuple(waves))
 
 
 def _connector_link(scene: Scene, name: str, connector: Connector, groups: dict[str, tuple[int, int]],
@@ -206,12 +206,26 @@ def _connector_link(scene: Scene, name: str, connector: Connector, groups: dict[
     ends = [bodies[b] for b in (connector.from_body, connector.to_body) if b != GROUND]
     compliance = sum(body.half_segment_compliance_m_per_n() for body in ends)
     rigid = math.inf if compliance == 0 else None  # rigid faces joined without a stiffness (module doc)
-    stiffness = connector.stiffness_n_per_m or rigid or _derived_stiffness_n_per_m(ends)
+    stiffness = connector.stiffness_n_per_m or sleeve_stiffness_n_per_m(connector, ends) or rigid or \
+        _derived_stiffness_n_per_m(ends)
     body_a = None if connector.from_body == GROUND else groups[connector.from_body][1]
     extra = {key: getattr(connector, key) for key in LINK_TYPES[connector.type].parameters()
              if getattr(connector, key) is not None}
     return LINK_TYPES[connector.type](name, body_a, groups[connector.to_body][0], stiffness,
                                       connector.damping_n_s_per_m if damped else 0.0, **extra)
+
+
+def sleeve_stiffness_n_per_m(connector: Connector, ends: list[Body]) -> float | None:
+    """A coupling's sleeve as a spring: E pi (D_s^2 - D^2) / (4 L_s), D the larger of the joined bodies' diameters
+    (its bore: the threads), E the first's modulus; None without a sleeve."""
+    if connector.sleeve_length_m is None:
+        return None
+    bore = max(body.diameter_m or 0.0 for body in ends)
+    if connector.sleeve_outer_diameter_m <= bore:
+        raise ValueError(f"sleeve_outer_diameter_m {connector.sleeve_outer_diameter_m} must exceed the rods' diameter "
+                         f"{bore}")
+    area = math.pi * (connector.sleeve_outer_diameter_m**2 - bore**2) / 4
+    return ends[0].youngs_modulus_pa * area / connector.sleeve_length_m
 
 
 def link_load_n(chain: AxialChain, positions: np.ndarray, velocities: np.ndarray,

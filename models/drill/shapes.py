@@ -104,4 +104,4 @@ def layout(scene: Scene) -> Layout:
             x += length / len(parts)
         x += gap
     cylinders = tuple(cylinder for name in bodies for cylinder in placed[name])  # the chain's order
-    return Layout(cylinders, gap, placed[scene.drill_string.rock_body][-1].end_m)
+    return Layout(cylinders, gap, placed[scene.drill_string.foot][-1].end_m)

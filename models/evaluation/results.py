@@ -13,6 +13,7 @@ from ..drill.chain import AxialChain
 from .parts import link_series
 from .rod_outputs import stress_columns
 from .run_record import ExudynModelRecord, SolverRecord, SteadyStateRecord
+from .wave_readings import WaveReadings, wave_readings
 
 if TYPE_CHECKING:
     from ..drill.piston import PistonHistory
@@ -96,6 +97,11 @@ class SimulationResult:
         return self.simulation.scene
 
     @property
+    def wave_readings(self) -> WaveReadings | None:
+        """The readings along a string of wave rods (models.evaluation.wave_readings); None without wave rods."""
+        return wave_readings(self)
+
+    @property
     def chain(self) -> AxialChain:
         return self.simulation.chain
 
@@ -166,11 +172,15 @@ class SimulationResult:
         return out
 
     def resampled(self, interval_s: float) -> dict[str, np.ndarray]:
-        """Histories on a uniform grid of ``interval_s`` (x_n held, the rest interpolated)."""
+        """Histories on a uniform grid of ``interval_s`` (x_n held, the rest interpolated), with wave rods also
+        the samples on both sides of every front and at every blow's peaks (models.waves.recording), as recorded."""
         grid = np.arange(0.0, self.time_s[-1] + 0.5 * interval_s, interval_s)
         grid = grid[grid <= self.time_s[-1] + 1e-12]
+        kept = self.waves.kept if self.waves is not None else np.zeros(0, dtype=int)
+        order = np.argsort(np.concatenate([grid, self.time_s[kept]]), kind="stable")
         out = {}
         for name, values in self.columns().items():
-            out[name] = self.bottom_at(grid) if name == "borehole_bottom_m" else np.interp(grid, self.time_s, values)
-        out["time_s"] = grid
+            on_grid = self.bottom_at(grid) if name == "borehole_bottom_m" else np.interp(grid, self.time_s, values)
+            out[name] = np.concatenate([on_grid, values[kept]])[order]
+        out["time_s"] = np.concatenate([grid, self.time_s[kept]])[order]
         return out

@@ -137,3 +137,28 @@ def _blow_index(result: Any, closing: bool = True) -> np.ndarray:
     if closing:
         return np.maximum(np.ceil(result.time_s / period - 1e-9).astype(int) - 1, 0)
     return np.floor(result.time_s / period + 1e-9).astype(int)
+
+
+# Stress waves in a segmented rod (a rod of length L split into N lumped segments, models.drill.chain, is a
+# discrete wave-guide: its long waves travel at c = sqrt(E / rho), its cut-off is omega_max = 2 c N / L, so a
+# pulse of duration tau is carried faithfully once N >> L / (c tau)): the travel time of a pulse from the struck
+# end to the rock, between the instants the impact force and the rock force first reach half of their peaks.
+
+def first_crossing_s(time_s: np.ndarray, values: np.ndarray, fraction: float = 0.5) -> float:
+    """First time ``values`` reaches ``fraction`` of its peak, linearly interpolated between samples."""
+    level = fraction * np.max(values)
+    i = int(np.argmax(values >= level))
+    if i == 0:
+        return float(time_s[0])
+    t0, t1, v0, v1 = time_s[i - 1], time_s[i], values[i - 1], values[i]
+    return float(t0 + (level - v0) / (v1 - v0) * (t1 - t0))
+
+
+def travel_time_s(result: Any) -> float:
+    """Half-peak arrival of the rock force minus half-peak arrival of the impact force."""
+    return first_crossing_s(result.time_s, result.rock_force_n) - first_crossing_s(result.time_s, result.impact_force_n)
+
+
+def transmitted_pulse_n(result: Any, time_s: np.ndarray) -> np.ndarray:
+    """The rock force interpolated onto ``time_s`` (to compare runs of different segmentations)."""
+    return np.interp(time_s, result.time_s, result.rock_force_n)

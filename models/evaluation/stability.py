@@ -19,7 +19,7 @@ from scipy.linalg import block_diag, eigvals
 
 from ...rocklaw import RockLaw
 from ..definition.scene import Scene, Torsion
-from ..drill.chain import AxialChain, torsion_first_order_matrix
+from ..drill.chain import AxialChain, joined, torsion_first_order_matrix
 from ..drill.pulse import impulse_per_blow_n_s
 from .energy import energy_account
 from .solver_settings import StepScales
@@ -103,6 +103,39 @@ def scales_of(eigenvalues: np.ndarray, blow_period_s: float, damper_rate_per_s: 
     |lambda|_max, the largest |lambda| still ringing at the next blow (-Re(lambda) T < 1) and c_n / m_bit."""
     ringing = np.abs(eigenvalues[-eigenvalues.real * blow_period_s < 1.0])
     return StepScales(float(np.abs(eigenvalues).max(initial=0.0)), float(ringing.max(initial=0.0)), damper_rate_per_s)
+
+
+def wave_bodies_eigenvalues_per_s(chain: AxialChain, law: RockLaw) -> np.ndarray:
+    """The eigenvalues of what Exudyn integrates in a scene with wave rods (models.waves.exudyn_waves): the
+    bodies with mass, the links between them (and ground), the rock on a bit with mass at its stiffest, and
+    the dashpot Z of every rod end joined rigidly to one of them; the faces, the rods and what touches a face
+    are the wave element's, integrated exactly (not on the explicit solver's step), so a rigid joint's
+    infinite stiffness and a face's zero mass take no part."""
+    masses = np.array([body.mass_kg for body in chain.bodies])
+    bodies = np.flatnonzero(masses > 0)
+    if not len(bodies):
+        return np.zeros(0)
+    index = {int(node): i for i, node in enumerate(bodies)}
+    n = len(bodies)
+    stiffness, damping = np.zeros((n, n)), np.zeros((n, n))
+    for link in chain.links:
+        if link.rigid or link.body_b not in index or (link.body_a is not None and link.body_a not in index):
+            continue
+        ends = [(index[link.body_b], 1.0)] + ([] if link.body_a is None else [(index[link.body_a], -1.0)])
+        for i, si in ends:
+            for j, sj in ends:
+                stiffness[i, j] += si * sj * link.stiffness_n_per_m
+                damping[i, j] += si * sj * link.damping_n_s_per_m
+    if chain.bit_body in index:
+        bit = index[chain.bit_body]
+        stiffness[bit, bit] += max(law.loading_stiffness_n_per_m, min(law.unloading_stiffness_n_per_m, 1e300))
+        damping[bit, bit] += law.damping_n_s_per_m
+    owner = joined(chain.size, chain.rigid_pairs(), frozenset(index))
+    for rod in chain.waves:
+        for node in (rod.top, rod.bottom):
+            if owner[node] in index:  # a face joined rigidly to a body with mass: the rod's dashpot on it
+                damping[index[owner[node]], index[owner[node]]] += rod.impedance_n_s_per_m
+    return second_order_eigenvalues_per_s(np.diag(masses[bodies]), stiffness, damping)
 
 
 def second_order_eigenvalues_per_s(mass: np.ndarray, stiffness: np.ndarray, damping: np.ndarray) -> np.ndarray:
@@ -204,8 +237,12 @@ def spring_spread(scene: Scene, chain: AxialChain, law: RockLaw) -> tuple[str, f
     rock_key = "rock.unloading_stiffness_n_per_m" if scene.rock.law == "bilinear" else "rock.stiffness_n_per_m"
     rock = max(law.loading_stiffness_n_per_m, law.unloading_stiffness_n_per_m)
     springs = [(rock, rock_key, getattr(scene.rock, rock_key.split(".")[1]))]
+    for rod in chain.waves:  # a wave rod is a spring E A / L in the statics (models.waves.statics)
+        if rod.name in scene.drill_string.bodies:
+            springs.append((rod.stiffness_n_per_m, f"drill_string.bodies.{rod.name}.youngs_modulus_pa",
+                            scene.drill_string.bodies[rod.name].youngs_modulus_pa))
     for link in chain.links:
-        if link.stiffness_n_per_m > 0:
+        if 0 < link.stiffness_n_per_m < math.inf:  # a rigid joint is one point in the statics, not a spring
             connector = scene.drill_string.connectors.get(link.name)
             key = f"drill_string.connectors.{link.name}.stiffness_n_per_m" if connector is not None else \
                 f"drill_string.bodies.{owner[link.body_b]}.youngs_modulus_pa"
@@ -223,8 +260,17 @@ def largest_stable_step_s(simulation: PreparedRun, solver_type: str | None = Non
     if solver_type not in STABLE_STEP_FACTOR:
         return None
     factor = STABLE_STEP_FACTOR[solver_type]
-    radius = simulation.spectral_radius_per_s or spectral_radius_per_s(simulation.chain, simulation.rock,
-                                                                        simulation.torsion)
+    if simulation.dynamic_chain.waves:  # what Exudyn integrates beside the wave element
+        rates = np.abs(wave_bodies_eigenvalues_per_s(simulation.chain, simulation.rock))
+        if simulation.torsion is not None:
+            rates = np.concatenate([rates, np.abs(np.linalg.eigvals(
+                torsion_first_order_matrix(simulation.torsion)[:, :-1]))])
+        radius = float(rates.max(initial=0.0))
+        if radius == 0.0:
+            return math.inf
+    else:
+        radius = simulation.spectral_radius_per_s or spectral_radius_per_s(simulation.chain, simulation.rock,
+                                                                            simulation.torsion)
     return 0.0 if factor is None else factor / radius
 
 

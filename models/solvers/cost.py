@@ -17,7 +17,9 @@ of the order of the spectral radius |lambda|_max), n bodies and a state of m = 2
   states per step) and m values per sample.
 
 * a scene with wave rods (models.waves), either formulation: T / h steps of the characteristics, h the
-  wave step (models.waves.steps), at a measured cost per step and body; it stores its samples only.
+  wave step (models.waves.steps), at a measured cost per step and body; it stores its samples, every rod
+  end's waves over the longest rod's transit (T_rod / h steps: a tiny step on a long rod is refused naming the
+  key that makes that rod's transit long against the step) and the levels of its keys.
 
 Histories resampled after the run (``rpdrill simulate``: every ``output_interval_s``) add 2 n + 8
 columns. Memory is 8 bytes per value times the copies held at the peak (MEMORY_COPIES,
@@ -50,6 +52,12 @@ CPU_S_PER_STEP = {"exudyn": (3e-6, 6e-7, 1), "exact": (2.6e-7, 3.2e-9, 2), "exac
                   # a step of the characteristics (benchmarks/bench_waves.py --strings: 14 and 12 bodies)
                   "exact waves": (0.0, 2e-6, 1), "exudyn waves": (0.0, 1.7e-5, 1)}
 ODE_STEPS_PER_RADIAN = 2.0  # DOP853 steps per unit of r T
+# a rod end's stored waves per step of the characteristics held (models.waves.history: left, right, start, square,
+# mean, broken) over the longest rod's transit; the levels of one key of the characteristics' system (models.waves.levels:
+# 33 propagators, their Gram matrices and integrals) per state^2, and at most this many keys held
+WAVE_VALUES_PER_CELL = 6
+WAVE_KEY_VALUES = 100
+WAVE_KEYS = 64
 ODE_STAGES = 10  # state vectors per step kept by DOP853's dense output
 OPERATOR_VALUES = 55  # values per state^2 of one exact propagator key (expm, anchors, read-outs, Taylor)
 # stored values held at once at the peak of a run (its storage, the result's arrays and their copies),
@@ -201,14 +209,31 @@ def _waves(simulation: Simulation) -> tuple[float, Cause, list[Part]]:
     else:
         preset = settings.preset or DEFAULT_PRESET
         shortest = min(waves, key=lambda rod: rod.transit_time_s)
-        where = "impact.piston" if shortest.name == PISTON else f"drill_string.bodies.{shortest.name}"
-        cause = Cause(f"{where}.length_m", shortest.length_m)
+        cause = _rod_cause(scene, shortest.name)
         if simulation.pulse_duration_s / STEPS_PER_PULSE[preset] < shortest.transit_time_s / STEPS_PER_TRANSIT[preset]:
             cause = _pulse(simulation)
     sampled = _interval(simulation) if settings.formulation == "exact" else \
         Cause("solver.output_interval_s", settings.output_interval_s)
     values = _state_size(simulation) + 2 + 2 * len(waves) + len(simulation.dynamic_chain.links)
-    return step, cause, [(sampled, settings.end_time_s / sampled.value * values, sampled.value)]
+    longest = max(waves, key=lambda rod: rod.transit_time_s)
+    grid = cause if getattr(scene.solver, given) is not None else _rod_cause(scene, longest.name)
+    cells = 2 * len(waves) * (longest.transit_time_s / step + 2) * WAVE_VALUES_PER_CELL
+    m = _state_size(simulation) + 4 * len(waves)  # the characteristics' state: every port's (a, b)
+    keys = min(2 ** len(simulation.dynamic_chain.nonlinear_links()) * len(simulation.rock.modes()), WAVE_KEYS)
+    return step, cause, [(sampled, settings.end_time_s / sampled.value * values, sampled.value), (grid, cells, None),
+                         (Cause("drill_string.bodies", f"{len(waves)} wave rods"), keys * WAVE_KEY_VALUES * m**2, None)]
+
+
+def _rod_cause(scene, name: str) -> Cause:
+    """The key of a rod's transit time that departs most from a steel rod of a metre (log scale): its length,
+    its Young's modulus or its density (a piston's under impact.piston)."""
+    body = scene.impact.piston if name == PISTON else scene.drill_string.bodies[name]
+    where = "impact.piston" if name == PISTON else f"drill_string.bodies.{name}"
+    departures = {"length_m": abs(math.log10(body.length_m / 1.0)),
+                  "youngs_modulus_pa": abs(math.log10(body.youngs_modulus_pa / 2.1e11)),
+                  "density_kg_per_m3": abs(math.log10(body.density_kg_per_m3 / 7850.0))}
+    key = max(departures, key=departures.get)
+    return Cause(f"{where}.{key}", getattr(body, key))
 
 
 ESTIMATES = {"exudyn": _exudyn, "exact": _exact, "ode": _ode}

@@ -52,7 +52,7 @@ from ..drill.wave_rod import WaveRod
 from ..evaluation.solver_settings import ExudynSettings, Settings, resolve_settings
 from ..evaluation.stability import FastestElement, StepScales, fastest_element, spring_spread, step_scales
 from ..waves.statics import wave_preload_m
-from ..waves.steps import wave_settings
+from ..waves.steps import WaveStepError, wave_settings
 
 
 class SceneError(ValueError):
@@ -208,7 +208,10 @@ def solver_settings(scene: Scene, piston: PistonSetup | None, scales: StepScales
     pulse_s = scene.impact.duration_s if piston is None else piston.pulse_duration_s
     settings = resolve_settings(scene.solver, pulse_s, scales)
     if waves:
-        return wave_settings(settings, scene.solver, waves, scene.impact, pulse_s)
+        try:
+            return wave_settings(settings, scene.solver, waves, scene.impact, pulse_s)
+        except WaveStepError as error:
+            raise SceneError(("solver", error.key), error.value, str(error)) from None
     if piston is not None and isinstance(settings, ExudynSettings) and scene.solver.step_s is None:
         # the strikes fall on step starts: a whole number of steps per period (a strike one step late
         # shifts the blow against the string's ringing; 2 % in the rate of the top-hammer scene)

@@ -42,9 +42,10 @@ def simulate(simulation, progress: Callable[[float], None] | None = None) -> Sim
 def result(stepper: Stepper, formulation: str, cpu_s: float, coordinates: int | None = None) -> SimulationResult:
     """The run's result from the stepper's samples (module doc)."""
     simulation, layout, samples = stepper.simulation, stepper.layout, stepper.samples
-    time_s = np.array(samples.time_s)
-    states, velocity = np.array(samples.states), np.array(samples.velocity)
-    forces, works = np.array(samples.forces), np.array(samples.works)
+    order = samples.order()  # a blow's peaks are recorded once it is done (models.waves.recording)
+    time_s = np.array(samples.time_s)[order]
+    states, velocity = np.array(samples.states)[order], np.array(samples.velocity)[order]
+    forces, works = np.array(samples.forces)[order], np.array(samples.works)[order]
     string = simulation.chain.size
     rock_states = states[:, layout.rock:layout.rock + layout.rock_states]
     piston = None if stepper.setup is None else _piston(stepper, time_s, states, velocity, forces[:, 1])
@@ -52,9 +53,10 @@ def result(stepper: Stepper, formulation: str, cpu_s: float, coordinates: int | 
     record = WaveRecord(
         rods=chain.waves, ports=tuple((chain.waves[p.rod].name, p.end) for p in stepper.ports),
         step_s=stepper.step_s, transit_errors=transit_errors(chain.waves, stepper.step_s),
-        compression_n=np.array(samples.compression).reshape(len(time_s), len(stepper.ports)),
+        compression_n=np.array(samples.compression).reshape(len(time_s), len(stepper.ports))[order],
         **{f"blow_{name}": value for name, value in stepper.statistics.arrays(len(stepper.ports)).items()},
-        energy_j=np.array(samples.waves_j),
+        envelopes=stepper.statistics.envelopes, gauges=stepper.statistics.gauges,
+        energy_j=np.array(samples.waves_j)[order], kept=np.flatnonzero(np.array(samples.kept, dtype=bool)[order]),
         joint_force_n={name: forces[:, 2 + i] for i, name in enumerate(stepper.rigid_names)})
     return SimulationResult(
         simulation=simulation, formulation=formulation, time_s=time_s,
@@ -75,9 +77,10 @@ def result(stepper: Stepper, formulation: str, cpu_s: float, coordinates: int | 
 def _piston(stepper: Stepper, time_s: np.ndarray, states: np.ndarray, velocity: np.ndarray,
             contact_force_n: np.ndarray) -> PistonHistory:
     setup, jumps = stepper.setup, stepper.jumps
-    after = np.array(stepper.samples.after)  # a strike at a blow start comes after the sample there
+    order = stepper.samples.order()
+    after = np.array(stepper.samples.after)[order]  # a strike at a blow start comes after the sample there
     energy = None
     if stepper.piston_rod is not None:
-        energy = np.array(stepper.samples.piston_j)
+        energy = np.array(stepper.samples.piston_j)[order]
     return PistonHistory(setup, states[:, setup.bodies], velocity[:, setup.bodies], contact_force_n,
                          jumps.input_j(time_s, after), np.array(jumps.rebounds).reshape(-1, 3), energy)

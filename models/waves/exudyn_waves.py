@@ -52,6 +52,8 @@ from ..drill.pulse import impact_force
 from ..evaluation.results import SimulationResult
 from ..evaluation.stability import SimulationFailed
 from .exact_waves import BLAS, result
+from .outgoing import BodyMotion, body_segments, port_work_j
+from .recording import Snapshot
 from .stepping import Stepper
 
 
@@ -128,6 +130,11 @@ class WaveExudyn:
         self.indices = np.array([mbs.GetNodeODE2Index(self.bodies[i][0]) for i in kinematic], dtype=int)
         self.velocity_index = [self.stepper.layout.velocity[i] for i in kinematic]
         self.closed, self.previous = 0, self.stepper.w[:self.stepper.layout.n].copy()
+        self.previous_velocity = np.zeros(self.stepper.layout.n)
+        self.last_velocity: np.ndarray | None = None  # the bodies' velocities at the last step's start
+        self.last_positions = np.zeros(len(self.bodies))
+        self.step_start = None  # the snapshot of the step in progress at its start (models.waves.recording)
+        self.masses = np.array([chain.bodies[i].mass_kg for i in sorted(self.bodies)])
         self.failed_at_s: float | None = None
 
     def _ports(self, kinematic: tuple[int, ...]) -> None:
@@ -192,14 +199,21 @@ class WaveExudyn:
         for face, body in self.attached.items():
             w[face] = w[body]
         k = stepper.step_index
+        velocity = stepper.key().velocity @ w
         if len(self.body_ports) and k > 0 and self.closed < k:
             nodes = stepper.port_nodes
-            velocity = stepper.key().velocity @ w
-            a0, a1 = stepper.last_inputs
-            stepper.close_ports(k - 1, self.body_ports, w[nodes] - self.previous[nodes], velocity[nodes], a0, a1,
-                                again=True)
+            motion = BodyMotion(self.previous[nodes], w[nodes], self.previous_velocity[nodes], velocity[nodes],
+                                stepper.step_s)
+            def end() -> Snapshot:  # Exudyn's state at the step's end: exact (taken only for a peak there)
+                return stepper._snapshot(k * stepper.step_s, w, stepper.key(), after=False)
+            stepper.close_ports(k - 1, self.body_ports, body_segments(stepper.last_segments, motion), again=True,
+                                ends=(self.step_start, end))
+            stepper.works[1] += port_work_j(stepper.last_segments, motion, self.body_ports, stepper.port_impedances)
             self.closed = k
-        self.previous = w[:stepper.layout.n].copy() if k >= self.closed else before
+        if k >= self.closed:
+            self.previous, self.previous_velocity = w[:stepper.layout.n].copy(), velocity
+        else:
+            self.previous = before
 
     def pre_step(self, mbs: Any, t: float) -> bool:
         """Before the step that ends at ``t`` (Exudyn passes the end; the state is the start's)."""
@@ -211,12 +225,26 @@ class WaveExudyn:
         if not np.all(np.isfinite(stepper.w)):
             self.failed_at_s = k * stepper.step_s
             return False
+        velocity = stepper.w[self.velocity_index].copy()
+        positions = stepper.w[sorted(self.bodies)].copy()
+        if self.last_velocity is not None:  # Exudyn's forces over the last step: the bodies' motion predicted
+            h = stepper.step_s
+            applied = self.load_values[:, 0] + 0.5 * h * self.load_values[:, 1] \
+                - self.dashpots * (positions - self.last_positions) / h
+            stepper.w[stepper.layout.acceleration:stepper.layout.acceleration + len(velocity)] = \
+                (velocity - self.last_velocity) / h - applied / self.masses
+        self.last_velocity, self.last_positions = velocity, positions
         self._add_works(k * stepper.step_s)
         if k % stepper.sample_every == 0 or stepper.caught_at_end:
-            stepper._record(k * stepper.step_s, stepper.w, stepper.key(), after=stepper.caught_at_end)
+            stepper._record(k * stepper.step_s, stepper.w, stepper.key(), after=stepper.caught_at_end,
+                            kept=stepper.caught_at_end)
+        if len(self.body_ports):  # the step's start after its arriving jumps: a body port's peak may be there
+            stepper._set_inputs(k)
+            self.step_start = stepper._snapshot(k * stepper.step_s, stepper.w, stepper.key(), after=True)
         stepper.advance()
-        self._port_start()
-        start, end = stepper.body_loads + self.dashpots * stepper.w[self.velocity_index]  # the dashpots are Exudyn's
+        # the dashpots are Exudyn's: their force at the predicted velocity, a straight line, taken out
+        start = stepper.body_loads[0] + self.dashpots * velocity
+        end = stepper.body_loads[1] + self.dashpots * stepper.w[self.velocity_index]
         slope = (end - start) / stepper.step_s
         self.step_start_s = k * stepper.step_s
         self.load_values[:, 0], self.load_values[:, 1] = start, slope
@@ -242,15 +270,6 @@ class WaveExudyn:
                 * velocity[chain.bit_body]
         return np.array([impact, internal + rock, rock])
 
-    def _port_power(self, arriving: np.ndarray) -> float:
-        """sum Z (v - 2 w_in) v into the rods at the bodies' ports, at the bodies' velocities now."""
-        if not len(self.body_ports):
-            return 0.0
-        stepper = self.stepper
-        velocity = (stepper.key().velocity @ stepper.w)[stepper.port_nodes[self.body_ports]]
-        return float(np.sum(stepper.port_impedances[self.body_ports] * (velocity - 2.0 * arriving[self.body_ports])
-                            * velocity))
-
     def _add_works(self, t: float) -> None:
         """The works of what Exudyn integrates over the step that ended at ``t``, by the trapezoidal rule on
         the states at its ends (smooth: bodies with mass; a port's arriving wave on each side of its jumps),
@@ -258,18 +277,10 @@ class WaveExudyn:
         powers = self._powers(t)
         stepper = self.stepper
         if self.last_powers is not None:
-            powers_end = powers.copy()
-            if len(self.body_ports):
-                powers_end[1] += self._port_power(stepper.w[stepper.layout.inputs::2])  # arriving waves' step ends
-            done = 0.5 * stepper.step_s * (self.last_powers + powers_end)
+            done = 0.5 * stepper.step_s * (self.last_powers + powers)
             stepper.works += done[:2]
             stepper.statistics.rock_work_j[-1] += done[2]
         self.last_powers = powers
-
-    def _port_start(self) -> None:
-        """The ports' power at the start of the step just set (its arriving waves: models.waves.stepping)."""
-        if len(self.body_ports) and self.last_powers is not None:
-            self.last_powers[1] += self._port_power(self.stepper.last_inputs[0])
 
     def model(self, model_type: type, body_type: type, connector_type: type, settings: Any, named: str) -> Any:
         """The built model (models.solvers.exudyn_model.ExudynModel, its types given: this package sits below
@@ -298,7 +309,9 @@ class WaveExudyn:
         simulation, mbs, stepper = self.simulation, self.mbs, self.stepper
         self._sync()
         self._add_works(stepper.step_index * stepper.step_s)
-        stepper._record(stepper.step_index * stepper.step_s, stepper.w, stepper.key())
+        stepper._record(stepper.step_index * stepper.step_s, stepper.w, stepper.key(), kept=False)
+        stepper.record_peaks()
+        stepper.read_envelopes(stepper.step_index)
         if not ok or self.failed_at_s is not None or stepper.step_index < stepper.steps:
             at = self.failed_at_s if self.failed_at_s is not None else stepper.step_index * stepper.step_s
             raise SimulationFailed(f"scene '{simulation.name}': solver {simulation.settings.type} with the wave step "

@@ -7,14 +7,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..definition.links import CLOSED, OPEN
-from .kernels import CATCH, PISTON_CLOSED, PISTON_NONE, PISTON_OPEN, SWITCH, run_steps
+from .kernels import CATCH, PISTON_CLOSED, PISTON_NONE, PISTON_OPEN, STEPS_DONE, SWITCH, run_steps
 from .levels import key_levels
+from .outgoing import Segment
+from .recording import Snapshot
 from .system import Key
 
 
 def key_arrays(stepper, key: Key) -> tuple[np.ndarray, ...]:
     """(propagator, grams, exit rows, exit slopes, port velocity rows, impulse integral, body force rows,
-    impact row) of ``key`` for a whole step, cached."""
+    impact row, each port velocity row's nonzero columns and their count) of ``key`` for a whole step, cached."""
     if "kernel" not in key.cache:
         m = key.matrix.shape[0]
         levels = key_levels(stepper, key)
@@ -26,6 +28,12 @@ def key_arrays(stepper, key: Key) -> tuple[np.ndarray, ...]:
             np.ascontiguousarray(key.velocity[stepper.port_nodes]).reshape(len(stepper.ports), m),
             np.zeros((m, m)) if integral is None else np.ascontiguousarray(integral),
             np.ascontiguousarray(key.body_forces), np.ascontiguousarray(stepper.impact_row(key)))
+        velocity = key.cache["kernel"][4]
+        counts = np.count_nonzero(velocity, axis=1).astype(np.int64)
+        columns = np.zeros((len(velocity), max(int(counts.max(initial=0)), 1)), dtype=np.int64)
+        for p, row in enumerate(velocity):
+            columns[p, :counts[p]] = np.flatnonzero(row)
+        key.cache["kernel"] = (*key.cache["kernel"], columns, counts)
     return key.cache["kernel"]
 
 
@@ -33,7 +41,7 @@ def run_fast(stepper, stop: int) -> tuple[int, int]:
     """Whole steps from the stepper's step index up to ``stop`` (exclusive) in the kernel; (status, the
     step reached). The caller makes sure no blow start, phase change or sample falls before ``stop``."""
     key, lines, stats = stepper.key(), stepper.lines, stepper.statistics
-    propagator, grams, rows, slopes, velocity, integral, forces, impact = key_arrays(stepper, key)
+    propagator, grams, rows, slopes, velocity, integral, forces, impact, columns, counts = key_arrays(stepper, key)
     own = np.zeros(len(stepper.ports), dtype=np.bool_)
     own[stepper.own_ports] = True
     mode, pistons, impedance = PISTON_NONE, np.zeros(2, dtype=np.int64), 0.0
@@ -50,16 +58,30 @@ def run_fast(stepper, stop: int) -> tuple[int, int]:
     loads = np.zeros((2, len(forces)))
     status, reached = run_steps(
         stepper.w, stepper.step_index, stop, stepper.step_s, stepper.layout.inputs, propagator, grams, rows, slopes,
-        stepper.port_nodes, velocity, lines.port_delays, stepper.port_signs, stepper.port_impedances,
-        stepper.port_down, own, lines.left, lines.right, lines.square, lines.mean, lines.square_sum, lines.mean_sum,
-        lines.ring, stepper.works, rock, stats.compression_n[-1], stats.tension_n[-1], stats.energy_j[-1], integral,
-        forces, loads, mode, pistons, impact, momentum_tolerance, force_tolerance, impedance)
+        stepper.port_nodes, velocity, columns, counts, lines.port_delays, stepper.port_signs, stepper.port_impedances,
+        stepper.port_down, own, lines.left, lines.right, lines.start, lines.broken, lines.square, lines.mean,
+        lines.square_sum, lines.mean_sum,
+        lines.ring, stepper.works, rock, stats.compression_n[-1], stats.tension_n[-1], stats.energy_j[-1],
+        stats.arriving_j[-1], integral,
+        forces, loads, mode, pistons, impact, momentum_tolerance, force_tolerance, impedance, stepper.energy_weights,
+        stepper.peak_states, stepper.peak_extras, stepper.peak_sides)
+    for port, kind in zip(*np.nonzero(stepper.peak_sides), strict=True):  # the blow's peaks raised in these steps
+        extras = stepper.peak_extras[port, kind]
+        stepper.peaks.offer(int(port), int(kind), Snapshot(
+            float(extras[0]), stepper.peak_states[port, kind].copy(), key, bool(stepper.peak_sides[port, kind] == 1),
+            np.array([extras[1], extras[2]]), float(extras[3]), float(extras[4])))
+    stepper.peak_sides[:] = 0
     stats.rock_work_j[-1] += rock[0]
     if reached > stepper.step_index and len(forces):
         stepper.body_loads = loads
     stepper.step_index = reached
     if reached > 0 and len(stepper.ports):  # the last step's arriving waves (the Exudyn bodies' ports close with them)
-        stepper.last_inputs = (lines.incoming(reached - 1)[0], stepper.w[stepper.layout.inputs::2].copy())
+        a0, a1 = lines.incoming(reached - 1)[0], stepper.w[stepper.layout.inputs::2].copy()
+        stepper.last_inputs = (a0, a1)
+        nothing = np.zeros(len(stepper.ports))
+        stepper.last_segments = [Segment(0.0, 1.0, nothing, nothing, nothing, nothing, a0, a1, nothing, nothing, False)]
+    if status == CATCH and reached % stepper.period_steps == 0:  # the strike there resets the piston itself
+        status = STEPS_DONE
     if status == CATCH:
         stepper.catch_wave_piston(reached)
     return status, reached

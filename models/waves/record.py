@@ -28,9 +28,18 @@ class WaveRecord:
     blow_compression_n: np.ndarray  # blows x ports, the largest compression of each blow
     blow_tension_n: np.ndarray  # blows x ports, the largest tension (a positive number)
     blow_energy_j: np.ndarray  # blows x ports, int P v dt along +x
+    blow_arriving_j: np.ndarray  # blows x ports, Z int w_in^2 dt: the energy the wave arriving there brings
     blow_rock_work_j: np.ndarray  # blows, int F_r v_bit dt
     energy_j: np.ndarray  # samples: the energy of the string's waves in flight
     joint_force_n: dict[str, np.ndarray] = field(default_factory=dict)  # rigid joint -> samples (F > 0 pulls)
+    # the samples a time series keeps as rows beside its uniform grid: both sides of every front and every blow's
+    # peaks at each rod end (models.waves.recording)
+    kept: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    # per blow and string rod: (sections' positions from its top, largest compression there (N), its time, largest
+    # tension, its time) (models.waves.stepping.Stepper.read_envelopes)
+    envelopes: list[dict[str, tuple[np.ndarray, ...]]] = field(default_factory=list)
+    # per blow and gauge: (each step's start time, the down-going wave at its start and end, the up-going's)
+    gauges: list[dict[str, tuple[np.ndarray, ...]]] = field(default_factory=list)
 
     def port(self, rod: str, end: str) -> int:
         return self.ports.index((rod, end))

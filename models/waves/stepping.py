@@ -34,9 +34,13 @@ from .fast_path import SWITCH, run_fast
 from .history import WaveLines
 from .kernels import CATCH
 from .levels import key_levels
+from .outgoing import Segment, StepWaves, outgoing, readings
+from .recording import BlowPeaks, Recorder, Samples, Snapshot
 from .system import Key, Modes, WaveSystem
 
 MAX_SWITCHES_PER_STEP = 64
+SWITCH_AT_START = 1e-9  # a switch this soon (a fraction of the step) after a jump is at the jump
+
 
 
 @dataclass
@@ -48,35 +52,30 @@ class BlowStatistics:
     compression_n: list[np.ndarray] = field(default_factory=list)
     tension_n: list[np.ndarray] = field(default_factory=list)
     energy_j: list[np.ndarray] = field(default_factory=list)
+    arriving_j: list[np.ndarray] = field(default_factory=list)  # the energy the arriving wave brings, Z int w_in^2
+    # per blow and string rod: (stations' positions from its top, largest compression there, its time, largest
+    # tension, its time) (Stepper.read_envelopes)
+    envelopes: list[dict[str, tuple[np.ndarray, ...]]] = field(default_factory=list)
+    # per blow and gauge: (every step's start time, the down-going wave at its start and end, the up-going's)
+    gauges: list[dict[str, tuple[np.ndarray, ...]]] = field(default_factory=list)
     rock_work_j: list[float] = field(default_factory=list)
 
     def open_blow(self, ports: int) -> None:
         self.compression_n.append(np.zeros(ports))
         self.tension_n.append(np.zeros(ports))
         self.energy_j.append(np.zeros(ports))
+        self.arriving_j.append(np.zeros(ports))
         self.rock_work_j.append(0.0)
 
     def arrays(self, ports: int) -> dict[str, np.ndarray]:
         shape = (len(self.energy_j), ports)
         return {"compression_n": np.array(self.compression_n).reshape(shape),
                 "tension_n": np.array(self.tension_n).reshape(shape),
-                "energy_j": np.array(self.energy_j).reshape(shape), "rock_work_j": np.array(self.rock_work_j)}
+                "energy_j": np.array(self.energy_j).reshape(shape),
+                "arriving_j": np.array(self.arriving_j).reshape(shape), "rock_work_j": np.array(self.rock_work_j)}
 
 
-@dataclass
-class Samples:
-    time_s: list[float] = field(default_factory=list)
-    states: list[np.ndarray] = field(default_factory=list)
-    velocity: list[np.ndarray] = field(default_factory=list)
-    forces: list[np.ndarray] = field(default_factory=list)  # rock, impact, then each rigid joint's
-    works: list[np.ndarray] = field(default_factory=list)  # cumulative impact, internal (string) work
-    waves_j: list[float] = field(default_factory=list)  # energy of the string's rods' waves in flight
-    piston_j: list[float] = field(default_factory=list)  # a wave piston's energy
-    compression: list[np.ndarray] = field(default_factory=list)  # every port's compression
-    after: list[bool] = field(default_factory=list)  # recorded after a jump at its own time (a catch)
-
-
-class Stepper:
+class Stepper(Recorder):
     """One run on the grid of the characteristics (module doc). ``kinematic`` nodes move at their
     velocity over each step (the Exudyn formulation's bodies, set before each step)."""
 
@@ -91,10 +90,10 @@ class Stepper:
         self.system = WaveSystem(chain, simulation.rock, simulation.torsion, simulation.impact, kinematic,
                                  catch_by_row=self.piston_rod is None)
         self.layout = self.system.layout
-        self.lines = WaveLines(chain.waves, step_s, initial_outgoing(simulation, chain))
         end = simulation.settings.end_time_s
         self.steps = max(1, round(end / step_s))
         self.period_steps = round(simulation.impact.period_s / step_s)
+        self.lines = WaveLines(chain.waves, step_s, initial_outgoing(simulation, chain), self.period_steps + 1)
         times, phases = phase_pieces(simulation.impact, end)
         self.phase_changes, self.phases = times[:, 0], phases
         self.blows = simulation.blow_starts()
@@ -105,6 +104,9 @@ class Stepper:
             self.jumps.blow_energy_j = 0.5 * rod.impedance_n_s_per_m * self.lines.delays[self.piston_rod] * step_s \
                 * self.setup.strike_velocity_m_per_s**2
         self.ports = self.system.ports
+        impact = simulation.impact  # the wave scale: the strike velocity, or the pulse over the smallest impedance
+        self.wave_scale_m_per_s = self.setup.strike_velocity_m_per_s if self.setup is not None else \
+            impact.amplitude_n / min((rod.impedance_n_s_per_m for rod in chain.waves), default=1.0)
         self.port_nodes = np.array([port.node for port in self.ports], dtype=int)
         self.port_impedances = np.array([port.impedance_n_s_per_m for port in self.ports])
         self.port_signs = np.array([SIGMA[port.end] for port in self.ports]) * self.port_impedances
@@ -117,17 +119,25 @@ class Stepper:
         self.w = self._initial_state()
         self.modes = self.system.initial_modes(self.w)
         self.phase_index = 0
-        self.samples, self.statistics = Samples(), BlowStatistics()
+        self.samples, self.statistics, self.peaks = Samples(), BlowStatistics(), BlowPeaks()
+        self.step_start: Snapshot | None = None  # the state at the start of the step in progress (a peak's sample)
+        weights = np.zeros((2, len(self.ports)))  # the string's and a wave piston's waves' energy: Z h square sums
+        for p, port in enumerate(self.ports):
+            weights[int(port.rod == self.piston_rod), p] = port.impedance_n_s_per_m * step_s
+        self.energy_weights = weights
+        self.peak_states = np.zeros((len(self.ports), 2, self.layout.size))
+        self.peak_extras = np.zeros((len(self.ports), 2, 5))
+        self.peak_sides = np.zeros((len(self.ports), 2), dtype=np.int64)
         self.works = np.zeros(2)
         self.switch_times: list[float] = []
         self.switch_modes: list[Modes] = []
         self.step_index = 0
         self.kinematic = tuple(sorted(kinematic))
         self.record_steps = record_steps  # False: the Exudyn model records at its step starts
-        self.record_inputs = False  # True: a sample after the arriving waves are set at every step start
         self.caught_at_end = False  # the last step ended with a wave piston's catch
         self._set_inputs(0)  # the waves arriving at the start (a preload's), for the first sample
-        self._step_flux = np.zeros(2)  # energy into the string's rods and a wave piston since the step's start
+        # energy into the string's rods, into a wave piston and through the Exudyn bodies' ports since the step's start
+        self._step_flux = np.zeros(3)
         self.body_loads = np.zeros((2, len(self.kinematic)))  # (start, end) of the force on each over the step
 
     # -- state ----------------------------------------------------------------------------------------
@@ -153,7 +163,7 @@ class Stepper:
         w, works, moved = key_levels(self, key).advance(w0, span_s)
         self.works += works[:2]
         self.statistics.rock_work_j[-1] += works[2]
-        self._step_flux += works[3:]  # into the rods since the step's start (not in their waves in flight yet)
+        self._step_flux[:len(works) - 3] += works[3:]  # into the rods since the step's start (not in their waves in flight yet)
         if moved is not None:
             self._step_impulse += key.body_forces @ moved
         return w
@@ -164,9 +174,6 @@ class Stepper:
         """Step ``step_index`` (module doc): in the compiled kernel when nothing happens in it (no blow
         start, pulse phase change or switch), else here."""
         if self._quiet(self.step_index):
-            if self.record_inputs:
-                self._set_inputs(self.step_index)
-                self._record(self.step_index * self.step_s, self.w, self.key(), after=True)
             status, _ = run_fast(self, self.step_index + 1)
             if status != SWITCH:
                 self._after(status == CATCH)
@@ -174,7 +181,8 @@ class Stepper:
         self._step()
 
     def _quiet(self, k: int) -> bool:
-        """Whether step k has no blow start and no pulse phase change (the kernel's steps)."""
+        """Whether step k has no blow start and no pulse phase change (the kernel's steps; it returns itself
+        before a step into which a wave arrives with a break)."""
         if k % self.period_steps == 0:
             return False
         t0, t1 = k * self.step_s, (k + 1) * self.step_s
@@ -186,61 +194,94 @@ class Stepper:
         self.caught_at_end = caught
         k = self.step_index
         if self.record_steps and (caught or k % self.sample_every == 0 or k == self.steps):
-            self._record(k * self.step_s, self.w, self.key(), after=caught)
+            self._record(k * self.step_s, self.w, self.key(), after=caught, kept=caught)
 
     def _step(self) -> None:
-        """Step ``step_index`` here (module doc)."""
+        """Step ``step_index`` here (module doc): pieces between the switches, the pulse's phase changes and the
+        breaks of the arriving waves (models.waves.history), each integrated exactly; the step's outgoing waves
+        from its segments (models.waves.outgoing)."""
         k, h, layout = self.step_index, self.step_s, self.layout
         t0 = k * h
         w = self.w
+        strike = k % self.period_steps == 0 and self.setup is not None
         if k % self.period_steps == 0:
             self._start_blow(k, t0)
-            if self.setup is not None:  # the strike: a jump, recorded on both sides
-                self._set_inputs(k)
-                self._record(t0, w, self.key(), after=True)
         self._set_inputs(k)
-        if self.record_inputs:  # the arriving waves jump at t0: a sample on this side too (an energy account)
-            self._record(t0, w, self.key(), after=True)
-        x0, a0 = w[:layout.n].copy(), w[layout.inputs::2].copy()
+        arrivals = self.lines.arriving_breaks(k)
         t, t1, switches = t0, t0 + h, 0
-        key = self.key()
+        jumped = strike  # a jump just now whose other side is still to be sampled (the strike's, a front's)
         self._step_impulse = np.zeros(len(self.kinematic))
+        segments: list[Segment] = []
+        begin = (t0, w.copy(), self.key(), -1)
+        self.step_start = self._snapshot(t0, w, self.key(), after=True)  # a peak there: after the step's jumps
         while t < t1 - 1e-12 * h:
             later = np.flatnonzero(self.phase_changes > t + 1e-12 * h)
-            boundary = min(t1, self.phase_changes[later[0]]) if len(later) else t1
+            phase = self.phase_changes[later[0]] if len(later) else np.inf
+            arrival = t0 + arrivals[0][0] * h if arrivals else np.inf
+            boundary = min(t1, phase, arrival)
+            if boundary >= t1 - 1e-9 * h:  # a phase change a round-off before the step's end: at its end
+                boundary = t1
             key = self.key()
             span = boundary - t
             w1 = key_levels(self, key).propagate(w, span)
             hit = self._first_switch(key, w, w1, span)
+            at_jump = hit is not None and hit[0] <= SWITCH_AT_START * h and (jumped or t == t0)
+            if jumped and not at_jump:  # the jump's other side (a switch at the jump: the state after it)
+                begin = (*begin[:3], self._record(t, w, key, after=True))
             if hit is None:
                 w, t = self._piece(key, w, span), boundary
-                if len(later) and boundary >= self.phase_changes[later[0]] - 1e-12 * h:
-                    if self.record_inputs:  # the pulse may jump here: both sides (the trapezoidal account)
-                        self._record(t, w, key)
+                jumped = False
+                if boundary >= t1 - 1e-9 * h:  # the step's end (a phase change there: the next step's start)
+                    if phase <= boundary + 1e-9 * h:
+                        self.phase_index = int(later[0])
+                        self._start_phase(w, t)
+                    break
+                segments.append(self._segment(begin, t, w, key, self._record(t, w, key)))  # a front: both sides
+                if phase <= boundary + 1e-12 * h:
                     self.phase_index = int(later[0])
                     self._start_phase(w, t)
-                    if self.record_inputs:
-                        self._record(t, w, self.key())
+                while arrivals and t0 + arrivals[0][0] * h <= boundary + 1e-12 * h:
+                    _, port, value, slope = arrivals.pop(0)
+                    w[self.ports[port].input], w[self.ports[port].input + 1] = value, slope / h
+                begin, jumped = (t, w.copy(), self.key(), -1), True
                 continue
             s, exit_ = hit
             w_s = self._piece(key, w, s)
             t += s
-            self._record(t, w_s, key)
+            before = -1 if at_jump else self._record(t, w_s, key)  # a switch at a jump is at the jump: no sample between
+            segments.append(self._segment(begin, t, w_s, key, before))
             w = self._switch(t, w_s, key, exit_)
-            self._record(t, w, self.key(), after=True)
+            begin, jumped = (t, w.copy(), self.key(), self._record(t, w, self.key(), after=True)), False
             switches += 1
             if switches > MAX_SWITCHES_PER_STEP:
                 raise SimulationFailed(f"scene '{self.simulation.name}': more than {MAX_SWITCHES_PER_STEP} switches "
                                        f"within one wave step at t = {t:.6g} s (a chattering contact)")
+        if t1 - begin[0] > 1e-12 * h or not segments:
+            segments.append(self._segment(begin, t1, w, key))
         self.w = w
         if not np.all(np.isfinite(w)) or np.max(np.abs(w[:layout.n])) > POSITION_LIMIT_M:
             raise SimulationFailed(f"scene '{self.simulation.name}': the wave solution diverged at t = {t1:.6g} s")
-        caught = self._close_step(k, x0, a0, key)
+        caught = self._close_step(k, segments, key)
         if self.kinematic:  # the loads on the Exudyn bodies over the step: its end value and its mean
             end = key.body_forces @ w
             self.body_loads = np.array([2.0 * self._step_impulse / h - end, end])
         self.step_index += 1
         self._after(caught)
+
+    def _segment(self, begin: tuple[float, np.ndarray, Key, int], t: float, w: np.ndarray, key: Key,
+                 sample: int = -1) -> Segment:
+        """The segment from ``begin`` (time, state, key, its sample or -1) to the state ``w`` at ``t`` (its sample
+        ``sample``) (models.waves.outgoing)."""
+        t_begin, w_begin, key_begin, first = begin
+        t0, h, nodes, inputs = self.step_index * self.step_s, self.step_s, self.port_nodes, self.layout.inputs
+        if "accelerations" not in key.cache:  # the ports' nodes' accelerations: d/dt (V w) = V A w
+            key.cache["accelerations"] = key.velocity[nodes] @ key.matrix
+        if "accelerations" not in key_begin.cache:
+            key_begin.cache["accelerations"] = key_begin.velocity[nodes] @ key_begin.matrix
+        return Segment((t_begin - t0) / h, (t - t0) / h, w_begin[nodes], w[nodes], key_begin.velocity[nodes] @ w_begin,
+                       key.velocity[nodes] @ w, w_begin[inputs::2].copy(), w[inputs::2].copy(),
+                       key_begin.cache["accelerations"] @ w_begin - w_begin[inputs + 1::2],
+                       key.cache["accelerations"] @ w - w[inputs + 1::2], True, (first, sample))
 
     def _start_phase(self, w: np.ndarray, t: float) -> None:
         """The pulse generator's states (u1, u2) at the start of the phase piece beginning at ``t``."""
@@ -250,19 +291,20 @@ class Stepper:
         w[one + 1:one + 3] = generator_states(self.simulation.impact, np.array([max(local, 0.0)]))[0]
 
     def _set_inputs(self, k: int) -> None:
-        """The arriving waves of step k as (a, b) of every port."""
+        """The arriving waves of step k as (a, b) of every port (the first piece of a wave with breaks)."""
         if not self.ports:
             return
-        left, right = self.lines.incoming(k)
+        value, slope = self.lines.first_pieces(k)
         inputs = self.layout.inputs
-        self.w[inputs::2], self.w[inputs + 1::2] = left, (right - left) / self.step_s
+        self.w[inputs::2], self.w[inputs + 1::2] = value, slope / self.step_s
 
     def run(self) -> None:
-        """Every step, runs of quiet steps in the kernel up to the next blow start, phase change or sample."""
-        self._record(0.0, self.w, self.key())
+        """Every step, runs of quiet steps in the kernel up to the next blow start, phase change or sample; the
+        last blow's peaks recorded at the end."""
+        self._record(0.0, self.w, self.key(), kept=False)
         while self.step_index < self.steps:
             k = self.step_index
-            if not self._quiet(k) or self.record_inputs:
+            if not self._quiet(k):
                 self.advance()
                 continue
             stop = min(self.steps, (k // self.period_steps + 1) * self.period_steps,
@@ -272,6 +314,8 @@ class Stepper:
                 self._step()
             elif self.step_index == stop or status == CATCH:
                 self._after(status == CATCH)
+        self.record_peaks()
+        self.read_envelopes(self.step_index)
 
     def _phase_step(self, k: int) -> int:
         """The first step from k on that holds the next pulse phase change (the kernel stops before it)."""
@@ -280,37 +324,50 @@ class Stepper:
             return self.steps
         return max(k + 1, int(np.floor(later[0] / self.step_s - 1e-9)))
 
-    def _close_step(self, k: int, x0: np.ndarray, a0: np.ndarray, key: Key) -> bool:
-        """The outgoing waves of step k (at its end before any change there: ``key`` that of its last
-        piece), the blow's section statistics, a wave piston's catch (True then)."""
+    def _close_step(self, k: int, segments: list[Segment], key: Key) -> bool:
+        """The outgoing waves of step k from its segments (``key`` that of its last piece), the blow's section
+        figures, a wave piston's catch (True then)."""
         self._step_flux[:] = 0.0  # in the waves in flight from now on
         if self.ports:
-            w, nodes = self.w, self.port_nodes
-            a1 = w[self.layout.inputs::2].copy()
-            self.last_inputs = (a0, a1)
-            self.close_ports(k, self.own_ports, w[nodes] - x0[nodes], key.velocity[nodes] @ w, a0, a1,
-                             provisional=True)
-        if self.piston_rod is not None and self._wave_piston_done(key):
+            self.last_segments = segments
+            self.last_inputs = (segments[0].a0, segments[-1].a1)
+            self.close_ports(k, self.own_ports, segments, provisional=True)
+        if self.piston_rod is not None and (k + 1) % self.period_steps and self._wave_piston_done(key):
+            # (a catch at a blow start: the strike there resets the piston, its energy counted as rebound)
             self.catch_wave_piston(k + 1)
             return True
         return False
 
-    def close_ports(self, k: int, ports: np.ndarray, moved_m: np.ndarray, velocity: np.ndarray, a0: np.ndarray,
-                    a1: np.ndarray, again: bool = False, provisional: bool = False) -> None:
-        """Store the outgoing waves over step k from the ports' nodes' displacement over the step and velocity
-        at its end (arrays over every port) and add the step to the blow's section figures of ``ports``;
-        ``provisional``: store every port (the others are stored ``again`` later, from the Exudyn bodies)."""
-        h = self.step_s
-        right = velocity - a1
-        left = 2.0 * (moved_m / h - 0.5 * (a0 + a1)) - right
-        self.lines.store(k, left, right, None if provisional else ports, again)
-        left, right, a0, a1 = left[ports], right[ports], a0[ports], a1[ports]
-        stats, signs = self.statistics, self.port_signs[ports]
-        start, end = signs * (left - a0), signs * (right - a1)  # compression: sigma Z (outgoing - incoming)
-        stats.compression_n[-1][ports] = np.maximum(stats.compression_n[-1][ports], np.maximum(start, end))
-        stats.tension_n[-1][ports] = np.maximum(stats.tension_n[-1][ports], -np.minimum(start, end))
-        flux = self.port_impedances[ports] * h * ((left**2 + left * right + right**2) - (a0**2 + a0 * a1 + a1**2)) / 3
-        stats.energy_j[-1][ports] += self.port_down[ports] * flux
+    def close_ports(self, k: int, ports: np.ndarray, segments: list[Segment], again: bool = False,
+                    provisional: bool = False, ends: tuple[Snapshot | None, Snapshot | None] | None = None) -> None:
+        """Store the outgoing waves over step k from its segments (models.waves.outgoing) and add the step to
+        the blow's section figures of ``ports``; ``provisional``: store every port (the others are stored
+        ``again`` later, from the Exudyn bodies)."""
+        stored = np.arange(len(self.ports)) if provisional else ports
+        waves = outgoing(segments, self.step_s, stored, self.wave_scale_m_per_s)
+        size = len(self.ports)
+        left, right, start = np.zeros(size), np.zeros(size), np.zeros(size)
+        left[stored], right[stored], start[stored] = waves.left, waves.right, waves.start
+        self.lines.store(k, left, right, start, stored, again)
+        for j, rows in waves.pieces.items():
+            self.lines.store_pieces(k, int(stored[j]), rows, again=True)
+        if not provisional:
+            read = readings(segments, waves, self.step_s, ports, self.port_signs, self.port_impedances, self.port_down)
+        else:  # every port stored (``stored`` is every index): the readings of ``ports``
+            position = {int(port): i for i, port in enumerate(ports)}
+            mine = StepWaves(waves.left[ports], waves.right[ports], waves.start[ports],
+                             {position[j]: rows for j, rows in waves.pieces.items() if j in position})
+            read = readings(segments, mine, self.step_s, ports, self.port_signs, self.port_impedances, self.port_down)
+        stats = self.statistics
+        raised = (read.compression_n > stats.compression_n[-1][ports], read.tension_n > stats.tension_n[-1][ports])
+        if raised[0].any() or raised[1].any():
+            if ends is None:  # the step just done by the stepper: its start, and its end now
+                ends = (self.step_start, self._snapshot((k + 1) * self.step_s, self.w, self.key(), after=False))
+            self.offer_peaks(read, raised, ports, ends)
+        stats.compression_n[-1][ports] = np.maximum(stats.compression_n[-1][ports], read.compression_n)
+        stats.tension_n[-1][ports] = np.maximum(stats.tension_n[-1][ports], read.tension_n)
+        stats.energy_j[-1][ports] += read.energy_j
+        stats.arriving_j[-1][ports] += read.arriving_j
 
     def _wave_piston_done(self, key: Key) -> bool:
         """A wave piston is caught when its contact is open and its momentum not forward, or when it rests
@@ -377,7 +434,10 @@ class Stepper:
     # -- blows ----------------------------------------------------------------------------------------
 
     def _start_blow(self, k: int, t: float) -> None:
-        """The rock state the blow meets (indexing) and the piston's strike."""
+        """The rock state the blow meets (indexing) and the piston's strike; the last blow's peaks recorded and its
+        stresses along the rods read."""
+        self.record_peaks()
+        self.read_envelopes(k)
         self.statistics.open_blow(len(self.ports))
         layout, w = self.layout, self.w
         if self.blows:
@@ -418,31 +478,6 @@ class Stepper:
         return np.concatenate([w, self.key().velocity @ w])
 
     # -- records --------------------------------------------------------------------------------------
-
-    def _record(self, t: float, w: np.ndarray, key: Key, after: bool = False) -> None:
-        """A sample: the state, every node's velocity, the forces (rock, impact, rigid joints), the works,
-        the energy in the string's rods and in a wave piston, every port's compression."""
-        samples, layout, n = self.samples, self.layout, self.layout.n
-        if "record" not in key.cache:  # velocities, forces and compressions as one matrix over w
-            ports = self.port_signs[:, None] * key.velocity[self.port_nodes]
-            ports[np.arange(len(self.ports)), layout.inputs + 2 * np.arange(len(self.ports))] -= 2.0 * self.port_signs
-            rows = [key.velocity, key.rock_force[None], self.impact_row(key)[None],
-                    np.array([key.constraints[name] for name in self.rigid_names]).reshape(-1, layout.size), ports]
-            key.cache["record"] = np.vstack(rows)
-        values = key.cache["record"] @ w
-        forces = 2 + len(self.rigid_names)
-        samples.time_s.append(t)
-        samples.after.append(after)
-        samples.states.append(w.copy())
-        samples.velocity.append(values[:n])
-        samples.forces.append(values[n:n + forces])
-        samples.compression.append(values[n + forces:])
-        samples.works.append(self.works.copy())
-        energies = self.lines.energies_j()
-        piston = 0.0 if self.piston_rod is None else energies[self.piston_rod]
-        samples.piston_j.append(piston + self._step_flux[1])
-        samples.waves_j.append(float(np.sum(energies)) - piston + self._step_flux[0])
-
 
 def initial_outgoing(simulation, chain) -> np.ndarray:
     """Every port's outgoing wave before the start: at rest, P / (2 Z) at the top and -P / (2 Z) at the

@@ -5,7 +5,8 @@ linear function of time, w_in(t) = a + b (t - t_k), and the rest of the drill is
 model of the other formulations, with the faces of the wave rods as massless nodes. In the augmented
 state
 
-    w = (x (every node), v (nodes with mass), rock states, [phi, phi'], 1, u1, u2, (a_p, b_p) per port)
+    w = (x (every node), v (nodes with mass), rock states, [phi, phi'], 1, u1, u2, [acceleration per kinematic node],
+         (a_p, b_p) per port)
 
 (a_p' = b_p, b_p' = 0; 1, u1, u2 the pulse generator of models.drill.pulse) the model is linear and
 autonomous in each key (the modes of its piecewise elements, the pulse phase): w' = A w, A generated
@@ -23,8 +24,11 @@ here, never written by hand:
 * a rigid link or contact carries the force that balances the massless side of its group
   (:meth:`WaveSystem.key`: ``constraints``); a rigid contact opens when that force would pull.
 
-A node may also be *kinematic* (the Exudyn formulation's bodies seen from the waves: moving at its
-velocity at the step's start, models.waves.exudyn_waves): v' = 0. What acts only between kinematic
+A node may also be *kinematic* (the Exudyn formulation's bodies seen from the waves, models.waves.exudyn_waves):
+the element predicts its motion over the step, m v' = (this system's force on it) + m a_e, a_e' = 0, with a_e
+the acceleration of the forces Exudyn applies (its links, the rock on a bit with mass, items of one's own) as
+over the last step: what acts between a face and a body (a stiff spring, a port) is integrated with the
+body's inertia, not at first order in the step. What acts only between kinematic
 nodes (and ground) is then Exudyn's, not this system's: those links, the rock law on a kinematic bit,
 the pulse on a kinematic impact body and the feed on kinematic nodes; the system gives each kinematic
 node the force of everything else on it (``Key.body_forces``), which the Exudyn model applies as a load.
@@ -71,6 +75,7 @@ class Layout:
     rock_states: int
     torsion: bool
     ports: int
+    accelerations: int = 0  # the kinematic nodes' a_e (in node order)
 
     @property
     def velocity(self) -> dict[int, int]:
@@ -89,8 +94,12 @@ class Layout:
         return self.angle + 2 * self.torsion
 
     @property
-    def inputs(self) -> int:
+    def acceleration(self) -> int:
         return self.one + 3
+
+    @property
+    def inputs(self) -> int:
+        return self.one + 3 + self.accelerations
 
     @property
     def size(self) -> int:
@@ -145,7 +154,7 @@ class WaveSystem:
         self.rock_owned = chain.bit_body not in self.kinematic
         velocity_nodes = tuple(i for i in range(n) if self.masses[i] > 0 or i in self.kinematic)
         self.layout = layout = Layout(n, velocity_nodes, len(rock.state_names), torsion is not None,
-                                      2 * len(chain.waves))
+                                      2 * len(chain.waves), len(self.kinematic))
         self.ports = tuple(Port(r, end, rod.node(end), rod.impedance_n_s_per_m, layout.inputs + 2 * (2 * r + e))
                            for r, rod in enumerate(chain.waves) for e, end in enumerate((TOP, BOTTOM)))
         self.z = layout.size + n
@@ -286,6 +295,9 @@ class WaveSystem:
         for node, index in velocity_index.items():
             if node not in self.kinematic:
                 matrix[index] = forces[owner[node]].sum(axis=0) / self.masses[node]
+        for j, node in enumerate(sorted(self.kinematic)):
+            matrix[velocity_index[node]] = forces[owner[node]].sum(axis=0) / self.masses[node]
+            matrix[velocity_index[node], layout.acceleration + j] += 1.0
         key = Key(matrix, velocity, [], np.zeros(m), [], {}, phase=phase)
         key.body_forces = np.array([forces[owner[node]].sum(axis=0) for node in sorted(self.kinematic)]).reshape(-1, m)
         for index, (piece, mode) in enumerate(zip(self.pieces, modes, strict=True)):

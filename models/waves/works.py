@@ -19,8 +19,8 @@ from .system import Key
 
 
 def power_forms(stepper, key: Key) -> np.ndarray:
-    """(Q_impact, Q_internal, Q_rock, Q_string_rods, Q_piston_rod) of ``key`` (module doc; the last two the power
-    into the string's rods and into a wave piston, so that a sample inside a step has their waves' energy)."""
+    """(Q_impact, Q_internal, Q_rock, Q_string_rods, Q_piston_rod, Q_body_ports) of ``key`` (module doc; the last
+    three so that a sample inside a step has the waves' energy and the bodies' ports' work)."""
     system, layout, velocity, chain = stepper.system, stepper.layout, key.velocity, stepper.chain
     m = layout.size
 
@@ -44,7 +44,7 @@ def power_forms(stepper, key: Key) -> np.ndarray:
         force[layout.angle], force[layout.angle + 1] = torsion.stiffness_n_m_per_rad, torsion.damping_n_m_s_per_rad
         rate[layout.angle + 1] = 1.0
         internal += pair(force, rate)
-    rods, piston = np.zeros((m, m)), np.zeros((m, m))
+    rods, piston, bodies = np.zeros((m, m)), np.zeros((m, m)), np.zeros((m, m))
     for p, port in enumerate(stepper.ports):
         arriving = np.zeros(m)
         arriving[layout.inputs + 2 * p] = 2.0
@@ -55,5 +55,9 @@ def power_forms(stepper, key: Key) -> np.ndarray:
             rods += power
             if p in stepper.own_ports:  # a body's ports: the Exudyn element's works
                 internal += power
+            else:
+                bodies += power
     impact = np.zeros((m, m)) if stepper.pulse_outside else pair(stepper.impact_row(key), velocity[chain.impact_body])
-    return np.array([impact, internal, rock, rods, piston])
+    if not len(stepper.kinematic):  # no Exudyn bodies: no sixth form (its Van Loan block would cost (6/5)^3)
+        return np.array([impact, internal, rock, rods, piston])
+    return np.array([impact, internal, rock, rods, piston, bodies])

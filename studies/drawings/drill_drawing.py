@@ -110,7 +110,7 @@ def drawn_layout(scene: Scene) -> DrawnLayout:
                                               BODY_HEIGHT * cylinder.diameter_m / widest, scale < 1 - 1e-9)
             x += cylinder.length_m * scale
         x += gap
-    rock_body = [b for b in placed.values() if b.group == scene.drill_string.rock_body][-1]
+    rock_body = [b for b in placed.values() if b.group == scene.drill_string.foot][-1]
     return DrawnLayout(tuple(placed[c.name] for c in shapes.cylinders), gap, rock_body.end, shapes)
 
 
@@ -233,8 +233,10 @@ def draw_string(ax: Axes, scene: Scene, drawing: DrawnLayout | None = None, offs
                                    zorder=3))
     # the rock: a hatched block from the rock face (a connector's gap deep on the drawing)
     depth = 2.5 * drawing.gap
-    ax.add_patch(Rectangle((drawing.rock_face + rock_offset, -0.7 * BODY_HEIGHT), depth, 1.4 * BODY_HEIGHT, facecolor=ROCK_COLOUR,
-                           edgecolor="0.3", hatch="..", lw=0.8, alpha=0.8, zorder=1))
+    rock = scene.rock.law != "none"  # a string that ends free: no rock drawn
+    if rock:
+        ax.add_patch(Rectangle((drawing.rock_face + rock_offset, -0.7 * BODY_HEIGHT), depth, 1.4 * BODY_HEIGHT,
+                               facecolor=ROCK_COLOUR, edgecolor="0.3", hatch="..", lw=0.8, alpha=0.8, zorder=1))
     connector_x = []
     gaps = {name: c.gap_m for name, c in scene.drill_string.connectors.items()}
     for link in chain.links:
@@ -258,8 +260,9 @@ def draw_string(ax: Axes, scene: Scene, drawing: DrawnLayout | None = None, offs
         ax.annotate(text, (x, -0.2 * BODY_HEIGHT), (x, y), fontsize=8, ha="center", va="top",
                     color=COUPLING_COLOUR if not link.linear else "0.1",
                     arrowprops={"arrowstyle": "-", "color": "0.5", "lw": 0.6})
-    ax.text(drawing.rock_face + 0.5 * depth, 0, f"rock\n{_rock_text(scene)}", ha="center", va="center",
-            fontsize=8, zorder=5, bbox={"facecolor": "white", "alpha": 0.7, "edgecolor": "none"})
+    if rock:
+        ax.text(drawing.rock_face + 0.5 * depth, 0, f"rock\n{_rock_text(scene)}", ha="center", va="center",
+                fontsize=8, zorder=5, bbox={"facecolor": "white", "alpha": 0.7, "edgecolor": "none"})
     arrow = 0.8 * drawing.gap
     impact = drawing.bodies[chain.impact_body]
     _arrow(ax, impact.start, 0.42 * BODY_HEIGHT, arrow, IMPACT_COLOUR, _impact_text(scene))
