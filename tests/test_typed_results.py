@@ -49,14 +49,14 @@ def test_a_periodic_result_holds_its_orbit_with_complex_multipliers(tmp_path):
     np.testing.assert_allclose(multipliers, np.array(orbit.multipliers), rtol=1e-15)
 
 
-def test_a_scene_that_cannot_have_an_orbit_says_it_was_refused_and_why():
+def test_a_wave_scene_whose_cap_comes_before_it_settles_says_so_with_the_time_run():
     scene = rpdrill.load_scene("top_hammer_waves").with_({"solver.steady_state": "periodic",
                                                           "solver.formulation": "exact",
                                                           "solver.end_time_s": 0.05, "metrics.transient_blows": 1,
                                                           "metrics.block_blows": 1, "impact.frequency_hz": 40.0})
     result = rpdrill.simulate(scene)
-    assert result.steady_state.regime is rpdrill.Regime.REFUSED
-    assert "wave rods" in result.steady_state.note and result.time_s[-1] == pytest.approx(0.05)
+    assert result.steady_state.regime is rpdrill.Regime.NOT_FOUND and result.steady_state.blows == 2
+    assert "not settled within the cap" in result.steady_state.note and result.time_s[-1] == pytest.approx(0.05)
 
 
 def test_warnings_of_a_run_are_shown_and_kept():

@@ -97,13 +97,25 @@ def test_the_wave_step_divides_the_period_and_makes_the_transit_times_whole():
     assert abs(transit / step - round(transit / step)) / (transit / step) < 1e-3
 
 
-def test_a_periodic_steady_state_falls_back_to_the_time_run_with_a_note():
-    """Shooting needs a state vector; the waves in flight are a history: the time run, and the reason."""
+def test_a_periodic_steady_state_runs_blows_until_they_settle_or_says_the_cap_came_first():
+    """The waves in flight are a history, not a state to shoot on: blows are run (models.steady.wave_settling);
+    three blows cannot show three changes below 1e-6: the cap, said with the last change."""
     import rpdrill
     data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4, "frequency_hz": 1000.0},
                     {"name": "sandstone"}, 3e-3, "exact", steady_state="periodic")
-    result = rpdrill.simulate(Scene.model_validate(data))
-    assert result.steady_state.regime_name != "period-1" and "waves in flight" in result.steady_state.note
+    steady = rpdrill.simulate(Scene.model_validate(data)).steady_state
+    assert steady.regime is rpdrill.Regime.NOT_FOUND and steady.blows == 3
+    assert "not settled within the cap of 3 blows" in steady.note
+
+
+def test_relative_changes_and_the_settled_blows():
+    from rpdrill.models.steady.wave_settling import relative_changes, settling
+    advance = np.array([1.0, 2.0, 1.5, 1.5 + 1e-7, 1.5 + 2e-7, 1.5 + 2e-7, 1.5 + 3e-7])
+    changes = relative_changes(advance, 2 * advance)
+    assert changes[0] == pytest.approx(0.5) and changes[4] == 0.0
+    found = settling(changes, 7)
+    assert found.settled and found.first_settled_blow == 2 and found.last_change == pytest.approx(1e-7 / 1.5, rel=1e-6)
+    assert not settling(changes[:4], 5).settled
 
 
 def test_the_cost_of_a_wave_run_counts_the_steps_of_the_characteristics():

@@ -85,6 +85,9 @@ class Regime(Enum):
         No periodic orbit found: the result is the time run, the reason in the note.
     REFUSED
         A scene that cannot have an orbit relative to the bottom: the time run, the reason in the note.
+    SETTLED
+        A drill with wave rods run blow by blow until its per-blow figures settled (models.steady.wave_settling):
+        the metrics over the settled blows, the blows run and the last change in the record.
 
     Examples
     --------
@@ -92,13 +95,14 @@ class Regime(Enum):
     >>> rpdrill.Regime("periodic") is rpdrill.Regime.PERIODIC
     True
     >>> [regime.value for regime in rpdrill.Regime]
-    ['time run', 'periodic', 'no periodic orbit found', 'periodic orbit refused']
+    ['time run', 'periodic', 'no periodic orbit found', 'periodic orbit refused', 'settled']
     """
 
     TIME_RUN = "time run"
     PERIODIC = "periodic"
     NOT_FOUND = "no periodic orbit found"
     REFUSED = "periodic orbit refused"
+    SETTLED = "settled"
 
 
 @dataclass(frozen=True)
@@ -148,7 +152,8 @@ class SteadyStateRecord:
     ``regime``, the stable ``orbit`` (None unless the regime is periodic), the ``unstable`` orbits met on the
     way, where the drill goes from its scene's ``start`` (None: not checked; another attractor there: the orbit
     coexists with it), the ``note`` (coexisting regimes, why none was found, why the scene was refused) and what
-    the search cost."""
+    the search cost; a drill with wave rods run until it settled: the ``blows`` run and the ``last_change`` of
+    its per-blow figures (models.steady.wave_settling)."""
 
     requested: Literal["time", "periodic"] = "time"
     regime: Regime = Regime.TIME_RUN
@@ -158,6 +163,8 @@ class SteadyStateRecord:
     note: str = ""
     map_runs: int = 0
     cpu_time_s: float = 0.0
+    blows: int = 0
+    last_change: float = float("nan")
     json_properties = ("regime_name", "period_blows", "floquet_max_abs")  # written beside the fields
 
     @property

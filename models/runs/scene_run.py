@@ -92,6 +92,9 @@ def _raw(simulation: Simulation, progress: Callable[[float], None] | None, guess
          cold_newton: bool, solution_file: Path | None, start_check: bool) -> SimulationResult:
     if simulation.scene.solver.steady_state != "periodic":
         return time_run(simulation, progress, solution_file)
+    if simulation.dynamic_chain.waves:  # the waves in flight: blows run until they settle
+        from ..steady.wave_settling import settled_run
+        return settled_run(simulation, progress)
     from ..solvers.exact_model import BLAS  # numba's kernels: loaded for a periodic run only
     from ..steady.regimes import RegimeFinder
 

@@ -1,0 +1,149 @@
+"""The steady state of a drill with wave rods: blows run until the per-blow figures settle.
+
+A wave rod's state is the waves in flight (a history over each transit time), not a state vector a period
+map could shoot on (models.steady.regimes). Its steady state is reached by running blows: the run goes on
+until the advance per blow and the energy per blow reaching the rock change by less than
+:data:`TOLERANCE` (relative) between consecutive blows for :data:`SETTLED_CHANGES` blows running, or until
+the scene's ``solver.end_time_s`` (the cap, checked by the run budget before the run). The exact formulation
+stops at the blow start where the figures settled (models.waves.stepping.Stepper.stop); another formulation
+runs to the cap and the settled blows are read from its run. The exact formulation's figures are the
+stepper's own at each blow start (the bottom by the rock law's return map to the bit there); read from the
+run's samples (SimulationResult.bottom_at) they agree to about 1e-8 of the advance per blow.
+
+The metrics are those of the settled blows: the run's metrics window is moved to them (``transient_blows``
+the first settled blow, whole blocks of at most the scene's ``block_blows`` to the run's last blow). The
+regime is ``settled`` with the blows run and the last change; where the cap is reached first it is ``no
+periodic orbit found``, the metrics those of the scene's own window of the run, with the last change in the
+note.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..definition.sections import Metrics
+from ..evaluation.results import SimulationResult
+from ..evaluation.rod_outputs import rock_energy_per_blow_j
+from ..evaluation.run_record import Regime, SteadyStateRecord
+from ..solvers.simulation import Simulation
+from ..solvers.time_run import time_run
+from .section import drift_problem
+
+TOLERANCE = 1e-6  # relative change between consecutive blows of the advance and the rock's energy per blow
+SETTLED_CHANGES = 3  # consecutive blows whose change is below TOLERANCE
+
+
+@dataclass(frozen=True)
+class Settling:
+    """What the run of blows found: ``settled``, the ``blows`` run, the first settled blow, the largest
+    relative change of the last :data:`SETTLED_CHANGES` blows (NaN: too few blows)."""
+
+    settled: bool
+    blows: int
+    first_settled_blow: int
+    last_change: float
+
+
+def relative_changes(advance_m: np.ndarray, energy_j: np.ndarray) -> np.ndarray:
+    """Per pair of consecutive blows, the larger relative change of the advance and of the rock's energy."""
+    advance_m, energy_j = np.asarray(advance_m, dtype=float), np.asarray(energy_j, dtype=float)
+    def change(values: np.ndarray) -> np.ndarray:  # none where the figure repeats exactly (a drill at rest too)
+        step = np.abs(np.diff(values))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(step == 0.0, 0.0, step / np.abs(values[1:]))
+
+    return np.maximum(change(advance_m), change(energy_j))
+
+
+def settling(changes: np.ndarray, blows: int) -> Settling:
+    """The settled blows of a run of ``blows`` blows with these ``changes`` (change i: blow i to i + 1; the
+    first blow may be left out, the changes then end at the last blow)."""
+    changes = np.asarray(changes, dtype=float)
+    last = float(np.max(changes[-SETTLED_CHANGES:])) if len(changes) >= SETTLED_CHANGES else float("nan")
+    above = np.flatnonzero(~(changes < TOLERANCE))
+    below = len(changes) - (above[-1] + 1 if len(above) else 0)  # the trailing changes below the tolerance
+    settled = below >= SETTLED_CHANGES
+    return Settling(settled, blows, blows - below - 1 if settled else blows, last)
+
+
+def per_blow(result: SimulationResult) -> tuple[np.ndarray, np.ndarray]:
+    """(advance, rock's energy) of every whole blow of a run."""
+    period = result.scene.impact.period_s
+    blows = int(np.floor(result.time_s[-1] / period + 1e-9))
+    advance = np.diff(result.bottom_at(np.arange(blows + 1) * period))
+    return advance, rock_energy_per_blow_j(result)[:blows]
+
+
+class _Watch:
+    """The exact formulation's stop (models.waves.stepping.Stepper.stop): at each blow start, the bottom
+    and the rock's work of the blow just done; True once the changes have settled."""
+
+    def __init__(self, simulation: Simulation) -> None:
+        self.law, self.blows = simulation.rock, 0
+        self.found: Settling | None = None  # where it stopped the run
+        self.bottoms: list[float] = []
+        self.energy: list[float] = []
+
+    def __call__(self, stepper) -> bool:
+        blows = len(stepper.statistics.rock_work_j)
+        if blows == self.blows:  # this blow start was asked already
+            return False
+        self.blows, layout, w = blows, stepper.layout, stepper.w
+        state = tuple(float(v) for v in w[layout.rock:layout.rock + layout.rock_states])
+        self.bottoms.append(self.law.return_map(float(w[stepper.chain.bit_body]), state)[self.law.bottom_index])
+        self.energy.append(stepper.statistics.rock_work_j[-1])
+        found = settling(relative_changes(np.diff(self.bottoms), self.energy[1:]), blows)
+        self.found = found if found.settled else None
+        return found.settled
+
+
+def settled_run(simulation: Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
+    """The steady state of a scene with wave rods (module doc), its record in the result's ``steady_state``."""
+    start = time.process_time()
+    problem = drift_problem(simulation)
+    if problem:
+        result = time_run(simulation, progress)
+        result.steady_state = SteadyStateRecord("periodic", Regime.REFUSED, note=problem)
+        return result
+    watch = _Watch(simulation)
+    if simulation.settings.formulation == "exact" and not simulation.scene.extensions:
+        from ..waves import exact_waves
+        result = exact_waves.simulate(simulation, progress, stop=watch)
+    else:
+        result = time_run(simulation, progress)
+    found = watch.found or settling(relative_changes(*per_blow(result)),
+                                    int(np.floor(result.time_s[-1] / simulation.impact.period_s + 1e-9)))
+    cap = simulation.settings.end_time_s
+    if found.settled:
+        result.simulation = settled_window(simulation, found)
+        note = (f"settled after {found.blows} blows: the advance and the rock's energy per blow change by at most "
+                f"{found.last_change:.3g} (relative) over the last {SETTLED_CHANGES} blows; metrics over blows "
+                f"{result.simulation.scene.metrics.transient_blows}..{found.blows}")
+        regime = Regime.SETTLED
+    else:
+        note = (f"not settled within the cap of {found.blows} blows (solver.end_time_s {cap:g} s): the last change "
+                f"of the advance or the rock's energy per blow is {found.last_change:.3g}, above {TOLERANCE:g}; "
+                "the time run's metrics")
+        regime = Regime.NOT_FOUND
+    result.cpu_time_s = time.process_time() - start
+    result.steady_state = SteadyStateRecord("periodic", regime, note=note, cpu_time_s=result.cpu_time_s,
+                                            blows=found.blows, last_change=found.last_change)
+    return result
+
+
+def settled_window(simulation: Simulation, found: Settling) -> Simulation:
+    """``simulation`` ending at the run's last blow, its metrics' window the settled blows: whole blocks of at
+    most its ``block_blows`` that end at the last blow."""
+    scene = simulation.scene
+    settled = found.blows - found.first_settled_blow
+    block = min(scene.metrics.block_blows, settled)
+    first = found.blows - (settled // block) * block
+    end_s = int(found.blows) * simulation.impact.period_s
+    scene = scene.model_copy(update={
+        "solver": scene.solver.model_copy(update={"end_time_s": end_s}),
+        "metrics": Metrics.model_construct(transient_blows=int(first), block_blows=int(block))})
+    return replace(simulation, scene=scene, settings=replace(simulation.settings, end_time_s=end_s))
