@@ -16,6 +16,7 @@ the API reference of the documentation site, ``docs/reference/index.md``)::
     rpdrill.accuracy("studies/accuracy_studies/paper_base.yaml").pareto
     rpdrill.reproduce(out="runs/reproduction").passed
     rpdrill.rotation_report("runs/rotation").ridge
+    rpdrill.drill_hole("holes/top_hammer_30m", out="runs/hole").summary["total_time_s"]
 
 Every command of the ``rpdrill`` program is one of these calls. The package's folders: ``rocklaw`` (the
 rock contact laws), ``models`` (the drill models and their three formulations), ``studies`` (YAML
@@ -39,6 +40,8 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "Advice": ("studies.advice.advice_run", "Advice"),
          "AdviceSearch": ("studies.advice.advice_run", "AdviceSearch"),
          "advise": ("studies.advice.advice_run", "advise_scene"),
+         "drill_hole": ("studies.hole.drill", "drill_hole"),
+         "HoleResult": ("studies.hole.hole_run", "HoleResult"),
          "load_scene": ("studies.api", "load_scene"),
          "load_study": ("studies.api", "load_study"),
          "run_study": ("studies.api", "run_study"),
@@ -86,6 +89,8 @@ if _TYPE_CHECKING:  # the names as type checkers and editors see them
     from .studies.crosscheck.crosscheck_run import Crosscheck, crosscheck
     from .studies.drawings.drill_animation import view_solution, write_animation
     from .studies.drawings.drill_drawing import draw
+    from .studies.hole.drill import drill_hole
+    from .studies.hole.hole_run import HoleResult
     from .studies.inputs.shipped import ShippedFile, shipped_files
     from .studies.pages.reproduction_run import ReproductionResult, reproduce
     from .studies.pages.rotation_note import RotationReport, rotation_report
@@ -112,9 +117,9 @@ def __dir__() -> list[str]:
 
 
 __all__ = ["AccuracyResult", "Advice", "AdviceSearch", "Budget", "BudgetError", "CalibrationResult",
-           "Crosscheck", "ExudynModel", "InputError", "Regime", "ReproductionResult", "Result",
+           "Crosscheck", "HoleResult", "ExudynModel", "InputError", "Regime", "ReproductionResult", "Result",
            "RockLaw", "RotationReport", "RunOptions", "Scene", "SensitivityResult", "ShippedFile",
            "SimulationFailed", "Study", "accuracy", "advise", "build_exudyn", "calibrate", "crosscheck",
-           "draw", "extension", "load_scene", "load_study", "reproduce", "rotation_report", "run_study",
+           "draw", "drill_hole", "extension", "load_scene", "load_study", "reproduce", "rotation_report", "run_study",
            "save_result", "sensitivity", "shipped_files", "simulate", "table_frame", "view_solution",
            "write_animation"]

@@ -51,6 +51,7 @@ COMMANDS = {
     "sensitivity": "how the frequency optima move with each scene parameter (+-10 %%, SALib global indices)",
     "rotation-report": "the rotation-speed note (rpm x frequency map, best speed against the manual's rule)",
     "advise": "the operating point that maximises a metric within bounds",
+    "hole": "drill a hole over its depth, rod by rod and layer by layer (rate, time, stresses against depth)",
     "shipped": "list the scenes, studies and analyses that ship with rpdrill, by the names that open them",
 }
 
@@ -76,6 +77,8 @@ def command_module(name: str) -> ModuleType:
         from . import rotation_report_command as module
     elif name == "advise":
         from . import advise_command as module
+    elif name == "hole":
+        from . import hole_command as module
     elif name == "shipped":
         from . import shipped_command as module
     else:
@@ -154,7 +157,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except Exception as err:  # noqa: BLE001 - a bug, not bad input: one line naming the input, no traceback
         where = traceback.extract_tb(err.__traceback__)[-1]
-        source = next((getattr(args, key) for key in ("scene", "study", "calibration", "sensitivity", "reproduction", "runs")
+        source = next((getattr(args, key) for key in ("scene", "study", "hole", "calibration", "sensitivity", "reproduction", "runs")
                        if hasattr(args, key)), "")
         own = blame_resolved(err)  # the code of one's own a scene named raised it: a run that failed, not a bug
         if own is not None:

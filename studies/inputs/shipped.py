@@ -5,7 +5,7 @@ A shipped file is a YAML file of the package's ``studies`` folder, installed wit
 package data); its name is its path there without ``.yaml``, a scene's its file name alone (``paper_base``
 for ``scenes/paper_base.yaml``). Its kind follows from its top-level keys (a scene has a ``drill_string``,
 a study a ``scan``, a sensitivity study ``scans``, a work-precision study ``repeats``, a calibration
-``parameters``, a reproduction the rest) and its description is its own ``description``. A path that exists
+``parameters``, a hole ``layers``, a reproduction the rest) and its description is its own ``description``. A path that exists
 is always the file there: a name is looked up only where no such file is.
 """
 
@@ -19,9 +19,9 @@ from pathlib import Path
 from ...models.definition.validation import InputError
 from .strict_yaml import parse_yaml
 
-KINDS = ("scene", "study", "calibration", "sensitivity", "accuracy", "reproduction")
+KINDS = ("scene", "study", "calibration", "sensitivity", "accuracy", "hole", "reproduction")
 _KEYS = (("drill_string", "scene"), ("scan", "study"), ("scans", "sensitivity"), ("repeats", "accuracy"),
-         ("parameters", "calibration"))  # in this order: a sensitivity study has parameters too
+         ("parameters", "calibration"), ("layers", "hole"))  # in this order: a sensitivity study has parameters too
 
 
 @dataclass(frozen=True)
@@ -30,7 +30,7 @@ class ShippedFile:
 
     Parameters
     ----------
-    kind : {"scene", "study", "calibration", "sensitivity", "accuracy", "reproduction"}
+    kind : {"scene", "study", "calibration", "sensitivity", "accuracy", "hole", "reproduction"}
         What it holds (:data:`KINDS`).
     name : str
         The name that opens it anywhere (``load_scene("paper_base")``, ``rpdrill study paper/frequency_scan``).
