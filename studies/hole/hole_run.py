@@ -18,6 +18,7 @@ unchanged and runs the rest; a Ctrl-C keeps every finished record (studies.runti
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -147,7 +148,7 @@ def _segment_lengths(hole: Hole) -> dict[tuple[int, int], float]:
     """The depth each segment drills."""
     lengths: dict[tuple[int, int], float] = {}
     breaks = _breaks(hole)
-    for top, bottom in zip(breaks[:-1], breaks[1:], strict=True):
+    for top, bottom in itertools.pairwise(breaks):
         key = (hole.rods_at(bottom), hole.layer_at(bottom))
         lengths[key] = lengths.get(key, 0.0) + bottom - top
     return lengths
@@ -160,7 +161,7 @@ def hole_rows(hole: Hole, found: dict[tuple[int, int], Segment], runs: dict[tupl
     breaks = _breaks(hole)
     elapsed = {0.0: 0.0}
     clock = 0.0
-    for top, bottom in zip(breaks[:-1], breaks[1:], strict=True):
+    for top, bottom in itertools.pairwise(breaks):
         rods = hole.rods_at(bottom)
         clock += (rods - hole.rods_at(top)) * spec.rod_change_s  # the rods added to drill below ``top``
         clock += (bottom - top) / runs[(rods, hole.layer_at(bottom))].rate_m_per_s
@@ -198,7 +199,7 @@ def hole_summary(hole: Hole, rows: pd.DataFrame, runs: dict[tuple[int, int], Seg
     start, the largest stresses and where."""
     spec, breaks = hole.spec, _breaks(hole)
     hammer = rock = drilling = 0.0
-    for top, bottom in zip(breaks[:-1], breaks[1:], strict=True):
+    for top, bottom in itertools.pairwise(breaks):
         run = runs[(hole.rods_at(bottom), hole.layer_at(bottom))]
         hammer += (bottom - top) * run.hammer_energy_per_blow_j / run.advance_per_blow_m
         rock += (bottom - top) * run.rock_energy_per_blow_j / run.advance_per_blow_m
