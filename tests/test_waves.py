@@ -109,13 +109,16 @@ def test_a_periodic_steady_state_runs_blows_until_they_settle_or_says_the_cap_ca
 
 
 def test_relative_changes_and_the_settled_blows():
-    from rpdrill.models.steady.wave_settling import relative_changes, settling
+    from rpdrill.models.steady.wave_settling import relative_changes, settled_of, settling
     advance = np.array([1.0, 2.0, 1.5, 1.5 + 1e-7, 1.5 + 2e-7, 1.5 + 2e-7, 1.5 + 3e-7])
     changes = relative_changes(advance, 2 * advance)
     assert changes[0] == pytest.approx(0.5) and changes[4] == 0.0
     found = settling(changes, 7)
-    assert found.settled and found.first_settled_blow == 2 and found.last_change == pytest.approx(1e-7 / 1.5, rel=1e-6)
+    assert found.settled and found.first_settled_blow == 2 and found.period_blows == 1 and found.last_change == pytest.approx(1e-7 / 1.5, rel=1e-6)
     assert not settling(changes[:4], 5).settled
+    alternating = np.array([1.0, 2.0] * 4)
+    found = settled_of(alternating, alternating, 8)
+    assert found.settled and found.period_blows == 2 and found.first_settled_blow == 0 and found.last_change == 0.0
 
 
 def test_the_cost_of_a_wave_run_counts_the_steps_of_the_characteristics():

@@ -153,7 +153,7 @@ class SteadyStateRecord:
     way, where the drill goes from its scene's ``start`` (None: not checked; another attractor there: the orbit
     coexists with it), the ``note`` (coexisting regimes, why none was found, why the scene was refused) and what
     the search cost; a drill with wave rods run until it settled: the ``blows`` run and the ``last_change`` of
-    its per-blow figures (models.steady.wave_settling)."""
+    its per-blow figures and the period they settled with (models.steady.wave_settling)."""
 
     requested: Literal["time", "periodic"] = "time"
     regime: Regime = Regime.TIME_RUN
@@ -165,15 +165,19 @@ class SteadyStateRecord:
     cpu_time_s: float = 0.0
     blows: int = 0
     last_change: float = float("nan")
+    settled_period_blows: int | None = None
     json_properties = ("regime_name", "period_blows", "floquet_max_abs")  # written beside the fields
 
     @property
     def period_blows(self) -> int | None:
-        return None if self.orbit is None else self.orbit.period_blows
+        return self.settled_period_blows if self.orbit is None else self.orbit.period_blows
 
     @property
     def regime_name(self) -> str:
-        """``period-n`` for an orbit of n blows, else the regime's text (``time run``, ...)."""
+        """``period-n`` for an orbit of n blows, ``settled`` (``settled period-n`` where the blows alternate), else
+        the regime's text (``time run``, ...)."""
+        if self.regime is Regime.SETTLED and (self.settled_period_blows or 1) > 1:
+            return f"settled period-{self.settled_period_blows}"
         return f"period-{self.orbit.period_blows}" if self.orbit is not None else self.regime.value
 
     @property

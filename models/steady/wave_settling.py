@@ -3,7 +3,8 @@
 A wave rod's state is the waves in flight (a history over each transit time), not a state vector a period
 map could shoot on (models.steady.regimes). Its steady state is reached by running blows: the run goes on
 until the advance per blow and the energy per blow reaching the rock change by less than
-:data:`TOLERANCE` (relative) between consecutive blows for :data:`SETTLED_CHANGES` blows running, or until
+:data:`TOLERANCE` (relative) between consecutive blows for :data:`SETTLED_CHANGES` blows running (or, a drill
+whose blows alternate, between each blow and the blow two before: settled with a period of 2 blows), or until
 the scene's ``solver.end_time_s`` (the cap, checked by the run budget before the run). The exact formulation
 stops at the blow start where the figures settled (models.waves.stepping.Stepper.stop); another formulation
 runs to the cap and the settled blows are read from its run. The exact formulation's figures are the
@@ -11,7 +12,8 @@ stepper's own at each blow start (the bottom by the rock law's return map to the
 run's samples (SimulationResult.bottom_at) they agree to about 1e-8 of the advance per blow.
 
 The metrics are those of the settled blows: the run's metrics window is moved to them (``transient_blows``
-the first settled blow, whole blocks of at most the scene's ``block_blows`` to the run's last blow). The
+the first settled blow, whole blocks of at most the scene's ``block_blows``, whole periods, to the run's last
+blow). The
 regime is ``settled`` with the blows run and the last change; where the cap is reached first it is ``no
 periodic orbit found``, the metrics those of the scene's own window of the run, with the last change in the
 note.
@@ -35,39 +37,51 @@ from .section import drift_problem
 
 TOLERANCE = 1e-6  # relative change between consecutive blows of the advance and the rock's energy per blow
 SETTLED_CHANGES = 3  # consecutive blows whose change is below TOLERANCE
+MAX_PERIOD_BLOWS = 2  # a drill whose blows alternate: each blow against the blow two before
 
 
 @dataclass(frozen=True)
 class Settling:
-    """What the run of blows found: ``settled``, the ``blows`` run, the first settled blow, the largest
-    relative change of the last :data:`SETTLED_CHANGES` blows (NaN: too few blows)."""
+    """What the run of blows found: ``settled`` (with a period of ``period_blows``), the ``blows`` run, the first
+    settled blow, the largest relative change over the last :data:`SETTLED_CHANGES` blows (NaN: too few blows;
+    of the period that came nearest to settling where none settled)."""
 
     settled: bool
     blows: int
     first_settled_blow: int
     last_change: float
+    period_blows: int = 1
 
 
-def relative_changes(advance_m: np.ndarray, energy_j: np.ndarray) -> np.ndarray:
-    """Per pair of consecutive blows, the larger relative change of the advance and of the rock's energy."""
+def relative_changes(advance_m: np.ndarray, energy_j: np.ndarray, period: int = 1) -> np.ndarray:
+    """Per pair of blows ``period`` apart, the larger relative change of the advance and of the rock's energy."""
     advance_m, energy_j = np.asarray(advance_m, dtype=float), np.asarray(energy_j, dtype=float)
+
     def change(values: np.ndarray) -> np.ndarray:  # none where the figure repeats exactly (a drill at rest too)
-        step = np.abs(np.diff(values))
+        step = np.abs(values[period:] - values[:-period]) if len(values) > period else np.zeros(0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(step == 0.0, 0.0, step / np.abs(values[1:]))
+            return np.where(step == 0.0, 0.0, step / np.abs(values[period:]))
 
     return np.maximum(change(advance_m), change(energy_j))
 
 
-def settling(changes: np.ndarray, blows: int) -> Settling:
-    """The settled blows of a run of ``blows`` blows with these ``changes`` (change i: blow i to i + 1; the
-    first blow may be left out, the changes then end at the last blow)."""
+def settling(changes: np.ndarray, blows: int, period: int = 1) -> Settling:
+    """The settled blows of a run of ``blows`` blows with these ``changes`` of blows ``period`` apart (change i:
+    blow i to i + period; the first blow may be left out, the changes then end at the last blow)."""
     changes = np.asarray(changes, dtype=float)
     last = float(np.max(changes[-SETTLED_CHANGES:])) if len(changes) >= SETTLED_CHANGES else float("nan")
     above = np.flatnonzero(~(changes < TOLERANCE))
     below = len(changes) - (above[-1] + 1 if len(above) else 0)  # the trailing changes below the tolerance
-    settled = below >= SETTLED_CHANGES
-    return Settling(settled, blows, blows - below - 1 if settled else blows, last)
+    settled = below >= SETTLED_CHANGES + period - 1
+    return Settling(settled, blows, blows - below - period if settled else blows, last, period)
+
+
+def settled_of(advance_m: np.ndarray, energy_j: np.ndarray, blows: int) -> Settling:
+    """The shortest period up to :data:`MAX_PERIOD_BLOWS` whose blows have settled, else the period that came
+    nearest (its last change the smallest)."""
+    found = [settling(relative_changes(advance_m, energy_j, n), blows, n) for n in range(1, MAX_PERIOD_BLOWS + 1)]
+    return next((f for f in found if f.settled), None) or \
+        min(found, key=lambda f: (np.nan_to_num(f.last_change, nan=np.inf), f.period_blows))
 
 
 def per_blow(result: SimulationResult) -> tuple[np.ndarray, np.ndarray]:
@@ -96,7 +110,7 @@ class _Watch:
         state = tuple(float(v) for v in w[layout.rock:layout.rock + layout.rock_states])
         self.bottoms.append(self.law.return_map(float(w[stepper.chain.bit_body]), state)[self.law.bottom_index])
         self.energy.append(stepper.statistics.rock_work_j[-1])
-        found = settling(relative_changes(np.diff(self.bottoms), self.energy[1:]), blows)
+        found = settled_of(np.diff(self.bottoms), self.energy[1:], blows)
         self.found = found if found.settled else None
         return found.settled
 
@@ -115,23 +129,27 @@ def settled_run(simulation: Simulation, progress: Callable[[float], None] | None
         result = exact_waves.simulate(simulation, progress, stop=watch)
     else:
         result = time_run(simulation, progress)
-    found = watch.found or settling(relative_changes(*per_blow(result)),
-                                    int(np.floor(result.time_s[-1] / simulation.impact.period_s + 1e-9)))
+    found = watch.found or settled_of(*per_blow(result), int(np.floor(result.time_s[-1] / simulation.impact.period_s
+                                                                      + 1e-9)))
     cap = simulation.settings.end_time_s
     if found.settled:
         result.simulation = settled_window(simulation, found)
-        note = (f"settled after {found.blows} blows: the advance and the rock's energy per blow change by at most "
-                f"{found.last_change:.3g} (relative) over the last {SETTLED_CHANGES} blows; metrics over blows "
+        period = "" if found.period_blows == 1 else f" with a period of {found.period_blows} blows"
+        note = (f"settled{period} after {found.blows} blows: the advance and the rock's energy per blow change by at "
+                f"most {found.last_change:.3g} (relative, against the blow {found.period_blows} before) over the last "
+                f"{SETTLED_CHANGES} blows; metrics over blows "
                 f"{result.simulation.scene.metrics.transient_blows}..{found.blows}")
         regime = Regime.SETTLED
     else:
         note = (f"not settled within the cap of {found.blows} blows (solver.end_time_s {cap:g} s): the last change "
-                f"of the advance or the rock's energy per blow is {found.last_change:.3g}, above {TOLERANCE:g}; "
+                f"of the advance or the rock's energy per blow (against the blow {found.period_blows} before) is "
+                f"{found.last_change:.3g}, above {TOLERANCE:g}; "
                 "the time run's metrics")
         regime = Regime.NOT_FOUND
     result.cpu_time_s = time.process_time() - start
     result.steady_state = SteadyStateRecord("periodic", regime, note=note, cpu_time_s=result.cpu_time_s,
-                                            blows=found.blows, last_change=found.last_change)
+                                            blows=found.blows, last_change=found.last_change,
+                                            settled_period_blows=found.period_blows if found.settled else None)
     return result
 
 
@@ -139,8 +157,8 @@ def settled_window(simulation: Simulation, found: Settling) -> Simulation:
     """``simulation`` ending at the run's last blow, its metrics' window the settled blows: whole blocks of at
     most its ``block_blows`` that end at the last blow."""
     scene = simulation.scene
-    settled = found.blows - found.first_settled_blow
-    block = min(scene.metrics.block_blows, settled)
+    settled, period = found.blows - found.first_settled_blow, found.period_blows
+    block = period * max(1, min(scene.metrics.block_blows, settled) // period)  # whole periods
     first = found.blows - (settled // block) * block
     end_s = int(found.blows) * simulation.impact.period_s
     scene = scene.model_copy(update={

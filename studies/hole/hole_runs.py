@@ -51,6 +51,8 @@ class SegmentRun:
     tension_position_m: float
     coupling_lost_j: dict[str, float] = field(default_factory=dict)
     coupling_transmission: dict[str, float] = field(default_factory=dict)
+    coupling_in_j: dict[str, float] = field(default_factory=dict)  # the net energy reaching it per blow
+    coupling_out_j: dict[str, float] = field(default_factory=dict)  # the energy it passes into the rod below
     cpu_time_s: float = 0.0
     operating: dict[str, float] = field(default_factory=dict)
 
@@ -79,12 +81,14 @@ def run_segment(task: tuple[str, int, int, dict[str, Any], str]) -> SegmentRun:
     first = round(metrics["window_start_s"] / period)
     window = slice(first, first + int(metrics["window_blows"]))
     readings = result.raw.wave_readings
-    lost, transmission = {}, {}
+    lost, transmission, energy_in, energy_out = {}, {}, {}, {}
     largest = {"compression_pa": (0.0, "", math.nan), "tension_pa": (0.0, "", math.nan)}
     if readings is not None:
         for name, coupling in readings.couplings.items():
             lost[name] = float(np.mean(coupling.lost_j[window]))
             transmission[name] = float(np.nanmean(coupling.transmission[window]))
+            energy_in[name] = float(np.mean(coupling.energy_in_j[window]))
+            energy_out[name] = float(np.mean(coupling.energy_out_j[window]))
         for rod, envelope in readings.envelopes.items():
             found = envelope.largest(window)
             for kind in largest:
@@ -98,7 +102,7 @@ def run_segment(task: tuple[str, int, int, dict[str, Any], str]) -> SegmentRun:
         metrics["energy_transfer_efficiency"], steady.regime_name, steady.blows, steady.last_change,
         largest["compression_pa"][0], largest["compression_pa"][1], largest["compression_pa"][2],
         largest["tension_pa"][0], largest["tension_pa"][1], largest["tension_pa"][2], lost, transmission,
-        time.process_time() - start)
+        energy_in, energy_out, time.process_time() - start)
 
 
 def _hammer_energy(result: Any, blows: int) -> float:

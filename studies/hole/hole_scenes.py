@@ -58,7 +58,7 @@ def check_fits(hole: Hole) -> None:
                          "body and the rock body for the string to replace; give a rig with extension rods "
                          "(model: waves) joined by connectors from its impact body to its rock body")
     widest = max(hole.rig.drill_string.bodies[name].diameter_m for name in rods)
-    if spec.string.rod.diameter_m > widest + 1e-12:
+    if spec.hammer == "top_hammer" and spec.string.rod.diameter_m > widest + 1e-12:  # (DTH tubes carry no blow)
         raise InputError(f"{source}: string.rod.diameter_m: {spec.string.rod.diameter_m}: does not fit the rig's rod "
                          f"chain ({' -> '.join(chain)}), whose rods are at most {widest} m; give at most {widest}")
 
