@@ -11,7 +11,7 @@ from typing import Any
 from ..inputs.arguments import check, either, file_problem, instance_problem
 from ..runtime.output_files import check_out
 from ..runtime.run_options import RunOptions
-from .hole_run import RECORD, HoleResult, drilled, holes_folders, write_hole
+from .hole_run import RECORD, HoleResult, check_segments, drilled, holes_folders, segments, write_hole
 from .hole_spec import Hole, load_hole
 
 HOLE_OPTIONS = ("workers", "dask", "out", "overwrite", "budget", "quiet")  # its run options (rpdrill.RunOptions)
@@ -75,10 +75,13 @@ def drill_holes(holes: Sequence[Hole], options: RunOptions, comparison: bool = F
         folders = holes_folders(holes, out)
         for folder in folders:
             check_out(folder, options.overwrite, RECORD)
+        planned = [segments(hole) for hole in holes]
+        for hole, found in zip(holes, planned, strict=True):  # every hole's runs against the budget first
+            check_segments(hole, found, options)
         results = []
         with pool(options.dask, options.workers, "--dask") as (_, runner):
-            for hole, folder in zip(holes, folders, strict=True):
-                result = drilled(hole, folder, runner, options)
+            for hole, found, folder in zip(holes, planned, folders, strict=True):
+                result = drilled(hole, found, folder, runner, options)
                 if options.out is not None:
                     write_hole(hole, result, folder)
                 results.append(result if options.out is not None else

@@ -31,7 +31,6 @@ from tqdm import tqdm
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, parse
 from ..inputs.reading import prepare_scene
-from ..runtime.budgets import duration
 from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import write_atomic, write_json, write_resolved, write_rows_csv
 from ..runtime.run_options import RunOptions
@@ -253,14 +252,10 @@ def prepare_out(hole: Hole, found: dict[tuple[int, int], Segment], out: Path, ov
         write_resolved(out / segment.file, segment.data)
 
 
-def estimate_text(cpu_s: float, runs: int) -> str:
-    return f"{runs} runs, estimated {duration(cpu_s)} of CPU before they settle"
-
-
-def drilled(hole: Hole, out: Path, runner: Any, options: RunOptions) -> HoleResult:
-    """Drill ``hole`` into ``out`` (its segments checked and written first; module doc)."""
-    found = segments(hole)
-    check_segments(hole, found, options)
+def drilled(hole: Hole, found: dict[tuple[int, int], Segment], out: Path, runner: Any,
+            options: RunOptions) -> HoleResult:
+    """Drill ``hole`` (its segments ``found`` and checked: :func:`segments`, :func:`check_segments`) into ``out``
+    (module doc)."""
     prepare_out(hole, found, out, options.overwrite)
     runs = run_segments(hole, found, out, runner, options.quiet)
     rows = hole_rows(hole, found, runs)

@@ -1,0 +1,81 @@
+"""The cost of a hole (issue 46): the shipped 30 m top-hammer hole (studies/holes/top_hammer_30m.yaml: 9 rods,
+3 layers, fixed operation) drilled in the exact formulation, and what the same costs in the Exudyn formulation.
+
+    python benchmarks/bench_hole.py [--repeat N] [--hole NAME] [--exudyn]
+
+Default: the hole drilled N times (default 3) in this process (``workers=1``) into a scratch folder, the CPU
+seconds of the process each time (time.process_time: every run is in this process), their median against the
+target of 60 s; then per run (one per rod count and layer) its rods, the blows it ran before it settled (or its
+cap), its CPU and the CPU per blow: how the cost grows with the rods (the CPU per blow) and with the depth (the
+runs: one per rod count and layer, so a deeper hole adds a run per rod and per layer boundary, each run
+costing blows x CPU per blow).
+``--exudyn``: the Exudyn formulation's CPU per blow at each rod count of the hole (a run of 5 blows each, after a
+warm-up) and the hole's cost estimated as the sum over its runs of the exact runs' blows x Exudyn's CPU per
+blow (a full Exudyn hole takes too long to run here; the blows to settle are taken from the exact runs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import rpdrill
+from rpdrill.studies.hole.hole_scenes import scene_data
+from rpdrill.studies.hole.hole_spec import load_hole
+
+TARGET_CPU_S = 60.0
+
+
+def drill_once(name: str) -> tuple[float, rpdrill.HoleResult]:
+    start = time.process_time()
+    result = rpdrill.drill_hole(name, workers=1)
+    return time.process_time() - start, result
+
+
+def exudyn_per_blow(name: str, rods: list[int]) -> dict[int, float]:
+    """CPU per blow of the hole's scene at each rod count (first layer) in the Exudyn formulation: 5 blows."""
+    hole = load_hole(name)
+    out = {}
+    for count in [rods[0], *rods]:  # the first again: a warm-up
+        data = scene_data(hole, count, 0)
+        data["solver"].update({"formulation": "exudyn", "end_time_s": 0.1, "steady_state": "time"})
+        data["metrics"] = {"transient_blows": 1, "block_blows": 1}
+        scene = rpdrill.Scene.model_validate(data)
+        start = time.process_time()
+        rpdrill.simulate(scene)
+        out[count] = (time.process_time() - start) / 5
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--hole", default="holes/top_hammer_30m")
+    parser.add_argument("--exudyn", action="store_true")
+    args = parser.parse_args()
+    times, result = [], None
+    for i in range(args.repeat):
+        cpu, result = drill_once(args.hole)
+        times.append(cpu)
+        print(f"run {i + 1}: {cpu:.1f} CPU s")
+    median = statistics.median(times)
+    print(f"{args.hole}: median {median:.1f} CPU s of {args.repeat} (target <= {TARGET_CPU_S:g} s: "
+          f"{'met' if median <= TARGET_CPU_S else 'NOT met'}); {len(result.runs)} runs, "
+          f"{len(result.rows)} depth rows")
+    print("run                 rods  blows  regime                     CPU s   CPU s/blow")
+    for key, run in sorted(result.runs.items()):
+        print(f"{key:<20}{run.rods:>4}{run.blows:>7}  {run.regime:<25}{run.cpu_time_s:>7.2f}{run.cpu_time_s / run.blows:>12.4f}")
+    if args.exudyn:
+        rods = sorted({run.rods for run in result.runs.values()})
+        per_blow = exudyn_per_blow(args.hole, rods)
+        estimate = sum(run.blows * per_blow[run.rods] for run in result.runs.values())
+        print("rods  Exudyn CPU s/blow")
+        for count in rods:
+            print(f"{count:>4}  {per_blow[count]:.3f}")
+        print(f"the hole in the Exudyn formulation: about {estimate:.0f} CPU s (the exact runs' blows x Exudyn's CPU "
+              f"per blow), {estimate / median:.0f} x the exact formulation's")
+
+
+if __name__ == "__main__":
+    main()
