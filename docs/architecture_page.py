@@ -80,6 +80,8 @@ ROLES = {
     "studies.accuracy": "Work-precision studies: every solver setting's error against its CPU time.",
     "studies.advice": "The operating point that maximises a metric within bounds (`rpdrill advise`) and "
                       "its report.",
+    "studies.hole": "A hole over its depth (`rpdrill hole`): the hole file, its scene rod by rod and layer by "
+                    "layer, one steady run per rod count and layer, the rows against depth, their figure.",
     "studies.crosscheck": "The Exudyn model against the paper's Eq. 4 as an ODE over the first blows.",
     "studies.reproduction": "The paper reproduced: each headline case scanned, its optima against the "
                             "paper's, the trends checked.",

@@ -57,7 +57,29 @@ class Segment:
 
 @dataclass(frozen=True)
 class HoleResult:
-    """A hole drilled (:func:`drill_hole`): one row a depth, the summary, the folder written."""
+    """A hole drilled (:func:`drill_hole`).
+
+    Parameters
+    ----------
+    name : str
+        The hole file's ``name``.
+    rows : pandas.DataFrame
+        One row a depth (``hole.csv``): rods, layer, rate, time to the depth, energies per blow, the energy
+        lost in each coupling, the largest stresses and where, efficiencies, regime, the depth's scene file.
+    summary : dict
+        What ``hole.json`` holds: total time, mean rate, energy per metre, the depth where the rate falls below
+        half its start, the largest stresses and where.
+    out : pathlib.Path or None
+        The folder written (None: a scratch folder, removed).
+    runs : dict of str to SegmentRun
+        Each run's record (studies.hole.hole_runs.SegmentRun) by its key, ``rods003_layer02``.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> drilled = rpdrill.drill_hole("holes/top_hammer_30m", out="runs/hole")  # doctest: +SKIP
+    >>> drilled.rows[["depth_m", "rods", "rate_mm_per_s"]].tail(1)  # doctest: +SKIP
+    """
 
     name: str
     rows: pd.DataFrame

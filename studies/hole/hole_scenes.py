@@ -24,43 +24,10 @@ from typing import Any
 
 from ...models.definition.scene import Scene
 from ...models.definition.validation import InputError, parse
-from .hole_spec import Hole
+from .hole_spec import Hole, rig_rods, rod_chain
 
 HOLE_METRICS = ["penetration_rate_m_per_s", "advance_per_blow_m", "rock_energy_per_blow_j",
                 "rock_transfer_efficiency", "energy_transfer_efficiency", "window_start_s", "window_blows"]
-
-
-def rod_chain(scene: Scene) -> list[str]:
-    """The bodies from the impact body to the rock body along the connectors (the rig's rod chain)."""
-    string = scene.drill_string
-    nexts = {c.from_body: c.to_body for c in string.connectors.values() if c.from_body != "ground"}
-    chain, body = [string.impact_body], string.impact_body
-    while body != string.rock_body and body in nexts and len(chain) <= len(string.bodies):
-        body = nexts[body]
-        chain.append(body)
-    return chain if body == string.rock_body else []
-
-
-def rig_rods(scene: Scene) -> list[str]:
-    """The rig's extension rods: the wave rods of its rod chain between the impact and the rock body."""
-    bodies = scene.drill_string.bodies
-    return [name for name in rod_chain(scene)[1:-1] if bodies[name].is_rod and bodies[name].model == "waves"]
-
-
-def check_fits(hole: Hole) -> None:
-    """InputError naming the hole file and the key unless the rig has a rod chain with wave rods the string's rod
-    replaces, and the rod is no wider than them (the rig's shank and couplings take that rod)."""
-    spec, source = hole.spec, hole.source
-    chain, rods = rod_chain(hole.rig), rig_rods(hole.rig)
-    if not rods:
-        shown = " -> ".join(chain) or f"{hole.rig.drill_string.impact_body} .. {hole.rig.drill_string.rock_body}"
-        raise InputError(f"{source}: rig: {spec.rig!r}: its rod chain ({shown}) has no wave rod between the impact "
-                         "body and the rock body for the string to replace; give a rig with extension rods "
-                         "(model: waves) joined by connectors from its impact body to its rock body")
-    widest = max(hole.rig.drill_string.bodies[name].diameter_m for name in rods)
-    if spec.hammer == "top_hammer" and spec.string.rod.diameter_m > widest + 1e-12:  # (DTH tubes carry no blow)
-        raise InputError(f"{source}: string.rod.diameter_m: {spec.string.rod.diameter_m}: does not fit the rig's rod "
-                         f"chain ({' -> '.join(chain)}), whose rods are at most {widest} m; give at most {widest}")
 
 
 def scene_data(hole: Hole, rods: int, layer: int, operating: dict[str, Any] | None = None) -> dict[str, Any]:

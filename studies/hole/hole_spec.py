@@ -3,7 +3,7 @@ the rock column in layers, the depth and its rows, the operating point and the t
 
 Read strictly (unknown keys, wrong types and values refused naming the file and the key path, exit status 2
 before anything runs): layers top down that neither overlap nor leave a gap, a depth within the last layer, a
-string rod that fits the rig's rod chain (studies.hole.hole_scenes). The rig is a scene file relative to the
+string rod that fits the rig's rod chain (:func:`check_fits`). The rig is a scene file relative to the
 hole file, or a shipped scene's name.
 """
 
@@ -162,6 +162,38 @@ def load_hole(path: str | Path, allow_code: tuple[str, ...] = ()) -> Hole:
     if spec.rig_overrides:
         rig = rig.with_(dict(spec.rig_overrides), f"{path}: rig_overrides")
     hole = Hole(spec, path, rig, str(rig_file))
-    from .hole_scenes import check_fits  # the rig's rod chain takes the string's rod
     check_fits(hole)
     return hole
+
+
+def rod_chain(scene: Scene) -> list[str]:
+    """The bodies from the impact body to the rock body along the connectors (the rig's rod chain)."""
+    string = scene.drill_string
+    nexts = {c.from_body: c.to_body for c in string.connectors.values() if c.from_body != "ground"}
+    chain, body = [string.impact_body], string.impact_body
+    while body != string.rock_body and body in nexts and len(chain) <= len(string.bodies):
+        body = nexts[body]
+        chain.append(body)
+    return chain if body == string.rock_body else []
+
+
+def rig_rods(scene: Scene) -> list[str]:
+    """The rig's extension rods: the wave rods of its rod chain between the impact and the rock body."""
+    bodies = scene.drill_string.bodies
+    return [name for name in rod_chain(scene)[1:-1] if bodies[name].is_rod and bodies[name].model == "waves"]
+
+
+def check_fits(hole: Hole) -> None:
+    """InputError naming the hole file and the key unless the rig has a rod chain with wave rods the string's rod
+    replaces, and the rod is no wider than them (the rig's shank and couplings take that rod)."""
+    spec, source = hole.spec, hole.source
+    chain, rods = rod_chain(hole.rig), rig_rods(hole.rig)
+    if not rods:
+        shown = " -> ".join(chain) or f"{hole.rig.drill_string.impact_body} .. {hole.rig.drill_string.rock_body}"
+        raise InputError(f"{source}: rig: {spec.rig!r}: its rod chain ({shown}) has no wave rod between the impact "
+                         "body and the rock body for the string to replace; give a rig with extension rods "
+                         "(model: waves) joined by connectors from its impact body to its rock body")
+    widest = max(hole.rig.drill_string.bodies[name].diameter_m for name in rods)
+    if spec.hammer == "top_hammer" and spec.string.rod.diameter_m > widest + 1e-12:  # (DTH tubes carry no blow)
+        raise InputError(f"{source}: string.rod.diameter_m: {spec.string.rod.diameter_m}: does not fit the rig's rod "
+                         f"chain ({' -> '.join(chain)}), whose rods are at most {widest} m; give at most {widest}")
