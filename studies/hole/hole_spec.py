@@ -161,6 +161,10 @@ def load_hole(path: str | Path, allow_code: tuple[str, ...] = ()) -> Hole:
         raise InputError(f"{path}: rig: {spec.rig!r}: {error}") from None
     if spec.rig_overrides:
         rig = rig.with_(dict(spec.rig_overrides), f"{path}: rig_overrides")
+    if spec.operating != "fixed":  # the advisor per rod count and layer is not wired in yet: refused, not ignored
+        raise InputError(f"{path}: operating: {spec.operating.model_dump()}: the advised operating point per rod count "
+                         "and layer is not implemented yet; allowed: fixed (the rig's operating point; run rpdrill "
+                         "advise on a depth's scene in DIR/scenes/ for its best point)")
     hole = Hole(spec, path, rig, str(rig_file))
     check_fits(hole)
     return hole
