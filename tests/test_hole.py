@@ -121,3 +121,20 @@ def test_an_interrupted_hole_resumes_to_the_same_hole_csv(drilled, tmp_path, mon
     assert main(["hole", str(path), "--out", str(out), "--workers", "1", "--quiet"]) == 0
     assert (out / "hole.csv").read_text() == (drilled.out / "hole.csv").read_text().replace(
         str(drilled.out), str(out))
+
+
+def test_an_advised_hole_runs_each_depth_at_the_advisors_point_and_says_the_time_gained(tmp_path):
+    """``operating: advise`` (a small search at a fixed power): the depth's run is at the point found, inside the
+    bounds, its scene written beside the rig's; the time gained is the fixed setting's time less the hole's."""
+    advise = {"bounds": {"impact.frequency_hz": [40.0, 60.0], "feed.force_n": [8000.0, 16000.0]}, "power_kw": 15.0,
+              "popsize": 2, "max_generations": 1, "search_end_time_s": 0.3}
+    path = hole_file(tmp_path, "advised", depth_m=1.5, layers=[{"to_m": 1.5, "rock": {"name": "sandstone"}}],
+                     operating={"advise": advise})
+    drilled = rpdrill.drill_hole(path, out=tmp_path / "out", workers=1)
+    row, run = drilled.rows.iloc[0], drilled.runs["rods001_layer01"]
+    assert 40.0 <= run.operating["impact.frequency_hz"] <= 60.0 and 8e3 <= run.operating["feed.force_n"] <= 16e3
+    assert run.operating["impact.piston.energy_j"] == pytest.approx(15e3 / run.operating["impact.frequency_hz"])
+    assert row["scene"].endswith("_advised.yaml") and (drilled.out / row["scene"]).exists()
+    summary = drilled.summary
+    assert summary["time_gained_s"] == pytest.approx(summary["fixed_total_time_s"] - summary["total_time_s"])
+    assert summary["fixed_total_time_s"] == pytest.approx(1.5 / run.fixed_rate_m_per_s)

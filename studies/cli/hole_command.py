@@ -45,8 +45,12 @@ def run(args: argparse.Namespace) -> int:
               f"{s['rock_energy_per_m_j'] / 1e3:.4g} kJ/m into the rock; largest stress "
               f"{s['largest_compression']['stress_mpa']:.4g} MPa compression ({s['largest_compression']['rod']}, "
               f"{s['largest_compression']['position_m']:.3g} m below its top, at {s['largest_compression']['depth_m']:g} m "
-              "depth), {s['largest_tension']['stress_mpa']:.4g} MPa tension; "
+              f"depth), {s['largest_tension']['stress_mpa']:.4g} MPa tension; "
               f"wrote {result.out}")
+    for result in results:
+        if "time_gained_s" in result.summary:
+            print(f"{result.name}: the advised points save {result.summary['time_gained_s'] / 60:.4g} min against the "
+                  f"rig's own ({result.summary['fixed_total_time_s'] / 60:.4g} min)")
     unsettled = [r.name for r in results if any(g != "settled" for g in r.summary["regimes"])]
     for name in unsettled:
         print(f"{name}: some depths did not settle within their cap (regime in hole.csv)", file=sys.stderr)

@@ -10,6 +10,10 @@ Time to a depth: the integral of dz / rate over the segments above it (the rate 
 ``rod_change_s`` for each rod added on the way. Energy per metre: the hammer's energy per blow over the advance
 per blow, integrated over the depth (and the energy reaching the rock alike).
 
+With ``operating: advise`` each segment's run is at the point the advisor finds for it (studies.hole.hole_advice;
+its scene written beside the rig's as ``*_advised.yaml``), its rate at the rig's own point kept, and the summary
+gives the time gained against that fixed setting.
+
 Resumable: each run's record is written to ``DIR/runs/<key>.json`` as it finishes (and each depth's scene to
 ``DIR/scenes/`` before any runs, for ``rpdrill simulate``); a rerun into DIR reads the records whose scene is
 unchanged and runs the rest; a Ctrl-C keeps every finished record (studies.runtime.interrupts). The hole's files
@@ -35,7 +39,7 @@ from ..runtime.interrupts import raise_if_stopped
 from ..runtime.output_files import write_atomic, write_json, write_resolved, write_rows_csv
 from ..runtime.run_options import RunOptions
 from .hole_runs import SegmentRun, run_segment, scene_hash
-from .hole_scenes import scene_data
+from .hole_scenes import apply_changes, scene_data
 from .hole_spec import Hole
 
 RECORD = "hole.resolved.yaml"  # written first: a rerun into the folder resumes the same hole only
@@ -142,15 +146,16 @@ def run_segments(hole: Hole, found: dict[tuple[int, int], Segment], out: Path, r
     (out / "runs").mkdir(parents=True, exist_ok=True)
     done: dict[tuple[int, int], SegmentRun] = {}
     todo = []
+    advise = None if hole.spec.operating == "fixed" else hole.spec.operating.options
     for key, segment in found.items():
         path = out / "runs" / f"{segment.key}.json"
         if path.exists():
             record = SegmentRun.from_json(path.read_text(encoding="utf-8"))
-            if record.scene_hash == scene_hash(segment.data):
+            if record.scene_hash == scene_hash(segment.data, advise):
                 done[key] = record
                 continue
         todo.append((segment.key, segment.rods, segment.layer, segment.data,
-                     f"{hole.source}: {segment.file}"))
+                     f"{hole.source}: {segment.file}", advise))
     lengths = _segment_lengths(hole)
     keys = {segment.key: key for key, segment in found.items()}
     with tqdm(total=hole.spec.depth_m, desc=hole.spec.name, unit="m", disable=quiet,
@@ -175,18 +180,25 @@ def _segment_lengths(hole: Hole) -> dict[tuple[int, int], float]:
     return lengths
 
 
+def elapsed_times(hole: Hole, rates: dict[tuple[int, int], float]) -> dict[float, float]:
+    """The time to reach each break depth (:func:`_breaks`) at these rates by (rods, layer): the integral of
+    dz / rate plus ``rod_change_s`` for each rod added on the way."""
+    breaks = _breaks(hole)
+    elapsed, clock = {breaks[0]: 0.0}, 0.0
+    for top, bottom in itertools.pairwise(breaks):
+        rods = hole.rods_at(bottom)
+        clock += (rods - hole.rods_at(top)) * hole.spec.rod_change_s  # the rods added to drill below ``top``
+        clock += (bottom - top) / rates[(rods, hole.layer_at(bottom))]
+        elapsed[bottom] = clock
+    return elapsed
+
+
 def hole_rows(hole: Hole, found: dict[tuple[int, int], Segment], runs: dict[tuple[int, int], SegmentRun]
               ) -> pd.DataFrame:
     """One row a depth (module doc)."""
     spec = hole.spec
-    breaks = _breaks(hole)
-    elapsed = {0.0: 0.0}
-    clock = 0.0
-    for top, bottom in itertools.pairwise(breaks):
-        rods = hole.rods_at(bottom)
-        clock += (rods - hole.rods_at(top)) * spec.rod_change_s  # the rods added to drill below ``top``
-        clock += (bottom - top) / runs[(rods, hole.layer_at(bottom))].rate_m_per_s
-        elapsed[bottom] = clock
+    elapsed = elapsed_times(hole, {key: run.rate_m_per_s for key, run in runs.items()})
+    advised = spec.operating != "fixed"
     couplings = sorted({name for run in runs.values() for name in run.coupling_lost_j}, key=_coupling_order)
     rows = []
     for depth in depth_rows(hole):
@@ -204,10 +216,18 @@ def hole_rows(hole: Hole, found: dict[tuple[int, int], Segment], runs: dict[tupl
                "compression_position_m": run.compression_position_m, "tension_max_mpa": run.tension_pa / 1e6,
                "tension_rod": run.tension_rod, "tension_position_m": run.tension_position_m,
                "regime": run.regime, "settle_blows": run.blows, "last_change": run.last_change,
-               "scene": found[key].file}
+               "scene": advised_file(found[key]) if advised else found[key].file}
+        if advised:
+            row.update({"fixed_rate_mm_per_s": 1e3 * run.fixed_rate_m_per_s,
+                        **{f"advised_{path}": value for path, value in run.operating.items() if value is not None}})
         row.update({f"lost_j_{name}": run.coupling_lost_j.get(name, math.nan) for name in couplings})
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def advised_file(segment: Segment) -> str:
+    """The file of a segment's scene at its advised operating point."""
+    return segment.file.removesuffix(".yaml") + "_advised.yaml"
 
 
 def _coupling_order(name: str) -> tuple[int, int, str]:
@@ -240,9 +260,17 @@ def hole_summary(hole: Hole, rows: pd.DataFrame, runs: dict[tuple[int, int], Seg
         **{f"largest_{kind}": {"stress_mpa": float(row[f"{kind}_max_mpa"]), "depth_m": float(row["depth_m"]),
                                "rod": row[f"{kind}_rod"], "position_m": float(row[f"{kind}_position_m"])}
            for kind, row in worst.items()},
+        **({} if spec.operating == "fixed" else _gained(hole, runs, total)),
         "regimes": sorted({run.regime for run in runs.values()}),
         "run_cpu_time_s": sum(run.cpu_time_s for run in runs.values()),
     }
+
+
+def _gained(hole: Hole, runs: dict[tuple[int, int], SegmentRun], total_s: float) -> dict[str, float]:
+    """With ``operating: advise``: the total time at the rig's own operating point and the time gained."""
+    fixed = elapsed_times(hole, {key: run.fixed_rate_m_per_s for key, run in runs.items()})
+    fixed_total = fixed[max(fixed)]
+    return {"fixed_total_time_s": fixed_total, "time_gained_s": fixed_total - total_s}
 
 
 def write_hole(hole: Hole, result: HoleResult, out: Path) -> list[Path]:
@@ -280,6 +308,9 @@ def drilled(hole: Hole, found: dict[tuple[int, int], Segment], out: Path, runner
     (module doc)."""
     prepare_out(hole, found, out, options.overwrite)
     runs = run_segments(hole, found, out, runner, options.quiet)
+    for key, run in runs.items():  # each advised point's scene beside the rig's (rpdrill simulate runs it)
+        if run.operating:
+            write_resolved(out / advised_file(found[key]), apply_changes(found[key].data, run.operating))
     rows = hole_rows(hole, found, runs)
     return HoleResult(hole.spec.name, rows, hole_summary(hole, rows, runs), out,
                       {found[key].key: run for key, run in runs.items()})

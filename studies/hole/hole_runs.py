@@ -15,7 +15,7 @@ import hashlib
 import json
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -24,6 +24,8 @@ from ...models.definition.scene import Scene
 from ...models.definition.validation import parse
 from ...models.runs.scene_run import run
 from ..inputs.reading import prepare_scene
+from .hole_advice import advised_changes
+from .hole_scenes import apply_changes
 
 
 @dataclass(frozen=True)
@@ -54,7 +56,8 @@ class SegmentRun:
     coupling_in_j: dict[str, float] = field(default_factory=dict)  # the net energy reaching it per blow
     coupling_out_j: dict[str, float] = field(default_factory=dict)  # the energy it passes into the rod below
     cpu_time_s: float = 0.0
-    operating: dict[str, float] = field(default_factory=dict)
+    operating: dict[str, float | None] = field(default_factory=dict)  # the advised point's changes (advise)
+    fixed_rate_m_per_s: float = math.nan  # the rate at the rig's own operating point (advise)
 
     def as_json(self) -> str:
         return json.dumps(asdict(self), indent=1, allow_nan=True)
@@ -64,15 +67,29 @@ class SegmentRun:
         return cls(**json.loads(text))
 
 
-def scene_hash(data: dict[str, Any]) -> str:
-    """A digest of a scene's data (a resumed hole reruns a segment whose scene changed)."""
-    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
+def scene_hash(data: dict[str, Any], advise: dict[str, Any] | None = None) -> str:
+    """A digest of a scene's data and the advisor's options (a resumed hole reruns a segment whose scene changed)."""
+    payload = data if advise is None else [data, advise]
+    return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
 
-def run_segment(task: tuple[str, int, int, dict[str, Any], str]) -> SegmentRun:
-    """Run one segment's scene (``(key, rods, layer, scene data, source)``, what a worker receives) into its
-    record."""
-    key, rods, layer, data, source = task
+def run_segment(task: tuple[str, int, int, dict[str, Any], str, dict[str, Any] | None]) -> SegmentRun:
+    """Run one segment's scene (``(key, rods, layer, scene data, source, advise options or None)``, what a worker
+    receives) into its record; with the advisor's options, the steady run at the point it finds (its rate at the
+    rig's own point kept beside it)."""
+    key, rods, layer, data, source, advise = task
+    start = time.process_time()
+    fixed = settled_record(key, rods, layer, data, source)
+    if advise is None:
+        return replace(fixed, scene_hash=scene_hash(data))
+    changes = advised_changes(data, source, advise)
+    advised = settled_record(key, rods, layer, apply_changes(data, changes), source)
+    return replace(advised, scene_hash=scene_hash(data, advise), operating=changes,
+                   fixed_rate_m_per_s=fixed.rate_m_per_s, cpu_time_s=time.process_time() - start)
+
+
+def settled_record(key: str, rods: int, layer: int, data: dict[str, Any], source: str) -> SegmentRun:
+    """The record of the steady run of the scene ``data`` (module doc)."""
     start = time.process_time()
     scene = parse(Scene, data, source)
     result = run(prepare_scene(scene, source), source=source)

@@ -20,6 +20,7 @@ per-blow figures settle, models.steady.wave_settling) and for the metrics the ho
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 from ...models.definition.scene import Scene
@@ -74,12 +75,21 @@ def scene_data(hole: Hole, rods: int, layer: int, operating: dict[str, Any] | No
     data["rock"] = dict(spec.layers[layer].rock)
     data["solver"]["steady_state"] = "periodic"
     data["outputs"] = {"metrics": list(HOLE_METRICS)}
-    for path, value in (operating or {}).items():
+    return apply_changes(data, operating or {})
+
+
+def apply_changes(data: dict[str, Any], changes: dict[str, Any]) -> dict[str, Any]:
+    """A copy of scene ``data`` with each dotted key path set to its value (None: the key taken out)."""
+    data = copy.deepcopy(data)
+    for path, value in changes.items():
         part = data
         *parents, leaf = path.split(".")
         for key in parents:
             part = part.setdefault(key, {})
-        part[leaf] = value
+        if value is None:
+            part.pop(leaf, None)
+        else:
+            part[leaf] = value
     return data
 
 

@@ -81,15 +81,37 @@ class Layer(StrictSpec):
 
 
 class Advise(StrictSpec):
-    """The best operating point at each rod count and layer, as ``rpdrill advise`` takes it."""
+    """The best operating point at each rod count and layer, as ``rpdrill advise`` takes it (``bounds`` by key path,
+    SI units: ``impact.frequency_hz`` and ``feed.force_n`` at least), its search's budget and the simulated time of
+    each of its runs (studies.hole.hole_advice)."""
 
     bounds: dict[str, list[float]]
     power_kw: float | None = Field(None, gt=0.0)
     max_rod_stress_mpa: float | None = Field(None, gt=0.0)
+    popsize: int = Field(4, ge=1, le=100)
+    max_generations: int = Field(3, ge=1, le=1000)
+    seed: int = Field(1, ge=0)
+    search_end_time_s: float = Field(0.4, gt=0.0)
+
+    @model_validator(mode="after")
+    def _bounds(self) -> Advise:
+        for path, pair in self.bounds.items():
+            if len(pair) != 2 or not pair[0] < pair[1]:
+                raise ValueError(f"bounds.{path}: {pair}: give [low, high] with low below high")
+        missing = [path for path in ("impact.frequency_hz", "feed.force_n") if path not in self.bounds]
+        if missing:
+            raise ValueError(f"bounds: give {' and '.join(missing)} [low, high]")
+        return self
 
 
 class Operating(StrictSpec):
+    """``operating: {advise: {...}}``."""
+
     advise: Advise
+
+    @property
+    def options(self) -> dict[str, Any]:
+        return self.advise.model_dump()
 
 
 class HoleSpec(StrictSpec):
@@ -161,10 +183,6 @@ def load_hole(path: str | Path, allow_code: tuple[str, ...] = ()) -> Hole:
         raise InputError(f"{path}: rig: {spec.rig!r}: {error}") from None
     if spec.rig_overrides:
         rig = rig.with_(dict(spec.rig_overrides), f"{path}: rig_overrides")
-    if spec.operating != "fixed":  # the advisor per rod count and layer is not wired in yet: refused, not ignored
-        raise InputError(f"{path}: operating: {spec.operating.model_dump()}: the advised operating point per rod count "
-                         "and layer is not implemented yet; allowed: fixed (the rig's operating point; run rpdrill "
-                         "advise on a depth's scene in DIR/scenes/ for its best point)")
     hole = Hole(spec, path, rig, str(rig_file))
     check_fits(hole)
     return hole
