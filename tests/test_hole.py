@@ -21,7 +21,7 @@ ROD = {"length_m": 1.5, "diameter_m": 0.045, "bore_diameter_m": 0.012, "model": 
 def hole_file(folder: Path, name: str = "short", **changes) -> Path:
     data = {"name": name, "rig": str(RIG), "string": {"rod": dict(ROD), "first_rods": 1},
             "layers": [{"to_m": 3.0, "rock": {"name": "sandstone"}}], "depth_m": 3.0, "depth_step_m": "at_changes",
-            "rod_change_s": 30.0, "rig_overrides": {"solver.formulation": "exact", "solver.end_time_s": 3.0,
+            "rod_change_s": 30.0, "rig_overrides": {"solver.formulation": "exact", "solver.end_time_s": 2.0,
                               "solver.output_interval_s": 1e-4}}
     data.update(changes)
     path = folder / f"{name}.yaml"
