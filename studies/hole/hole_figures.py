@@ -33,10 +33,10 @@ def plot_hole(results: Sequence[Any], holes: Sequence[Any], path: Path) -> list[
         for result, style in zip(results, styles, strict=True):
             rows = result.rows
             kwargs = {**style.kwargs(), "markersize": 3}
-            ax.plot(rows[column] * scale, rows["depth_m"], drawstyle="steps-pre" if column != "time_s" else "default",
+            ax.plot(rows[column] * scale, rows["depth_m"], drawstyle="steps-post" if column != "time_s" else "default",
                     label=result.name, **kwargs)
             if column == "compression_max_mpa":
-                ax.plot(rows["tension_max_mpa"], rows["depth_m"], drawstyle="steps-pre", alpha=0.6,
+                ax.plot(rows["tension_max_mpa"], rows["depth_m"], drawstyle="steps-post", alpha=0.6,
                         **{**kwargs, "linestyle": ":"}, label=f"{result.name} (tension)")
         ax.set_xlabel(label)
         ax.grid(alpha=0.3)
