@@ -138,3 +138,21 @@ def test_an_advised_hole_runs_each_depth_at_the_advisors_point_and_says_the_time
     summary = drilled.summary
     assert summary["time_gained_s"] == pytest.approx(summary["fixed_total_time_s"] - summary["total_time_s"])
     assert summary["fixed_total_time_s"] == pytest.approx(1.5 / run.fixed_rate_m_per_s)
+
+
+def test_a_down_the_hole_hammer_strikes_the_bit_and_its_tubes_only_add_mass(tmp_path):
+    """``hammer: down_the_hole``: the rig's rods are taken out, the struck shank joined to the bit; the tubes' mass
+    joins the body the feed pushes; the rate with 1 and 2 tubes is the same within 1e-3 (no coupling crossed)."""
+    tube = {"length_m": 1.5, "diameter_m": 0.076, "bore_diameter_m": 0.060}
+    path = hole_file(tmp_path, "dth", hammer="down_the_hole", string={"rod": tube, "first_rods": 1})
+    drilled = rpdrill.drill_hole(path, out=tmp_path / "out", workers=1)
+    one, two = drilled.runs["rods001_layer01"], drilled.runs["rods002_layer01"]
+    assert one.coupling_lost_j == {} and two.rate_m_per_s == pytest.approx(one.rate_m_per_s, rel=1e-3)
+    scenes = [rpdrill.load_scene(drilled.out / f"scenes/dth_{n}rods_layer1.yaml") for n in (1, 2)]
+    rig = rpdrill.load_scene(RIG)
+    tube_kg = 7800.0 * 1.5 * math.pi * (0.076**2 - 0.060**2) / 4  # the rig's rods' steel (the scene's default)
+    for n, scene in enumerate(scenes, start=1):
+        bodies = scene.drill_string.bodies
+        assert set(bodies) == {"carriage", "shank", "bit"}
+        assert scene.drill_string.connectors["bit_coupling"].from_body == "shank"
+        assert bodies["carriage"].mass_kg == pytest.approx(rig.drill_string.bodies["carriage"].mass_kg + n * tube_kg)
