@@ -9,6 +9,10 @@ target of 60 s; then per run (one per rod count and layer) its rods, the blows i
 cap), its CPU and the CPU per blow: how the cost grows with the rods (the CPU per blow) and with the depth (the
 runs: one per rod count and layer, so a deeper hole adds a run per rod and per layer boundary, each run
 costing blows x CPU per blow).
+``--profile ROD_COUNT LAYER``: where one run's CPU goes (cProfile of the steady run of the hole's scene at that rod
+count and layer, 1-based): the compiled kernels of the characteristics (models.waves.kernels, models.waves.fast_path's
+calls of them) against the Python step loop around them (models.waves.stepping, levels, outgoing, recording), and
+the blows the run needed.
 ``--exudyn``: the Exudyn formulation's CPU per blow at each rod count of the hole (a run of 5 blows each, after a
 warm-up) and the hole's cost estimated as the sum over its runs of the exact runs' blows x Exudyn's CPU per
 blow (a full Exudyn hole takes too long to run here; the blows to settle are taken from the exact runs).
@@ -48,12 +52,40 @@ def exudyn_per_blow(name: str, rods: list[int]) -> dict[int, float]:
     return out
 
 
+def profile(name: str, rods: int, layer: int) -> None:
+    """cProfile of one run (module doc), its own time grouped by module."""
+    import cProfile
+    import pstats
+
+    from rpdrill.studies.hole.hole_runs import settled_record
+
+    hole = load_hole(name)
+    data = scene_data(hole, rods, layer - 1)
+    settled_record("warm-up", 1, 0, scene_data(hole, 1, 0), name)  # numba's kernels loaded once
+    profiler = cProfile.Profile()
+    start = time.process_time()
+    record = profiler.runcall(settled_record, "profiled", rods, layer - 1, data, name)
+    total = time.process_time() - start
+    by_module: dict[str, float] = {}
+    for (file, _, function), (_, _, own, _, _) in pstats.Stats(profiler).stats.items():
+        module = file.rsplit("/", 1)[-1] if file.startswith("/") else function
+        by_module[module] = by_module.get(module, 0.0) + own
+    print(f"{rods} rods in layer {layer}: {record.blows} blows ({record.regime}), {total:.1f} CPU s "
+          f"({total / record.blows:.3f} s a blow; the profiler's own overhead included)")
+    for module, own in sorted(by_module.items(), key=lambda item: -item[1])[:12]:
+        print(f"  {own:7.2f} s  {100 * own / sum(by_module.values()):5.1f} %  {module}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--hole", default="holes/top_hammer_30m")
     parser.add_argument("--exudyn", action="store_true")
+    parser.add_argument("--profile", nargs=2, type=int, metavar=("ROD_COUNT", "LAYER"))
     args = parser.parse_args()
+    if args.profile:
+        profile(args.hole, *args.profile)
+        return
     times, result = [], None
     for i in range(args.repeat):
         cpu, result = drill_once(args.hole)
