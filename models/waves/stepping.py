@@ -32,7 +32,7 @@ from ..drill.wave_rod import SIGMA, TOP
 from ..evaluation.stability import POSITION_LIMIT_M, SimulationFailed
 from .fast_path import SWITCH, run_fast
 from .history import WaveLines
-from .kernels import CATCH
+from .kernels import CATCH, ROUND_OFF
 from .levels import key_levels
 from .outgoing import Segment, StepWaves, outgoing, readings
 from .recording import BlowPeaks, Recorder, Samples, Snapshot
@@ -407,7 +407,7 @@ class Stepper(Recorder):
         rows, slopes = key.cache["exit_rows"], key.cache["exit_slopes"]
         start, end = rows @ w0, rows @ w1
         returning = (start < 0.0) & (end <= 0.0) & (slopes @ w0 > 0.0) & (slopes @ w1 < 0.0)
-        candidates = (end > 0.0) | returning
+        candidates = (end > ROUND_OFF * (np.abs(rows) @ np.abs(w1))) | returning  # beyond round-off (kernels)
         if not np.any(candidates):
             return None
         return key_levels(self, key).first_switch(rows, slopes, w0, span_s, candidates)
