@@ -80,18 +80,16 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
         for e in range(exits.shape[0]):
             g0 = 0.0
             g1 = 0.0
-            n0 = 0.0
-            n1 = 0.0
             r0 = 0.0
             r1 = 0.0
             for j in range(m):
                 g0 += exits[e, j] * w[j]
                 g1 += exits[e, j] * w1[j]
-                n0 += abs(exits[e, j] * w[j])
-                n1 += abs(exits[e, j] * w1[j])
                 r0 += slopes[e, j] * w[j]
                 r1 += slopes[e, j] * w1[j]
-            if g0 > ROUND_OFF * n0 or g1 > ROUND_OFF * n1 or (g0 < 0.0 and r0 > 0.0 and r1 < 0.0):
+            if (g0 > 0.0 or g1 > 0.0) and (_beyond_round_off(exits, e, w, g0) or _beyond_round_off(exits, e, w1, g1)):
+                return SWITCH, step
+            if g0 < 0.0 and r0 > 0.0 and r1 < 0.0:
                 return SWITCH, step
         for q in range(3):
             total = 0.0
@@ -191,16 +189,25 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
 
 
 @njit(cache=True)
+def _beyond_round_off(rows, e, w, g):
+    """Whether the value g = rows[e] . w is positive beyond its round-off (ROUND_OFF)."""
+    if g <= 0.0:
+        return False
+    size = 0.0
+    for j in range(w.shape[0]):
+        size += abs(rows[e, j] * w[j])
+    return g > ROUND_OFF * size
+
+
+@njit(cache=True)
 def _crossed(rows, w):
     """The row with the largest positive value at w beyond its round-off (ROUND_OFF), -1 if none is."""
     best, top = -1, 0.0
     for e in range(rows.shape[0]):
         g = 0.0
-        size = 0.0
         for j in range(w.shape[0]):
             g += rows[e, j] * w[j]
-            size += abs(rows[e, j] * w[j])
-        if g > top and g > ROUND_OFF * size:
+        if g > top and _beyond_round_off(rows, e, w, g):
             best, top = e, g
     return best
 
