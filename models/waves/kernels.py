@@ -18,13 +18,6 @@ import numpy as np
 from numba import njit
 
 STEPS_DONE, SWITCH, CATCH = 0, 1, 2
-# An exit function g = r . w is on its crossed side when g > ROUND_OFF sum_j |r_j w_j|: a value within the state's
-# round-off is zero. A wave piston resting on the struck face without force, its gap closed at rest, has both
-# modes give the same motion; deciding on the sign of round-off switched it open and closed at one instant
-# without end (measured: 1.4e-14 of the sum, a state carried over 2 000 steps; the bound leaves 700 times that; a
-# switch is then late by at most 1e-11 of the sum over the exit function's rate, 1e-11 s for a 1 m position at
-# 1 m/s).
-ROUND_OFF = 1e-11
 PISTON_NONE, PISTON_OPEN, PISTON_CLOSED = 0, 1, 2
 
 
@@ -87,9 +80,7 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
                 g1 += exits[e, j] * w1[j]
                 r0 += slopes[e, j] * w[j]
                 r1 += slopes[e, j] * w1[j]
-            if (g0 > 0.0 or g1 > 0.0) and (_beyond_round_off(exits, e, w, g0) or _beyond_round_off(exits, e, w1, g1)):
-                return SWITCH, step
-            if g0 < 0.0 and r0 > 0.0 and r1 < 0.0:
+            if g0 > 0.0 or g1 > 0.0 or (g0 < 0.0 and r0 > 0.0 and r1 < 0.0):
                 return SWITCH, step
         for q in range(3):
             total = 0.0
@@ -189,25 +180,14 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
 
 
 @njit(cache=True)
-def _beyond_round_off(rows, e, w, g):
-    """Whether the value g = rows[e] . w is positive beyond its round-off (ROUND_OFF)."""
-    if g <= 0.0:
-        return False
-    size = 0.0
-    for j in range(w.shape[0]):
-        size += abs(rows[e, j] * w[j])
-    return g > ROUND_OFF * size
-
-
-@njit(cache=True)
 def _crossed(rows, w):
-    """The row with the largest positive value at w beyond its round-off (ROUND_OFF), -1 if none is."""
+    """The row with the largest positive value at w, -1 if none is positive."""
     best, top = -1, 0.0
     for e in range(rows.shape[0]):
         g = 0.0
         for j in range(w.shape[0]):
             g += rows[e, j] * w[j]
-        if g > top and _beyond_round_off(rows, e, w, g):
+        if g > top:
             best, top = e, g
     return best
 
