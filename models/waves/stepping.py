@@ -211,6 +211,7 @@ class Stepper(Recorder):
         self._set_inputs(k)
         arrivals = self.lines.arriving_breaks(k)
         t, t1, switches = t0, t0 + h, 0
+        ignored: tuple[Key, int] | None = None  # a grazing exit, ignored for the rest of the step (below)
         jumped = strike  # a jump just now whose other side is still to be sampled (the strike's, a front's)
         self._step_impulse = np.zeros(len(self.kinematic))
         segments: list[Segment] = []
@@ -226,7 +227,7 @@ class Stepper(Recorder):
             key = self.key()
             span = boundary - t
             w1 = key_levels(self, key).propagate(w, span)
-            hit = self._first_switch(key, w, w1, span)
+            hit = self._first_switch(key, w, w1, span, ignored[1] if ignored and ignored[0] is key else None)
             at_jump = hit is not None and hit[0] <= SWITCH_AT_START * h and (jumped or t == t0)
             if jumped and not at_jump:  # the jump's other side (a switch at the jump: the state after it)
                 begin = (*begin[:3], self._record(t, w, key, after=True))
@@ -248,6 +249,9 @@ class Stepper(Recorder):
                 begin, jumped = (t, w.copy(), self.key(), -1), True
                 continue
             s, exit_ = hit
+            if self._grazing(t + s, key, exit_):  # back into the modes just left, at the same instant
+                ignored = (key, exit_)
+                continue
             w_s = self._piece(key, w, s)
             t += s
             before = -1 if at_jump else self._record(t, w_s, key)  # a switch at a jump is at the jump: no sample between
@@ -404,10 +408,21 @@ class Stepper(Recorder):
 
     # -- switches -------------------------------------------------------------------------------------
 
-    def _first_switch(self, key: Key, w0: np.ndarray, w1: np.ndarray, span_s: float) -> tuple[float, int] | None:
+    def _grazing(self, t: float, key: Key, exit_: int) -> bool:
+        """Whether the exit at ``t`` would return into the modes the last switch left at the same instant: a
+        contact at rest without force, its gap and its force both nil, where each mode's exit is crossed by
+        round-off and both modes give the same motion (a rod piston of the struck rod's impedance resting on a
+        fed face switched open and closed at one instant without end). The exit is then ignored for the rest of
+        the step: the contact stays as it is, and the next step looks again."""
+        if len(self.switch_times) < 2 or t - self.switch_times[-1] > SWITCH_AT_START * self.step_s:
+            return False
+        return key.exits[exit_][2] == self.switch_modes[-2]
+
+    def _first_switch(self, key: Key, w0: np.ndarray, w1: np.ndarray, span_s: float,
+                      ignored: int | None = None) -> tuple[float, int] | None:
         """(time into the piece, exit) of the first switch in the piece, None without one: an exit function
         on its crossed side at the piece's end, or one whose slopes show a maximum inside, located on the
-        key's levels (models.waves.levels)."""
+        key's levels (models.waves.levels); the exit ``ignored`` left out."""
         if "exit_rows" not in key.cache:
             rows = np.array([direction * row for row, direction, *_ in key.exits]).reshape(len(key.exits), len(w0))
             key.cache["exit_rows"], key.cache["exit_slopes"] = rows, rows @ key.matrix
@@ -415,6 +430,8 @@ class Stepper(Recorder):
         start, end = rows @ w0, rows @ w1
         returning = (start < 0.0) & (end <= 0.0) & (slopes @ w0 > 0.0) & (slopes @ w1 < 0.0)
         candidates = (end > 0.0) | returning
+        if ignored is not None:
+            candidates[ignored] = False
         if not np.any(candidates):
             return None
         return key_levels(self, key).first_switch(rows, slopes, w0, span_s, candidates)
