@@ -6,7 +6,7 @@ until the advance per blow and the energy per blow reaching the rock change by l
 :data:`TOLERANCE` (relative) between consecutive blows for :data:`SETTLED_CHANGES` blows running (or, a drill
 whose blows alternate, between each blow and the blow two before: settled with a period of 2 blows), or until
 the scene's ``solver.end_time_s`` (the cap, checked by the run budget before the run). The exact formulation
-stops at the blow start where the figures settled (models.waves.stepping.Stepper.stop); another formulation
+stops at the blow start where the figures settled (:class:`_SettlingStepper`); another formulation
 runs to the cap and the settled blows are read from its run. The exact formulation's figures are the
 stepper's own at each blow start (the bottom by the rock law's return map to the bit there); read from the
 run's samples (SimulationResult.bottom_at) they agree to about 1e-8 of the advance per blow.
@@ -33,6 +33,9 @@ from ..evaluation.rod_outputs import rock_energy_per_blow_j
 from ..evaluation.run_record import Regime, SteadyStateRecord
 from ..solvers.simulation import Simulation
 from ..solvers.time_run import time_run
+from ..waves.exact_waves import BLAS
+from ..waves.exact_waves import result as wave_result
+from ..waves.stepping import Stepper
 from .section import drift_problem
 
 TOLERANCE = 1e-6  # relative change between consecutive blows of the advance and the rock's energy per blow
@@ -93,7 +96,7 @@ def per_blow(result: SimulationResult) -> tuple[np.ndarray, np.ndarray]:
 
 
 class _Watch:
-    """The exact formulation's stop (models.waves.stepping.Stepper.stop): at each blow start, the bottom
+    """The exact formulation's stop (:class:`_SettlingStepper`): at each blow start, the bottom
     and the rock's work of the blow just done; True once the changes have settled."""
 
     def __init__(self, simulation: Simulation) -> None:
@@ -115,6 +118,35 @@ class _Watch:
         return found.settled
 
 
+class _SettlingStepper(Stepper):
+    """The exact formulation's stepper (models.waves.stepping) that asks ``stop`` at each blow start, the blows
+    before it done, and ends the run there (its last sample at that instant) when it answers True."""
+
+    def __init__(self, simulation: Simulation, stop: Callable[[Stepper], bool]) -> None:
+        super().__init__(simulation, simulation.settings.wave_step_s, simulation.settings.sample_interval_s)
+        self.stop = stop
+
+    def advance(self) -> None:
+        k = self.step_index
+        if k and k % self.period_steps == 0 and self.stop(self):  # (a blow start is never a quiet step)
+            self.steps = k
+            if k % self.sample_every and not self.caught_at_end:
+                self._record(k * self.step_s, self.w, self.key(), kept=False)
+            return
+        super().advance()
+
+
+def _exact_run(simulation: Simulation, watch: _Watch, progress: Callable[[float], None] | None) -> SimulationResult:
+    """The exact formulation's run of a scene with wave rods (models.waves.exact_waves), ended by ``watch``."""
+    start = time.process_time()
+    with BLAS.limit(limits=1, user_api="blas"):  # small matrices: threads cost more than they save
+        stepper = _SettlingStepper(simulation, watch)
+        stepper.run()
+    if progress is not None:
+        progress(stepper.steps * stepper.step_s)
+    return wave_result(stepper, "exact", time.process_time() - start)
+
+
 def settled_run(simulation: Simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
     """The steady state of a scene with wave rods (module doc), its record in the result's ``steady_state``."""
     start = time.process_time()
@@ -125,8 +157,7 @@ def settled_run(simulation: Simulation, progress: Callable[[float], None] | None
         return result
     watch = _Watch(simulation)
     if simulation.settings.formulation == "exact" and not simulation.scene.extensions:
-        from ..waves import exact_waves
-        result = exact_waves.simulate(simulation, progress, stop=watch)
+        result = _exact_run(simulation, watch, progress)
     else:
         result = time_run(simulation, progress)
     found = watch.found or settled_of(*per_blow(result), int(np.floor(result.time_s[-1] / simulation.impact.period_s

@@ -26,20 +26,16 @@ from .stepping import Stepper
 BLAS = ThreadpoolController()
 
 
-def simulate(simulation, progress: Callable[[float], None] | None = None,
-             stop: Callable[[Stepper], bool] | None = None) -> SimulationResult:
-    """Run ``simulation`` (a prepared scene with wave rods) in the exact formulation (module doc); ``stop``,
-    asked at each blow start with the stepper, ends the run there when it answers True (models.steady
-    .wave_settling)."""
+def simulate(simulation, progress: Callable[[float], None] | None = None) -> SimulationResult:
+    """Run ``simulation`` (a prepared scene with wave rods) in the exact formulation (module doc)."""
     settings = simulation.settings
     start = time.process_time()
     with BLAS.limit(limits=1, user_api="blas"):  # small matrices: threads cost more than they save
         stepper = Stepper(simulation, settings.wave_step_s, settings.sample_interval_s)
-        stepper.stop = stop
         stepper.run()
     cpu = time.process_time() - start
     if progress is not None:
-        progress(stepper.steps * stepper.step_s)
+        progress(settings.end_time_s)
     return result(stepper, "exact", cpu)
 
 

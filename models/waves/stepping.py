@@ -21,7 +21,6 @@ negative at a step's end: at most a step late, its energy kept (models.drill.pis
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -133,7 +132,6 @@ class Stepper(Recorder):
         self.switch_times: list[float] = []
         self.switch_modes: list[Modes] = []
         self.step_index = 0
-        self.stop: Callable[[Stepper], bool] | None = None  # asked at each blow start: end the run there
         self.kinematic = tuple(sorted(kinematic))
         self.record_steps = record_steps  # False: the Exudyn model records at its step starts
         self.caught_at_end = False  # the last step ended with a wave piston's catch
@@ -310,11 +308,6 @@ class Stepper(Recorder):
         self._record(0.0, self.w, self.key(), kept=False)
         while self.step_index < self.steps:
             k = self.step_index
-            if self.stop is not None and k and k % self.period_steps == 0 and self.stop(self):
-                self.steps = k  # a blow start, the blows before it done: the caller ended the run there
-                if k % self.sample_every and not self.caught_at_end:  # its last sample there
-                    self._record(k * self.step_s, self.w, self.key(), kept=False)
-                break
             if not self._quiet(k):
                 self.advance()
                 continue
