@@ -1,6 +1,6 @@
 """The static preload of a drill with wave rods: each rod a spring E A / L between its faces, each rigid
 joint one point (models.drill.chain.static_preload_m on that reduced chain). The rods' compression at
-rest sets their initial waves (models.waves.stepping.initial_outgoing)."""
+rest sets their initial waves (initial_outgoing)."""
 
 from __future__ import annotations
 
@@ -34,3 +34,16 @@ def wave_preload_m(chain: AxialChain, law: RockLaw) -> np.ndarray:
                          groups={})
     positions = static_preload_m(reduced, law)
     return np.array([positions[index[node]] for node in range(chain.size)])
+
+
+def initial_outgoing(simulation, chain) -> np.ndarray:
+    """Every port's outgoing wave before the start: at rest, P / (2 Z) at the top and -P / (2 Z) at the
+    bottom of a rod compressed by P (a preload: P = (E A / L) (x_top - x_bottom))."""
+    positions = simulation.initial_positions_m
+    out = np.zeros(2 * len(chain.waves))
+    for r, rod in enumerate(chain.waves):
+        if rod.top < len(positions):
+            compression = rod.stiffness_n_per_m * (positions[rod.top] - positions[rod.bottom])
+            out[2 * r], out[2 * r + 1] = compression / (2 * rod.impedance_n_s_per_m), \
+                -compression / (2 * rod.impedance_n_s_per_m)
+    return out

@@ -36,6 +36,7 @@ from .kernels import CATCH
 from .levels import key_levels
 from .outgoing import Segment, StepWaves, outgoing, readings
 from .recording import BlowPeaks, Recorder, Samples, Snapshot
+from .statics import initial_outgoing
 from .system import Key, Modes, WaveSystem
 
 MAX_SWITCHES_PER_STEP = 64
@@ -495,16 +496,3 @@ class Stepper(Recorder):
         return np.concatenate([w, self.key().velocity @ w])
 
     # -- records --------------------------------------------------------------------------------------
-
-def initial_outgoing(simulation, chain) -> np.ndarray:
-    """Every port's outgoing wave before the start: at rest, P / (2 Z) at the top and -P / (2 Z) at the
-    bottom of a rod compressed by P (a preload: P = (E A / L) (x_top - x_bottom))."""
-    positions = simulation.initial_positions_m
-    out = np.zeros(2 * len(chain.waves))
-    for r, rod in enumerate(chain.waves):
-        if rod.top < len(positions):
-            compression = rod.stiffness_n_per_m * (positions[rod.top] - positions[rod.bottom])
-            out[2 * r], out[2 * r + 1] = compression / (2 * rod.impedance_n_s_per_m), \
-                -compression / (2 * rod.impedance_n_s_per_m)
-    return out
-
