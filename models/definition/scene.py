@@ -312,7 +312,7 @@ class Scene(Strict):
     def _feed_body_exists(self) -> Scene:
         bodies = self.drill_string.bodies
         if self.feed.acts_on != EVERY_BODY and self.feed.acts_on not in bodies:
-            raise ValueError(f"feed.acts_on {self.feed.acts_on!r} is not one of {EVERY_BODY}, {', '.join(bodies)}")
+            raise ValueError(f"feed.acts_on: {self.feed.acts_on!r}: not one of {EVERY_BODY}, {', '.join(bodies)}")
         return self
 
     @model_validator(mode="after")
@@ -369,12 +369,12 @@ class Scene(Strict):
         needed = (self.metrics.transient_blows + self.metrics.block_blows) * period
         if self.solver.end_time_s < needed * (1 - 1e-12):
             raise ValueError(
-                f"solver.end_time_s {self.solver.end_time_s} covers {self.solver.end_time_s / period:.3g} blows; "
+                f"solver.end_time_s: {self.solver.end_time_s}: covers {self.solver.end_time_s / period:.3g} blows; "
                 f"the metrics need transient_blows + block_blows = "
                 f"{self.metrics.transient_blows + self.metrics.block_blows} blows ({needed:.6g} s)"
             )
         if self.solver.step_s is not None and self.solver.step_s > period / 20:
-            raise ValueError(f"solver.step_s {self.solver.step_s} must resolve the impact period: at most {period / 20:.3g} s")
+            raise ValueError(f"solver.step_s: {self.solver.step_s}: must resolve the impact period: at most {period / 20:.3g} s")
         return self
 
 

@@ -154,6 +154,9 @@ STRICT_TYPES = {
 }
 
 
+OWN_PATH = re.compile(r"[A-Za-z_][\w]*(\.[\w]+)*: ")  # a message that begins with the key path it is about
+
+
 def problem(item: Any) -> str:
     """What one problem of a pydantic validation says: a validator's own text, or what the key allows."""
     if item["type"] == "value_error":
@@ -174,6 +177,8 @@ def describe_validation_error(source: str, error: ValidationError, model: type[B
             lines.append(f"{source}: {path}: {short(item['input'])}: {hint}")
         elif item["type"] == "missing":
             lines.append(f"{source}: {path}: missing: a value is required")
+        elif item["type"] == "value_error" and not location and OWN_PATH.match(problem(item)):
+            lines.append(f"{source}: {problem(item)}")  # a check of the whole file that names its key path itself
         elif item["type"] == "value_error":
             lines.append(f"{source}: {path}: {problem(item)}")
         else:
