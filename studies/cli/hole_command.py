@@ -51,8 +51,8 @@ def run(args: argparse.Namespace) -> int:
         if "time_gained_s" in result.summary:
             print(f"{result.name}: the advised points save {result.summary['time_gained_s'] / 60:.4g} min against the "
                   f"rig's own ({result.summary['fixed_total_time_s'] / 60:.4g} min)")
-    unsettled = [r.name for r in results if any(g != "settled" for g in r.summary["regimes"])]
+    unsettled = [r.name for r in results if any(not g.startswith("settled") for g in r.summary["regimes"])]
     for name in unsettled:
-        print(f"{name}: some depths did not settle within their cap (regime in hole.csv; "
-                  "a longer cap: rig_overrides solver.end_time_s)", file=sys.stderr)
+        print(f"{name}: some depths did not settle within their cap (regime in hole.csv; a longer cap: "
+              "rig_overrides solver.end_time_s)", file=sys.stderr)
     return 0
