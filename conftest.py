@@ -17,3 +17,24 @@ class _CheckoutFolder:
 
 def pytest_configure(config: pytest.Config) -> None:
     config.pluginmanager.register(_CheckoutFolder(), "rpdrill-checkout-folder")
+
+
+def _module_fixtures(item: pytest.Item) -> bool:
+    """Whether ``item`` uses a module-scoped fixture (a result computed once and asserted on many times)."""
+    definitions = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
+    return any(defs and defs[-1].scope == "module" for defs in definitions.values())
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The long-running checks (marked ``slow``) first, and every module with a module-scoped fixture one
+    group (pyproject.toml: ``--dist loadgroup --no-loadscope-reorder``).
+
+    pytest-xdist hands the tests out in this order, so the longest start while the short ones fill the other
+    core, instead of one core finishing them alone at the end; a module's shared results are computed once,
+    on the one worker that runs its tests, not once on each worker that gets some of them (the order within
+    each group is kept)."""
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+    for item in items:
+        if _module_fixtures(item):
+            item.add_marker(pytest.mark.xdist_group(item.module.__name__ if item.module else item.nodeid))

@@ -1,6 +1,7 @@
 """Run-cost estimates (models.solvers.cost) and budgets (studies.runtime.budgets): what a run will cost, which key
 makes it cost that, and the refusals above a budget. The estimate against measurement is
-benchmarks/bench_budgets.py (no timing here)."""
+benchmarks/bench_budgets.py (no timing here).
+Unit tests of models.solvers.cost and studies.runtime.budgets: they import them."""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """studies.display.catalogue: every metric, time history and scene parameter has a name and a unit, and no
-plot shows a raw key name."""
+plot shows a raw key name.
+Unit tests of studies.display.catalogue: they import it."""
 
 from __future__ import annotations
 

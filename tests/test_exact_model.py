@@ -6,7 +6,7 @@ after a sub-grid point is found at the same time; (d) chattering contact runs to
 exceeded switch limit is reported; (e) the compiled event loop (models.solvers.exact_kernels) gives the
 answer of the former pure-Python implementation and of its own Python execution; a diverged run is
 reported at its first bad sample.
-"""
+Unit tests of models.solvers.exact_model: they import it."""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """Strict YAML reading (studies.inputs.reading): what it accepts that YAML 1.1 gets wrong or lets pass, and
-that valid files still read as before. Malformed files are in the corpus (tests/test_bad_inputs.py)."""
+that valid files still read as before. Malformed files are in the corpus (tests/test_bad_inputs.py).
+Unit tests of studies.inputs.reading: they import it."""
 
 from __future__ import annotations
 

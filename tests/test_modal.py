@@ -1,4 +1,5 @@
-"""models.drill.modal: the rock mode of the in-contact chain on chains with known answers and on a scene."""
+"""models.drill.modal: the rock mode of the in-contact chain on chains with known answers and on a scene.
+Unit tests of models.drill.modal: they import it."""
 
 import math
 

@@ -1,4 +1,5 @@
-"""The plain ODE of Eq. 4 (models.solvers.ode_model): law, energy, events, methods, failures."""
+"""The plain ODE of Eq. 4 (models.solvers.ode_model): law, energy, events, methods, failures.
+Unit tests of models.solvers.ode_model: they import it."""
 
 from __future__ import annotations
 

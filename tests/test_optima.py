@@ -1,4 +1,5 @@
-"""studies.scan.curve_optima on synthetic curves: refined peaks, lobes, main lobe, bands, and why a curve has none."""
+"""studies.scan.curve_optima on synthetic curves: refined peaks, lobes, main lobe, bands, and why a curve has none.
+Unit tests of that module: they import it."""
 
 import numpy as np
 import pytest

@@ -7,8 +7,8 @@ import pytest
 from pydantic import ValidationError
 from scenes import crushing_scene, scene, simulate
 
+import rpdrill
 from rpdrill import load_scene
-from rpdrill.models.evaluation.metrics import summary_metrics
 
 SHORT = {"solver__end_time_s": 0.1, "metrics__transient_blows": 1, "metrics__block_blows": 2}
 LINKS = ("shock_absorber", "shank_collar_joint", "collar_bit_joint")
@@ -66,8 +66,8 @@ def test_a_coupling_reports_its_gap_opening():
 def test_metrics_of_any_body_by_name():
     names = ["shank_velocity_peak_m_per_s", "collar_velocity_peak_m_per_s", "carriage_velocity_rms_m_per_s"]
     s = crushing_scene(outputs={"metrics": names}, **SHORT)
-    result = simulate(s, "exact")
-    metrics = summary_metrics(result)
+    result = rpdrill.simulate(s, "exact")
+    metrics = result.metrics
     assert list(metrics) == names
     window = (result.time_s >= metrics_window(result)[0] - 1e-12) & (result.time_s <= metrics_window(result)[1] + 1e-12)
     shank = result.body_velocity_m_per_s("shank")
@@ -90,7 +90,7 @@ def test_a_rod_segment_by_its_name_and_an_unknown_body_refused():
     data["solver"] = {"formulation": "exact", "end_time_s": 0.08}
     data["outputs"] = {"metrics": ["rod1[0]_velocity_peak_m_per_s", "rod1_velocity_peak_m_per_s"]}
     s = type(four).model_validate(data)
-    metrics = summary_metrics(simulate(s))
+    metrics = rpdrill.simulate(s).metrics
     assert metrics["rod1[0]_velocity_peak_m_per_s"] > 0
     assert metrics["rod1[0]_velocity_peak_m_per_s"] != metrics["rod1_velocity_peak_m_per_s"]  # the rod: its last segment
     with pytest.raises(ValidationError, match="need a body named colar"):

@@ -1,5 +1,6 @@
 """The rock laws alone, through the interface (rocklaw.base.RockLaw): pure functions, the ODE mode
-tables against the return maps, and the symbolic recording for Exudyn."""
+tables against the return maps, and the symbolic recording for Exudyn.
+Unit tests of rocklaw.base: they import it."""
 
 import dataclasses
 import math

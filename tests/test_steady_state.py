@@ -7,7 +7,7 @@ rate; (d) a drill held to ground has no orbit relative to the bottom and says so
 every metric of the orbit through the public API, and results tables gain the regime columns; (f) the
 Exudyn and ODE formulations' shooting agrees with the exact orbit; (g) continuation along a scan (a
 neighbour's orbit Newton fails from is run on to the orbit), and the bifurcations read from a branch.
-"""
+Unit tests of models.steady: they import it."""
 
 from __future__ import annotations
 

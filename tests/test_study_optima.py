@@ -1,5 +1,6 @@
 """studies.scan.study_optima: the curve axis, the optima of every curve of a study, the optima files and
-table of ``rpdrill study``, and no plot for a study whose every point failed."""
+table of ``rpdrill study``, and no plot for a study whose every point failed.
+Unit tests of studies.scan.study_optima: they import it."""
 
 from __future__ import annotations
 

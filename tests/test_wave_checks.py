@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 import yaml
 from commands import main
+from scenes import read_yaml
 
 import rpdrill
-from rpdrill.studies.inputs.reading import read_yaml
 
 E_PA, RHO = 2.1e11, 7850.0
 C = math.sqrt(E_PA / RHO)

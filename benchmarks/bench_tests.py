@@ -1,0 +1,68 @@
+"""Where the test suite's CPU goes: every test's CPU seconds, its own and its subprocesses'.
+
+Usage: python benchmarks/bench_tests.py [PYTEST ARGS ...]   (default: the whole suite, as the README runs it)
+Runs ``python -m pytest -q -p bench_tests PYTEST ARGS`` from the checkout with this file as a pytest plugin
+(loaded by every xdist worker too): each test's ``time.process_time()`` of the process that ran it plus
+``resource.getrusage(RUSAGE_CHILDREN)`` (the subprocesses and pool workers it waited for), setup and
+teardown included. Prints the 40 costliest tests, the CPU per test file and the total.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+RECORDS = "RPDRILL_BENCH_TESTS_DIR"
+
+
+def _cpu_s() -> tuple[float, float]:
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time(), children.ru_utime + children.ru_stime
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
+    """Record ``item``'s CPU seconds (own, children) and wall seconds to this process's file."""
+    own, children, wall = *_cpu_s(), time.monotonic()
+    yield
+    own_after, children_after = _cpu_s()
+    folder = os.environ.get(RECORDS)
+    if folder:
+        with open(Path(folder) / f"{os.getpid()}.txt", "a", encoding="utf-8") as handle:
+            handle.write(f"{own_after - own:.3f} {children_after - children:.3f} {time.monotonic() - wall:.3f} "
+                         f"{item.nodeid}\n")
+
+
+def main(arguments: list[str]) -> int:
+    with tempfile.TemporaryDirectory() as folder:
+        env = {**os.environ, RECORDS: folder,
+               "PYTHONPATH": os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")]))}
+        status = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "bench_tests", *arguments], cwd=ROOT,
+                                env=env, check=False).returncode
+        rows = [line.split(" ", 3) for path in Path(folder).glob("*.txt") for line in path.read_text().splitlines()]
+    tests = sorted(((float(own) + float(children), float(own), float(children), node.split("@")[0])
+                    for own, children, _, node in rows), reverse=True)
+    print(f"\n{'CPU s':>8} {'own':>8} {'children':>8}  test")
+    for total, own, children, node in tests[:40]:
+        print(f"{total:8.2f} {own:8.2f} {children:8.2f}  {node}")
+    files: dict[str, float] = defaultdict(float)
+    for total, _, _, node in tests:
+        files[node.split("::")[0]] += total
+    print(f"\n{'CPU s':>8}  file")
+    for name, total in sorted(files.items(), key=lambda item: -item[1]):
+        print(f"{total:8.2f}  {name}")
+    print(f"\n{len(tests)} tests, {sum(t[0] for t in tests):.1f} CPU s in the tests (collection and worker start aside)")
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
