@@ -20,6 +20,8 @@ the scenes at these segments per rod in the exact formulation (the convergence o
 the waves).
 ``--lumped-lundberg``: Lundberg's check on lumped rods of 64 to 512 segments (Exudyn, reference preset),
 the dispersion the wave element removes.
+``--cost --base REV [--repeat N]``: the same in the exact formulation at git revision REV and at this checkout, in
+turns, each a process of its own (N rounds; each round's ratio and their median).
 ``--cost [--repeat N]``: the CPU per blow of studies/scenes/top_hammer_waves.yaml as shipped (20 blows) in each
 formulation, the median of N runs (default 3) after a warm-up, the process's CPU.
 ``--fronts``: tests/test_wave_fronts.py's cases against its independent characteristics solution
@@ -33,9 +35,14 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+import statistics
+import subprocess
 import sys
+import tempfile
 import time
 import warnings
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -220,6 +227,52 @@ def cost(repeat: int = 3) -> None:
               f"{', '.join(f'{t:.2f}' for t in times)} |", flush=True)
 
 
+# One formulation's CPU per blow of the shipped top-hammer wave scene, in a process of its own (rpdrill imported
+# from PYTHONPATH: this checkout, or a revision exported by --base), after a warm-up run; through the public API.
+PER_BLOW = """
+import statistics, sys, time, warnings
+warnings.simplefilter("ignore")
+import rpdrill
+formulation, repeat = sys.argv[1], int(sys.argv[2])
+scene = rpdrill.load_scene("studies/scenes/top_hammer_waves.yaml").with_({"solver.formulation": formulation})
+blows = round(scene.solver.end_time_s * scene.impact.frequency_hz)
+rpdrill.simulate(scene)
+times = []
+for _ in range(repeat):
+    start = time.process_time()
+    rpdrill.simulate(scene)
+    times.append(time.process_time() - start)
+print(rpdrill.__file__, statistics.median(times) / blows)
+"""
+
+
+def cost_against(base: str, rounds: int, formulation: str = "exact") -> None:
+    """CPU per blow of the shipped top-hammer wave scene at revision ``base`` and at this checkout, in turns (base,
+    then here, ``rounds`` times; each a process of 3 runs after a warm-up, its median): each round's ratio and
+    the median of the rounds'."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    from bench_same_results import ROOT, export
+
+    with tempfile.TemporaryDirectory() as folder:
+        trees = {"base": export(base, Path(folder)), "here": ROOT}
+        print(f"| round | {base} CPU s per blow | this checkout | ratio |")
+        print("|---|---|---|---|")
+        ratios = []
+        for n in range(rounds):
+            per_blow = {}
+            for name, tree in trees.items():
+                env = {**os.environ, "PYTHONPATH": str(tree)}
+                cwd = tree / "rpdrill" if name == "base" else tree
+                out = subprocess.run([sys.executable, "-c", PER_BLOW, formulation, "3"], env=env, cwd=cwd, check=True,
+                                     capture_output=True, text=True).stdout.split()
+                if not out[0].startswith(str(tree)):
+                    raise SystemExit(f"rpdrill imported from {out[0]}, not from {tree}")
+                per_blow[name] = float(out[1])
+            ratios.append(per_blow["here"] / per_blow["base"])
+            print(f"| {n + 1} | {per_blow['base']:.4f} | {per_blow['here']:.4f} | {ratios[-1]:.3f} |", flush=True)
+        print(f"median ratio {statistics.median(ratios):.3f} ({formulation})")
+
+
 def fronts() -> None:
     sys.path.insert(0, "tests")
     import test_wave_fronts as cases  # the tests' scenes and their reference (tests/wave_reference.py)
@@ -261,6 +314,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--lumped-lundberg", action="store_true")
     parser.add_argument("--cost", action="store_true", help="CPU per blow of the shipped top-hammer wave scene")
     parser.add_argument("--repeat", type=int, default=3, help="--cost: runs per formulation (the median)")
+    parser.add_argument("--base", help="--cost: against this git revision instead, in turns (--repeat rounds)")
     parser.add_argument("--fronts", action="store_true", help="the model against the tests' characteristics solution")
     parser.add_argument("--fine", action="store_true", help="--strings: lumped rods refined (--segments), exact")
     parser.add_argument("--segments", type=lambda text: tuple(int(n) for n in text.split(",")), default=(16, 32, 64),
@@ -273,7 +327,9 @@ def main(argv: list[str] | None = None) -> None:
         checks()
     if args.fronts:
         fronts()
-    if args.cost:
+    if args.cost and args.base:
+        cost_against(args.base, args.repeat)
+    elif args.cost:
         cost(args.repeat)
     if args.strings:
         strings(args.fine, args.segments, args.scenes)
