@@ -98,7 +98,7 @@ def test_bad_hole_files_exit_2_naming_the_key(tmp_path, capsys, change, named):
     path = hole_file(tmp_path, **change)
     assert main(["hole", str(path), "--out", str(tmp_path / "out"), "--workers", "1"]) == 2
     error = capsys.readouterr().err
-    assert named in error and str(path) in error
+    assert f"{path}: {named}" in error  # the file, then the key path (not '(top level)'), the value, the rule
     assert not (tmp_path / "out" / "runs").exists()  # refused before anything ran
 
 
