@@ -13,6 +13,10 @@ costing blows x CPU per blow).
 count and layer, 1-based): the compiled kernels of the characteristics (models.waves.kernels, models.waves.fast_path's
 calls of them) against the Python step loop around them (models.waves.stepping, levels, outgoing, recording), and
 the blows the run needed.
+``--periods ROD_COUNT LAYER BLOWS``: a time run of BLOWS blows of the hole's scene at that rod count and layer
+(1-based; exact formulation), and for every period n of 1 to 12 blows the blow from which each blow's advance and
+rock energy stay within 1e-6 (relative) of the blow n before, and the last such change: which steady state a depth
+that did not settle within its cap reaches later.
 ``--exudyn``: the Exudyn formulation's CPU per blow at each rod count of the hole (a run of 5 blows each, after a
 warm-up) and the hole's cost estimated as the sum over its runs of the exact runs' blows x Exudyn's CPU per
 blow (a full Exudyn hole takes too long to run here; the blows to settle are taken from the exact runs).
@@ -76,15 +80,41 @@ def profile(name: str, rods: int, layer: int) -> None:
         print(f"  {own:7.2f} s  {100 * own / sum(by_module.values()):5.1f} %  {module}")
 
 
+def periods(name: str, rods: int, layer: int, blows: int) -> None:
+    """The periods a long time run settles on (module doc)."""
+    import numpy as np
+
+    from rpdrill.models.steady.wave_settling import TOLERANCE, per_blow, relative_changes
+
+    data = scene_data(load_hole(name), rods, layer - 1)
+    period_s = 1.0 / data["impact"]["frequency_hz"]
+    data["solver"].update({"steady_state": "time", "end_time_s": blows * period_s})
+    start = time.process_time()
+    result = rpdrill.simulate(rpdrill.Scene.model_validate(data))
+    advance, energy = per_blow(result.raw)
+    print(f"{rods} rods in layer {layer}: {len(advance)} blows, {time.process_time() - start:.1f} CPU s; mean advance "
+          f"over the last 120 blows {1e6 * np.mean(advance[-120:]):.4f} um a blow")
+    for n in range(1, 13):
+        changes = relative_changes(advance, energy, n)
+        above = np.flatnonzero(~(changes < TOLERANCE))
+        first = above[-1] + 1 + n if len(above) else n
+        since = "never" if len(above) and above[-1] == len(changes) - 1 else f"from blow {first}"
+        print(f"  period {n:2d}: within {TOLERANCE:g} of the blow {n} before {since}; last change {changes[-1]:.2e}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--periods", type=int, nargs=3, metavar=("ROD_COUNT", "LAYER", "BLOWS"))
     parser.add_argument("--hole", default="holes/top_hammer_30m")
     parser.add_argument("--exudyn", action="store_true")
     parser.add_argument("--profile", nargs=2, type=int, metavar=("ROD_COUNT", "LAYER"))
     args = parser.parse_args()
     if args.profile:
         profile(args.hole, *args.profile)
+        return
+    if args.periods:
+        periods(args.hole, *args.periods)
         return
     times, result = [], None
     for i in range(args.repeat):
