@@ -24,7 +24,7 @@ import copy
 from typing import Any
 
 from ...models.definition.scene import Scene
-from ...models.definition.validation import InputError, parse
+from ...models.definition.validation import InputError, parse, set_path
 from .hole_spec import Hole, rig_rods, rod_chain
 
 HOLE_METRICS = ["penetration_rate_m_per_s", "advance_per_blow_m", "rock_energy_per_blow_j",
@@ -82,14 +82,14 @@ def apply_changes(data: dict[str, Any], changes: dict[str, Any]) -> dict[str, An
     """A copy of scene ``data`` with each dotted key path set to its value (None: the key taken out)."""
     data = copy.deepcopy(data)
     for path, value in changes.items():
-        part = data
+        if value is not None:
+            set_path(data, path, value)
+            continue
         *parents, leaf = path.split(".")
+        part = data
         for key in parents:
-            part = part.setdefault(key, {})
-        if value is None:
-            part.pop(leaf, None)
-        else:
-            part[leaf] = value
+            part = part.get(key, {})
+        part.pop(leaf, None)
     return data
 
 
