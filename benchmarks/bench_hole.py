@@ -17,6 +17,11 @@ the blows the run needed.
 (1-based; exact formulation), and for every period n of 1 to 12 blows the blow from which each blow's advance and
 rock energy stay within 1e-6 (relative) of the blow n before, and the last such change: which steady state a depth
 that did not settle within its cap reaches later.
+``--projections``: every run of the hole (one per rod count and layer) without the early stop (to where it settles or
+to its cap), and from blow
+PROJECTION_START_BLOWS on every 10 blows the blow at which its changes would settle at their recent rate
+(models.steady.wave_settling.earliest_settling, inf: they do not fall): how far the early stop of a run that will
+not settle (beyond PROJECTION_MARGIN times the cap) is from the runs that do.
 ``--exudyn``: the Exudyn formulation's CPU per blow at each rod count of the hole (a run of 5 blows each, after a
 warm-up) and the hole's cost estimated as the sum over its runs of the exact runs' blows x Exudyn's CPU per
 blow (a full Exudyn hole takes too long to run here; the blows to settle are taken from the exact runs).
@@ -80,6 +85,23 @@ def profile(name: str, rods: int, layer: int) -> None:
         print(f"  {own:7.2f} s  {100 * own / sum(by_module.values()):5.1f} %  {module}")
 
 
+def projections(name: str) -> None:
+    """Per run of the hole, its projected settling every 10 blows (module doc)."""
+    from rpdrill.models.steady import wave_settling
+    from rpdrill.models.steady.wave_settling import PROJECTION_START_BLOWS, earliest_settling, per_blow
+    from rpdrill.studies.hole.hole_run import segments
+
+    wave_settling.PROJECTION_MARGIN = float("inf")  # this script's process only: no early stop
+    hole = load_hole(name)
+    for rods, layer in segments(hole):
+        data = scene_data(hole, rods, layer)
+        result = rpdrill.simulate(rpdrill.Scene.model_validate(data))
+        advance, energy = per_blow(result.raw)
+        bounds = range(PROJECTION_START_BLOWS, len(advance) + 1, 10)
+        shown = " ".join(f"{b}:{earliest_settling(advance[:b], energy[:b], b):.0f}" for b in bounds)
+        print(f"{rods} rods, layer {layer + 1}: {shown}")
+
+
 def periods(name: str, rods: int, layer: int, blows: int) -> None:
     """The periods a long time run settles on (module doc)."""
     import numpy as np
@@ -109,9 +131,13 @@ def main() -> None:
     parser.add_argument("--hole", default="holes/top_hammer_30m")
     parser.add_argument("--exudyn", action="store_true")
     parser.add_argument("--profile", nargs=2, type=int, metavar=("ROD_COUNT", "LAYER"))
+    parser.add_argument("--projections", action="store_true")
     args = parser.parse_args()
     if args.profile:
         profile(args.hole, *args.profile)
+        return
+    if args.projections:
+        projections(args.hole)
         return
     if args.periods:
         periods(args.hole, *args.periods)

@@ -121,6 +121,25 @@ def test_relative_changes_and_the_settled_blows():
     assert found.settled and found.period_blows == 2 and found.first_settled_blow == 0 and found.last_change == 0.0
 
 
+
+def test_the_projected_settling_of_falling_flat_and_settled_changes():
+    """A run that would settle only far beyond its cap is stopped early (models.steady.wave_settling): the
+    projection of changes falling geometrically lands within a window after the blow they fall below the
+    tolerance; flat or rising changes never settle; a period-2 drill's alternation is seen by its own period."""
+    from rpdrill.models.steady.wave_settling import (PROJECTION_WINDOW_BLOWS, TOLERANCE, earliest_settling,
+                                                     projected_settling)
+    blows = 60
+    falling = 1e-2 * 0.9 ** np.arange(blows - 1)  # change i: blow i to blow i + 1
+    below = int(np.ceil(np.log(TOLERANCE / 1e-2) / np.log(0.9)))  # the first change below the tolerance
+    assert below <= projected_settling(falling, blows) <= below + PROJECTION_WINDOW_BLOWS + 1
+    assert projected_settling(np.full(blows - 1, 7e-3), blows) == np.inf
+    assert projected_settling(np.linspace(1e-3, 1e-2, blows - 1), blows) == np.inf
+    assert projected_settling(np.full(blows - 1, 1e-7), blows) == blows
+    assert np.isnan(projected_settling(falling[:20], 21))
+    advance = 1.0 + np.where(np.arange(blows) % 2, 0.01, -0.01) * (1 + 0.8 ** np.arange(blows))  # period 2
+    assert projected_settling(np.abs(np.diff(advance)) / advance[1:], blows) > 1e4  # blow to blow: 2 % for ever
+    assert earliest_settling(advance, advance, blows) < 2 * blows
+
 def test_the_cost_of_a_wave_run_counts_the_steps_of_the_characteristics():
     from rpdrill.models.solvers.cost import run_cost
     for formulation in FORMULATIONS:

@@ -6,8 +6,9 @@ until the advance per blow and the energy per blow reaching the rock change by l
 :data:`TOLERANCE` (relative) between consecutive blows for :data:`SETTLED_CHANGES` blows running (or, a drill
 whose blows alternate, between each blow and the blow two before: settled with a period of 2 blows), or until
 the scene's ``solver.end_time_s`` (the cap, checked by the run budget before the run). The exact formulation
-stops at the blow start where the figures settled (:class:`_SettlingStepper`); another formulation
-runs to the cap and the settled blows are read from its run. The exact formulation's figures are the
+stops at the blow start where the figures settled (:class:`_SettlingStepper`), or where they would settle only
+far beyond the cap (:func:`projected_settling`: not settled, stopped early); another formulation runs to the cap and
+the settled blows are read from its run. The exact formulation's figures are the
 stepper's own at each blow start (the bottom by the rock law's return map to the bit there); read from the
 run's samples (SimulationResult.bottom_at) they agree to about 1e-8 of the advance per blow.
 
@@ -41,6 +42,13 @@ from .section import drift_problem
 TOLERANCE = 1e-6  # relative change between consecutive blows of the advance and the rock's energy per blow
 SETTLED_CHANGES = 3  # consecutive blows whose change is below TOLERANCE
 MAX_PERIOD_BLOWS = 2  # a drill whose blows alternate: each blow against the blow two before
+# a run that will not settle within its cap is stopped early (:func:`projected_settling`): from this many blows on,
+# when the changes, falling at their rate over the last 3 windows of WINDOW_BLOWS blows, would reach TOLERANCE only
+# beyond MARGIN times the cap (the 30 m hole's settling runs: at most 198 blows projected against their cap of 200,
+# its two unsettled depths 653 and never at blow 60: `python benchmarks/bench_hole.py --projections`)
+PROJECTION_START_BLOWS = 60
+PROJECTION_WINDOW_BLOWS = 10
+PROJECTION_MARGIN = 2.0
 
 
 @dataclass(frozen=True)
@@ -87,6 +95,29 @@ def settled_of(advance_m: np.ndarray, energy_j: np.ndarray, blows: int) -> Settl
         min(found, key=lambda f: (np.nan_to_num(f.last_change, nan=np.inf), f.period_blows))
 
 
+def projected_settling(changes: np.ndarray, blows: int) -> float:
+    """The blow at which ``changes`` would fall below TOLERANCE at the geometric rate r of their largest value per
+    window over the last three windows (W = PROJECTION_WINDOW_BLOWS): blows + log(TOL / m_last) / log(r),
+    r = (m_last / m_first)^(1 / 2W); ``blows`` when they are below already, inf when they do not fall."""
+    window = PROJECTION_WINDOW_BLOWS
+    changes = np.asarray(changes, dtype=float)
+    if len(changes) < 3 * window:
+        return float("nan")
+    first, last = float(np.max(changes[-3 * window:-2 * window])), float(np.max(changes[-window:]))
+    if last < TOLERANCE:
+        return float(blows)
+    if not 0.0 < last < first:
+        return float("inf")
+    rate = (last / first) ** (1.0 / (2 * window))
+    return blows + float(np.log(TOLERANCE / last) / np.log(rate))
+
+
+def earliest_settling(advance_m: np.ndarray, energy_j: np.ndarray, blows: int) -> float:
+    """The earliest :func:`projected_settling` over the periods up to MAX_PERIOD_BLOWS."""
+    return min(projected_settling(relative_changes(advance_m, energy_j, n), blows)
+               for n in range(1, MAX_PERIOD_BLOWS + 1))
+
+
 def per_blow(result: SimulationResult) -> tuple[np.ndarray, np.ndarray]:
     """(advance, rock's energy) of every whole blow of a run."""
     period = result.scene.impact.period_s
@@ -97,11 +128,16 @@ def per_blow(result: SimulationResult) -> tuple[np.ndarray, np.ndarray]:
 
 class _Watch:
     """The exact formulation's stop (:class:`_SettlingStepper`): at each blow start, the bottom
-    and the rock's work of the blow just done; True once the changes have settled."""
+    and the rock's work of the blow just done; True once the changes have settled, or once they would settle only
+    beyond PROJECTION_MARGIN times the cap (``projected``: the blow they would, inf: never)."""
 
     def __init__(self, simulation: Simulation) -> None:
         self.law, self.blows = simulation.rock, 0
+        self.cap_blows = int(np.floor(simulation.settings.end_time_s / simulation.impact.period_s + 1e-9))
+        self.start_blows = max(PROJECTION_START_BLOWS,
+                               simulation.scene.metrics.transient_blows + simulation.scene.metrics.block_blows)
         self.found: Settling | None = None  # where it stopped the run
+        self.projected: float | None = None  # where it stopped a run that would not settle within its cap
         self.bottoms: list[float] = []
         self.energy: list[float] = []
 
@@ -115,7 +151,13 @@ class _Watch:
         self.energy.append(stepper.statistics.rock_work_j[-1])
         found = settled_of(np.diff(self.bottoms), self.energy[1:], blows)
         self.found = found if found.settled else None
-        return found.settled
+        if found.settled or blows < self.start_blows or blows >= self.cap_blows:
+            return found.settled
+        projected = earliest_settling(np.diff(self.bottoms), self.energy[1:], blows)
+        if projected > PROJECTION_MARGIN * self.cap_blows:
+            self.projected = projected
+            return True
+        return False
 
 
 class _SettlingStepper(Stepper):
@@ -171,6 +213,17 @@ def settled_run(simulation: Simulation, progress: Callable[[float], None] | None
                 f"{SETTLED_CHANGES} blows; metrics over blows "
                 f"{result.simulation.scene.metrics.transient_blows}..{found.blows}")
         regime = Regime.SETTLED
+    elif watch.projected is not None:
+        result.simulation = settled_window(simulation, replace(found, period_blows=1, first_settled_blow=min(
+            found.blows, simulation.scene.metrics.transient_blows)))
+        when = (f"would not fall below {TOLERANCE:g}" if np.isinf(watch.projected) else
+                f"would fall below {TOLERANCE:g} only after about {watch.projected:.0f} blows, beyond "
+                f"{PROJECTION_MARGIN:g} times the cap of {watch.cap_blows} blows (solver.end_time_s {cap:g} s)")
+        note = (f"not settled, stopped after {found.blows} blows: the changes of the advance and the rock's energy per "
+                f"blow (the last {found.last_change:.3g} against the blow {found.period_blows} before), at their rate "
+                f"over the last {3 * PROJECTION_WINDOW_BLOWS} blows, {when}; "
+                f"the time run's metrics over blows {result.simulation.scene.metrics.transient_blows}..{found.blows}")
+        regime = Regime.NOT_FOUND
     else:
         note = (f"not settled within the cap of {found.blows} blows (solver.end_time_s {cap:g} s): the last change "
                 f"of the advance or the rock's energy per blow (against the blow {found.period_blows} before) is "

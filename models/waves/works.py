@@ -58,6 +58,6 @@ def power_forms(stepper, key: Key) -> np.ndarray:
             else:
                 bodies += power
     impact = np.zeros((m, m)) if stepper.pulse_outside else pair(stepper.impact_row(key), velocity[chain.impact_body])
-    if not len(stepper.kinematic):  # no Exudyn bodies: no sixth form (its Van Loan block would cost (6/5)^3)
+    if not len(stepper.kinematic):  # no Exudyn bodies: no sixth form (a sixth Gram series per level)
         return np.array([impact, internal, rock, rods, piston])
     return np.array([impact, internal, rock, rods, piston, bodies])

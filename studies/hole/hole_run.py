@@ -251,7 +251,8 @@ def hole_summary(hole: Hole, rows: pd.DataFrame, runs: dict[tuple[int, int], Seg
     worst = {kind: rows.loc[rows[f"{kind}_max_mpa"].idxmax()] for kind in ("compression", "tension")}
     return {
         "name": spec.name, "hammer": spec.hammer, "depth_m": spec.depth_m, "rows": len(rows), "runs": len(runs),
-        "total_time_s": total, "drilling_time_s": drilling, "rod_change_time_s": total - drilling,
+        "total_time_s": total, "drilling_time_s": drilling,
+        "rod_change_time_s": int(rows["rods"].iloc[-1] - spec.string.first_rods) * spec.rod_change_s,
         "rods_added": int(rows["rods"].iloc[-1] - spec.string.first_rods),
         "mean_rate_m_per_s": spec.depth_m / drilling, "start_rate_m_per_s": start,
         "end_rate_m_per_s": float(rows["rate_m_per_s"].iloc[-1]),
