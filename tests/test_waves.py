@@ -126,8 +126,12 @@ def test_the_projected_settling_of_falling_flat_and_settled_changes():
     """A run that would settle only far beyond its cap is stopped early (models.steady.wave_settling): the
     projection of changes falling geometrically lands within a window after the blow they fall below the
     tolerance; flat or rising changes never settle; a period-2 drill's alternation is seen by its own period."""
-    from rpdrill.models.steady.wave_settling import (PROJECTION_WINDOW_BLOWS, TOLERANCE, earliest_settling,
-                                                     projected_settling)
+    from rpdrill.models.steady.wave_settling import (
+        PROJECTION_WINDOW_BLOWS,
+        TOLERANCE,
+        earliest_settling,
+        projected_settling,
+    )
     blows = 60
     falling = 1e-2 * 0.9 ** np.arange(blows - 1)  # change i: blow i to blow i + 1
     below = int(np.ceil(np.log(TOLERANCE / 1e-2) / np.log(0.9)))  # the first change below the tolerance
