@@ -53,6 +53,6 @@ def run(args: argparse.Namespace) -> int:
                   f"rig's own ({result.summary['fixed_total_time_s'] / 60:.4g} min)")
     unsettled = [r.name for r in results if any(not g.startswith("settled") for g in r.summary["regimes"])]
     for name in unsettled:
-        print(f"{name}: some depths did not settle within their cap (regime in hole.csv; a longer cap: "
-              "rig_overrides solver.end_time_s)", file=sys.stderr)
+        print(f"{name}: some depths did not settle (regime, settle_blows and last_change in "
+              "hole.csv: their figures are their time runs' windows)", file=sys.stderr)
     return 0
