@@ -108,6 +108,23 @@ def test_a_periodic_steady_state_runs_blows_until_they_settle_or_says_the_cap_ca
     assert "not settled within the cap of 3 blows" in steady.note
 
 
+def test_a_run_that_would_settle_only_beyond_its_cap_stops_early_and_says_so(monkeypatch):
+    """The early stop of models.steady.wave_settling on a run (its margin 0 and windows of one blow, so that the
+    first projection, at the start of blow 6, stops it: three changes of the advance, from blow 2 on): not settled, the blows run, the window up to them, the note."""
+    import rpdrill
+    from rpdrill.models.steady import wave_settling
+    monkeypatch.setattr(wave_settling, "PROJECTION_START_BLOWS", 1)
+    monkeypatch.setattr(wave_settling, "PROJECTION_WINDOW_BLOWS", 1)
+    monkeypatch.setattr(wave_settling, "PROJECTION_MARGIN", 0.0)
+    data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4, "frequency_hz": 1000.0},
+                    {"name": "sandstone"}, 8e-3, "exact", steady_state="periodic")
+    result = rpdrill.simulate(Scene.model_validate(data))
+    steady = result.steady_state
+    assert steady.regime is rpdrill.Regime.NOT_FOUND and steady.blows == 5
+    assert "stopped after 5 blows" in steady.note and "metrics over blows 0..5" in steady.note
+    assert result.time_s[-1] == pytest.approx(5e-3)
+
+
 def test_relative_changes_and_the_settled_blows():
     from rpdrill.models.steady.wave_settling import relative_changes, settled_of, settling
     advance = np.array([1.0, 2.0, 1.5, 1.5 + 1e-7, 1.5 + 2e-7, 1.5 + 2e-7, 1.5 + 3e-7])

@@ -113,9 +113,10 @@ def projected_settling(changes: np.ndarray, blows: int) -> float:
 
 
 def earliest_settling(advance_m: np.ndarray, energy_j: np.ndarray, blows: int) -> float:
-    """The earliest :func:`projected_settling` over the periods up to MAX_PERIOD_BLOWS."""
-    return min(projected_settling(relative_changes(advance_m, energy_j, n), blows)
-               for n in range(1, MAX_PERIOD_BLOWS + 1))
+    """The earliest :func:`projected_settling` over the periods up to MAX_PERIOD_BLOWS (NaN: too few blows)."""
+    projected = [projected_settling(relative_changes(advance_m, energy_j, n), blows)
+                 for n in range(1, MAX_PERIOD_BLOWS + 1)]
+    return min((p for p in projected if not np.isnan(p)), default=float("nan"))
 
 
 def per_blow(result: SimulationResult) -> tuple[np.ndarray, np.ndarray]:
