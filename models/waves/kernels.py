@@ -65,11 +65,7 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
         for p in range(ports):
             start_extra[3] += energy_weights[0, p] * square_sum[p]
             start_extra[4] += energy_weights[1, p] * square_sum[p]
-        for i in range(m):
-            total = 0.0
-            for j in range(m):
-                total += propagator[i, j] * w[j]
-            w1[i] = total
+        w1[:] = propagator @ w
         for e in range(exits.shape[0]):
             g0 = 0.0
             g1 = 0.0
@@ -83,12 +79,7 @@ def run_steps(w, step, stop, h, inputs, propagator, grams, exits, slopes, port_n
             if g0 > 0.0 or g1 > 0.0 or (g0 < 0.0 and r0 > 0.0 and r1 < 0.0):
                 return SWITCH, step
         for q in range(3):
-            total = 0.0
-            for i in range(m):
-                row = 0.0
-                for j in range(m):
-                    row += grams[q, i, j] * w[j]
-                total += w[i] * row
+            total = w @ (grams[q] @ w)
             if q < 2:
                 works[q] += total
             else:
