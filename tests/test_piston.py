@@ -19,7 +19,6 @@ import rpdrill
 from rpdrill import Scene
 from rpdrill.models.drill.piston import rigid_piston_pulse_n
 from rpdrill.models.evaluation.energy import energy_account
-from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import SceneError, prepare
 from rpdrill.studies.advice.advice_search import (
     FEED,
@@ -62,7 +61,7 @@ def rod_piston(segments: int) -> dict:
 
 
 def run(data: dict):
-    return run_simulation(prepare(Scene.model_validate(data))).raw
+    return rpdrill.simulate(Scene.model_validate(data), budget=None).raw
 
 
 def plateau_and_length(result) -> tuple[float, float]:

@@ -14,17 +14,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from commands import main
 from pydantic import ValidationError
 
-from rpdrill.models.definition.scene import Scene
-from rpdrill.models.definition.validation import InputError
+from rpdrill import InputError, Scene, build_exudyn
 from rpdrill.models.drill.piston import rigid_piston_pulse_n
 from rpdrill.models.drill.wave_rod import reflected_force_share, transmitted_force_share
 from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import SceneError, prepare
-from rpdrill.studies.cli.main import main
 from rpdrill.studies.inputs.reading import prepare_scene, read_yaml
 
 E_PA, RHO, D = 2.1e11, 7850.0, 0.045
@@ -324,7 +323,6 @@ def test_an_item_of_ones_own_on_a_body_acts_through_the_wave_element(both):
         ObjectMassPoint,
     )
 
-    from rpdrill.models.solvers.exudyn_model import build_exudyn
 
     # from rest: a preloaded start of a wave drill with items of one's own is refused (its statics would miss the
     # rods: tests/test_extension_start.py), so both runs compared here start at rest
