@@ -2,6 +2,7 @@
 package of tests: pytest collects its folder as a plain directory, so that the tests run in a checkout
 of any folder name (``rpdrill-main``, ``rpdrill-1.0``), not only in one whose name is a Python name."""
 
+import warnings
 from pathlib import Path
 
 import pytest
@@ -38,3 +39,17 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if _module_fixtures(item):
             item.add_marker(pytest.mark.xdist_group(item.module.__name__ if item.module else item.nodeid))
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """On a pytest-xdist worker of ``--dist loadgroup``: a warning when a grouped test's node id lacks its group
+    (pytest-xdist issue 1386, pytest 9.2): the groups are then ignored, silently, and every module's shared
+    results computed on each worker that gets some of its tests."""
+    if not getattr(session.config.option, "loadgroup", False):
+        return
+    lost = [item.nodeid for item in session.items if item.get_closest_marker("xdist_group") and "@" not in item.nodeid]
+    if lost:
+        warnings.warn(f"pytest-xdist --dist loadgroup groups nothing with this pytest ({len(lost)} grouped tests, "
+                      f"e.g. {lost[0]}, without their group): a module's shared results are computed on every "
+                      "worker (pytest-xdist issue 1386; pyproject.toml pins pytest below 9.2)", stacklevel=1)

@@ -6,10 +6,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import rpdrill
 from rpdrill import Scene
 from rpdrill.models.evaluation.results import SimulationResult
-from rpdrill.models.runs.scene_run import run as run_simulation
-from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.inputs.reading import read_yaml
 
 PAPER_BASE = Path(__file__).resolve().parent / "test_drill.yaml"
@@ -46,5 +45,6 @@ def crushing_scene(**overrides: Any) -> Scene:
 
 
 def simulate(scene: Scene, formulation: str | None = None, **options: Any) -> SimulationResult:
-    """Run ``scene`` with ``formulation`` (default: the scene's) and solver ``options``."""
-    return run_simulation(prepare(scene.with_solver(formulation, **options))).raw
+    """Run ``scene`` with ``formulation`` (default: the scene's) and solver ``options``: ``rpdrill.simulate``,
+    unbudgeted (tests run scenes of many steps on purpose), its formulation's result (``Result.raw``)."""
+    return rpdrill.simulate(scene.with_solver(formulation, **options), budget=None).raw

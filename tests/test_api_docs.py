@@ -1,11 +1,10 @@
 """Every Python example of docs/api.md runs as written from the root of the checkout."""
 
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from doc_examples import Ran, run_examples
 
 ROOT = Path(__file__).resolve().parents[1]
 BLOCKS = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "api.md").read_text(encoding="utf-8"), re.DOTALL)
@@ -15,11 +14,16 @@ def test_the_page_has_examples():
     assert len(BLOCKS) >= 8
 
 
-@pytest.mark.parametrize("code", BLOCKS, ids=[f"example{i}" for i in range(len(BLOCKS))])
-def test_every_example_runs(code):
-    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=False, timeout=600)
-    assert done.returncode == 0, done.stderr
-    assert "Traceback" not in done.stderr
+@pytest.fixture(scope="module")
+def ran() -> list[Ran]:
+    """Every example run in order in one fresh process (tests/doc_examples.py)."""
+    return run_examples(BLOCKS, ROOT)
+
+
+@pytest.mark.parametrize("index", range(len(BLOCKS)), ids=[f"example{i}" for i in range(len(BLOCKS))])
+def test_every_example_runs(ran, index):
+    assert not ran[index].failed, ran[index].err
+    assert "Traceback" not in ran[index].err, ran[index].err
 
 
 def test_every_public_name_is_on_the_page():

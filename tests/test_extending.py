@@ -3,12 +3,11 @@ the checkout, and the worked example checked: a new connector type (a threaded j
 registered and used from YAML."""
 
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from doc_examples import Ran, run_examples
 from scenes import scene_dict, simulate
 
 from rpdrill import Scene
@@ -37,11 +36,15 @@ def test_the_page_shows_each_way_with_an_example():
         assert any(way in block for block in _blocks("python")) or way in DOC.read_text(), way
 
 
-@pytest.mark.parametrize("code", RUNNABLE, ids=[f"example{i}" for i in range(len(RUNNABLE))])
-def test_every_python_block_runs_from_the_root_of_the_checkout(code):
-    done = subprocess.run([sys.executable, "-c", code], cwd=DOC.parents[1], capture_output=True, text=True,
-                          check=False, timeout=600)
-    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr
+@pytest.fixture(scope="module")
+def ran() -> list[Ran]:
+    """Every runnable block run in order in one fresh process (tests/doc_examples.py)."""
+    return run_examples(RUNNABLE, DOC.parents[1])
+
+
+@pytest.mark.parametrize("index", range(len(RUNNABLE)), ids=[f"example{i}" for i in range(len(RUNNABLE))])
+def test_every_python_block_runs_from_the_root_of_the_checkout(ran, index):
+    assert not ran[index].failed and "Traceback" not in ran[index].err, ran[index].err
 
 
 @pytest.fixture(scope="module")

@@ -44,7 +44,7 @@ from typing import ClassVar
 from exudyn.itemInterface import MarkerNodeCoordinate, Node1D, ObjectConnectorCoordinateSpringDamper, ObjectMass1D
 
 import rpdrill
-from rpdrill.rocklaw import JenkinsRock, RockLaw
+from rpdrill.rocklaw import JenkinsRock
 
 CALLS = os.path.join(os.path.dirname(__file__), "calls.txt")
 
@@ -128,7 +128,7 @@ class Plain:
         open(CALLS, "a").write("constructed\\n")
 
 
-class Empty(RockLaw):
+class Empty(rpdrill.RockLaw):
     pass
 
 
