@@ -79,10 +79,6 @@ class KeyLevels:
         """``span_s`` in finest steps."""
         return round(float(span_s) / self.step_s * 2**LEVELS)
 
-    def propagate(self, w: np.ndarray, span_s: float) -> np.ndarray:
-        """w after ``span_s`` (<= h): the levels of the binary digits of span / h."""
-        return self.advance(w, span_s)[0]
-
     def advance(self, w: np.ndarray, span_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         """(w after ``span_s``, the works over it (one per form), int_0^span w(u) du or None)."""
         units = self.units(span_s)

@@ -162,12 +162,16 @@ class Stepper(Recorder):
         """w after a piece of ``span_s`` (<= h) from w0 on the key's levels, its works and the kinematic
         bodies' impulse added (models.waves.levels)."""
         w, works, moved = key_levels(self, key).advance(w0, span_s)
+        self._add_works(key, works, moved)
+        return w
+
+    def _add_works(self, key: Key, works: np.ndarray, moved: np.ndarray | None) -> None:
+        """A piece's works (one per power form) and the integral of its state (kinematic bodies) added."""
         self.works += works[:2]
         self.statistics.rock_work_j[-1] += works[2]
         self._step_flux[:len(works) - 3] += works[3:]  # into the rods since the step's start (not in their waves in flight yet)
         if moved is not None:
             self._step_impulse += key.body_forces @ moved
-        return w
 
     # -- one step -------------------------------------------------------------------------------------
 
@@ -225,13 +229,14 @@ class Stepper(Recorder):
                 boundary = t1
             key = self.key()
             span = boundary - t
-            w1 = key_levels(self, key).propagate(w, span)
+            w1, works, moved = key_levels(self, key).advance(w, span)  # the whole piece, kept where nothing switches
             hit = self._first_switch(key, w, w1, span, ignored[1] if ignored and ignored[0] is key else None)
             at_jump = hit is not None and hit[0] <= SWITCH_AT_START * h and (jumped or t == t0)
             if jumped and not at_jump:  # the jump's other side (a switch at the jump: the state after it)
                 begin = (*begin[:3], self._record(t, w, key, after=True))
             if hit is None:
-                w, t = self._piece(key, w, span), boundary
+                self._add_works(key, works, moved)
+                w, t = w1, boundary
                 jumped = False
                 if boundary >= t1 - 1e-9 * h:  # the step's end (a phase change there: the next step's start)
                     if phase <= boundary + 1e-9 * h:
