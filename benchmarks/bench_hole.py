@@ -19,7 +19,7 @@ rock energy stay within 1e-6 (relative) of the blow n before, and the last such 
 that did not settle within its cap reaches later.
 ``--projections``: every run of the hole (one per rod count and layer) without the early stop (to where it settles or
 to its cap), and from blow
-PROJECTION_START_BLOWS on every 10 blows the blow at which its changes would settle at their recent rate
+the first blow it may be stopped at (wave_settling.projection_start) every 5 blows the blow at which its changes would settle at their recent rate
 (models.steady.wave_settling.earliest_settling, inf: they do not fall): how far the early stop of a run that will
 not settle (beyond PROJECTION_MARGIN times the cap) is from the runs that do.
 ``--exudyn``: the Exudyn formulation's CPU per blow at each rod count of the hole (a run of 5 blows each, after a
@@ -86,18 +86,17 @@ def profile(name: str, rods: int, layer: int) -> None:
 
 
 def projections(name: str) -> None:
-    """Per run of the hole, its projected settling every 10 blows (module doc)."""
+    """Per run of the hole, its projected settling every 5 blows (module doc)."""
     from rpdrill.models.steady import wave_settling
-    from rpdrill.models.steady.wave_settling import PROJECTION_START_BLOWS, earliest_settling, per_blow
+    from rpdrill.models.steady.wave_settling import earliest_settling, per_blow, projection_start
     from rpdrill.studies.hole.hole_run import segments
 
     wave_settling.PROJECTION_MARGIN = float("inf")  # this script's process only: no early stop
     hole = load_hole(name)
     for rods, layer in segments(hole):
-        data = scene_data(hole, rods, layer)
-        result = rpdrill.simulate(rpdrill.Scene.model_validate(data))
-        advance, energy = per_blow(result.raw)
-        bounds = range(PROJECTION_START_BLOWS, len(advance) + 1, 10)
+        scene = rpdrill.Scene.model_validate(scene_data(hole, rods, layer))
+        advance, energy = per_blow(rpdrill.simulate(scene).raw)
+        bounds = range(projection_start(scene.metrics), len(advance) + 1, 5)
         shown = " ".join(f"{b}:{earliest_settling(advance[:b], energy[:b], b):.0f}" for b in bounds)
         print(f"{rods} rods, layer {layer + 1}: {shown}")
 

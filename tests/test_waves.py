@@ -109,10 +109,10 @@ def test_a_periodic_steady_state_runs_blows_until_they_settle_or_says_the_cap_ca
 
 def test_a_run_that_would_settle_only_beyond_its_cap_stops_early_and_says_so(monkeypatch):
     """The early stop of models.steady.wave_settling on a run (its margin 0 and windows of one blow, so that the
-    first projection, at the start of blow 6, stops it: three changes of the advance, from blow 2 on): not settled, the blows run, the window up to them, the note."""
+    first projection, at the start of blow 6, stops it: three changes of the advance, from blow 2 on): not
+    settled, the blows run, the window up to them, the note."""
     import rpdrill
     from rpdrill.models.steady import wave_settling
-    monkeypatch.setattr(wave_settling, "PROJECTION_START_BLOWS", 1)
     monkeypatch.setattr(wave_settling, "PROJECTION_WINDOW_BLOWS", 1)
     monkeypatch.setattr(wave_settling, "PROJECTION_MARGIN", 0.0)
     data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4, "frequency_hz": 1000.0},

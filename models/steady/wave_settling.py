@@ -42,11 +42,10 @@ from .section import drift_problem
 TOLERANCE = 1e-6  # relative change between consecutive blows of the advance and the rock's energy per blow
 SETTLED_CHANGES = 3  # consecutive blows whose change is below TOLERANCE
 MAX_PERIOD_BLOWS = 2  # a drill whose blows alternate: each blow against the blow two before
-# a run that will not settle within its cap is stopped early (:func:`projected_settling`): from this many blows on,
-# when the changes, falling at their rate over the last 3 windows of WINDOW_BLOWS blows, would reach TOLERANCE only
-# beyond MARGIN times the cap (the 30 m hole's settling runs: at most 198 blows projected against their cap of 200,
-# its two unsettled depths 653 and never at blow 60: `python benchmarks/bench_hole.py --projections`)
-PROJECTION_START_BLOWS = 60
+# a run that will not settle within its cap is stopped early (:func:`projected_settling`): once three windows of
+# WINDOW_BLOWS blows follow the scene's transient blows (:func:`projection_start`), when the changes, falling at their
+# rate over those windows, would reach TOLERANCE only beyond MARGIN times the cap (docs/hole.md: the 30 m hole's
+# projections, `python benchmarks/bench_hole.py --projections`)
 PROJECTION_WINDOW_BLOWS = 10
 PROJECTION_MARGIN = 2.0
 
@@ -95,6 +94,12 @@ def settled_of(advance_m: np.ndarray, energy_j: np.ndarray, blows: int) -> Settl
         min(found, key=lambda f: (np.nan_to_num(f.last_change, nan=np.inf), f.period_blows))
 
 
+def projection_start(metrics: Metrics) -> int:
+    """The first blow at which a run may be stopped as one that will not settle: the scene's transient blows and
+    three windows of PROJECTION_WINDOW_BLOWS after them (at least a block of its metrics)."""
+    return metrics.transient_blows + max(3 * PROJECTION_WINDOW_BLOWS, metrics.block_blows)
+
+
 def projected_settling(changes: np.ndarray, blows: int) -> float:
     """The blow at which ``changes`` would fall below TOLERANCE at the geometric rate r of their largest value per
     window over the last three windows (W = PROJECTION_WINDOW_BLOWS): blows + log(TOL / m_last) / log(r),
@@ -135,8 +140,7 @@ class _Watch:
     def __init__(self, simulation: Simulation) -> None:
         self.law, self.blows = simulation.rock, 0
         self.cap_blows = int(np.floor(simulation.settings.end_time_s / simulation.impact.period_s + 1e-9))
-        self.start_blows = max(PROJECTION_START_BLOWS,
-                               simulation.scene.metrics.transient_blows + simulation.scene.metrics.block_blows)
+        self.start_blows = projection_start(simulation.scene.metrics)
         self.found: Settling | None = None  # where it stopped the run
         self.projected: float | None = None  # where it stopped a run that would not settle within its cap
         self.bottoms: list[float] = []
