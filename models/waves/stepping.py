@@ -43,7 +43,6 @@ MAX_SWITCHES_PER_STEP = 64
 SWITCH_AT_START = 1e-9  # a switch this soon (a fraction of the step) after a jump is at the jump
 
 
-
 @dataclass
 class BlowStatistics:
     """Per blow and per port (2 per rod: top, bottom): the largest compression and tension (N, tension as a
@@ -158,15 +157,8 @@ class Stepper(Recorder):
     def key(self) -> Key:
         return self.system.key(self.modes, self.phases[self.phase_index])
 
-    def _piece(self, key: Key, w0: np.ndarray, span_s: float) -> np.ndarray:
-        """w after a piece of ``span_s`` (<= h) from w0 on the key's levels, its works and the kinematic
-        bodies' impulse added (models.waves.levels)."""
-        w, works, moved = key_levels(self, key).advance(w0, span_s)
-        self._add_works(key, works, moved)
-        return w
-
     def _add_works(self, key: Key, works: np.ndarray, moved: np.ndarray | None) -> None:
-        """A piece's works (one per power form) and the integral of its state (kinematic bodies) added."""
+        """A piece's works (one per power form, models.waves.levels) and the kinematic bodies' impulse added."""
         self.works += works[:2]
         self.statistics.rock_work_j[-1] += works[2]
         self._step_flux[:len(works) - 3] += works[3:]  # into the rods since the step's start (not in their waves in flight yet)
@@ -256,7 +248,8 @@ class Stepper(Recorder):
             if self._grazing(t + s, key, exit_):  # back into the modes just left, at the same instant
                 ignored = (key, exit_)
                 continue
-            w_s = self._piece(key, w, s)
+            w_s, works, moved = key_levels(self, key).advance(w, s)
+            self._add_works(key, works, moved)
             t += s
             before = -1 if at_jump else self._record(t, w_s, key)  # a switch at a jump is at the jump: no sample between
             segments.append(self._segment(begin, t, w_s, key, before))
