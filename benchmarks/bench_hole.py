@@ -18,13 +18,13 @@ the blows the run needed.
 rock energy stay within 1e-6 (relative) of the blow n before, and the last such change: which steady state a depth
 that did not settle within its cap reaches later.
 ``--projections``: every run of the hole (one per rod count and layer) without the early stop (to where it settles or
-to its cap), and from blow
-the first blow it may be stopped at (wave_settling.projection_start) every 5 blows the blow at which its changes would settle at their recent rate
-(models.steady.wave_settling.earliest_settling, inf: they do not fall): how far the early stop of a run that will
-not settle (beyond PROJECTION_MARGIN times the cap) is from the runs that do.
+to its cap), and every 5 blows from the first blow it may be stopped at (wave_settling.projection_start) the blow at
+which its changes would settle at their recent rate (wave_settling.earliest_settling, inf: they do not fall): how far
+the early stop of a run that will not settle (beyond PROJECTION_MARGIN times the cap) is from the runs that do.
 ``--exudyn``: the Exudyn formulation's CPU per blow at each rod count of the hole (a run of 5 blows each, after a
-warm-up) and the hole's cost estimated as the sum over its runs of the exact runs' blows x Exudyn's CPU per
-blow (a full Exudyn hole takes too long to run here; the blows to settle are taken from the exact runs).
+warm-up) and the hole's cost estimated from it (a full Exudyn hole takes too long to run here): as the Exudyn
+formulation runs (every depth to its cap: only the exact formulation stops where the blows settle), and at the exact
+runs' blows.
 """
 
 from __future__ import annotations
