@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +20,8 @@ from pathlib import Path
 import pytest
 import yaml
 from scenes import PAPER_BASE
+
+import rpdrill
 
 ROOT = Path(__file__).resolve().parents[1]
 EXIT_WITHIN_S = 2.0
@@ -305,6 +308,38 @@ def test_a_ctrl_c_while_the_program_starts_prints_one_line(tmp_path, after_s):
     assert len(err.splitlines()) == 1 and "interrupted" in err and "Traceback" not in err, err
     assert not out.exists()
 
+
+
+def test_a_ctrl_c_caught_inside_string_code_exits_with_the_commands_status(tmp_path):
+    """A Ctrl-C that lands in code run from a string (a namedtuple numba makes as it loads) is caught as any
+    other, and the program exits 130: CPython killed itself by SIGINT at exit (status -2) when run as
+    ``python -m``. The command here raises the interrupt from such code at once."""
+    (tmp_path / "stopped_in_string_code.py").write_text(
+        "from rpdrill.studies.cli import main, simulate_command\n"
+        "simulate_command.run = lambda args: exec('raise KeyboardInterrupt')\n"
+        "main.console()\n")
+    done = subprocess.run([sys.executable, "-m", "stopped_in_string_code", "simulate", str(PAPER_BASE), "--out",
+                           str(tmp_path / "out")], cwd=tmp_path, capture_output=True, text=True, timeout=120, check=False)
+    assert done.returncode == 130, done.stderr
+    assert done.stderr == "rpdrill: interrupted; finished results are kept\n"
+
+
+@pytest.mark.parametrize("interrupt", [KeyboardInterrupt, type("Terminated", (KeyboardInterrupt,), {})])
+def test_a_ctrl_c_during_an_exudyn_solve_is_the_callers_interrupt_not_a_failed_run(interrupt):
+    """A Ctrl-C reaching a Python function Exudyn's solver calls (here the progress callback) reaches the
+    caller of rpdrill.simulate as the interrupt it was (it was a SimulationFailed wrapping Exudyn's
+    ModelError), and Exudyn's "DYNAMIC SOLVER FAILED" lines are not issued as warnings (the command line
+    printed them before its one line)."""
+    def progress(time_s: float) -> None:
+        if time_s > 0.01:
+            raise interrupt()
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(interrupt) as raised:
+            rpdrill.simulate(PAPER_BASE, formulation="exudyn", progress=progress)
+    assert type(raised.value) is interrupt
+    assert [str(warning.message) for warning in caught] == []
 
 @pytest.mark.slow
 def test_a_study_on_a_dask_local_cluster_stops_within_2_s_without_worker_tracebacks(tmp_path):

@@ -20,6 +20,7 @@ import contextlib
 import gc
 import io
 import re
+import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from typing import TYPE_CHECKING, Any
@@ -70,15 +71,29 @@ EXUDYN_PREFIX = re.compile(r"^\s*Python WARNING \[file '[^']*', line \d+\]:\s*")
 @contextlib.contextmanager
 def exudyn_messages_as_warnings(name: str) -> Iterator[None]:
     """What Exudyn prints while the block runs (it prints through sys.stdout) comes out as one
-    :class:`ExudynMessage` warning per distinct line, without Exudyn's file and line prefix."""
+    :class:`ExudynMessage` warning per distinct line, without Exudyn's file and line prefix; nothing when
+    a Ctrl-C stopped the run (Exudyn's "DYNAMIC SOLVER FAILED" lines then tell of the stop itself)."""
     printed = io.StringIO()
     try:
         with contextlib.redirect_stdout(printed):
             yield
     finally:
-        lines = [EXUDYN_PREFIX.sub("", line).strip() for line in printed.getvalue().splitlines()]
+        stopped = interrupt_behind(sys.exc_info()[1]) is not None
+        lines = [] if stopped else [EXUDYN_PREFIX.sub("", line).strip() for line in printed.getvalue().splitlines()]
         for line in dict.fromkeys(line for line in lines if line):
             warnings.warn(f"scene '{name}': Exudyn: {line}", ExudynMessage, stacklevel=3)
+
+
+def interrupt_behind(error: BaseException | None) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt ``error`` is, or was raised on (Exudyn's ModelError when a Ctrl-C reached a Python
+    function it called, and what the run made of that error); None when there is none."""
+    seen: set[int] = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
 
 
 class MinimumStepGuard:
@@ -225,10 +240,14 @@ def _named(scene: Any) -> str:
 def solver_errors(model: Any) -> Iterator[None]:
     """Exudyn's solver refusing the system (a mass matrix it cannot invert, a constraint its solver does not
     take) as a failed run: SimulationFailed naming the scene, and the extensions or items of one's own
-    that the system holds beside the drill."""
+    that the system holds beside the drill. A Ctrl-C during the solve stays the KeyboardInterrupt it was
+    (Exudyn wraps it in its ModelError when it reaches a Python function the solver calls)."""
     try:
         yield
     except exu.ExudynError as error:
+        interrupt = interrupt_behind(error)
+        if interrupt is not None:  # a Ctrl-C reached a Python function Exudyn called: a stop, not a failed run
+            raise interrupt from None
         scene = model.simulation.scene
         own = _named(scene) if scene.extensions else \
             "items added to the built model" if model.user_items().keys() - {"sensors"} else None

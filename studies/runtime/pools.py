@@ -219,6 +219,7 @@ def dask_pool(address: str | None = None, workers: int | None = None, option: st
     from dask.distributed import as_completed as dask_completed
 
     with contextlib.ExitStack() as stack:
+        stack.enter_context(_dask_logs_quiet())
         if address:
             why = dask_unreachable(address)
             if why is None:
@@ -248,6 +249,21 @@ def dask_pool(address: str | None = None, workers: int | None = None, option: st
 
         yield run
 
+
+
+@contextlib.contextmanager
+def _dask_logs_quiet() -> Iterator[None]:
+    """Dask's logs in this process at ERROR while a cluster or client of this run lives and closes, the level
+    before restored after. A LocalCluster quiets them (``silence_logs``) only until it closes: after a stop
+    its scheduler then logged a closed connection at INFO with a traceback, in 1 stop of 3
+    (tests/test_interrupts.py::test_a_study_on_a_dask_local_cluster_stops_within_2_s_without_worker_tracebacks)."""
+    logger = logging.getLogger("distributed")
+    previous = logger.level
+    logger.setLevel(logging.ERROR)
+    try:
+        yield
+    finally:
+        logger.setLevel(previous)
 
 def _forkserver_without_interrupts() -> None:
     """Start multiprocessing's fork server (if not running) ignoring Ctrl-C, so that the processes it forks
