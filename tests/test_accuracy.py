@@ -100,6 +100,7 @@ def write_study(path: Path, **changes) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_accuracy_study_end_to_end(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["accuracy", str(write_study(tmp_path / "s.yaml")), "--out", str(out), "--workers", "1",

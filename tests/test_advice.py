@@ -41,6 +41,7 @@ def short_scene(**overrides) -> rpdrill.Scene:
     return scene(**SHORT, **overrides)
 
 
+@pytest.mark.slow
 def test_advise_finds_the_best_of_a_fine_grid():
     """Differential evolution against every point of a 1 Hz x 1 kN grid over the same bounds."""
     base = short_scene()
@@ -144,6 +145,7 @@ def test_advise_command_writes_the_advice(tmp_path, capsys):
     assert "| sandstone |" in text and "feed force [kN]" in text
 
 
+@pytest.mark.slow
 def test_an_interrupted_advice_continues_where_it_stopped(tmp_path, capsys):
     """The points of a cut run (its checkpoint cut mid-line, as a kill leaves it) are replayed, the rest
     run: the same advice as an uncut run; a finished advice run again replays every point; another
@@ -183,6 +185,7 @@ def test_advise_bad_bounds_exit_2(tmp_path, capsys, arguments, expected):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_the_library_call_gives_the_commands_advice(tmp_path):
     """rpdrill.advise with the bounds in SI units: the advice and the files the command writes for the same
     inputs (``out``; a rerun there replays every point); a bound the search does not take is an InputError naming it and what is allowed."""
@@ -212,6 +215,7 @@ def test_the_library_call_gives_the_commands_advice(tmp_path):
                                "rock.threshold_n": (1e5, 2e5)})
 
 
+@pytest.mark.slow
 def test_a_small_budget_reports_no_best_below_a_point_of_its_own_curves(tmp_path, capsys):
     """Issue 47: on a budget of 2 x 2 members and one generation the search stopped at 5.36 mm/s while a point of
     its own feed curve gave 7.25 mm/s. The best is now the best point run (the curves run again through it); the

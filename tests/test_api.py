@@ -115,6 +115,7 @@ print(json.dumps({"backend": matplotlib.get_backend(), "pyplot": "matplotlib.pyp
 """
 
 
+@pytest.mark.slow
 def test_library_calls_leave_the_callers_process_as_it_was(tmp_path):
     """``rpdrill.simulate`` loads no figure module; saving a result and running a study with plots draw
     their figures without pyplot: the backend the user chose stays, no pyplot is loaded, standard

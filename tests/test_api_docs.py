@@ -20,6 +20,7 @@ def ran() -> list[Ran]:
     return run_examples(BLOCKS, ROOT)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("index", range(len(BLOCKS)), ids=[f"example{i}" for i in range(len(BLOCKS))])
 def test_every_example_runs(ran, index):
     assert not ran[index].failed, ran[index].err

@@ -63,6 +63,7 @@ def test_warning_format_is_restored_after_a_command(tmp_path):
     assert warnings.formatwarning is before
 
 
+@pytest.mark.slow
 def test_worker_warnings_print_once_as_one_line(tmp_path):
     """Two points on two worker processes, both warned about their step: one line, no source path."""
     study = tmp_path / "steps.yaml"

@@ -59,6 +59,7 @@ def whole(tmp_path_factory) -> Path:
     return folder / "out"
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_the_chains_done_records_the_session_and_resumes_to_the_uninterrupted_files(tmp_path, whole):
     """Issue 47: Ctrl-C kept nothing (the folder removed, no session): the chains ran before the results
     table and its study.json were written."""

@@ -58,6 +58,7 @@ def test_lengths_drawn_to_scale_but_for_the_shortened_ones_named_in_the_title(tm
         assert path.stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_the_animation_shows_the_last_blows_magnified(tmp_path):
     result = simulate(crushing_scene(solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2))
     factor = write_animation(result, tmp_path / "drill.gif", blows=2)
@@ -72,6 +73,7 @@ def test_the_animation_shows_the_last_blows_magnified(tmp_path):
     assert [nice_factor(v) for v in (7.0, 0.03, 250.0)] == [5.0, 0.02, 200.0]
 
 
+@pytest.mark.slow
 def test_simulate_draws_the_drill_and_with_animate_writes_what_exudyns_viewer_opens(tmp_path, monkeypatch):
     """Both formulations; the animations at 4 frames a blow, not 20: the frames are the test above's (two
     thirds of this test's CPU went into drawing them, measured)."""

@@ -151,6 +151,7 @@ def test_stress_wave_converges_and_travels_at_the_bar_speed():
     assert runs[64].rock_force_n.max() == pytest.approx(2 * scene_64.impact.amplitude_n, rel=0.05)
 
 
+@pytest.mark.slow
 def test_resolved_scene_uses_the_scene_file_keys(tmp_path):
     out = tmp_path / "out"
     assert main(["simulate", str(SCENES / "four_rod_string.yaml"), "--out", str(out), "--quiet"]) == 0

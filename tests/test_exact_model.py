@@ -284,6 +284,7 @@ SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 FOUR_ROD = SCENES / "four_rod_string.yaml"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", sorted(SCENES.glob("*.yaml")), ids=lambda path: path.stem)
 def test_every_shipped_scene_runs_exact_and_agrees_with_the_ode(path: Path) -> None:
     """The exact formulation takes every shipped scene (its laws, couplings, torsion, rods of many
@@ -331,6 +332,7 @@ BILINEAR = {"law": "bilinear", "loading_stiffness_n_per_m": 2e8, "unloading_stif
 @pytest.mark.parametrize("make", [
     pytest.param(lambda: crushing_scene(rock=BILINEAR, solver__end_time_s=0.1, **SHORT_METRICS), id="bilinear_law"),
     pytest.param(four_rods_with_couplings, id="four_rods_with_couplings", marks=pytest.mark.slow)])
+@pytest.mark.slow
 def test_piecewise_laws_agree_with_the_ode_to_1e_9_in_the_bottom(make):
     """The exact formulation runs every declared law: the bilinear rock (two states, resets on entering
     loading and free) and compression-only couplings (modes of five links at once)."""

@@ -27,12 +27,14 @@ def test_every_example_has_a_test():
     assert {path.name for path in EXAMPLES.glob("*.py")} == tested
 
 
+@pytest.mark.slow
 def test_a_tuned_absorber_on_the_collar_changes_the_penetration_rate(tmp_path):
     out = run("tuned_absorber.py", "--end-time-s", "0.5", cwd=tmp_path)
     without, with_ = map(float, re.findall(r"([0-9.]+) mm/s", out))
     assert without > 0 and abs(with_ - without) > 0.2 * without, out
 
 
+@pytest.mark.slow
 def test_a_changed_geometry_agrees_between_exudyn_and_the_exact_formulation(tmp_path):
     out = run("geometry_crosscheck.py", "--end-time-s", "0.5", cwd=tmp_path)
     assert "refused as it should be" in out and "collar.mass_kg" in out
@@ -41,6 +43,7 @@ def test_a_changed_geometry_agrees_between_exudyn_and_the_exact_formulation(tmp_
     assert relative < 1e-4 and velocity < 1e-3, out  # the reference preset's stated error (docs/stability.md)
 
 
+@pytest.mark.slow
 def test_a_study_from_python_into_pandas_and_a_plot(tmp_path):
     out = run("study_to_pandas.py", "--figure", "scan.png", "--workers", "2", cwd=tmp_path)
     best = float(re.search(r"best grid point: ([0-9.]+) Hz", out).group(1))
@@ -48,6 +51,7 @@ def test_a_study_from_python_into_pandas_and_a_plot(tmp_path):
     assert (tmp_path / "scan.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_a_rate_dependent_crushing_threshold_of_ones_own_runs_in_the_exudyn_and_exact_formulations(tmp_path):
     out = run("rate_dependent_rock.py", "--end-time-s", "0.3", cwd=tmp_path)
     exudyn, exact, paper = map(float, re.findall(r"([0-9.]+) mm/s", out))
@@ -58,6 +62,7 @@ def test_a_rate_dependent_crushing_threshold_of_ones_own_runs_in_the_exudyn_and_
     assert 0 < exact < paper  # the threshold rises with the crushing speed: slower than the paper's law
 
 
+@pytest.mark.slow
 def test_a_clamp_extension_is_stepped_accounted_and_read_back(tmp_path):
     out = run("clamp_extension.py", "--end-time-s", "0.3", cwd=tmp_path)
     without, with_ = map(float, re.search(r"step: ([0-9.e+-]+) s without the clamp, ([0-9.e+-]+) s with it", out).groups())

@@ -42,6 +42,7 @@ def ran() -> list[Ran]:
     return run_examples(RUNNABLE, DOC.parents[1])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("index", range(len(RUNNABLE)), ids=[f"example{i}" for i in range(len(RUNNABLE))])
 def test_every_python_block_runs_from_the_root_of_the_checkout(ran, index):
     assert not ran[index].failed and "Traceback" not in ran[index].err, ran[index].err
@@ -105,6 +106,7 @@ def test_declared_modes_agree_with_the_closed_form(joint_type):
     assert {link.initial_mode(v) for v in samples} == set(link.modes())
 
 
+@pytest.mark.slow
 def test_exact_formulation_runs_the_new_type_from_its_modes(joint_type):
     """Two blows, the second crushing (the rattle amplifies differences over many): the exact solution
     against the ODE."""

@@ -61,6 +61,7 @@ def test_a_yaml_study_scans_an_extension_parameter_on_two_workers_as_single_runs
     assert plot.stat().st_size > 10_000
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("runner", ["processes", "dask"])
 def test_run_study_scans_an_extension_parameter_on_processes_and_a_dask_local_cluster(tmp_path, singles, runner):
     study = rpdrill.load_study(study_file(tmp_path / "scan.yaml", plots=[]), allow_code=ALLOW)
@@ -69,6 +70,7 @@ def test_run_study_scans_an_extension_parameter_on_processes_and_a_dask_local_cl
     assert dict(zip(table[MASS], table["penetration_rate_m_per_s"], strict=True)) == pytest.approx(singles, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_an_extension_parameter_is_a_calibration_axis(tmp_path):
     calibration = {
         "name": "clamp_fit", "base_scene": str(PAPER_BASE), "base_overrides": {**SHORT, "extensions": CLAMP},
@@ -99,6 +101,7 @@ def test_an_extension_parameter_is_a_sensitivity_parameter(tmp_path):
         assert {row["parameter"] for row in csv.DictReader(handle)} == {MASS}
 
 
+@pytest.mark.slow
 def test_an_extension_parameter_is_an_advice_axis():
     scene = rpdrill.load_scene(PAPER_BASE, allow_code=ALLOW).with_({**SHORT, "extensions": CLAMP, "solver.end_time_s": 0.07,
                                                   "metrics.transient_blows": 1, "metrics.block_blows": 2})

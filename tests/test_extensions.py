@@ -140,6 +140,7 @@ def test_an_item_the_account_cannot_take_makes_the_balance_not_a_number_unless_d
         model.add_energy_term("x", "lost", lambda model, t: t)
 
 
+@pytest.mark.slow
 def test_an_extension_named_by_the_scene_is_applied_in_every_run_and_recorded(tmp_path):
     scene = PAPER.with_({"extensions": {"clamp": {**CLAMP, "parameters": {"mass_kg": 300.0, "stiffness_n_per_m": 1e9}}}})
     result = rpdrill.simulate(scene)
@@ -273,6 +274,7 @@ def test_draw_an_extended_model_from_its_exudyn_graphics(tmp_path):
     # its animation: test_view_solution_replays_an_extended_run_... (rpdrill simulate --animate)
 
 
+@pytest.mark.slow
 def test_view_solution_replays_an_extended_run_and_refuses_one_it_cannot_rebuild(tmp_path):
     """Why 6: view_solution of an extended run failed (SetODE2Coords: incompatible size of vectors)."""
     from commands import main

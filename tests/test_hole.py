@@ -36,6 +36,7 @@ def drilled(tmp_path_factory):
     return rpdrill.drill_hole(hole_file(folder), out=folder / "out", workers=1)
 
 
+@pytest.mark.slow
 def test_one_rod_in_one_layer_drills_at_the_steady_rate_of_the_scene_it_writes(drilled):
     row = drilled.rows.iloc[0]
     assert row["rods"] == 1 and row["regime"] == "settled" and row["settle_blows"] < 150
@@ -71,6 +72,7 @@ def test_rigid_joints_lose_nothing_so_the_rods_change_the_rock_energy_only_by_ma
     assert one.rock_energy_per_blow_j != two.rock_energy_per_blow_j
 
 
+@pytest.mark.slow
 def test_lossy_couplings_deliver_the_product_of_their_transmissions(tmp_path):
     """Couplings with a spring and a damper: the energy delivered into the last rod over the energy reaching the
     first coupling equals the product of each coupling's measured transmission (the rods between carry it
@@ -103,6 +105,7 @@ def test_bad_hole_files_exit_2_naming_the_key(tmp_path, capsys, change, named):
     assert not (tmp_path / "out" / "runs").exists()  # refused before anything ran
 
 
+@pytest.mark.slow
 def test_an_interrupted_hole_resumes_to_the_same_hole_csv(drilled, tmp_path, monkeypatch, capsys):
     from rpdrill.studies.hole import hole_run
 
@@ -124,6 +127,7 @@ def test_an_interrupted_hole_resumes_to_the_same_hole_csv(drilled, tmp_path, mon
         str(drilled.out), str(out))
 
 
+@pytest.mark.slow
 def test_an_advised_hole_runs_each_depth_at_the_advisors_point_and_says_the_time_gained(tmp_path):
     """``operating: advise`` (a small search at a fixed power): the depth's run is at the point found, inside the
     bounds, its scene written beside the rig's; the time gained is the fixed setting's time less the hole's."""
@@ -141,6 +145,7 @@ def test_an_advised_hole_runs_each_depth_at_the_advisors_point_and_says_the_time
     assert summary["fixed_total_time_s"] == pytest.approx(1.5 / run.fixed_rate_m_per_s)
 
 
+@pytest.mark.slow
 def test_a_down_the_hole_hammer_strikes_the_bit_and_its_tubes_only_add_mass(tmp_path):
     """``hammer: down_the_hole``: the rig's rods are taken out, the struck shank joined to the bit; the tubes' mass
     joins the body the feed pushes; the rate with 1 and 2 tubes is the same within 1e-3 (no coupling crossed)."""

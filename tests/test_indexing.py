@@ -127,6 +127,7 @@ def paper_rate() -> float:
     return rate(simulate(crushing_scene(**SHORT), "exact"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(INDEXED))
 def test_exudyn_agrees_with_the_reference_with_indexing_on(name):
     reference, exudyn = indexed(name)

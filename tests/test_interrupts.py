@@ -106,6 +106,7 @@ def assert_stopped_cleanly(stopped: Stopped, status: int, kept: int) -> None:
     assert kept >= stopped.kept_at_signal  # every point finished before the signal is kept
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signum, group", [(signal.SIGINT, True), (signal.SIGTERM, True), (signal.SIGTERM, False)])
 def test_a_study_stops_within_2_s_keeping_its_finished_points(tmp_path, signum, group):
     out = tmp_path / "out"
@@ -117,6 +118,7 @@ def test_a_study_stops_within_2_s_keeping_its_finished_points(tmp_path, signum, 
     assert json.loads((out / "study.json").read_text())["sessions"][-1]["interrupted"] is True
 
 
+@pytest.mark.slow
 def test_a_killed_study_leaves_no_worker(tmp_path):
     out = tmp_path / "out"
     stopped = stop(command("study", str(study_file(tmp_path)), "--out", str(out), "--workers", "2", "--quiet"),
@@ -124,6 +126,7 @@ def test_a_killed_study_leaves_no_worker(tmp_path):
     assert stopped.status == -signal.SIGKILL and not stopped.left, stopped
 
 
+@pytest.mark.slow
 def test_a_worker_killed_alone_stops_the_run_keeping_its_finished_points(tmp_path):
     out = tmp_path / "out"
     stopped = stop(command("study", str(study_file(tmp_path)), "--out", str(out), "--workers", "2", "--quiet"),
@@ -146,6 +149,7 @@ def after(seconds: float) -> Callable[[], int]:
     return lambda: int(time.monotonic() - start >= seconds)
 
 
+@pytest.mark.slow
 def test_a_killed_command_leaves_no_worker_in_the_middle_of_a_point(tmp_path):
     """Why a pool worker asks the kernel to end it with its command (PR_SET_PDEATHSIG,
     studies.runtime.interrupts.worker_ends_with_its_command): the command killed (SIGKILL: none of its
@@ -157,6 +161,7 @@ def test_a_killed_command_leaves_no_worker_in_the_middle_of_a_point(tmp_path):
     assert stopped.status == -signal.SIGKILL and not stopped.left, stopped
 
 
+@pytest.mark.slow
 def test_a_stop_does_not_wait_for_the_points_under_way(tmp_path):
     """Why the command ends its workers on a stop (studies.runtime.pools._terminate_workers: Python 3.14's
     ``terminate_workers``, before it the executor's own processes): Ctrl-C while both workers are seconds

@@ -47,6 +47,7 @@ def test_a_rock_damper_of_the_smallest_float_runs(tmp_path, capsys):
     assert main(["simulate", str(path), "--out", str(tmp_path / "out")]) == 0, capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_two_studies_on_one_out_one_runs_the_other_exits_2(tmp_path):
     study = write_study(tmp_path / "two.yaml", [40, 45, 50, 55, 60, 65], end_time_s=0.3)
     out = tmp_path / "out"
@@ -71,6 +72,7 @@ def test_a_stale_lock_is_taken_over_and_said_once(tmp_path, capsys):
     assert not (out / ".rpdrill.lock").exists() and len(rows(out)) == 2
 
 
+@pytest.mark.slow
 def test_a_resumed_table_with_edited_rows_runs_them_again(tmp_path, capsys):
     study = write_study(tmp_path / "edited.yaml", [40, 50, 60])
     out = tmp_path / "out"
@@ -99,6 +101,7 @@ def test_a_resumed_table_with_edited_rows_runs_them_again(tmp_path, capsys):
         [{k: v for k, v in r.items() if k not in strip} for r in original]
 
 
+@pytest.mark.slow
 def test_simulate_of_an_unsettled_run_says_so_in_one_warning_line(tmp_path):
     """The test drill at 65 Hz: the bit stops crushing after the first block (its block rates 0.11 and
     0 mm/s): a result, but one warning line and the status in summary.json."""
@@ -151,6 +154,7 @@ def _strict_json(path: Path) -> dict:
     return json.loads(path.read_text(encoding="utf-8"), parse_constant=refuse)
 
 
+@pytest.mark.slow
 def test_a_run_whose_figures_are_not_numbers_is_not_ok_and_its_summary_is_valid_json(tmp_path):
     """A rock threshold of 1e-3 N: the impact does no work, so the efficiency is 0 / 0; the run's status says
     so in one warning line and summary.json, which holds null (valid JSON), not NaN."""

@@ -66,6 +66,7 @@ def test_an_out_on_a_read_only_mount_is_refused_before_anything_runs(tmp_path, c
         assert list(mount.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_an_out_of_mode_555_is_refused_for_a_user_who_cannot_write_there(tmp_path):
     if shutil.which("unshare") is None or subprocess.run(["unshare", "--user", "true"], check=False).returncode:
         pytest.skip("no user namespaces here")
@@ -94,6 +95,7 @@ def test_a_full_disk_ends_a_simulation_with_one_line_and_leaves_nothing(tmp_path
         assert list(mount.iterdir()) == []  # no half file, no staging folder, no lock
 
 
+@pytest.mark.slow
 def test_a_study_on_a_disk_that_fills_up_resumes_once_there_is_room(tmp_path):
     """The disk fills up while the study writes: exit 1, one line; every file it left is whole
     (study.json was left empty and the next run refused to resume); with room again the same command
@@ -122,6 +124,7 @@ def test_an_out_name_that_is_not_utf8_is_refused_naming_the_byte(tmp_path, capsy
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_a_closed_standard_output_ends_quietly_once_the_files_are_written(tmp_path):
     """``rpdrill simulate ... | head -n 0``: the reader is gone before the summary line is printed; the
     files are written and the command ends with its own status, silently (it was a BrokenPipeError)."""

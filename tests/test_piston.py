@@ -145,6 +145,7 @@ def test_the_formulations_agree_on_the_rod_pistons_blow(rod_on_rod, formulation,
     assert other.piston.rebounds[0, 1:] == pytest.approx(exact.piston.rebounds[0, 1:], rel=rebound_gap)
 
 
+@pytest.mark.slow
 def test_a_rigid_piston_sends_the_exponential_pulse():
     """4.5 kg at 9 m/s on a 0.5 m rod of 240 segments through k_c = 100 Z^2 / m_p."""
     piston = {"mass_kg": 4.5, "contact_stiffness_n_per_m": RIGID_CONTACT}
@@ -190,6 +191,7 @@ def test_the_issues_rod_piston_at_reference(formulation):
 
 # ---- what a user sees -------------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_simulate_writes_the_pistons_outputs(tmp_path):
     path = tmp_path / "scene.yaml"
     path.write_text(yaml.safe_dump(one_blow(rod_piston(8), 4.0, 64)))
@@ -205,6 +207,7 @@ def test_simulate_writes_the_pistons_outputs(tmp_path):
     assert load_scene(out / "scene.resolved.yaml").impact == load_scene(path).impact  # runs again as it ran
 
 
+@pytest.mark.slow
 def test_crosscheck_covers_a_piston_scene(tmp_path):
     """rpdrill crosscheck: the Exudyn model against the ODE over two blows of the rod piston, its contact
     force among the histories compared."""

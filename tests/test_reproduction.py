@@ -173,6 +173,7 @@ def test_the_shipped_scene_reproduces_the_headlines_but_fig_6_and_says_so(tmp_pa
     assert len(rows) == 4 and all(reason in row for row in rows)
 
 
+@pytest.mark.slow
 def test_the_fig6_searchs_best_drill_has_spikes_not_maxima(tmp_path, capsys):
     """docs/fig6.md: the best drill of the Fig. 6 search, scanned every 1 Hz, reaches six of the eight
     stated optima with every trend rising, but its Fig. 6 "optima" are single-frequency spikes (80 %

@@ -100,6 +100,7 @@ def test_a_period_one_orbit_is_the_limit_of_a_long_time_run(frequency_hz):
     assert "crushing" in state.orbit.event_sequence
 
 
+@pytest.mark.slow
 def test_a_period_doubling_the_time_run_shows_is_found_and_the_unstable_orbit_is_not_the_rate():
     scene_ = scene().with_solver("exact").with_(PERIOD_DOUBLING)
     simulation = prepare(scene_)

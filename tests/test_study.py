@@ -281,6 +281,7 @@ def test_sigterm_stops_like_ctrl_c(tmp_path):
     assert session["interrupted"] is True and session["points_run"] == len(kept)
 
 
+@pytest.mark.slow
 def test_dask_local_cluster(tmp_path):
     study = write_study(tmp_path / "dask.yaml", scan={"impact.frequency_hz": [40, 60]}, plots=[])
     out = tmp_path / "out"

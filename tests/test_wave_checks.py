@@ -82,6 +82,7 @@ def test_the_budgets_count_the_characteristics_grid(change, key):
     assert time.process_time() - started < 2.0
 
 
+@pytest.mark.slow
 def test_the_shipped_wave_scene_runs_ok_on_exudyn_without_warnings(tmp_path, capsys):
     """Every wave scene on Exudyn was "unstable" with ten NumPy warnings: the stability check computed on the rigid
     joints' infinite stiffness and the faces' zero mass. It now checks what Exudyn integrates (the bodies with mass,

@@ -192,6 +192,7 @@ def rod_end_checks(result, solution, scale: float, window_s: float, ref_ports: t
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_a_restrike_within_a_step_is_the_characteristics_solution(restrike, formulation):
     """Histories, peaks, rebound and rock energies of every blow within 1e-3 of Z v_p and of the blow energy
@@ -213,6 +214,7 @@ def test_a_restrike_within_a_step_is_the_characteristics_solution(restrike, form
     assert errors[1] < errors[0] / 4  # second order: measured 1.9e-4 and 4.3e-6 (exact)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_a_bit_at_the_foot_and_a_preload(formulation):
     """The same piston on the rod preloaded by a 5 kN feed on its top face (waves d = -u = P / 2 Z, the rock
@@ -383,6 +385,7 @@ def along(solution: ref.Solution, fraction: float, t: np.ndarray) -> np.ndarray:
     return rod.impedance * (down - up)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_the_stress_envelope_and_a_gauge_inside_the_rod(restrike, formulation):
     """Inside the rod of the re-strike case: every blow's largest compression and tension at sections along it, and

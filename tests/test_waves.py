@@ -288,6 +288,7 @@ def both():
     return {f: run(bit_on_rods(f)) for f in FORMULATIONS}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_the_energy_account_closes_with_the_waves_in_flight(both, formulation):
     account = energy_account(both[formulation])
@@ -308,6 +309,7 @@ def anvil_on_a_rod(formulation: str) -> dict:
             "metrics": {"transient_blows": 1, "block_blows": 1}}
 
 
+@pytest.mark.slow
 def test_a_pulse_on_a_lumped_body_is_counted_once():
     """Its work was counted by the wave element and by Exudyn both (Exudyn's balance off by 0.41 before the
     fix, measured)."""
@@ -353,6 +355,7 @@ def test_the_rod_outputs_of_a_blow(both):
     assert metrics["rock_transfer_efficiency"] == pytest.approx(metrics["rock_energy_per_blow_j"] / 150.0, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_an_item_of_ones_own_on_a_body_acts_through_the_wave_element(both):
     """build_exudyn of a scene with wave rods: the bodies with mass are Exudyn's, an item a user joins to
     one acts on it, and the waves see the body move (a 50 kg mass on a 300 Hz spring on the bit)."""
@@ -403,6 +406,7 @@ SHIPPED = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "top_hamm
 RODS = ("shank", "rod1", "rod2", "rod3", "rod4")
 
 
+@pytest.mark.slow
 def test_the_shipped_top_hammer_scene_reports_its_rods_stresses_and_energy_per_blow(tmp_path):
     """``rpdrill simulate`` of the shipped scene (exact formulation, 20 blows): every rod's stress histories
     at its ends, its largest stresses and the energy through its ends per blow; a rigid coupling is one

@@ -48,6 +48,7 @@ def rate_error(metrics: dict, reference: dict) -> float:
     return abs(metrics["penetration_rate_m_per_s"] - ref) / max(abs(ref), 1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("preset", list(EXUDYN_PRESETS))
 @pytest.mark.parametrize("name", list(HARD_SCENES))
 def test_preset_is_stable_and_within_its_stated_errors(name, preset):
