@@ -125,6 +125,7 @@ def write_scene(tmp_path) -> str:
     return str(path)
 
 
+@pytest.mark.slow
 def test_advise_command_writes_the_advice(tmp_path, capsys):
     out, markdown = tmp_path / "out", tmp_path / "advice.md"
     assert main(["advise", write_scene(tmp_path), "--frequency-hz", "45", "70", "--feed-kn", "35", "60",

@@ -169,6 +169,7 @@ def _has_avx2() -> bool:
         return any(line.startswith("flags") and "avx2" in line.split() for line in info)
 
 
+@pytest.mark.slow
 def test_exudyn_builds_as_the_process_chose_announced_by_exudyn_and_agreeing():
     """rocklaw.exudyn_module: importing rpdrill's Exudyn model loads Exudyn's regular build; a process that
     chose the fast one (EXUDYN_MODULE=fast, as the rpdrill command does for itself) the build without range

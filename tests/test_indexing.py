@@ -141,6 +141,7 @@ def test_exudyn_agrees_with_the_reference_with_indexing_on(name):
     np.testing.assert_allclose(exudyn.solver.fresh_fractions, etas, rtol=1e-3)
 
 
+@pytest.mark.slow
 def test_torsion_angle_between_blows_sets_each_share():
     """From the torsion line, eta of blow k is that of the angle turned since blow k - 1 (none before
     the first blow); the share settles as the bit spins up."""
@@ -237,6 +238,7 @@ def test_indexing_alone_builds_the_crushing_it_indexes(tmp_path, capsys):
 ROTATION_STUDIES = Path(__file__).resolve().parents[1] / "studies" / "rotation"
 
 
+@pytest.mark.slow
 def test_shipped_rotation_studies_are_valid():
     for name, points in (("rpm_frequency_map", 3 * 13 * 30), ("dth_example", 3 * 81)):
         study = load_study(ROTATION_STUDIES / f"{name}.yaml")

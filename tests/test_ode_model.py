@@ -94,6 +94,7 @@ def _one_blow(**changes: object) -> Scene:
     return scene_from_base(blows=1, **{"metrics.transient_blows": 0, "metrics.block_blows": 1, **changes})
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["Radau", "LSODA"])
 def test_methods_agree_with_dop853(method: str) -> None:
     scene = _one_blow(**{"rock.threshold_n": 60e3})

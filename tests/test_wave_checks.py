@@ -48,6 +48,7 @@ def test_a_wave_step_off_the_rods_grid_is_refused_naming_its_key(tmp_path, capsy
     assert not (tmp_path / "out" / "summary.json").exists()
 
 
+@pytest.mark.slow
 def test_a_wave_step_near_the_rods_grid_runs_on_it_and_says_so(tmp_path):
     """2.3 us is no whole fraction of the shipped scene's period and transit times; the run takes the nearest step
     on the rods' grid and says which (the transit times as run are in the summary)."""
