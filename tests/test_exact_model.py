@@ -382,3 +382,21 @@ def test_a_scan_reuses_the_propagators_and_its_results_are_those_of_a_fresh_buil
     for name in ("time_s", "position_m", "velocity_m_per_s", "bottom_m", "rock_force_n"):
         assert np.array_equal(getattr(fresh, name), getattr(again, name)), name
     assert all(np.array_equal(fresh.works_j[k], again.works_j[k]) for k in fresh.works_j)
+
+
+def test_keys_larger_than_the_cache_are_not_kept_and_the_run_is_the_same(monkeypatch):
+    """A key whose arrays exceed the whole cache (0.24 GB a key for the 290-body rod piston of test_piston) is
+    neither copied nor kept; the run is bit for bit the one that cached its keys."""
+    cache = rpdrill.models.solvers.exact_model.OPERATOR_CACHE
+    base = crushing_scene(solver__end_time_s=0.2, **SHORT_METRICS).with_solver("exact")
+    cache.clear()
+    cached = simulate(base)
+    assert len(cache.entries) > 0
+    cache.clear()
+    monkeypatch.setattr(cache, "max_bytes", 1)
+    offered = []
+    monkeypatch.setattr(cache, "put", lambda key, arrays: offered.append(key))
+    uncached = simulate(base)
+    assert offered == [] and len(cache.entries) == 0  # not even copied to be offered
+    for name in ("time_s", "position_m", "bottom_m", "rock_force_n"):
+        assert np.array_equal(getattr(cached, name), getattr(uncached, name)), name

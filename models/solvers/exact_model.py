@@ -116,9 +116,9 @@ class OperatorCache:
         return arrays
 
     def holds(self, arrays: tuple[np.ndarray, ...]) -> bool:
-        """Whether ``arrays`` fit in the cache at all: a key larger than the cache is neither copied nor kept (the
-        rod piston of 32 segments on a 256-segment rod of tests/test_piston.py: keys of 0.2 GB, a run of 11.2 CPU s,
-        12.0 when each key was copied and dropped at once; two runs each)."""
+        """Whether ``arrays`` fit in the cache at all: a key larger than the cache (0.24 GB a key for the rod piston
+        of 32 segments on a 256-segment rod of tests/test_piston.py) is neither copied nor kept, where its copy was
+        made only to be dropped at once."""
         return sum(array.nbytes for array in arrays) <= self.max_bytes
 
     def put(self, key: CacheKey, arrays: tuple[np.ndarray, ...]) -> None:

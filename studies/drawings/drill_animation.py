@@ -75,15 +75,11 @@ def movie_writer(path: Path) -> PillowWriter | FFMpegWriter:
 
 def save_frames(fig: Figure, frame: Callable[[int], None], count: int, path: Path, writer: AbstractMovieWriter) -> None:
     """Write ``count`` frames of ``fig`` to ``path``, ``frame(k)`` drawing the k-th: each drawn once (a
-    FuncAnimation draws each frame twice when it saves), the layout solved for the first frame and kept for
-    the others (as studies.figures.figure_style.save keeps it): the frames stand still around the drill, and
-    the 60 frames of the paper's drill over 3 blows take 5.9 CPU s, not 6.5 (medians of 3; the layout
-    solved again for each frame)."""
+    FuncAnimation draws each frame twice when it saves)."""
     with writer.saving(fig, str(path), fig.dpi):
         for k in range(count):
             frame(k)
             writer.grab_frame()
-            fig.set_layout_engine("none")  # laid out by the first frame
 
 
 def write_animation(result: SimulationResult | Result | ExudynModel, path: str | Path, blows: int = 3,
