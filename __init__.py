@@ -37,6 +37,10 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "Result": ("models.evaluation.run_result", "Result"),
          "Regime": ("models.evaluation.run_record", "Regime"),
          "SimulationFailed": ("models.evaluation.stability", "SimulationFailed"),
+         "StepLimitWarning": ("models.evaluation.stability", "StepLimitWarning"),
+         "UnsettledWarning": ("models.evaluation.run_status", "UnsettledWarning"),
+         "ExudynMessage": ("models.solvers.exudyn_messages", "ExudynMessage"),
+         "WaveStepRounded": ("models.waves.steps", "WaveStepRounded"),
          "Advice": ("studies.advice.advice_run", "Advice"),
          "AdviceSearch": ("studies.advice.advice_run", "AdviceSearch"),
          "advise": ("studies.advice.advice_run", "advise_scene"),
@@ -78,8 +82,11 @@ if _TYPE_CHECKING:  # the names as type checkers and editors see them
     from .models.definition.validation import InputError
     from .models.evaluation.run_record import Regime
     from .models.evaluation.run_result import Result
-    from .models.evaluation.stability import SimulationFailed
+    from .models.evaluation.run_status import UnsettledWarning
+    from .models.evaluation.stability import SimulationFailed, StepLimitWarning
+    from .models.solvers.exudyn_messages import ExudynMessage
     from .models.solvers.exudyn_model import ExudynModel, build_exudyn
+    from .models.waves.steps import WaveStepRounded
     from .rocklaw.base import RockLaw
     from .studies.accuracy.accuracy_run import AccuracyResult, accuracy
     from .studies.advice.advice_run import Advice, AdviceSearch
@@ -124,6 +131,7 @@ __all__ = [
     "BudgetError",
     "CalibrationResult",
     "Crosscheck",
+    "ExudynMessage",
     "ExudynModel",
     "HoleResult",
     "InputError",
@@ -137,7 +145,10 @@ __all__ = [
     "SensitivityResult",
     "ShippedFile",
     "SimulationFailed",
+    "StepLimitWarning",
     "Study",
+    "UnsettledWarning",
+    "WaveStepRounded",
     "accuracy",
     "advise",
     "build_exudyn",

@@ -9,7 +9,7 @@ import yaml
 from commands import main
 from scenes import scene_dict
 
-from rpdrill.models.evaluation.stability import StepLimitWarning
+import rpdrill
 
 QUICK = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_blows": 2}
 
@@ -90,7 +90,7 @@ def test_diverged_run_is_an_error_not_a_result(tmp_path, capsys):
     """Explicit Euler far beyond its stability limit: exit 1 and the message names the setting."""
     path = write(tmp_path, scene_dict(**QUICK, **{"solver.type": "explicit_euler", "solver.step_s": 2e-4}))
     out = tmp_path / "out"
-    with pytest.warns(StepLimitWarning, match="explicit_euler is unstable"):
+    with pytest.warns(rpdrill.StepLimitWarning, match="explicit_euler is unstable"):
         assert main(["simulate", str(path), "--out", str(out), "--quiet"]) == 1
     err = capsys.readouterr().err
     assert "diverged" in err and "explicit_euler" in err and "step_s" in err

@@ -17,7 +17,6 @@ import user_rig
 from scenes import crushing_scene
 
 import rpdrill
-from rpdrill.models.evaluation.stability import StepLimitWarning
 from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 
@@ -59,7 +58,7 @@ def test_a_stiff_clamp_added_in_python_runs_at_the_step_it_needs_and_equals_a_he
 def test_a_diverged_run_never_advises_a_step_larger_than_the_one_that_diverged():
     """Why 1: 'diverged ... try solver.step_s 8.22e-05' after 5e-05 diverged."""
     model = clamped(PAPER.with_({"solver.step_s": 5e-5, "solver.type": "rk44", "solver.preset": None}))
-    with pytest.warns(StepLimitWarning, match="exceeds the stability limit"), pytest.raises(rpdrill.SimulationFailed) as failed:
+    with pytest.warns(rpdrill.StepLimitWarning, match="exceeds the stability limit"), pytest.raises(rpdrill.SimulationFailed) as failed:
         model.run()
     advised = float(str(failed.value).split("try solver.step_s ")[1].split()[0])
     assert "diverged at t" in str(failed.value) and advised < 5e-5 / 2 * (1 + 1e-9)

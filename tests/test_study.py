@@ -23,7 +23,6 @@ from scenes import PAPER_BASE, scene_dict
 
 import rpdrill
 from rpdrill.models.definition.outputs import METRICS
-from rpdrill.models.evaluation.stability import StepLimitWarning
 from rpdrill.studies.runtime.pools import BATCHES_PER_WORKER, ONE_THREAD, batches, process_pool
 
 load_study = rpdrill.load_study
@@ -170,7 +169,7 @@ def test_two_studies_of_one_name_are_refused_before_any_runs(tmp_path, capsys):
 def test_failed_point_is_recorded_and_the_study_goes_on(tmp_path):
     study = write_study(tmp_path / "fail.yaml", scan={"solver.step_s": [2e-5, 1e-3]},
                         base_overrides={**SHORT, "impact.frequency_hz": 40}, plots=[])
-    with pytest.warns(StepLimitWarning, match="exceeds the stability limit"):
+    with pytest.warns(rpdrill.StepLimitWarning, match="exceeds the stability limit"):
         assert main(["study", str(study), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet"]) == 1
     by_step = {float(r["solver.step_s"]): r for r in rows(tmp_path / "out")}
     assert by_step[2e-5]["status"] == "ok" and by_step[2e-5]["error"] == ""

@@ -15,7 +15,6 @@ from scenes import PAPER_BASE
 
 import rpdrill
 from rpdrill.models.drill.modal import rock_mode_frequency_hz
-from rpdrill.models.evaluation.stability import StepLimitWarning
 from rpdrill.studies.scan.curve_optima import curve_optimum
 from rpdrill.studies.scan.study_optima import csv_rows, curve_axis, optima_table, study_optima
 
@@ -114,7 +113,7 @@ def test_a_study_whose_every_point_failed_draws_no_plot(tmp_path, capsys):
                   plots=[{"x": "impact.frequency_hz", "y": "penetration_rate_m_per_s"}],
                   base_overrides={**SHORT, "impact.frequency_hz": 40.0, "solver.step_s": 1e-3})  # RK44 unstable
     out = tmp_path / "out"
-    with pytest.warns(StepLimitWarning, match="exceeds the stability limit"):
+    with pytest.warns(rpdrill.StepLimitWarning, match="exceeds the stability limit"):
         assert main(["study", str(study), "--out", str(out), "--workers", "1", "--quiet"]) == 1
     assert not list(out.glob("*.png")) and not list(out.glob("*.svg"))
     err = capsys.readouterr().err

@@ -36,7 +36,24 @@ from .stability import step_warning
 
 
 class UnsettledWarning(UserWarning):
-    """A finished run whose figures do not stand as they are: its status is not ``ok`` (module doc)."""
+    """A finished run whose figures do not stand as they are: its status is not ``ok`` (module doc); the message
+    says why and what to change (a longer run, more transient blows).
+
+    Parameters
+    ----------
+    *args
+        The message, as for any warning.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import rpdrill
+    >>> issubclass(rpdrill.UnsettledWarning, UserWarning)
+    True
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("error", rpdrill.UnsettledWarning)
+    ...     result = rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
+    """
 
 
 STATUSES = ("ok", "unstable", "unsettled", "not_finite", "unbalanced")  # of a finished run (and "failed")

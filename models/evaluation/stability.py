@@ -68,7 +68,24 @@ class SimulationFailed(RuntimeError):
 
 
 class StepLimitWarning(UserWarning):
-    """A fixed explicit step beyond the measured stability limit of the scene's stiffest mode."""
+    """A fixed explicit step beyond the measured stability limit of the scene's stiffest mode; the message
+    names the solver that is stable and its largest step.
+
+    Parameters
+    ----------
+    *args
+        The message, as for any warning.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import rpdrill
+    >>> issubclass(rpdrill.StepLimitWarning, UserWarning)
+    True
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("error", rpdrill.StepLimitWarning)
+    ...     result = rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
+    """
 
 
 def contact_eigenvalues_per_s(chain: AxialChain, law: RockLaw, torsion: Torsion | None = None) -> np.ndarray:

@@ -62,7 +62,24 @@ def no_cyclic_gc() -> Iterator[None]:
 
 
 class ExudynMessage(UserWarning):
-    """What Exudyn printed during a run (its warnings), issued as a warning instead."""
+    """What Exudyn printed during a run (its warnings), issued as a warning instead: one a distinct line,
+    naming the scene.
+
+    Parameters
+    ----------
+    *args
+        The message, as for any warning.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import rpdrill
+    >>> issubclass(rpdrill.ExudynMessage, UserWarning)
+    True
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore", rpdrill.ExudynMessage)
+    ...     result = rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
+    """
 
 
 EXUDYN_PREFIX = re.compile(r"^\s*Python WARNING \[file '[^']*', line \d+\]:\s*")

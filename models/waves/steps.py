@@ -26,7 +26,23 @@ TRANSIT_TOLERANCE = 1e-3  # the largest rounding (N h - T) / T of a transit time
 
 
 class WaveStepRounded(UserWarning):
-    """A wave step given in the scene run as the nearest one on the rods' grid (said once per run)."""
+    """A wave step given in the scene run as the nearest one on the rods' grid (said once per run).
+
+    Parameters
+    ----------
+    *args
+        The message, as for any warning.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import rpdrill
+    >>> issubclass(rpdrill.WaveStepRounded, UserWarning)
+    True
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore", rpdrill.WaveStepRounded)
+    ...     result = rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
+    """
 
 
 class WaveStepError(ValueError):
