@@ -42,17 +42,17 @@ class UnsettledWarning(UserWarning):
     Parameters
     ----------
     *args
-        The message, as for any warning.
+        The message.
 
     Examples
     --------
     >>> import warnings
     >>> import rpdrill
-    >>> issubclass(rpdrill.UnsettledWarning, UserWarning)
-    True
-    >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("error", rpdrill.UnsettledWarning)
-    ...     result = rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
+    >>> with warnings.catch_warnings(record=True) as caught:  # doctest: +SKIP
+    ...     warnings.simplefilter("always", rpdrill.UnsettledWarning)
+    ...     result = rpdrill.simulate("my_scene.yaml")
+    >>> [str(w.message) for w in caught if w.category is rpdrill.UnsettledWarning]  # doctest: +SKIP
+    ["scene 'my_scene': the penetration rate has not settled: ..."]
     """
 
 

@@ -80,11 +80,10 @@ class StepLimitWarning(UserWarning):
     --------
     >>> import warnings
     >>> import rpdrill
-    >>> issubclass(rpdrill.StepLimitWarning, UserWarning)
-    True
-    >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("error", rpdrill.StepLimitWarning)
-    ...     result = rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
+    >>> warnings.simplefilter("error", rpdrill.StepLimitWarning)  # doctest: +SKIP
+    >>> rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
+    Traceback (most recent call last):
+    rpdrill.StepLimitWarning: scene 'my_scene': solver explicit_euler is unstable ...
     """
 
 

@@ -68,17 +68,13 @@ class ExudynMessage(UserWarning):
     Parameters
     ----------
     *args
-        The message, as for any warning.
+        The line, its scene named.
 
     Examples
     --------
-    >>> import warnings
     >>> import rpdrill
-    >>> issubclass(rpdrill.ExudynMessage, UserWarning)
+    >>> rpdrill.ExudynMessage("scene 'paper_base': Exudyn: ...").args[0].startswith("scene")
     True
-    >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("ignore", rpdrill.ExudynMessage)
-    ...     result = rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
     """
 
 

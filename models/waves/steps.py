@@ -28,20 +28,16 @@ TRANSIT_TOLERANCE = 1e-3  # the largest rounding (N h - T) / T of a transit time
 class WaveStepRounded(UserWarning):
     """A wave step given in the scene run as the nearest one on the rods' grid (said once per run).
 
-    Parameters
+    Attributes
     ----------
-    *args
-        The message, as for any warning.
+    args : tuple of str
+        The message: the step asked for and the step run.
 
     Examples
     --------
-    >>> import warnings
     >>> import rpdrill
     >>> issubclass(rpdrill.WaveStepRounded, UserWarning)
     True
-    >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("ignore", rpdrill.WaveStepRounded)
-    ...     result = rpdrill.simulate("my_scene.yaml")  # doctest: +SKIP
     """
 
 
