@@ -18,7 +18,6 @@ from typing import TYPE_CHECKING, Any
 from ..models.definition.formulations import FORMULATIONS
 from ..models.definition.scene import Scene
 from ..models.evaluation.run_result import Result
-from ..models.evaluation.run_status import run_status
 from ..models.solvers.cost import Cause
 from .inputs.arguments import (
     allow_code_problem,
@@ -95,7 +94,7 @@ def save_result(result: Result, folder: str | Path, animate: bool = False) -> li
     columns = {name: values.to_numpy() for name, values in result.timeseries.items()}
     write_columns_csv(folder / "timeseries.csv", columns)
     write_json(folder / "summary.json", {"scene": result.scene.name, "formulation": result.formulation,
-                                         "status": run_status(result.raw, result.metrics)[0], "metrics": result.metrics,
+                                         "status": result.status, "metrics": result.metrics,
                                          "run": run_record(result), "provenance": result.provenance})
     write_resolved(folder / "scene.resolved.yaml", result.raw.simulation.resolved_scene())
     written = [folder / "timeseries.csv", folder / "summary.json", folder / "scene.resolved.yaml",

@@ -14,6 +14,7 @@ import yaml
 from commands import main
 from scenes import PAPER_BASE
 
+import rpdrill
 from rpdrill import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -112,6 +113,8 @@ def test_simulate_of_an_unsettled_run_says_so_in_one_warning_line(tmp_path):
     warned = [line for line in done.stderr.splitlines() if line.startswith("rpdrill: warning:")]
     assert len(warned) == 1 and "has not settled" in warned[0] and "mm/s" in warned[0]
     assert json.loads((out / "summary.json").read_text())["status"] == "unsettled"
+    result = rpdrill.simulate(CORPUS / "valid" / "drill.yaml")  # from Python: the same status, and why
+    assert result.status == "unsettled" and result.status_why in warned[0]
 
 
 def test_a_study_row_of_a_run_the_stability_check_flags_is_not_ok(tmp_path, capsys):

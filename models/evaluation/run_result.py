@@ -12,6 +12,7 @@ from ..definition.scene import Scene
 from .metrics import summary_metrics
 from .results import SimulationResult
 from .run_record import ExudynModelRecord, SolverRecord, SteadyStateRecord
+from .run_status import run_status
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -44,6 +45,9 @@ class Result:
     timeseries : pandas.DataFrame
         Every ``solver.output_interval_s``: ``time_s`` a column on a plain index, every body's position and
         velocity, every connector's force and compression, units in the column names (as ``timeseries.csv``).
+    status, status_why : str
+        Whether the figures stand as they are (``ok``, ``unstable``, ``unsettled``, ``not_finite``, ``unbalanced``)
+        and, when not, why: the status ``summary.json`` and a study's rows hold.
     steady_state : SteadyStateRecord
         The ``regime`` (:class:`Regime`), the periodic ``orbit`` with its Floquet ``multipliers``, the ``note``.
     solver : SolverRecord
@@ -61,8 +65,8 @@ class Result:
     >>> result = rpdrill.simulate(scene)
     >>> result.steady_state.regime, result.steady_state.orbit.period_blows
     (<Regime.PERIODIC: 'periodic'>, 1)
-    >>> result.metrics["advance_per_blow_m"] > 0, result.timeseries.columns[0]
-    (True, 'time_s')
+    >>> result.metrics["advance_per_blow_m"] > 0, result.timeseries.columns[0], result.status
+    (True, 'time_s', 'ok')
     """
 
     scene: Scene
@@ -74,6 +78,21 @@ class Result:
     @cached_property
     def metrics(self) -> dict[str, float]:
         return summary_metrics(self.raw)
+
+    @cached_property
+    def _status(self) -> tuple[str, str]:
+        return run_status(self.raw, self.metrics)
+
+    @property
+    def status(self) -> str:
+        """Whether the figures stand as they are: ``ok``, ``unstable``, ``unsettled``, ``not_finite`` or
+        ``unbalanced`` (models.evaluation.run_status; summary.json's and a study row's ``status``)."""
+        return self._status[0]
+
+    @property
+    def status_why(self) -> str:
+        """Why the status is not ``ok`` (the message ``rpdrill simulate`` warns with), '' when it is."""
+        return self._status[1]
 
     @property
     def steady_state(self) -> SteadyStateRecord:

@@ -38,7 +38,7 @@ from .stability import step_warning
 class UnsettledWarning(UserWarning):
     """A finished run whose figures do not stand as they are: its status is not ``ok`` (module doc); the message
     says why and what to change (a longer run, more transient blows). The command ``rpdrill simulate`` issues it;
-    from Python the same status is a study row's ``status`` and ``summary.json``'s (``rpdrill.save_result``).
+    from Python the same status and message are ``Result.status`` and ``Result.status_why``.
 
     Parameters
     ----------

@@ -17,7 +17,7 @@ import warnings
 from pathlib import Path
 
 from ...models.definition.formulations import FORMULATIONS
-from ...models.evaluation.run_status import UnsettledWarning, run_status
+from ...models.evaluation.run_status import UnsettledWarning
 from ...models.evaluation.stability import SimulationFailed
 from ..api import save_result, simulate
 from ..display.catalogue import metric
@@ -66,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
             raise_if_stopped()  # the run was cut by Ctrl-C or SIGTERM
             print(f"{args.scene}: {err}", file=sys.stderr)
             return 1
-        status, why = run_status(result.raw, result.metrics)
+        status, why = result.status, result.status_why
         if status not in ("ok", "unstable"):  # (an unstable step was said as the run started: models.solvers.exudyn_model)
             warnings.warn(why, UnsettledWarning, stacklevel=1)
         with staged_directory(args.out) as stage:
