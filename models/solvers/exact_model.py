@@ -54,6 +54,7 @@ mode found again, and the loop goes on.
 
 from __future__ import annotations
 
+import bisect
 import copy
 import math
 import time
@@ -90,7 +91,11 @@ from .exact_power_kernels import integrate_powers, power_integrals
 from .exact_system import Model, Modes, balance, sub_step, unsupported
 from .simulation import SceneError, Simulation, as_simulation
 
-ANCHORS, PER_ANCHOR = 16, 16  # A, B: a batch is J = A B sub-grid points from one state (module doc)
+# A, B: a batch is J = A B sub-grid points from one state (module doc). Building a key costs about 2 B + A
+# products of m x m matrices, a sub-grid point m (m + r + m / B) multiply-adds: 8 x 8 against 16 x 16 (python
+# benchmarks/bench_size.py --segments 2,8,32,64 --times 0.2): exact CPU s 0.008 / 0.075 / 8.9 / 37.5 against
+# 0.008 / 0.090 / 9.4 / 42.6 at 11 / 35 / 131 / 259 bodies, operator memory 28 % less; 4 x 4: 40.1 s at 259.
+ANCHORS, PER_ANCHOR = 8, 8
 TAYLOR_REMAINDER = 1e-20  # relative truncation of the Taylor series on pieces shorter than h
 # The operators are small (m ~ 10-300): a multi-threaded BLAS spends more on its threads than on the
 # products (a 13 x 13 expm took 8 ms with two threads on a loaded 2-core machine, 0.1 ms with one).
@@ -309,13 +314,19 @@ class ExactSolver:
 
     def note_catches(self, time_s: np.ndarray, rows: np.ndarray, switch_times: np.ndarray,
                      entered: list[Modes]) -> None:
-        """Note every catch (a switch into the contact's ``caught`` mode, its entry reset applied by the
-        kernel) from the row recorded before it (the kernel records both sides of a switch)."""
+        """Note every catch (the first switch into the contact's ``caught`` mode after a strike, its entry
+        reset applied by the kernel) from the row recorded before it (the kernel records both sides of a
+        switch). The switches of the other links while the piston stays caught enter ``caught`` again and
+        are not catches."""
         n = self.layout.n
+        strikes = sorted(t for t, kind, _, _ in self.piston.log if kind == "strike")
+        caught_s = -math.inf  # the last catch noted
         for t, modes in zip(switch_times, entered, strict=True):
-            if modes[self.contact] == CAUGHT:
-                before = int(np.flatnonzero(time_s == t)[0])
+            struck = bisect.bisect_right(strikes, t)
+            if modes[self.contact] == CAUGHT and (struck and strikes[struck - 1] > caught_s):
+                before = int(np.searchsorted(time_s, t))  # the first of the two rows at t
                 self.piston.noted_catch(float(t), rows[before, :n], rows[before, n:2 * n], before + 1)
+                caught_s = float(t)
 
     def works_j(self, time_s: np.ndarray, rows: np.ndarray) -> dict[str, np.ndarray]:
         """Cumulative impact work int F_d v_shank dt and internal work (what the links, the rock and the
