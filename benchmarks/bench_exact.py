@@ -33,6 +33,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +44,7 @@ from rpdrill.models.evaluation.results import SimulationResult
 from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.exact_model import OPERATOR_CACHE
 from rpdrill.models.solvers.simulation import prepare
+from rpdrill.models.solvers.time_run import time_run
 from rpdrill.studies.inputs.reading import read_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -130,12 +132,12 @@ def main() -> None:
     for name, scene in scenes(args.end_time_s).items():
         reference = run_simulation(prepare(scene.with_solver("exact", sample_interval_s=scene.solver.output_interval_s / 100))).raw
         exudyn = prepare(scene)
-        runs = {
-            "exact (default)": prepare(scene.with_solver("exact")).run,
-            "exact (rate only)": prepare(lean[name].with_solver("exact")).run,
-            f"exudyn {exudyn.settings.type} {exudyn.settings.step_s:.3g} s": exudyn.run,
-            "ode DOP853 rtol 1e-8": prepare(scene.with_solver("ode", relative_tolerance=1e-8,
-                                                             absolute_tolerance=1e-11)).run,
+        runs = {  # each the formulation's time run of its prepared scene (a SimulationResult)
+            "exact (default)": partial(time_run, prepare(scene.with_solver("exact"))),
+            "exact (rate only)": partial(time_run, prepare(lean[name].with_solver("exact"))),
+            f"exudyn {exudyn.settings.type} {exudyn.settings.step_s:.3g} s": partial(time_run, exudyn),
+            "ode DOP853 rtol 1e-8": partial(time_run, prepare(scene.with_solver("ode", relative_tolerance=1e-8,
+                                                                               absolute_tolerance=1e-11))),
         }
         for label, run in runs.items():
             exact = label.startswith("exact")

@@ -31,12 +31,12 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ...rocklaw.backends import NUMERIC
+from ...rocklaw.backends import NUMERIC, SCALAR
 from ..definition.links import CLOSED, OPEN
 from ..definition.scene import Impact
 from ..drill.chain import AxialChain, link_load_n, torsion_first_order_matrix
@@ -68,11 +68,17 @@ class _System:
     impact: int
     masses_kg: np.ndarray
     chain: AxialChain  # the dynamic chain (models.solvers.simulation.Simulation.dynamic_chain)
+    rock_states: slice  # where the rock law's states sit in y
+    linear_states: np.ndarray = field(init=False)  # A without its constant column
+    linear_constant: np.ndarray = field(init=False)
+    nonlinear_links: tuple = field(init=False)
+    rates_by_mode: dict[str, list[tuple[int, np.ndarray, float]]] = field(init=False)  # rock_rates of every mode
 
-    @property
-    def rock_states(self) -> slice:
-        """Where the rock law's states sit in y."""
-        return slice(2 * self.n, 2 * self.n + len(self.simulation.rock.state_names))
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "linear_states", np.ascontiguousarray(self.linear[:, :-1]))
+        object.__setattr__(self, "linear_constant", self.linear[:, -1].copy())
+        object.__setattr__(self, "nonlinear_links", self.chain.nonlinear_links() if len(self.pieces) > 1 else ())
+        object.__setattr__(self, "rates_by_mode", {mode: self.rock_rates(mode) for mode in self.pieces[0].table})
 
     @property
     def state_size(self) -> int:
@@ -81,21 +87,27 @@ class _System:
     def rock_force_n(self, y: np.ndarray) -> np.ndarray:
         return self.simulation.rock.force(y[self.bit], y[self.n + self.bit], y[self.rock_states], NUMERIC)
 
+    def rock_rates(self, mode: str) -> list[tuple[int, np.ndarray, float]]:
+        """(index in y, row over y, constant) of each rock state's rate in ``mode``: dy_i = row . y + constant."""
+        rock = self.pieces[0]
+        return [(rock.states[state], *rock.row(affine)) for state, affine in rock.table[mode].rates.items()]
+
     def rhs(self, t_s: float, y: np.ndarray, pulse_n: _SegmentPulse, modes: Modes) -> np.ndarray:
-        n = self.n
+        """y' of Eq. 4 in ``modes``: (x, v)' = A (x, v, 1) + the pulse on the impact body - F_r on the bit + the
+        nonlinear links' loads, the rock states' rates, the torsion line's."""
+        n, rock_states = self.n, self.rock_states
         x, v = y[:n], y[n:2 * n]
         dy = np.zeros_like(y)
-        dy[:2 * n] = self.linear[:, :-1] @ y[:2 * n] + self.linear[:, -1]
+        dy[:2 * n] = self.linear_states @ y[:2 * n] + self.linear_constant
         acceleration = dy[n:2 * n]
         acceleration[self.impact] += pulse_n(t_s) / self.masses_kg[self.impact]
-        acceleration[self.bit] -= self.rock_force_n(y) / self.masses_kg[self.bit]
-        if len(self.pieces) > 1:
-            acceleration += link_load_n(self.chain, x, v, self.chain.nonlinear_links()) \
-                / self.masses_kg
-        rock = self.pieces[0]
-        for state, affine in rock.table[modes[0]].rates.items():
-            row, constant = rock.row(affine)
-            dy[rock.states[state]] = row @ y + constant
+        # one state: plain floats (the SCALAR backend), as fast as a law evaluates in Python
+        rock_force_n = self.simulation.rock.force(y[self.bit], y[n + self.bit], y[rock_states], SCALAR)
+        acceleration[self.bit] -= rock_force_n / self.masses_kg[self.bit]
+        if self.nonlinear_links:
+            acceleration += link_load_n(self.chain, x, v, self.nonlinear_links) / self.masses_kg
+        for index, row, constant in self.rates_by_mode[modes[0]]:
+            dy[index] = row @ y + constant
         if self.torsion is not None:
             dy[-2:] = self.torsion[:, :2] @ y[-2:] + self.torsion[:, 2]
         return dy
@@ -151,6 +163,7 @@ def _system(simulation: Simulation) -> _System:
         impact=chain.impact_body,
         masses_kg=np.array([b.mass_kg for b in chain.bodies]),
         chain=chain,
+        rock_states=slice(2 * n, size),
     )
 
 
@@ -174,7 +187,7 @@ class _SegmentPulse:
     def __call__(self, t_s: float) -> float:
         if self.constant_n is not None:
             return self.constant_n
-        return impact_force(self.impact, min(max(t_s - self.blow_start_s, self.low_s), self.high_s), NUMERIC)
+        return impact_force(self.impact, min(max(t_s - self.blow_start_s, self.low_s), self.high_s), SCALAR)
 
     def samples(self, t_s: np.ndarray) -> np.ndarray:
         local = np.clip(t_s - self.blow_start_s, self.low_s, self.high_s)
