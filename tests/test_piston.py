@@ -246,13 +246,15 @@ def test_advise_at_a_fixed_power_is_not_beaten_by_a_frequency_grid(monkeypatch):
     the search's best point, not those grids. The runs end at 0.3 s, the scene's at 0.4 (18 blows at 60 Hz:
     the 10-blow transient and one block of 5): the search and the grid read the same runs, and the best point
     is the scene's (66.39 Hz, 15 kN either way; grid best 35.98 against 36.38 mm/s, at 0.4 s 35.94 against
-    35.86), for 12.0 CPU s against 16.3."""
+    35.86), for 12.0 CPU s against 16.3. Four generations after the first, not eight: the same point within
+    0.01 Hz, 36.12 mm/s against the grid's 35.98 (79 runs, 7.7 CPU s; popsize 5 over 6 generations ends at
+    another point as good, 71.7 Hz and 7.8 kN, 36.02 mm/s: the landscape has several near-equal optima)."""
     from rpdrill.studies.advice import advice_search
 
     monkeypatch.setattr(advice_search, "MAP_POINTS", 2)
     monkeypatch.setattr(advice_search, "SLICE_POINTS", 3)
     bounds = {FREQUENCY: (60.0, 80.0), FEED: (5e3, 15e3)}
-    request = Request("penetration_rate_m_per_s", bounds, power_w=15e3, search=AdviceSearch(popsize=6, max_generations=8))
+    request = Request("penetration_rate_m_per_s", bounds, power_w=15e3, search=AdviceSearch(popsize=6, max_generations=4))
     data = runnable_scene(load_scene(TOP_HAMMER).with_({"solver.end_time_s": 0.3}), None, request, str(TOP_HAMMER))
     advice = search_advice(data, None, request, sequential)
     grid = AdviceEvaluator(data, request, sequential)([{FREQUENCY: f, FEED: advice.best[FEED]}
