@@ -162,10 +162,30 @@ def slow_points(tmp_path: Path) -> Path:
         "scan": {"impact.frequency_hz": [40, 45, 50, 55]}, "metrics": ["penetration_rate_m_per_s"]})
 
 
-def after(seconds: float) -> Callable[[], int]:
-    """1 once ``seconds`` have passed (the command's workers are then in the middle of their first points)."""
-    start = time.monotonic()
-    return lambda: int(time.monotonic() - start >= seconds)
+def cpu_s(pid: str) -> float:
+    """CPU seconds (user + system) process ``pid`` has used, 0 if it is gone."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")  # utime, stime: fields 14, 15
+
+
+def workers_into_their_points(study: Path, workers: int = 2, cpu_seconds: float = 1.0) -> Callable[[], int]:
+    """1 once ``workers`` pool workers of the command running ``study`` (forked from it: its command line, another
+    parent than this process) have each run ``cpu_seconds`` of their points: then in the middle of them."""
+    def into() -> int:
+        busy = 0
+        for proc in Path("/proc").glob("[0-9]*"):
+            try:
+                named = str(study) in (proc / "cmdline").read_text()
+                parent = (proc / "stat").read_text().rsplit(")", 1)[1].split()[1]
+            except OSError:
+                continue
+            if named and parent != str(os.getpid()) and cpu_s(proc.name) >= cpu_seconds:
+                busy += 1
+        return int(busy >= workers)
+    return into
 
 
 @pytest.mark.slow
@@ -175,8 +195,9 @@ def test_a_killed_command_leaves_no_worker_in_the_middle_of_a_point(tmp_path):
     own code runs) while its workers are seconds from the end of their points; 2 s later no worker is
     left. Without it each worker runs its point to the end before it finds its command gone (seen, with the
     call commented out: the workers still running 2 s after the kill)."""
-    stopped = stop(command("study", str(slow_points(tmp_path)), "--out", str(tmp_path / "out"), "--workers", "2",
-                           "--quiet"), after(4.0), signal.SIGKILL, group=False, at_least=1)
+    study = slow_points(tmp_path)
+    stopped = stop(command("study", str(study), "--out", str(tmp_path / "out"), "--workers", "2", "--quiet"),
+                   workers_into_their_points(study), signal.SIGKILL, group=False, at_least=1)
     assert stopped.status == -signal.SIGKILL and not stopped.left, stopped
 
 
@@ -187,8 +208,9 @@ def test_a_stop_does_not_wait_for_the_points_under_way(tmp_path):
     from the end of their points (they ignore it: the command stops the run) exits within 2 s. Without it
     the pool's shutdown waits for the points under way (seen, with the call commented out: no exit within
     the 60 s this test waits, on the shared 2-core machine)."""
-    stopped = stop(command("study", str(slow_points(tmp_path)), "--out", str(tmp_path / "out"), "--workers", "2",
-                           "--quiet"), after(4.0), signal.SIGINT, group=True, at_least=1)
+    study = slow_points(tmp_path)
+    stopped = stop(command("study", str(study), "--out", str(tmp_path / "out"), "--workers", "2", "--quiet"),
+                   workers_into_their_points(study), signal.SIGINT, group=True, at_least=1)
     assert stopped.status == 130 and stopped.exit_after_s < EXIT_WITHIN_S and not stopped.left, stopped
     assert "Traceback" not in stopped.err
 
