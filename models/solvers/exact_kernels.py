@@ -382,11 +382,11 @@ def run_events(taylor: np.ndarray, one_step: np.ndarray, anchors: np.ndarray, re
     return OK
 
 
-@njit(cache=True)
 def assemble(one_step: np.ndarray, matrix: np.ndarray, readout_rows: np.ndarray, anchor_count: int, per_anchor: int,
              readout: np.ndarray, anchors: np.ndarray, taylor: np.ndarray) -> None:
     """The cached operators of one key from E = expm(A h), A and R: readout [(R E^b)^T]_b (b < B),
-    anchors [(E^(a B))^T]_a (a < A), taylor [(R A^k / k!)^T]_k (k <= K)."""
+    anchors [(E^(a B))^T]_a (a < A), taylor [(R A^k / k!)^T]_k (k <= K). NumPy, not compiled: a few dozen
+    matrix products once per key (numba took 3.8 CPU s to compile it on a process's first run)."""
     size, width = one_step.shape[0], readout_rows.shape[0]
     powers = np.empty((max(per_anchor, anchor_count) + 1, size, size))
     # E^b = E^(b // 2) E^(b - b // 2), then the same for (E^B)^a: products of depth log2

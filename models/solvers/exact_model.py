@@ -36,7 +36,7 @@ reaches it.
 Works (with the energy outputs): the impact work and the work the links, the rock and the torsion
 line absorb are quadratic forms w^T Q w integrated exactly between the samples,
 int_0^s w^T Q w = w^T G(s) w with G(s) = int_0^s expm(A^T u) Q expm(A u) du per key, a series in s
-(models.solvers.exact_kernels.power_integrals and integrate_powers), so the samples stay at the output
+(models.solvers.exact_power_kernels.power_integrals and integrate_powers), so the samples stay at the output
 interval.
 
 Zero-length modes: a mode lasts at least ``min_switch_interval_s``. Its start is taken as not

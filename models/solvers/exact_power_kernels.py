@@ -1,6 +1,7 @@
-"""Compiled energy integrals of the exact solver (models.solvers.exact_model): the work of every element
-over a run, integrated exactly between switches from the same solution operators as the states
-(numba kernels on plain float arrays, cached on disk like models.solvers.exact_kernels)."""
+"""Energy integrals of the exact solver (models.solvers.exact_model): the work of every element over a run,
+integrated exactly between switches from the same solution operators as the states (the per-sample sums numba
+kernels on plain float arrays, cached on disk like models.solvers.exact_kernels; a key's integral operators,
+built once per key, NumPy)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,6 @@ from numba import njit
 from .exact_kernels import matvec
 
 
-@njit(cache=True)
 def power_integrals(one_step: np.ndarray, balanced: np.ndarray, scale: np.ndarray, forms: np.ndarray, step_s: float,
                     step_powers: np.ndarray, step_grams: np.ndarray, series: np.ndarray) -> None:
     """The integrals G(s) = int_0^s expm(A^T u) Q expm(A u) du of one key's power forms Q_q (power w^T Q w,
@@ -19,21 +19,16 @@ def power_integrals(one_step: np.ndarray, balanced: np.ndarray, scale: np.ndarra
     S_k = (A^T S_(k-1) + S_(k-1) A) / k (it solves F' = A^T F + F A), formed on the balanced matrix
     A_b = D^-1 A D (S_k = D^-1 S_k,b(D Q D) D^-1), so that G(s) = sum_k s^(k+1) series[q, k] for s <= h (the
     truncation after the Taylor order K of the sub-step leaves 2^(K+1) / (K+1)! of it, below 1e-14);
-    ``step_grams`` [q, j] = G(j h) = sum_(l < j) (E^l)^T G(h) E^l."""
+    ``step_grams`` [q, j] = G(j h) = sum_(l < j) (E^l)^T G(h) E^l. NumPy, not compiled: matrix products once per
+    key (numba took 2.1 CPU s to compile it on a process's first run)."""
     size, steps, terms = one_step.shape[0], step_powers.shape[0], series.shape[1]
     step_powers[0] = np.eye(size)
     for j in range(1, steps):
         step_powers[j] = np.dot(one_step, step_powers[j - 1])
-    unscale = np.empty((size, size))
-    for a in range(size):
-        for b in range(size):
-            unscale[a, b] = 1.0 / (scale[a] * scale[b])
+    unscale = 1.0 / np.multiply.outer(scale, scale)
     balanced_t = balanced.T.copy()
     for q in range(forms.shape[0]):
-        coefficient, gram = np.empty((size, size)), np.zeros((size, size))
-        for a in range(size):
-            for b in range(size):
-                coefficient[a, b] = scale[a] * forms[q, a, b] * scale[b]
+        coefficient, gram = scale[:, None] * forms[q] * scale[None, :], np.zeros((size, size))
         power = step_s
         for k in range(terms):
             if k:
