@@ -27,19 +27,20 @@ def power_integrals(one_step: np.ndarray, balanced: np.ndarray, scale: np.ndarra
         step_powers[j] = np.dot(one_step, step_powers[j - 1])
     unscale = 1.0 / np.multiply.outer(scale, scale)
     balanced_t = balanced.T.copy()
-    for q in range(forms.shape[0]):
-        coefficient, gram = scale[:, None] * forms[q] * scale[None, :], np.zeros((size, size))
-        power = step_s
-        for k in range(terms):
-            if k:
-                coefficient = (np.dot(balanced_t, coefficient) + np.dot(coefficient, balanced)) / k
-            series[q, k] = coefficient / (k + 1) * unscale
-            gram += series[q, k] * power
-            power *= step_s
-        step_grams[q, 0] = 0.0
-        for j in range(1, steps):
-            carried = step_powers[j - 1]
-            step_grams[q, j] = step_grams[q, j - 1] + np.dot(np.dot(carried.T, gram), carried)
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverging scene's terms: inf, as the run's check reports
+        for q in range(forms.shape[0]):
+            coefficient, gram = scale[:, None] * forms[q] * scale[None, :], np.zeros((size, size))
+            power = step_s
+            for k in range(terms):
+                if k:
+                    coefficient = (np.dot(balanced_t, coefficient) + np.dot(coefficient, balanced)) / k
+                series[q, k] = coefficient / (k + 1) * unscale
+                gram += series[q, k] * power
+                power *= step_s
+            step_grams[q, 0] = 0.0
+            for j in range(1, steps):
+                carried = step_powers[j - 1]
+                step_grams[q, j] = step_grams[q, j - 1] + np.dot(np.dot(carried.T, gram), carried)
 
 
 @njit(cache=True)
