@@ -55,6 +55,7 @@ def test_a_documented_command_is_python_and_finds_what_it_imports(where, code):
                     importlib.import_module(alias.name)
 
 
+@pytest.mark.slow
 def test_every_benchmark_imports():
     """In a process of its own: a benchmark sets BLAS's thread count before NumPy loads, as it runs."""
     names = sorted(path.stem for path in (ROOT / "benchmarks").glob("bench_*.py"))
