@@ -5,7 +5,8 @@ models.solvers.exact_model); these kernels only combine them. A batch of sub-gri
 products (BLAS through ``np.dot``): the anchor states expm(A a B h) s0 (a < A), then the outputs
 R expm(A b h) of every point a B + b from its anchor, in chunks of CHUNK anchors up to the first
 crossing; R stacks the identity, the rock and piston force rows and the exit rows, so a point's
-outputs are (w, F_r, F_d, g_e). Compiled functions are cached on disk (``cache=True``).
+outputs are (w, F_r, F_d, g_e). Compiled functions are cached on disk (``cache=True``); :func:`assemble`, run once
+per key, is plain NumPy.
 """
 
 from __future__ import annotations

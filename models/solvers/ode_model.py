@@ -31,13 +31,13 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from ...rocklaw.backends import NUMERIC, SCALAR
-from ..definition.links import CLOSED, OPEN
+from ..definition.links import CLOSED, OPEN, Link
 from ..definition.scene import Impact
 from ..drill.chain import AxialChain, link_load_n, torsion_first_order_matrix
 from ..drill.indexing import BlowStarts
@@ -60,7 +60,8 @@ class _System:
     """Eq. 4 in first-order form (module doc) with its piecewise elements."""
 
     simulation: Simulation
-    linear: np.ndarray  # A of (x, v)' = A (x, v, 1)
+    linear_states: np.ndarray  # A of (x, v)' = A (x, v) + a
+    linear_constant: np.ndarray  # a
     torsion: np.ndarray | None  # T of (phi, omega)' = T (phi, omega, 1)
     pieces: tuple[Element, ...]  # the rock first, then the nonlinear links
     n: int
@@ -69,16 +70,8 @@ class _System:
     masses_kg: np.ndarray
     chain: AxialChain  # the dynamic chain (models.solvers.simulation.Simulation.dynamic_chain)
     rock_states: slice  # where the rock law's states sit in y
-    linear_states: np.ndarray = field(init=False)  # A without its constant column
-    linear_constant: np.ndarray = field(init=False)
-    nonlinear_links: tuple = field(init=False)
-    rates_by_mode: dict[str, list[tuple[int, np.ndarray, float]]] = field(init=False)  # rock_rates of every mode
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "linear_states", np.ascontiguousarray(self.linear[:, :-1]))
-        object.__setattr__(self, "linear_constant", self.linear[:, -1].copy())
-        object.__setattr__(self, "nonlinear_links", self.chain.nonlinear_links() if len(self.pieces) > 1 else ())
-        object.__setattr__(self, "rates_by_mode", {mode: self.rock_rates(mode) for mode in self.pieces[0].table})
+    nonlinear_links: tuple[Link, ...]
+    rates_by_mode: dict[str, list[tuple[int, np.ndarray, float]]]  # per rock mode: (index in y, row, constant)
 
     @property
     def state_size(self) -> int:
@@ -86,11 +79,6 @@ class _System:
 
     def rock_force_n(self, y: np.ndarray) -> np.ndarray:
         return self.simulation.rock.force(y[self.bit], y[self.n + self.bit], y[self.rock_states], NUMERIC)
-
-    def rock_rates(self, mode: str) -> list[tuple[int, np.ndarray, float]]:
-        """(index in y, row over y, constant) of each rock state's rate in ``mode``: dy_i = row . y + constant."""
-        rock = self.pieces[0]
-        return [(rock.states[state], *rock.row(affine)) for state, affine in rock.table[mode].rates.items()]
 
     def rhs(self, t_s: float, y: np.ndarray, pulse_n: _SegmentPulse, modes: Modes) -> np.ndarray:
         """y' of Eq. 4 in ``modes``: (x, v)' = A (x, v, 1) + the pulse on the impact body - F_r on the bit + the
@@ -153,18 +141,30 @@ def _system(simulation: Simulation) -> _System:
     n = chain.size
     size = 2 * n + len(simulation.rock.state_names)
     torsion = simulation.torsion
+    linear = chain.first_order_matrix()
+    pieces = elements(chain, simulation.rock, size + (2 if torsion is not None else 0))
     return _System(
         simulation=simulation,
-        linear=chain.first_order_matrix(),
+        linear_states=np.ascontiguousarray(linear[:, :-1]),
+        linear_constant=linear[:, -1].copy(),
         torsion=None if torsion is None else torsion_first_order_matrix(torsion),
-        pieces=elements(chain, simulation.rock, size + (2 if torsion is not None else 0)),
+        pieces=pieces,
         n=n,
         bit=chain.bit_body,
         impact=chain.impact_body,
         masses_kg=np.array([b.mass_kg for b in chain.bodies]),
         chain=chain,
         rock_states=slice(2 * n, size),
+        nonlinear_links=chain.nonlinear_links() if len(pieces) > 1 else (),
+        rates_by_mode=_rock_rates(pieces[0]),
     )
+
+
+def _rock_rates(rock: Element) -> dict[str, list[tuple[int, np.ndarray, float]]]:
+    """Per mode of the rock element, (index in y, row over y, constant) of each of its states' rates:
+    dy_i = row . y + constant."""
+    return {mode: [(rock.states[state], *rock.row(affine)) for state, affine in rock.table[mode].rates.items()]
+            for mode in rock.table}
 
 
 class _SegmentPulse:
@@ -313,8 +313,8 @@ def _start_blow(system: _System, blows: BlowStarts, record: _Record, y: np.ndarr
     angle = y[-2] if system.torsion is not None else 0.0
     law, y[system.rock_states] = blows(y[system.bit], tuple(y[system.rock_states]), angle)
     if law != system.pieces[0].law:
-        system = replace(system, pieces=(rock_element(system.chain, law, system.state_size),
-                                         *system.pieces[1:]))
+        rock = rock_element(system.chain, law, system.state_size)
+        system = replace(system, pieces=(rock, *system.pieces[1:]), rates_by_mode=_rock_rates(rock))
     if record.time_s:
         record.states[-1][:, -1] = y
     return system, y, (system.pieces[0].initial_mode(y), *modes[1:])
