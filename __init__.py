@@ -36,6 +36,7 @@ _LAZY = {"Scene": ("models.definition.scene", "Scene"),
          "RockLaw": ("rocklaw.base", "RockLaw"),
          "Result": ("models.evaluation.run_result", "Result"),
          "Regime": ("models.evaluation.run_record", "Regime"),
+         "EnergyAccount": ("models.evaluation.energy", "EnergyAccount"),
          "SimulationFailed": ("models.evaluation.stability", "SimulationFailed"),
          "StepLimitWarning": ("models.evaluation.stability", "StepLimitWarning"),
          "UnsettledWarning": ("models.evaluation.run_status", "UnsettledWarning"),
@@ -80,6 +81,7 @@ if _TYPE_CHECKING:  # the names as type checkers and editors see them
     from .models.definition.own_code import extension
     from .models.definition.scene import Scene
     from .models.definition.validation import InputError
+    from .models.evaluation.energy import EnergyAccount
     from .models.evaluation.run_record import Regime
     from .models.evaluation.run_result import Result
     from .models.evaluation.run_status import UnsettledWarning
@@ -131,6 +133,7 @@ __all__ = [
     "BudgetError",
     "CalibrationResult",
     "Crosscheck",
+    "EnergyAccount",
     "ExudynMessage",
     "ExudynModel",
     "HoleResult",

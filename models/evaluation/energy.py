@@ -35,7 +35,33 @@ from .results import SimulationResult, UserEnergy
 
 @dataclass
 class EnergyAccount:
-    """Cumulative energies [J] at every stored step."""
+    """A run's energy account (``Result.energy``): cumulative works and energies [J] at every stored step.
+
+    W_impact + W_feed = dE_kinetic + dE_elastic + D_damping + W_crushing (the module's doc says what each holds;
+    with a piston W_piston in place of W_impact, with items of one's own their terms).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        The stored steps' times.
+    impact_work_j, feed_work_j : numpy.ndarray
+        W_impact = int F_d v_impact dt and W_feed = sum_i F_i (x_i - x_i(0)), cumulative.
+    kinetic_j, elastic_j : numpy.ndarray
+        The energy held: the bodies' kinetic energy; the springs', the rock's and the waves' in flight.
+    damping_j, crushing_work_j : numpy.ndarray
+        What the dampers have dissipated and the rock law's plastic work, cumulative.
+    piston_work_j : numpy.ndarray or None
+        With a piston: what its strikes put in, less the energy it holds.
+    user : UserEnergy or None
+        The items of one's own of an Exudyn model: what they put in, hold and dissipate.
+
+    Examples
+    --------
+    >>> import rpdrill
+    >>> account = rpdrill.simulate(rpdrill.load_scene("paper_base").with_({"solver.formulation": "exact"})).energy
+    >>> account.relative_residual() < 1e-6, bool(account.crushing_work_j[-1] > 0)
+    (True, True)
+    """
 
     time_s: np.ndarray
     impact_work_j: np.ndarray

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..definition.extensions import CodeRecords
 from ..definition.scene import Scene
+from .energy import EnergyAccount, energy_account
 from .metrics import summary_metrics
 from .results import SimulationResult
 from .run_record import ExudynModelRecord, SolverRecord, SteadyStateRecord
@@ -42,6 +43,9 @@ class Result:
     ----------
     metrics : dict of str to float
         The scene's metrics, SI units in the names (``penetration_rate_m_per_s``, ``bit_velocity_peak_m_per_s``).
+    energy : EnergyAccount
+        The run's energy account at every stored step: W_impact + W_feed = dE_kinetic + dE_elastic + D_damping
+        + W_crushing, its ``residual_j`` and ``relative_residual()`` (the balance a reviewer checks).
     timeseries : pandas.DataFrame
         Every ``solver.output_interval_s``: ``time_s`` a column on a plain index, every body's position and
         velocity, every connector's force and compression, units in the column names (as ``timeseries.csv``).
@@ -67,6 +71,8 @@ class Result:
     (<Regime.PERIODIC: 'periodic'>, 1)
     >>> result.metrics["advance_per_blow_m"] > 0, result.timeseries.columns[0], result.status
     (True, 'time_s', 'ok')
+    >>> result.energy.relative_residual() < 1e-6
+    True
     """
 
     scene: Scene
@@ -78,6 +84,12 @@ class Result:
     @cached_property
     def metrics(self) -> dict[str, float]:
         return summary_metrics(self.raw)
+
+    @cached_property
+    def energy(self) -> EnergyAccount:
+        """The energy account (models.evaluation.energy): cumulative works and energies [J] at every stored
+        step, W_impact + W_feed = dE_kinetic + dE_elastic + D_damping + W_crushing."""
+        return energy_account(self.raw)
 
     @cached_property
     def _status(self) -> tuple[str, str]:
