@@ -3,4 +3,6 @@ status (the program's entry point, imported here once so that the tests do not d
 
 from rpdrill.studies.cli.main import COMMANDS, main
 
+UNITS = ("rpdrill.studies.cli.main",)  # the program's entry point (pyproject.toml's [project.scripts]), in-process
+
 __all__ = ["COMMANDS", "main"]

@@ -1,15 +1,16 @@
 """Scenes for tests: the frozen test drill (tests/test_drill.yaml) with overrides by dotted key path, and the
-strict YAML reader (``read_yaml``: YAML 1.2 numbers) the tests read their files with."""
+YAML reader the tests read their files with (``read_yaml``: ruamel.yaml's safe loader, YAML 1.2 as rpdrill reads
+it; rpdrill's own reader adds refusals of bad input, which the tests' files are not)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
+from ruamel.yaml import YAML
+
 import rpdrill
 from rpdrill import Scene
-from rpdrill.models.evaluation.results import SimulationResult
-from rpdrill.studies.inputs.reading import read_yaml
 
 PAPER_BASE = Path(__file__).resolve().parent / "test_drill.yaml"
 
@@ -18,6 +19,11 @@ CRUSHING = {"impact.amplitude_n": 400e3, "impact.frequency_hz": 45.0}
 # The paper's Eq. 4 as printed: no carriage, the shock absorber anchored to ground, the feed on every body.
 PER_BODY = {"drill_string.bodies.carriage": None, "drill_string.connectors.shock_absorber.from": "ground",
             "feed.acts_on": "every_body"}
+
+
+def read_yaml(path: str | Path) -> dict[str, Any]:
+    """The mapping in a YAML file."""
+    return YAML(typ="safe", pure=True).load(Path(path).read_text(encoding="utf-8"))
 
 
 def scene_dict(path: Path = PAPER_BASE, **overrides: Any) -> dict:
@@ -44,7 +50,7 @@ def crushing_scene(**overrides: Any) -> Scene:
     return scene(**({k.replace(".", "__"): v for k, v in CRUSHING.items()} | overrides))
 
 
-def simulate(scene: Scene, formulation: str | None = None, **options: Any) -> SimulationResult:
+def simulate(scene: Scene, formulation: str | None = None, **options: Any) -> Any:
     """Run ``scene`` with ``formulation`` (default: the scene's) and solver ``options``: ``rpdrill.simulate``,
     unbudgeted (tests run scenes of many steps on purpose), its formulation's result (``Result.raw``)."""
     return rpdrill.simulate(scene.with_solver(formulation, **options), budget=None).raw

@@ -6,6 +6,9 @@ from pathlib import Path
 import pytest
 from doc_examples import Ran, run_examples
 
+# the study file's schema (its pydantic models) against the page that documents it
+UNITS = ("rpdrill.studies.inputs.specs", "rpdrill.studies.scan.study")
+
 ROOT = Path(__file__).resolve().parents[1]
 BLOCKS = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "api.md").read_text(encoding="utf-8"), re.DOTALL)
 

@@ -4,16 +4,19 @@ run that derives each thing from its scene once."""
 from __future__ import annotations
 
 import ast
+import functools
 import importlib.util
+import inspect
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
-from scenes import simulate
 
-from rpdrill import load_scene
-from rpdrill.models.evaluation.metrics import summary_metrics
+import rpdrill
+
+# the counters of the one-run test wrap the chain's builds and the stability check's eigenvalue solves
+UNITS = ("rpdrill.models.drill.chain", "rpdrill.models.evaluation.stability")
 
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("architecture_page", ROOT / "docs" / "architecture_page.py")
@@ -139,16 +142,18 @@ def counts(monkeypatch):
     counted = {"axial_chain": 0, "static_preload_m": 0, "eigvals": 0}
 
     def counting(name, function):
+        @functools.wraps(function)
         def wrapper(*args, **kwargs):
             counted[name] += 1
             return function(*args, **kwargs)
         return wrapper
 
     for name in ("axial_chain", "static_preload_m"):
-        original = getattr(chain, name)
+        original = inspect.unwrap(getattr(chain, name))
         wrapped = counting(name, original)
         for module in [m for key, m in sys.modules.items() if key.startswith("rpdrill.")]:
-            if getattr(module, name, None) is original:
+            # a module first imported while an earlier test counted holds that test's counter: counted here too
+            if callable(held := getattr(module, name, None)) and inspect.unwrap(held) is original:
                 monkeypatch.setattr(module, name, wrapped)
     monkeypatch.setattr(stability.np.linalg, "eigvals", counting("eigvals", np.linalg.eigvals))
     return counted
@@ -158,10 +163,10 @@ def counts(monkeypatch):
 def test_one_run_builds_the_chain_once(counts, formulation):
     """paper_base (preloaded start, standard preset): one chain, one preload solve, at most one
     eigenvalue solve (the Exudyn preset's step), through the run, its metrics and energy account."""
-    scene = load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml")
+    scene = rpdrill.load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml")
     scene = scene.model_copy(update={"metrics": scene.metrics.model_copy(update={"transient_blows": 2,
                                                                                  "block_blows": 2})})
-    result = simulate(scene, formulation, end_time_s=0.1)
-    assert summary_metrics(result)["energy_balance_relative_error"] < 1e-2
+    result = rpdrill.simulate(scene.with_solver(formulation, end_time_s=0.1), budget=None)
+    assert result.metrics["energy_balance_relative_error"] < 1e-2 and result.energy.relative_residual() < 1e-2
     assert counts["axial_chain"] == 1 and counts["static_preload_m"] == 1
     assert counts["eigvals"] == (1 if formulation == "exudyn" else 0)

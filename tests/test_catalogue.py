@@ -19,6 +19,9 @@ from rpdrill.models.definition.outputs import METRICS, SERIES
 from rpdrill.models.definition.validation import allowed_keys
 from rpdrill.studies.display import catalogue
 
+# the catalogue against the registries it names (outputs, the scene's keys) and the figures that read it
+UNITS = ("rpdrill.studies.display.catalogue", "rpdrill.models.definition.outputs", "rpdrill.models.definition.validation", "rpdrill.studies.figures", "rpdrill.studies.scan.study_optima")
+
 WORDS = re.compile(r"[a-z]+(?:[._][a-z0-9]+)+")  # snake_case or dotted keys
 
 

@@ -21,6 +21,9 @@ from commands import main
 import rpdrill
 from rpdrill.studies.scan import continuation_runs
 
+# a kill between the writes of a continuation chain, injected into its runner
+UNITS = ("rpdrill.studies.scan.continuation_runs",)
+
 ROOT = Path(__file__).resolve().parents[1]
 DRILL = Path(__file__).resolve().parent / "test_drill.yaml"
 FREQUENCIES = [27.5, 28.0, 28.5, 29.5]

@@ -7,6 +7,7 @@ the cross-check's default step, the references at their reference preset.
 
 from __future__ import annotations
 
+import inspect
 import json
 from pathlib import Path
 
@@ -15,9 +16,13 @@ import pytest
 from commands import main
 from scenes import PAPER_BASE, PER_BODY, scene_dict, simulate
 
+import rpdrill
 from rpdrill import Scene
 from rpdrill.models.evaluation.compare import compare_runs, verdict
-from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
+
+# the comparison of two runs and its verdict, which rpdrill.crosscheck reports
+UNITS = ("rpdrill.models.evaluation.compare",)
+DEFAULT_STEP_S = inspect.signature(rpdrill.crosscheck).parameters["step_s"].default
 
 BLOWS = 15
 LIFT_OFF_M = 1e-9  # a gap below this (round-off of the start from rest, ~1e-19 m) is no lift-off

@@ -10,6 +10,9 @@ from pathlib import Path
 
 from rpdrill.studies.pages.paper_pages import site_prefix
 
+# the generated pages' links to the site's root
+UNITS = ("rpdrill.studies.pages.paper_pages",)
+
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 README = (ROOT / "README.md").read_text(encoding="utf-8")

@@ -17,6 +17,9 @@ from rpdrill.studies.drawings import drill_animation
 from rpdrill.studies.drawings.drill_animation import load_solution, nice_factor
 from rpdrill.studies.drawings.drill_drawing import draw_string, drawn_layout
 
+# the drawing's layout, the animation's scale and the solution file read back for the viewer
+UNITS = ("rpdrill.models.drill.shapes", "rpdrill.studies.drawings")
+
 load_scene, draw, write_animation = rpdrill.load_scene, rpdrill.draw, rpdrill.write_animation
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"

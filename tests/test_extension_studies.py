@@ -17,6 +17,9 @@ from scenes import PAPER_BASE
 import rpdrill
 from rpdrill.studies.sensitivity.sensitivity_study import scene_values
 
+# the numbers of a scene a sensitivity study may vary
+UNITS = ("rpdrill.studies.sensitivity.sensitivity_study",)
+
 MASS = "extensions.clamp.parameters.mass_kg"
 ALLOW = ["user_rig"]  # the tests' rig (tests/user_rig.py): code of one's own, allowed by who reads the scenes
 CLAMP = {"clamp": {"function": "user_rig:add_clamp",

@@ -10,6 +10,9 @@ from scenes import PAPER_BASE
 from rpdrill.studies.figures import scan_figures
 from rpdrill.studies.scan.flat_curves import NO_CRUSHING, NO_RESULT, ZERO, why_no_optimum
 
+# why a curve has no optimum, and the scan figure that says it
+UNITS = ("rpdrill.studies.scan.flat_curves", "rpdrill.studies.figures")
+
 
 def test_the_reason_of_a_flat_curve():
     assert why_no_optimum("penetration_rate_m_per_s", [0.0, 0.0, 0.0]) == NO_CRUSHING

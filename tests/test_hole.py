@@ -14,6 +14,9 @@ from commands import main
 
 import rpdrill
 
+# an interrupt injected into a hole's segment runner
+UNITS = ("rpdrill.studies.hole.hole_run",)
+
 RIG = Path(rpdrill.__file__).parent / "studies" / "scenes" / "top_hammer_waves.yaml"
 ROD = {"length_m": 1.5, "diameter_m": 0.045, "bore_diameter_m": 0.012, "model": "waves"}
 

@@ -11,6 +11,9 @@ import pytest
 from rpdrill import InputError
 from rpdrill.studies.inputs.reading import parse_yaml, read_yaml
 
+# the strict YAML reader, and the resolved scene file's writer
+UNITS = ("rpdrill.studies.inputs.reading", "rpdrill.studies.runtime.output_files")
+
 
 def test_yaml_12_floats_are_numbers():
     data = parse_yaml("a: 1e5\nb: -1.5E-3\nc: 2.0e+9\nd: 100\ne: .5\nf: 1e\ng: 1_000\n", "x.yaml")

@@ -6,6 +6,9 @@ import pytest
 
 from rpdrill.studies.scan.curve_optima import band, curve_optimum, parabola_vertex
 
+# the optima of synthetic curves
+UNITS = ("rpdrill.studies.scan.curve_optima",)
+
 FREQUENCIES = np.arange(10.0, 121.0, 5.0)
 
 

@@ -31,7 +31,7 @@ class Reach:
 
 
 def internal_reaches(tree: ast.Module) -> list[Reach]:
-    """Every internal module a test module imports or patches by its dotted path."""
+    """Every internal module, or name in one, a test module imports or patches by its dotted path."""
     reaches = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
@@ -42,10 +42,9 @@ def internal_reaches(tree: ast.Module) -> list[Reach]:
                 reaches += [Reach(f"{node.module}.{alias.name}", node.lineno) for alias in node.names
                             if alias.name not in PUBLIC[node.module]]
             else:
-                reaches.append(Reach(node.module, node.lineno))
+                reaches += [Reach(f"{node.module}.{alias.name}", node.lineno) for alias in node.names]
         elif isinstance(node, ast.Call) and getattr(node.func, "attr", getattr(node.func, "id", "")) in PATCHERS:
-            reaches += [Reach(arg.value.rsplit(".", 1)[0] if arg.value.count(".") > 1 else arg.value, node.lineno)
-                        for arg in node.args[:1] if isinstance(arg, ast.Constant) and isinstance(arg.value, str)
+            reaches += [Reach(arg.value, node.lineno) for arg in node.args[:1] if isinstance(arg, ast.Constant) and isinstance(arg.value, str)
                         and arg.value.startswith("rpdrill.")]
     return reaches
 
@@ -78,5 +77,5 @@ def test_the_check_sees_imports_patches_and_private_names() -> None:
               "from rpdrill.rocklaw.modes import check_mode_forces\nfrom rpdrill.rocklaw import JenkinsRock\n"
               "def test(monkeypatch):\n    monkeypatch.setattr('rpdrill.studies.hole.hole_run.run', None)\n")
     assert [(r.module, r.line) for r in internal_reaches(ast.parse(source))] == [
-        ("rpdrill.models", 2), ("rpdrill.models.drill.chain", 3), ("rpdrill.rocklaw.modes", 4),
-        ("rpdrill.studies.hole.hole_run", 7)]
+        ("rpdrill.models", 2), ("rpdrill.models.drill.chain", 3), ("rpdrill.rocklaw.modes.check_mode_forces", 4),
+        ("rpdrill.studies.hole.hole_run.run", 7)]

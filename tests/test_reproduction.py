@@ -17,6 +17,9 @@ from rpdrill import Budget
 from rpdrill.studies.calibration.calibration_spec import is_free, load_calibration
 from rpdrill.studies.reproduction.paper_reproduction import load_reproduction
 
+# the reproduction file and the calibration's targets read, to check they state the paper's values once
+UNITS = ("rpdrill.studies.calibration.calibration_spec", "rpdrill.studies.reproduction.paper_reproduction")
+
 ROOT = Path(__file__).resolve().parents[1]
 PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"
 

@@ -16,6 +16,9 @@ from scenes import PAPER_BASE
 import rpdrill
 from rpdrill.studies.sensitivity.sensitivity_study import load_sensitivity, scene_values
 
+# the sensitivity file read, and the numbers of a scene it may vary
+UNITS = ("rpdrill.studies.sensitivity.sensitivity_study",)
+
 COLLAR, ROCK = "drill_string.bodies.collar.mass_kg", "rock.stiffness_n_per_m"
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -25,6 +25,9 @@ import rpdrill
 from rpdrill.models.definition.outputs import METRICS
 from rpdrill.studies.runtime.pools import BATCHES_PER_WORKER, ONE_THREAD, batches, process_pool
 
+# the metrics' registry, and the process pools' batches and threads
+UNITS = ("rpdrill.models.definition.outputs", "rpdrill.studies.runtime.pools")
+
 load_study = rpdrill.load_study
 
 ROOT = Path(__file__).resolve().parents[1]

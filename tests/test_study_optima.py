@@ -18,6 +18,9 @@ from rpdrill.models.drill.modal import rock_mode_frequency_hz
 from rpdrill.studies.scan.curve_optima import curve_optimum
 from rpdrill.studies.scan.study_optima import csv_rows, curve_axis, optima_table, study_optima
 
+# the optima of a study's curves; the rock mode and a curve's optimum as the references
+UNITS = ("rpdrill.studies.scan.study_optima", "rpdrill.studies.scan.curve_optima", "rpdrill.models.drill.modal")
+
 load_study = rpdrill.load_study
 
 SHORT = {"solver.end_time_s": 0.15, "metrics": {"transient_blows": 2, "block_blows": 2}}
