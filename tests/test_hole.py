@@ -14,8 +14,8 @@ from commands import main
 
 import rpdrill
 
-# an interrupt injected into a hole's segment runner
-UNITS = ("rpdrill.studies.hole.hole_run",)
+# an interrupt injected into a hole's segment runner; the time-depth curve the figure draws
+UNITS = ("rpdrill.studies.hole.hole_run", "rpdrill.studies.hole.hole_figures")
 
 RIG = Path(rpdrill.__file__).parent / "studies" / "scenes" / "top_hammer_waves.yaml"
 ROD = {"length_m": 1.5, "diameter_m": 0.045, "bore_diameter_m": 0.012, "model": "waves"}
@@ -61,6 +61,18 @@ def test_time_to_depth_is_the_integral_of_dz_over_the_rate_plus_the_rod_changes(
     assert summary["mean_rate_m_per_s"] == pytest.approx(3.0 / (summary["total_time_s"] - 30.0))
     for name in ("hole.csv", "hole.json", "hole.png", "scenes", "runs"):
         assert (drilled.out / name).exists()
+
+
+def test_the_figure_draws_a_rod_change_as_a_step_in_time_at_its_depth(drilled):
+    """The time-depth curve: drilling to 1.5 m, the 30 s rod change at 1.5 m (the depth stays), drilling to 3 m;
+    a line straight from the 1.5 m row to the 3 m row hid the change inside the second rod's drilling."""
+    from rpdrill.studies.hole.hole_figures import time_with_rod_changes
+
+    rows = drilled.rows
+    time_s, depth_m = time_with_rod_changes(rows, 30.0)
+    t = rows["time_s"].tolist()
+    assert depth_m.tolist() == [0.0, 1.5, 1.5, 3.0]
+    assert time_s.tolist() == [t[0], t[1], t[1] + 30.0, t[2]]
 
 
 def test_rigid_joints_lose_nothing_so_the_rods_change_the_rock_energy_only_by_mass_and_transit(drilled):

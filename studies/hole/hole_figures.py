@@ -1,5 +1,5 @@
 """A hole's figure in the pile-driving convention (depth down the vertical axis): the penetration rate, the time to
-reach each depth, the largest rod stress (compression and tension) and the energy per blow reaching the rock against
+reach each depth (a rod change a horizontal step: the clock runs, the depth stays), the largest rod stress (compression and tension) and the energy per blow reaching the rock against
 depth, the layers shaded; several holes (a top hammer and a down-the-hole hammer through the same column) on the
 same axes."""
 
@@ -9,11 +9,28 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..figures.figure_style import figure, line_styles, save
 
 PANELS = (("rate_mm_per_s", "penetration rate (mm/s)", 1.0), ("time_s", "time to depth (min)", 1 / 60),
           ("compression_max_mpa", "largest rod stress (MPa)", 1.0),
           ("rock_energy_per_blow_j", "energy reaching the rock per blow (J)", 1.0))
+
+
+def time_with_rod_changes(rows: Any, rod_change_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """The time-depth curve with each rod change drawn where it happens: at the depth of the row before the rows
+    where ``rods`` grows, the clock runs on by ``rod_change_s`` per rod added while the depth stays (a horizontal
+    step), then drilling resumes to the next row."""
+    time_s, depth_m, rods = (rows[c].to_numpy(dtype=float) for c in ("time_s", "depth_m", "rods"))
+    times, depths = [time_s[0]], [depth_m[0]]
+    for i in range(1, len(time_s)):
+        if rods[i] > rods[i - 1]:
+            times.append(time_s[i - 1] + (rods[i] - rods[i - 1]) * rod_change_s)
+            depths.append(depth_m[i - 1])
+        times.append(time_s[i])
+        depths.append(depth_m[i])
+    return np.array(times), np.array(depths)
 
 
 def plot_hole(results: Sequence[Any], holes: Sequence[Any], path: Path) -> list[Path]:
@@ -30,11 +47,14 @@ def plot_hole(results: Sequence[Any], holes: Sequence[Any], path: Path) -> list[
                 ax.text(0.02, (top + layer.to_m) / 2, layer.rock.get("name", f"layer {i + 1}"),
                         transform=ax.get_yaxis_transform(), va="center", fontsize=8, color="0.3")
             top = layer.to_m
-        for result, style in zip(results, styles, strict=True):
+        for result, hole, style in zip(results, holes, styles, strict=True):
             rows = result.rows
             kwargs = {**style.kwargs(), "markersize": 3}
-            ax.plot(rows[column] * scale, rows["depth_m"], drawstyle="steps-post" if column != "time_s" else "default",
-                    label=result.name, **kwargs)
+            if column == "time_s":
+                time_s, depth_m = time_with_rod_changes(rows, hole.spec.rod_change_s)
+                ax.plot(time_s * scale, depth_m, label=result.name, **kwargs)
+            else:
+                ax.plot(rows[column] * scale, rows["depth_m"], drawstyle="steps-post", label=result.name, **kwargs)
             if column == "compression_max_mpa":
                 ax.plot(rows["tension_max_mpa"], rows["depth_m"], drawstyle="steps-post", alpha=0.6,
                         **{**kwargs, "linestyle": ":"}, label=f"{result.name} (tension)")
