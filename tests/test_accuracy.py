@@ -1,5 +1,7 @@
 """Work-precision harness: measured convergence orders on a linear case against its exact solution,
-the Pareto front, and the ``rpdrill accuracy`` study end to end and on bad input."""
+the Pareto front, and the ``rpdrill accuracy`` study end to end and on bad input. Unit tests of the
+harness's measures (models.evaluation.workprecision) and of the study's time limit and points
+(studies.accuracy.accuracy_study); the study itself through the command and rpdrill.accuracy."""
 
 from __future__ import annotations
 
@@ -18,6 +20,10 @@ from scenes import PAPER_BASE, PER_BODY, scene_dict, simulate
 import rpdrill
 from rpdrill.models.evaluation.workprecision import errors, pareto_front, signature, uniform_grid_s
 from rpdrill.studies.accuracy.accuracy_study import TimeLimitExceeded, cpu_time_limit, load_accuracy_study
+
+# The errors of a run against a reference on a grid and the Pareto front; a setting's CPU time limit and the
+# study's expanded points.
+UNITS = ("rpdrill.models.evaluation.workprecision", "rpdrill.studies.accuracy.accuracy_study")
 
 END_S = 0.04  # two blows at 50 Hz
 GRID = uniform_grid_s(END_S, 1e-4)

@@ -1,5 +1,7 @@
 """``rpdrill advise`` (studies.advice.advice_search): the search against brute force, the thrust limit, the
-feed-force reading of the map, the penetration per impact energy, and the command."""
+feed-force reading of the map, the penetration per impact energy, and the command. Unit tests of
+studies.advice.advice_search and of the prepared run's mean thrust (models.solvers.simulation); the rest
+through rpdrill and the command."""
 
 from __future__ import annotations
 
@@ -14,8 +16,6 @@ from scenes import crushing_scene, scene, scene_dict, simulate
 
 import rpdrill
 from rpdrill.models.drill.pulse import impulse_per_blow_n_s
-from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.advice.advice_search import (
     FEED,
@@ -32,6 +32,11 @@ from rpdrill.studies.advice.advice_search import (
     thrust_ratio,
 )
 from rpdrill.studies.runtime.pools import sequential
+
+# The advice search's parts, the mean thrust a prepared run expects (with the blow's impulse) and the pool
+# the evaluator runs on.
+UNITS = ("rpdrill.models.drill.pulse", "rpdrill.models.solvers.simulation", "rpdrill.studies.advice.advice_search",
+         "rpdrill.studies.runtime.pools")
 
 RATE = "penetration_rate_m_per_s"
 SHORT = {"solver": {"end_time_s": 0.3}, "metrics": {"transient_blows": 4, "block_blows": 4}}
@@ -63,11 +68,12 @@ def test_advise_finds_the_best_of_a_fine_grid():
 
 def test_mean_thrust_is_the_mean_rock_force_of_a_steady_run():
     """Momentum over the averaging window: the rock takes the feed and the blows' impulse."""
-    simulation = prepare(crushing_scene(solver={"end_time_s": 1.0, "formulation": "exact"},
-                                        outputs={"metrics": ["rock_force_max_n", RATE]}))
+    crushing = crushing_scene(solver={"end_time_s": 1.0, "formulation": "exact"},
+                              outputs={"metrics": ["rock_force_max_n", RATE]})
+    simulation = prepare(crushing)
     expected = simulation.scene.feed.force_n + impulse_per_blow_n_s(simulation.impact) * simulation.impact.frequency_hz
     assert simulation.mean_thrust_n == pytest.approx(expected)
-    result = run_simulation(simulation).raw
+    result = simulate(crushing)
     window = result.time_s >= 10 / simulation.impact.frequency_hz
     t, force = result.time_s[window], result.rock_force_n[window]
     assert np.trapezoid(force, t) / (t[-1] - t[0]) == pytest.approx(simulation.mean_thrust_n, rel=1e-3)
@@ -105,9 +111,9 @@ def test_feed_response_reads_where_the_rate_is_highest_along_the_feed():
 
 def test_penetration_per_impact_energy_is_the_advance_over_the_impact_work():
     per_joule = "penetration_per_impact_energy_m_per_j"
-    result = simulate(crushing_scene(outputs={"metrics": [per_joule, RATE, "impact_energy_j", "window_start_s",
-                                                          "window_end_s"]}), "exact")
-    metrics = summary_metrics(result)
+    metrics = rpdrill.simulate(crushing_scene(outputs={"metrics": [per_joule, RATE, "impact_energy_j",
+                                                                   "window_start_s", "window_end_s"]}),
+                               "exact", budget=None).metrics
     advance = metrics[RATE] * (metrics["window_end_s"] - metrics["window_start_s"])
     assert metrics[per_joule] == pytest.approx(advance / metrics["impact_energy_j"], rel=1e-9)
     assert metrics[per_joule] > 0

@@ -1,7 +1,8 @@
 """Run-cost estimates (models.solvers.cost) and budgets (studies.runtime.budgets): what a run will cost, which key
 makes it cost that, and the refusals above a budget. The estimate against measurement is
 benchmarks/bench_budgets.py (no timing here).
-Unit tests of models.solvers.cost and studies.runtime.budgets: they import them."""
+Unit tests of models.solvers.cost and studies.runtime.budgets on prepared runs (models.solvers.simulation): they
+import them."""
 
 from __future__ import annotations
 
@@ -12,6 +13,9 @@ from rpdrill import Budget, BudgetError, load_study
 from rpdrill.models.solvers.cost import Cause, run_cost
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.studies.runtime.budgets import MAX_CPU_HOURS
+
+# A prepared run's cost and the key that causes it, and the budgets' checks of a run and of many runs.
+UNITS = ("rpdrill.models.solvers.cost", "rpdrill.models.solvers.simulation", "rpdrill.studies.runtime.budgets")
 
 PRESET = {"solver__step_s": None, "solver__type": None}  # the standard preset chooses the step
 

@@ -1,5 +1,7 @@
 """``rpdrill calibrate``: objective pieces, a tiny differential-evolution fit end to end, resume
-(nothing recomputed, identical result, interrupted and extended runs), refusals and bad input."""
+(nothing recomputed, identical result, interrupted and extended runs), refusals and bad input. The fit through
+the command and rpdrill.calibrate; the objective's pieces and the calibration file's reading are unit tests
+(UNITS)."""
 
 from __future__ import annotations
 
@@ -20,7 +22,11 @@ from rpdrill import Budget
 from rpdrill.models.evaluation.workprecision import non_dominated
 from rpdrill.studies.calibration.calibration_search import objective, refined_frequencies_hz
 from rpdrill.studies.calibration.calibration_spec import Parameter, load_calibration
-from rpdrill.studies.scan import curves
+
+# The Pareto filter, the objective and the refined axis, the calibration file's parameters and scenes, and the
+# run of a scan's point (failed on purpose).
+UNITS = ("rpdrill.models.evaluation.workprecision", "rpdrill.studies.calibration.calibration_search",
+         "rpdrill.studies.calibration.calibration_spec", "rpdrill.studies.scan.curves")
 
 ROOT = Path(__file__).resolve().parents[1]
 COLLAR = "drill_string.bodies.collar.mass_kg"
@@ -219,7 +225,7 @@ def test_nelder_mead_stays_within_its_budget(tmp_path):
 def test_every_simulation_failing_exits_1_without_a_scene(tmp_path, monkeypatch, capsys):
     def failing(branch, value, simulation, start_check=True):
         return {"status": "failed", "error": "RuntimeError: diverged", "wall_time_s": 0.0}
-    monkeypatch.setattr(curves, "run_followed", failing)  # runs in this process (--workers 1)
+    monkeypatch.setattr("rpdrill.studies.scan.curves.run_followed", failing)  # runs in this process (--workers 1)
     path = write(tmp_path / "c.yaml", spec(search={"popsize": 2, "max_generations": 0, "seed": 3}))
     assert calibrate(path, tmp_path / "out") == 1
     assert "RuntimeError: diverged" in capsys.readouterr().err

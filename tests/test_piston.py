@@ -1,6 +1,8 @@
 """The piston as a body (models.drill.piston, issue #31): the scene keys, the closed forms of a rod piston and
 a rigid piston striking a long segmented rod, the energy balance with the blow energy, and the
-formulations' agreement. The refinement study behind docs/model.md's table: benchmarks/bench_piston.py."""
+formulations' agreement. The refinement study behind docs/model.md's table: benchmarks/bench_piston.py.
+Runs through rpdrill and the command; unit tests of the rigid piston's closed form, the prepared contact, the
+exact solver's log of a blow and the advice search at a fixed hammer power (UNITS)."""
 
 from __future__ import annotations
 
@@ -19,7 +21,6 @@ from scenes import PAPER_BASE, scene_dict
 import rpdrill
 from rpdrill import Scene
 from rpdrill.models.drill.piston import rigid_piston_pulse_n
-from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.models.solvers.simulation import SceneError, prepare
 from rpdrill.studies.advice.advice_search import (
     FEED,
@@ -32,6 +33,11 @@ from rpdrill.studies.advice.advice_search import (
     search_advice,
 )
 from rpdrill.studies.runtime.pools import sequential
+
+# The rigid piston's pulse in closed form, a prepared run's piston contact, the exact solver's log of the
+# piston's modes, and the advice search at a fixed power on the pool it runs on.
+UNITS = ("rpdrill.models.drill.piston", "rpdrill.models.solvers.exact_model", "rpdrill.models.solvers.simulation",
+         "rpdrill.studies.advice.advice_search", "rpdrill.studies.runtime.pools")
 
 load_scene, load_study = rpdrill.load_scene, rpdrill.load_study
 
@@ -61,8 +67,8 @@ def rod_piston(segments: int) -> dict:
     return {"length_m": 0.5, "segments": segments, **STEEL}
 
 
-def run(data: dict):
-    return rpdrill.simulate(Scene.model_validate(data), budget=None).raw
+def run(data: dict) -> rpdrill.Result:
+    return rpdrill.simulate(Scene.model_validate(data), budget=None)
 
 
 def plateau_and_length(result) -> tuple[float, float]:
@@ -126,7 +132,7 @@ def test_a_rod_piston_sends_a_rectangular_pulse_and_keeps_no_energy(rod_on_rod, 
     blow = 0.5 * RHO * AREA * 0.5 * SPEED**2
     rebound = result.piston.rebounds
     assert len(rebound) == 1 and rebound[0, 1] < 0.03 * blow  # what it keeps: its ringing, 1.8 % at 8 segments
-    account = energy_account(result)
+    account = result.energy
     assert account.relative_residual() < 1e-3
     assert account.piston_work_j[-1] == pytest.approx(blow - rebound[0, 1], rel=1e-6)  # blow - rebound
     assert account.impact_work_j[-1] == pytest.approx(blow - rebound[0, 1], rel=2e-3)  # the contact's work
@@ -249,10 +255,8 @@ def test_advise_at_a_fixed_power_is_not_beaten_by_a_frequency_grid(monkeypatch):
     35.86), for 12.0 CPU s against 16.3. Four generations after the first, not eight: the same point within
     0.01 Hz, 36.12 mm/s against the grid's 35.98 (79 runs, 7.7 CPU s; popsize 5 over 6 generations ends at
     another point as good, 71.7 Hz and 7.8 kN, 36.02 mm/s: the landscape has several near-equal optima)."""
-    from rpdrill.studies.advice import advice_search
-
-    monkeypatch.setattr(advice_search, "MAP_POINTS", 2)
-    monkeypatch.setattr(advice_search, "SLICE_POINTS", 3)
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.MAP_POINTS", 2)
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.SLICE_POINTS", 3)
     bounds = {FREQUENCY: (60.0, 80.0), FEED: (5e3, 15e3)}
     request = Request("penetration_rate_m_per_s", bounds, power_w=15e3, search=AdviceSearch(popsize=6, max_generations=4))
     data = runnable_scene(load_scene(TOP_HAMMER).with_({"solver.end_time_s": 0.3}), None, request, str(TOP_HAMMER))

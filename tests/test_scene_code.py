@@ -6,7 +6,8 @@ API: a module imported while a scene was read, ``os:spawnvp`` run by a study's p
 ``subprocess:Popen`` constructed as a rock law; a user module that does not parse or raises on import, an
 extension that raises, adds a NaN spring or a mass Exudyn refuses, calls ``sys.exit``, or names a body the
 model lacks; a rock law whose constructor raises. The user's code is written into a temporary folder on
-``sys.path`` by each test (forked workers inherit it)."""
+``sys.path`` by each test (forked workers inherit it). Two are unit tests (UNITS): a prepared run's pickled copy
+runs its extension, and the registered names are read once per ``sys.path``."""
 
 from __future__ import annotations
 
@@ -24,9 +25,12 @@ from commands import main
 from scenes import scene_dict
 
 import rpdrill
-from rpdrill.models.definition import own_code
+from rpdrill.models.definition.own_code import registered
 from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
+
+# The registered names' lookup, and a prepared run pickled as a worker's copy and run.
+UNITS = ("rpdrill.models.definition.own_code", "rpdrill.models.runs.scene_run", "rpdrill.models.solvers.simulation")
 
 ROOT = Path(__file__).resolve().parents[1]
 SHORT = {"solver.end_time_s": 0.08, "metrics.transient_blows": 1, "metrics.block_blows": 3}
@@ -573,9 +577,9 @@ def test_registered_names_are_looked_up_per_sys_path_once(monkeypatch):
     reads = []
     monkeypatch.setattr(importlib.metadata, "entry_points", lambda group: reads.append(group) or ())
     for _ in range(3):
-        assert own_code.registered("rpdrill.extensions") == ()
+        assert registered("rpdrill.extensions") == ()
     monkeypatch.syspath_prepend("/nonexistent")
-    own_code.registered("rpdrill.extensions")
+    registered("rpdrill.extensions")
     assert reads == ["rpdrill.extensions", "rpdrill.extensions"]
 
 

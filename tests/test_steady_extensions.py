@@ -6,6 +6,8 @@ it, so the orbit's rate is the extended drill's settled rate. Before, each run r
 on the collar: the orbit of another machine, 7.4 % slower here, and nothing said so. What the section cannot
 hold (a coordinate no spring holds, a per-step function of one's own, a spring to ground) is refused by
 name, and the result is the scene's time run; a coordinate held to ground only stays where its spring holds it.
+Through rpdrill; units (UNITS): the standard preset's stated error, and the regime search with the
+extension's coordinates taken out of its section.
 """
 
 from __future__ import annotations
@@ -17,7 +19,9 @@ import pytest
 
 import rpdrill
 from rpdrill.models.evaluation.solver_settings import EXUDYN_PRESETS
-from rpdrill.models.steady import regimes
+
+# The Exudyn preset's stated error in the rate; the regime search, its section without the clamp's coordinates.
+UNITS = ("rpdrill.models.evaluation.solver_settings", "rpdrill.models.steady.regimes")
 
 PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"
 FREQUENCY_HZ = 65.0
@@ -65,7 +69,7 @@ def test_the_clamp_is_in_the_section_and_its_orbit_is_the_clamped_drills_settled
     assert rate(result) == pytest.approx(rate(rpdrill.simulate(as_body)), rel=STATED)
     # the section without the clamp (as before): each map run restarts it at rest on the collar, and the
     # orbit found is another machine's (measured: 7.4 % slower), which the tolerance above would not pass
-    monkeypatch.setattr(regimes, "with_extension_coordinates", lambda simulation: simulation)
+    monkeypatch.setattr("rpdrill.models.steady.regimes.with_extension_coordinates", lambda simulation: simulation)
     restarted = rpdrill.simulate(clamped())
     assert restarted.steady_state.regime_name == "period-1" and "clamp_position" not in restarted.steady_state.orbit.state_labels
     assert abs(rate(restarted) / rate(time_run) - 1) > 100 * STATED

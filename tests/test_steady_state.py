@@ -7,7 +7,8 @@ rate; (d) a drill held to ground has no orbit relative to the bottom and says so
 every metric of the orbit through the public API, and results tables gain the regime columns; (f) the
 Exudyn and ODE formulations' shooting agrees with the exact orbit; (g) continuation along a scan (a
 neighbour's orbit Newton fails from is run on to the orbit), and the bifurcations read from a branch.
-Unit tests of models.steady: they import it."""
+Unit tests of models.steady, of a run from a neighbour's orbit (models.runs.scene_run's guess) and of the
+bifurcation diagram (UNITS); the time runs and what a run reports through rpdrill."""
 
 from __future__ import annotations
 
@@ -19,17 +20,20 @@ import pytest
 from scenes import PER_BODY, scene
 
 import rpdrill
-from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.evaluation.solver_settings import EXUDYN_PRESETS
-from rpdrill.models.runs import scene_run
 from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
-from rpdrill.models.steady import regimes
 from rpdrill.models.steady.continuation import BranchPoint, Continuation, changes, hysteresis
 from rpdrill.models.steady.exact_map import exact_period_map
 from rpdrill.models.steady.regimes import RegimeFinder, steady_state
 from rpdrill.models.steady.shooting import NoConvergence, Shooter
 from rpdrill.models.steady.steady_state import SteadyStateUnavailable
+
+# The steady-state solver on prepared scenes, a run started from a guessed orbit, the standard preset's stated
+# error, and the bifurcation diagram's data and figure.
+UNITS = ("rpdrill.models.evaluation.solver_settings", "rpdrill.models.runs.scene_run",
+         "rpdrill.models.solvers.simulation", "rpdrill.models.steady", "rpdrill.studies.figures.bifurcation_figure",
+         "rpdrill.studies.scan.bifurcation_diagram")
 
 PIPE_DRILL = Path(__file__).resolve().parent / "pipe_drill.yaml"
 PAPER_BASE = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "paper_base.yaml"
@@ -60,8 +64,8 @@ def settled_advance(scene_: rpdrill.Scene, settle_to: float = 1e-9) -> tuple[flo
     frequency = scene_.impact.frequency_hz
     blows = 400
     while True:
-        run = run_simulation(prepare(scene_.with_({"solver.end_time_s": blows / frequency, "solver.steady_state": "time",
-                                    "outputs": {"metrics": ["penetration_rate_m_per_s"]}}))).raw
+        run = rpdrill.simulate(scene_.with_({"solver.end_time_s": blows / frequency, "solver.steady_state": "time",
+                                             "outputs": {"metrics": ["penetration_rate_m_per_s"]}}), budget=None)
         advances = np.diff(run.bottom_at(np.arange(blows + 1) / frequency))
         if abs(advances[-1] - advances[-2]) <= settle_to * abs(advances[-1]) or blows >= 6400:
             return float(advances[-1]), advances
@@ -147,9 +151,9 @@ def test_a_periodic_run_gives_every_metric_of_the_orbit():
     assert metrics["penetration_rate_m_per_s"] == pytest.approx(metrics["advance_per_blow_m"] / period_s)
     assert abs(metrics["energy_balance_relative_error"]) < 1e-9  # the exact works over the orbit
     # the same figures as the last blows of a long time run (peaks and efficiency included)
-    long_run = run_simulation(prepare(scene_.with_({"solver.steady_state": "time", "solver.end_time_s": 800 * period_s,
-                                     "metrics": {"transient_blows": 795, "block_blows": 5}}))).raw
-    settled = summary_metrics(long_run)
+    settled = rpdrill.simulate(scene_.with_({"solver.steady_state": "time", "solver.end_time_s": 800 * period_s,
+                                             "metrics": {"transient_blows": 795, "block_blows": 5}}),
+                               budget=None).metrics
     for name in ("penetration_rate_m_per_s", "collar_velocity_rms_m_per_s", "energy_transfer_efficiency",
                  "rock_force_max_n"):
         assert metrics[name] == pytest.approx(settled[name], rel=1e-6), name
@@ -207,8 +211,8 @@ def test_a_neighbours_orbit_newton_fails_from_is_run_on_to_the_orbit_without_the
         Shooter(exact_period_map(simulation), simulation).solve(neighbour)
     cold = run_simulation(simulation)  # from rest: the transient blows, then Newton
     never = lambda *args, **kwargs: pytest.fail("the scene's time run was run")
-    monkeypatch.setattr(scene_run, "time_run", never)
-    monkeypatch.setattr(regimes, "time_run", never)
+    monkeypatch.setattr("rpdrill.models.runs.scene_run.time_run", never)
+    monkeypatch.setattr("rpdrill.models.steady.regimes.time_run", never)
     followed = run_simulation(simulation, guess=(neighbour, 1))
     assert cold.steady_state.regime_name == followed.steady_state.regime_name == "period-1"
     # the same orbit: the two Newton runs end within their tolerance (measured 3.7e-8 apart; the orbits'

@@ -2,7 +2,9 @@
 formulation refuses, the closed forms (Lundberg's efficiency, the rigid and the rod piston, an impedance
 step) in the exact and the Exudyn formulation, the energy account, the two formulations against each
 other where Exudyn integrates bodies joined to the rods, a preloaded rod, and the rods' outputs.
-The refinement and CPU figures: benchmarks/bench_waves.py."""
+The refinement and CPU figures: benchmarks/bench_waves.py. Runs through rpdrill and the command; unit tests
+(UNITS) of the closed forms (the rigid piston's pulse, an impedance step's shares, the prescribed pulse),
+the prepared wave step and its cost, and the settling of blows."""
 
 from __future__ import annotations
 
@@ -16,15 +18,19 @@ import pytest
 import yaml
 from commands import main
 from pydantic import ValidationError
+from scenes import read_yaml
 
+import rpdrill
 from rpdrill import InputError, Scene, build_exudyn
 from rpdrill.models.drill.piston import rigid_piston_pulse_n
 from rpdrill.models.drill.wave_rod import reflected_force_share, transmitted_force_share
-from rpdrill.models.evaluation.energy import energy_account
-from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.models.runs.scene_run import run as run_simulation
-from rpdrill.models.solvers.simulation import SceneError, prepare
-from rpdrill.studies.inputs.reading import prepare_scene, read_yaml
+from rpdrill.models.solvers.simulation import prepare
+
+# The closed forms (a rigid piston's pulse, a joint's transmitted and reflected shares, the prescribed pulse),
+# a prepared wave run's step and cost, the settling of blows, and the advice search's coarser grids.
+UNITS = ("rpdrill.models.drill.piston", "rpdrill.models.drill.pulse", "rpdrill.models.drill.wave_rod",
+         "rpdrill.models.solvers.cost", "rpdrill.models.solvers.simulation", "rpdrill.models.steady.wave_settling",
+         "rpdrill.studies.advice.advice_search")
 
 E_PA, RHO, D = 2.1e11, 7850.0, 0.045
 STEEL = {"diameter_m": D, "youngs_modulus_pa": E_PA, "density_kg_per_m3": RHO}
@@ -54,8 +60,8 @@ def one_blow(bodies: dict, impact: dict, rock: dict, end_time_s: float, formulat
             "metrics": {"transient_blows": 0, "block_blows": 1}}
 
 
-def run(data: dict):
-    return run_simulation(prepare(Scene.model_validate(data))).raw
+def run(data: dict) -> rpdrill.Result:
+    return rpdrill.simulate(Scene.model_validate(data), budget=None)
 
 
 # ---- scene keys and refusals ------------------------------------------------------------------------
@@ -77,13 +83,13 @@ def test_the_ode_formulation_says_it_cannot_carry_waves():
     data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4}, {"name": "sandstone"}, 1e-3, "ode")
     with pytest.raises(InputError, match=r"solver.formulation: 'ode' cannot run this scene: "
                                          r"drill_string.bodies.rod.model is waves"):
-        prepare_scene(Scene.model_validate(data), "a scene")
+        run(data)
 
 
 def test_exudyn_steps_waves_at_a_fixed_step():
     data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4}, {"name": "sandstone"}, 1e-3,
                     "exudyn", type="dopri5", relative_tolerance=1e-6)
-    with pytest.raises(SceneError, match="fixed-step type"):
+    with pytest.raises(InputError, match="fixed-step type"):
         run(data)
 
 
@@ -99,7 +105,6 @@ def test_the_wave_step_divides_the_period_and_makes_the_transit_times_whole():
 def test_a_periodic_steady_state_runs_blows_until_they_settle_or_says_the_cap_came_first():
     """The waves in flight are a history, not a state to shoot on: blows are run (models.steady.wave_settling);
     three blows cannot show three changes below 1e-6: the cap, said with the last change."""
-    import rpdrill
     data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4, "frequency_hz": 1000.0},
                     {"name": "sandstone"}, 3e-3, "exact", steady_state="periodic")
     steady = rpdrill.simulate(Scene.model_validate(data)).steady_state
@@ -111,10 +116,8 @@ def test_a_run_that_would_settle_only_beyond_its_cap_stops_early_and_says_so(mon
     """The early stop of models.steady.wave_settling on a run (its margin 0 and windows of one blow, so that the
     first projection, at the start of blow 6, stops it: three changes of the advance, from blow 2 on): not
     settled, the blows run, the window up to them, the note."""
-    import rpdrill
-    from rpdrill.models.steady import wave_settling
-    monkeypatch.setattr(wave_settling, "PROJECTION_WINDOW_BLOWS", 1)
-    monkeypatch.setattr(wave_settling, "PROJECTION_MARGIN", 0.0)
+    monkeypatch.setattr("rpdrill.models.steady.wave_settling.PROJECTION_WINDOW_BLOWS", 1)
+    monkeypatch.setattr("rpdrill.models.steady.wave_settling.PROJECTION_MARGIN", 0.0)
     data = one_blow({"rod": rod(1.0)}, {"amplitude_n": 1e5, "duration_s": 1e-4, "frequency_hz": 1000.0},
                     {"name": "sandstone"}, 8e-3, "exact", steady_state="periodic")
     result = rpdrill.simulate(Scene.model_validate(data))
@@ -184,7 +187,7 @@ def lundberg(alpha: float, ratio: float, formulation: str) -> tuple[float, float
                     {"law": "bilinear", "loading_stiffness_n_per_m": loading,
                      "unloading_stiffness_n_per_m": ratio * loading}, 14 * pulse, formulation)
     result = run(data)
-    metric = summary_metrics(result)["rock_transfer_efficiency"]
+    metric = result.metrics["rock_transfer_efficiency"]
     assert metric == pytest.approx(result.waves.blow_rock_work_j[0] / (amplitude**2 * pulse / Z), rel=1e-12)
     return metric, lundberg_eta(alpha) * (1 - 1 / ratio)
 
@@ -291,7 +294,7 @@ def both():
 @pytest.mark.slow
 @pytest.mark.parametrize("formulation", FORMULATIONS)
 def test_the_energy_account_closes_with_the_waves_in_flight(both, formulation):
-    account = energy_account(both[formulation])
+    account = both[formulation].energy
     assert account.relative_residual() < 2e-4
 
 
@@ -316,13 +319,13 @@ def test_a_pulse_on_a_lumped_body_is_counted_once():
     for formulation in FORMULATIONS:
         # measured 1.9e-13 (exact) and 4.8e-4 (Exudyn: its trapezoidal works of the pulse, standard preset) over
         # two blows; 3.3e-13 and 2.6e-4 over four (0.1 s: twice the CPU, 15 s on Exudyn)
-        assert energy_account(run(anvil_on_a_rod(formulation))).relative_residual() < 2e-3
+        assert run(anvil_on_a_rod(formulation)).energy.relative_residual() < 2e-3
 
 
 def test_exudyn_and_exact_agree_where_exudyn_integrates_the_bodies(both):
     """The bit and the carriage are Exudyn's bodies, joined to the rods' faces (the bit rigidly: a port of
     the body; the carriage through the absorber, its force exchanged once per step)."""
-    exact, exudyn = (summary_metrics(both[f]) for f in FORMULATIONS)
+    exact, exudyn = (both[f].metrics for f in FORMULATIONS)
     assert exudyn["advance_per_blow_m"] == pytest.approx(exact["advance_per_blow_m"], rel=1e-3)
     assert exudyn["rod_stress_max_pa"] == pytest.approx(exact["rod_stress_max_pa"], rel=1e-3)
     assert exudyn["rock_energy_per_blow_j"] == pytest.approx(exact["rock_energy_per_blow_j"], rel=1e-3)
@@ -343,7 +346,7 @@ def test_the_rod_outputs_of_a_blow(both):
     leaves the shank enters the rod); what leaves the rod at the bit is what the rock takes (the bit's
     kinetic energy aside); the shank's face gets the piston's work less what the absorber on it takes."""
     result = both["exact"]
-    metrics, columns = summary_metrics(result), result.columns()
+    metrics, columns = result.metrics, result.columns()
     window = (result.time_s >= metrics["window_start_s"]) & (result.time_s <= metrics["window_end_s"])
     for name in ("shank", "rod"):
         sampled = max(columns[f"{name}_{end}_stress_pa"][window].max() for end in ("top", "bottom"))
@@ -445,10 +448,8 @@ def test_advise_keeps_the_shipped_scenes_rods_below_the_stress_bound(tmp_path, m
     before: 40 runs, the same answers to what is asserted) to keep the test under a minute: what is checked is
     the search's answer, not those grids (the map's corner at 40 Hz and 20 kN is the fastest point beyond the
     bound). The library call with the same inputs and folder gives the same advice, replaying every point."""
-    from rpdrill.studies.advice import advice_search
-
-    monkeypatch.setattr(advice_search, "MAP_POINTS", 2)
-    monkeypatch.setattr(advice_search, "SLICE_POINTS", 3)
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.MAP_POINTS", 2)
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.SLICE_POINTS", 3)
     data = read_yaml(str(SHIPPED))
     data["metrics"], data["solver"]["end_time_s"] = {"transient_blows": 0, "block_blows": 1}, 0.02
     path = tmp_path / "top_hammer_waves.yaml"
@@ -467,8 +468,7 @@ def test_advise_keeps_the_shipped_scenes_rods_below_the_stress_bound(tmp_path, m
     assert fastest["rod_stress_max_pa"] > 400e6 and advice["beyond_stress"] > 0
     assert fastest["value"] > advice["best_value"]
     assert advice["best"]["impact.frequency_hz"] > fastest["point"]["impact.frequency_hz"]
-    import rpdrill  # the library call with the same inputs: the same advice, every point replayed from out
-
+    # the library call with the same inputs: the same advice, every point replayed from out
     (library,) = rpdrill.advise(str(path), {"impact.frequency_hz": (40.0, 80.0), "feed.force_n": (5e3, 20e3)},
                                 power_kw=15.0, search=rpdrill.AdviceSearch(popsize=4, max_generations=1), workers=1,
                                 out=str(out), max_rod_stress_pa=400e6)
@@ -477,8 +477,6 @@ def test_advise_keeps_the_shipped_scenes_rods_below_the_stress_bound(tmp_path, m
 
 
 def test_advise_refuses_a_stress_bound_that_is_not_positive():
-    import rpdrill
-
     with pytest.raises(rpdrill.InputError, match="max_rod_stress_pa"):
         rpdrill.advise(str(SHIPPED), {"impact.frequency_hz": (40, 80), "feed.force_n": (5e3, 20e3)},
                        max_rod_stress_pa=-1.0)
