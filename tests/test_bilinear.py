@@ -30,7 +30,7 @@ ROCK = {"law": "bilinear", "loading_stiffness_n_per_m": K_LOAD, "unloading_stiff
 BLOWS = 15  # the shortest window the default metrics accept
 
 
-def run(s: rpdrill.Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
+def result_of(s: rpdrill.Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
     """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics, its energy account."""
     return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
@@ -181,7 +181,7 @@ def runs(request):
     """(the exact formulation, the Exudyn model) of the window; the exact formulation against the ODE on
     this law: tests/test_exact_model.py."""
     s = window(start=request.param)
-    return run(s, "exact", sample_interval_s=STEP_S), run(s)  # both on the same grid
+    return result_of(s, "exact", sample_interval_s=STEP_S), result_of(s)  # both on the same grid
 
 
 def test_exudyn_agrees_with_exact(runs):
@@ -206,8 +206,8 @@ def bouncing(formulation: str):
     """The window on the bouncing rock in a formulation (Exudyn: the window's, at the cross-check step)."""
     s = window(rock=BOUNCING)
     if formulation == "ode":
-        return run(s, "ode", preset="reference")
-    return run(s, None if formulation == "exudyn" else formulation)
+        return result_of(s, "ode", preset="reference")
+    return result_of(s, None if formulation == "exudyn" else formulation)
 
 
 def assert_remembers_its_crater(r) -> None:
