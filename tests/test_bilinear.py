@@ -1,27 +1,38 @@
 """The bilinear loading/unloading rock law: the pure law, its scene keys, and the Exudyn model
-against the exact formulation with it (both closing the energy balance)."""
+against the exact formulation with it (both closing the energy balance).
+Unit tests of models.evaluation.compare (the runs compared) and models.solvers.simulation (the law and the
+effects a scene builds): they import them."""
 
 from __future__ import annotations
 
 import functools
+import inspect
 
 import numpy as np
 import pytest
 import yaml
 from commands import main
-from scenes import scene, scene_dict, simulate
+from scenes import scene, scene_dict
 
+import rpdrill
 from rpdrill.models.evaluation.compare import compare_runs, verdict
-from rpdrill.models.evaluation.energy import energy_account
-from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw import BilinearRock, force_and_state
-from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
+
+# unit tests of: two runs compared and their verdict; the rock law and effects a prepared scene holds
+UNITS = ("rpdrill.models.evaluation.compare", "rpdrill.models.solvers.simulation")
+
+STEP_S = inspect.signature(rpdrill.crosscheck).parameters["step_s"].default  # the cross-check step
 
 K_LOAD, K_UNLOAD = 2e8, 1e9
 LAW = BilinearRock(K_LOAD, K_UNLOAD)
 ROCK = {"law": "bilinear", "loading_stiffness_n_per_m": K_LOAD, "unloading_stiffness_n_per_m": K_UNLOAD}
 BLOWS = 15  # the shortest window the default metrics accept
+
+
+def result_of(s: rpdrill.Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
+    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics, its energy account."""
+    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 def walk(path_m: np.ndarray, law: BilinearRock = LAW, state: tuple[float, ...] | None = None
@@ -162,7 +173,7 @@ def test_bad_rock_keys_one_message_exit_2(tmp_path, capsys, label, rock, expecte
 
 def window(**overrides: object):
     """The test drill on the bilinear rock over BLOWS blows, Exudyn at the cross-check step."""
-    return scene(**{"rock": ROCK, **overrides}, solver__end_time_s=BLOWS / 65.0, solver__step_s=DEFAULT_STEP_S)
+    return scene(**{"rock": ROCK, **overrides}, solver__end_time_s=BLOWS / 65.0, solver__step_s=STEP_S)
 
 
 @pytest.fixture(scope="module", params=["rest", "preloaded"])
@@ -170,12 +181,12 @@ def runs(request):
     """(the exact formulation, the Exudyn model) of the window; the exact formulation against the ODE on
     this law: tests/test_exact_model.py."""
     s = window(start=request.param)
-    return simulate(s, "exact", sample_interval_s=DEFAULT_STEP_S), simulate(s)  # both on the same grid
+    return result_of(s, "exact", sample_interval_s=STEP_S), result_of(s)  # both on the same grid
 
 
 def test_exudyn_agrees_with_exact(runs):
     exact, exudyn = runs
-    report = compare_runs(exact, exudyn, exact.scene.solver.end_time_s)
+    report = compare_runs(exact.raw, exudyn.raw, exact.scene.solver.end_time_s)
     checks = verdict(report)
     assert all(c["passed"] for c in checks.values()), checks
     rate = report["metrics"]["penetration_rate_m_per_s"]
@@ -195,8 +206,8 @@ def bouncing(formulation: str):
     """The window on the bouncing rock in a formulation (Exudyn: the window's, at the cross-check step)."""
     s = window(rock=BOUNCING)
     if formulation == "ode":
-        return simulate(s, "ode", preset="reference")
-    return simulate(s, None if formulation == "exudyn" else formulation)
+        return result_of(s, "ode", preset="reference")
+    return result_of(s, None if formulation == "exudyn" else formulation)
 
 
 def assert_remembers_its_crater(r) -> None:
@@ -238,7 +249,7 @@ def test_bouncing_bit_in_the_ode_and_the_exact_rate_agrees():
     agree on the penetration rate."""
     ode = bouncing("ode")
     assert_remembers_its_crater(ode)
-    rates = [summary_metrics(r)["penetration_rate_m_per_s"] for r in (ode, bouncing("exact"))]
+    rates = [r.metrics["penetration_rate_m_per_s"] for r in (ode, bouncing("exact"))]
     assert rates[1] == pytest.approx(rates[0], rel=1e-6)
 
 
@@ -255,10 +266,10 @@ def test_start_state_is_consistent_with_the_preload(runs):
 
 def test_energy_balance_closes_in_both_formulations(runs):
     for r in runs:
-        account = energy_account(r)
+        account = r.energy
         assert account.crushing_work_j[-1] > 0.3 * account.impact_work_j[-1]
         assert account.relative_residual() < 1e-4, r.formulation
-        assert 0 < summary_metrics(r)["energy_transfer_efficiency"] < 1
+        assert 0 < r.metrics["energy_transfer_efficiency"] < 1
 
 
 def test_exudyn_state_is_the_return_map_of_the_bit_path(runs):

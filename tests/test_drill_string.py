@@ -2,6 +2,9 @@
 
 The paper scene and the four-rod string run through the same builder; the segmented rod carries a
 stress wave at the bar speed c = sqrt(E / rho).
+Unit tests of models.drill.chain, models.definition.links and rocklaw.modes, with the prepared simulation's
+outputs and start (models.solvers.simulation) and the pulse measures of models.evaluation.rod_outputs: they
+import them.
 """
 
 import math
@@ -13,17 +16,26 @@ from commands import main
 from pydantic import ValidationError
 from scenes import read_yaml, scene, scene_dict, simulate
 
+import rpdrill
 from rpdrill import Scene, load_scene
 from rpdrill.models.definition.links import RATE, STRETCH, Coupling, Link
 from rpdrill.models.drill.chain import axial_chain, link_load_n
-from rpdrill.models.evaluation.energy import energy_account
-from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.evaluation.rod_outputs import transmitted_pulse_n, travel_time_s
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw.modes import check_mode_forces
 
+# unit tests of: links and the chain built of them, their mode rows; a prepared scene's outputs and start; a
+# rod's transmitted pulse and travel time
+UNITS = ("rpdrill.models.definition.links", "rpdrill.models.drill.chain", "rpdrill.models.evaluation.rod_outputs",
+         "rpdrill.models.solvers.simulation", "rpdrill.rocklaw.modes")
+
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 ROD = {"length_m": 3.66, "diameter_m": 0.045, "bore_diameter_m": 0.012}
+
+
+def result_of(s: Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
+    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics, its energy account."""
+    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 def rod_string(**rod_overrides) -> Scene:
@@ -107,28 +119,28 @@ def test_preloaded_string_with_couplings_is_in_static_equilibrium():
 @pytest.fixture(scope="module")
 def four_rod_run():
     s = load_scene(SCENES / "four_rod_string.yaml")
-    return simulate(s.model_copy(update={"solver": s.solver.model_copy(update={"end_time_s": 0.3})}))
+    return result_of(s.model_copy(update={"solver": s.solver.model_copy(update={"end_time_s": 0.3})}))
 
 
 def test_paper_scene_and_four_rod_string_run_through_the_same_builder(four_rod_run):
-    paper = simulate(load_scene(SCENES / "paper_base.yaml"))
+    paper = result_of(load_scene(SCENES / "paper_base.yaml"))
     for run, bodies in ((paper, 4), (four_rod_run, 1 + 1 + 4 * 4 + 1)):
         assert run.position_m.shape[1] == bodies
-        metrics = summary_metrics(run)
+        metrics = run.metrics
         assert metrics["penetration_rate_m_per_s"] > 0
         assert metrics["energy_balance_relative_error"] < 5e-3
         assert np.all(np.diff(run.bottom_m) >= 0)
 
 
 def test_couplings_never_pull_and_do_open():
-    run = simulate(rod_string(segments=2))
+    run = result_of(rod_string(segments=2))
     chain = run.chain
     couplings = [i for i, link in enumerate(chain.links) if isinstance(link, Coupling)]
     stretch, rate = chain.link_stretch(run.position_m), chain.link_stretch(run.velocity_m_per_s)
     forces = np.stack([chain.links[i].force_n(stretch[:, i], rate[:, i]) for i in couplings], axis=-1)
     assert forces.max() <= 0.0  # F > 0 would pull the joined bodies together
     assert (forces == 0.0).any() and (forces < 0.0).any()  # it opens on rebound and closes again
-    assert energy_account(run).relative_residual() < 5e-3
+    assert run.energy.relative_residual() < 5e-3
 
 
 def wave_run(segments: int):

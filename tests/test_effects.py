@@ -1,4 +1,6 @@
-"""Only the effects a scene calls for are built; outputs pull in what they need."""
+"""Only the effects a scene calls for are built; outputs pull in what they need.
+Unit tests of models.solvers.simulation (the effects, outputs and rock law a prepared scene holds): they
+import it."""
 
 import numpy as np
 import pytest
@@ -6,15 +8,23 @@ import yaml
 from commands import main
 from scenes import CRUSHING, scene, scene_dict, simulate
 
+import rpdrill
 from rpdrill import build_exudyn
-from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
+
+# unit tests of: the effects, outputs and rock law a prepared scene holds
+UNITS = ("rpdrill.models.solvers.simulation",)
 
 SHORT = {"solver__end_time_s": 0.25, "metrics__transient_blows": 3, "metrics__block_blows": 4}
 CRUSH = {k.replace(".", "__"): v for k, v in CRUSHING.items()}
 # what a penetration-rate scan needs: the same physics, no torsion, no forces, no energy
 RATE_ONLY = {"effects": {"rock_damping": True, "joint_damping": True},
              "outputs": {"metrics": ["penetration_rate_m_per_s"]}}
+
+
+def result_of(s: rpdrill.Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
+    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics."""
+    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 def test_full_model_when_no_effects_section():
@@ -25,7 +35,7 @@ def test_full_model_when_no_effects_section():
 
 
 def test_rate_only_scene_drops_torsion_sensors_and_storage():
-    full, lean = build_exudyn(prepare(scene(**CRUSH))), build_exudyn(prepare(scene(**CRUSH, **RATE_ONLY)))
+    full, lean = build_exudyn(scene(**CRUSH)), build_exudyn(scene(**CRUSH, **RATE_ONLY))
     assert (full.coordinate_count, lean.coordinate_count) == (5, 4)
     assert set(full.sensors) - set(lean.sensors) == {"rock", "impact", "phi", "omega"}
     assert lean.settings.solution.sensors.writePeriod == lean.simulation.settings.output_interval_s
@@ -35,11 +45,11 @@ def test_rate_only_scene_drops_torsion_sensors_and_storage():
 
 
 def test_dropping_decoupled_or_unused_parts_leaves_axial_results_unchanged():
-    full = simulate(scene(**CRUSH, **SHORT))
-    lean = simulate(scene(**CRUSH, **SHORT, **RATE_ONLY))
+    full = result_of(scene(**CRUSH, **SHORT))
+    lean = result_of(scene(**CRUSH, **SHORT, **RATE_ONLY))
     assert full.torsion_angle_rad is not None and lean.torsion_angle_rad is None
-    rate_full = summary_metrics(full)["penetration_rate_m_per_s"]
-    rate_lean = summary_metrics(lean)["penetration_rate_m_per_s"]
+    rate_full = full.metrics["penetration_rate_m_per_s"]
+    rate_lean = lean.metrics["penetration_rate_m_per_s"]
     assert rate_full > 0 and rate_lean == pytest.approx(rate_full, rel=1e-12)
     common = np.isin(np.round(full.time_s, 12), np.round(lean.time_s, 12))
     np.testing.assert_allclose(full.position_m[common], lean.position_m, rtol=1e-12, atol=1e-15)

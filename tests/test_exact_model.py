@@ -6,7 +6,8 @@ after a sub-grid point is found at the same time; (d) chattering contact runs to
 exceeded switch limit is reported; (e) the compiled event loop (models.solvers.exact_kernels) gives the
 answer of the former pure-Python implementation and of its own Python execution; a diverged run is
 reported at its first bad sample.
-Unit tests of models.solvers.exact_model: they import it."""
+Unit tests of models.solvers.exact_model and models.solvers.exact_kernels, with the divergence check of
+models.evaluation.stability and the prepared simulation's pulse (models.solvers.simulation): they import them."""
 
 from __future__ import annotations
 
@@ -19,14 +20,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scenes import PAPER_BASE, PER_BODY, crushing_scene, read_yaml, scene, simulate
+from scenes import PAPER_BASE, PER_BODY, crushing_scene, read_yaml, scene
 
+import rpdrill
 import rpdrill.models.evaluation.stability
 import rpdrill.models.solvers.exact_model
-from rpdrill import Scene, SimulationFailed
-from rpdrill.models.evaluation.energy import energy_account
-from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.models.evaluation.results import SimulationResult
+from rpdrill import Result, Scene, SimulationFailed
 from rpdrill.models.solvers.exact_kernels import (
     BRENT_RTOL,
     BRENT_XTOL,
@@ -36,6 +35,10 @@ from rpdrill.models.solvers.exact_kernels import (
     run_events,
 )
 from rpdrill.models.solvers.simulation import prepare
+
+# unit tests of: the exact formulation, its compiled kernels, its divergence check; a prepared scene's pulse
+UNITS = ("rpdrill.models.evaluation.stability", "rpdrill.models.solvers.exact_kernels",
+         "rpdrill.models.solvers.exact_model", "rpdrill.models.solvers.simulation")
 
 BLOWS = 12
 SHORT_METRICS = {"metrics__transient_blows": 2, "metrics__block_blows": 2}
@@ -55,6 +58,11 @@ ODE_BLOWS = 6  # the tight ODE's window against the exact solution: its cost gro
 AGREEMENT = 1e-9
 
 
+def result_of(s: Scene, formulation: str | None = None, **options: object) -> Result:
+    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics, its energy account."""
+    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
+
+
 def crushing(feed: str, damping_mode: str, blows: int = BLOWS, **changes: object) -> Scene:
     """The test drill made to crush (400 kN at 45 Hz) for ``blows`` blows."""
     return crushing_scene(rock__damping_mode=damping_mode, solver__end_time_s=blows / 45.0,
@@ -62,11 +70,11 @@ def crushing(feed: str, damping_mode: str, blows: int = BLOWS, **changes: object
 
 
 @functools.cache
-def exact(feed: str, damping_mode: str) -> SimulationResult:
-    return simulate(crushing(feed, damping_mode), "exact")
+def exact(feed: str, damping_mode: str) -> Result:
+    return result_of(crushing(feed, damping_mode), "exact")
 
 
-def held_at(result: SimulationResult, values: np.ndarray, times_s: np.ndarray) -> np.ndarray:
+def held_at(result: Result, values: np.ndarray, times_s: np.ndarray) -> np.ndarray:
     """Last stored value at or before each time (both formulations store every pulse switch)."""
     index = np.searchsorted(result.time_s, times_s + 1e-12, side="right") - 1
     return values[index]
@@ -79,7 +87,7 @@ def pulse_switches(scene_: Scene) -> np.ndarray:
     return np.sort(np.concatenate([starts, starts - period + tau]))
 
 
-def relative_error(result: SimulationResult, reference: SimulationResult, column: str) -> float:
+def relative_error(result: Result, reference: Result, column: str) -> float:
     times, exact_values = pulse_switches(reference.scene), getattr(reference, column)
     difference = held_at(result, getattr(result, column), times) - held_at(reference, exact_values, times)
     return float(np.max(np.abs(difference)) / np.max(np.abs(exact_values)))
@@ -105,8 +113,8 @@ def test_checking_and_estimating_a_run_does_not_load_the_kernels() -> None:
 def test_agrees_with_tight_ode(feed: str, damping_mode: str) -> None:
     """At every pulse switch of ODE_BLOWS blows: the carriage drill crushes in each; the per-body drill,
     held on the rock by the feed on every body, makes its last switch in its fourth blow."""
-    reference = simulate(crushing(feed, damping_mode, blows=ODE_BLOWS), "exact")
-    ode = simulate(reference.scene, "ode", method="DOP853", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
+    reference = result_of(crushing(feed, damping_mode, blows=ODE_BLOWS), "exact")
+    ode = result_of(reference.scene, "ode", method="DOP853", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
     assert reference.solver.switches_into.get("crushing", 0) >= 2
     assert reference.bottom_m[-1] > 5e-4  # the bottom advanced by crushing
     assert relative_error(ode, reference, "bottom_m") < AGREEMENT
@@ -119,8 +127,8 @@ def test_agrees_with_tight_ode(feed: str, damping_mode: str) -> None:
 @pytest.mark.parametrize("shape", ["rectangular", "triangular"])
 def test_other_pulse_shapes_agree_with_tight_ode(shape: str) -> None:
     """The rectangular pulse (constant state) and the triangular one (ramp state, two phases)."""
-    reference = simulate(crushing("carriage", "contact", blows=6, impact__shape=shape), "exact")
-    ode = simulate(reference.scene, "ode", method="DOP853", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
+    reference = result_of(crushing("carriage", "contact", blows=6, impact__shape=shape), "exact")
+    ode = result_of(reference.scene, "ode", method="DOP853", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
     assert reference.solver.switches_into.get("crushing", 0) >= 4
     assert relative_error(ode, reference, "bottom_m") < AGREEMENT
     assert relative_error(ode, reference, "bit_position_m") < AGREEMENT
@@ -128,7 +136,7 @@ def test_other_pulse_shapes_agree_with_tight_ode(shape: str) -> None:
 
 def test_torsion_without_stiffness_matches_closed_form() -> None:
     """k_x = 0 makes the torsion matrix defective (expm path): phi' = (M/c)(1 - exp(-c t / J))."""
-    result = simulate(crushing("carriage", "contact", blows=6, torsion__stiffness_n_m_per_rad=0.0), "exact")
+    result = result_of(crushing("carriage", "contact", blows=6, torsion__stiffness_n_m_per_rad=0.0), "exact")
     tor, t = result.scene.torsion, result.time_s
     rate = tor.damping_n_m_s_per_rad / tor.inertia_kg_m2
     terminal = (tor.drive_torque_n_m - tor.resisting_torque_n_m) / tor.damping_n_m_s_per_rad
@@ -143,11 +151,11 @@ def test_result_feeds_energy_and_metrics(feed: str) -> None:
     result = exact(feed, "contact")
     assert np.all(np.diff(result.time_s) >= 0.0)
     assert np.all(np.diff(result.bottom_m) >= -1e-15)
-    metrics = summary_metrics(result)
+    metrics = result.metrics
     assert metrics["penetration_rate_m_per_s"] > 0
     assert metrics["window_blows"] == BLOWS - 2
-    fine = simulate(result.scene, "exact", sample_interval_s=2e-6)
-    assert energy_account(fine).relative_residual() < 1e-4  # trapezoidal rule on the samples
+    fine = result_of(result.scene, "exact", sample_interval_s=2e-6)
+    assert fine.energy.relative_residual() < 1e-4  # trapezoidal rule on the samples
 
 
 @pytest.mark.parametrize("threshold_n", [1e9, None], ids=["no_crushing", "crushing"])
@@ -155,8 +163,8 @@ def test_energy_conserved_to_round_off_without_damping(threshold_n: float | None
     """Without dampers, T + V + F_spring^2/2k_n - W_feed + F_th x_n is constant between pulses (to
     round-off of its largest terms, thousands of J here against 160 J of impact work)."""
     changes = UNDAMPED | ({"rock__threshold_n": threshold_n} if threshold_n else {})
-    result = simulate(crushing("carriage", "contact", blows=8, **changes), "exact")
-    energy = energy_account(result)
+    result = result_of(crushing("carriage", "contact", blows=8, **changes), "exact")
+    energy = result.energy
     total = energy.kinetic_j + energy.elastic_j - energy.feed_work_j + energy.crushing_work_j
     impact = result.scene.impact
     blow = np.floor(result.time_s / impact.period_s + 1e-12)
@@ -178,7 +186,7 @@ def test_switch_just_after_a_grid_point_is_found() -> None:
     per_sample = round(base.solver.sample_interval_s / step)
     points = math.floor(contact_made / step)
     shifted_step = (contact_made - 1e-6 * step) / points
-    shifted = simulate(base.scene, "exact", sample_interval_s=shifted_step * per_sample)
+    shifted = result_of(base.scene, "exact", sample_interval_s=shifted_step * per_sample)
     assert shifted.solver.sub_step_s == pytest.approx(shifted_step, rel=1e-14)
     assert 0 < contact_made - points * shifted.solver.sub_step_s < 2e-6 * step
     assert shifted.solver.switch_modes == modes
@@ -217,7 +225,7 @@ def test_switches_do_not_depend_on_the_sample_interval() -> None:
     """The bilinear rock's brief loading episodes (one of 8 us on this drill, within a 14 us sub-step at
     1e-4 s samples) are found whatever the sub-grid: the same switches as on a 2 us sub-grid."""
     s = crushing_scene(rock=BILINEAR, solver__end_time_s=0.1, **SHORT_METRICS)
-    sparse, dense = (simulate(s, "exact", sample_interval_s=interval) for interval in (1e-4, 2e-6))
+    sparse, dense = (result_of(s, "exact", sample_interval_s=interval) for interval in (1e-4, 2e-6))
     assert sparse.solver.sub_step_s > 5 * dense.solver.sub_step_s
     assert sparse.solver.switch_modes == dense.solver.switch_modes
     np.testing.assert_allclose(sparse.solver.switch_times_s, dense.solver.switch_times_s, rtol=0, atol=1e-12)
@@ -230,13 +238,13 @@ CHATTER = {"drill_string__bodies__bit__mass_kg": 0.5, "drill_string__bodies__col
 
 def test_chattering_contact_runs_to_the_end() -> None:
     chatter = scene(solver__end_time_s=10 / 65, **SHORT_METRICS, **CHATTER)
-    result = simulate(chatter, "exact")
+    result = result_of(chatter, "exact")
     assert result.time_s[-1] == pytest.approx(chatter.solver.end_time_s)
     assert result.solver.mode_switches > 30 * 10
     assert np.min(np.diff(result.solver.switch_times_s)) >= result.solver.min_switch_interval_s
     assert result.cpu_time_s < 10.0
     with pytest.raises(SimulationFailed, match="chattering"):
-        simulate(chatter, "exact", max_switches_per_blow=5)
+        result_of(chatter, "exact", max_switches_per_blow=5)
 
 
 # The former pure-Python event loop (scipy brentq, before models.solvers.exact_kernels) on crushing("carriage",
@@ -258,9 +266,9 @@ def test_compiled_loop_gives_the_former_answer() -> None:
 def test_compiled_loop_matches_its_python_execution(monkeypatch: pytest.MonkeyPatch) -> None:
     """The same kernel run by the interpreter (numba's py_func) gives the same samples."""
     short = crushing("carriage", "contact", blows=4)
-    compiled = simulate(short, "exact", sample_interval_s=1e-4)
+    compiled = result_of(short, "exact", sample_interval_s=1e-4)
     monkeypatch.setattr(rpdrill.models.solvers.exact_model, "run_events", run_events.py_func)
-    interpreted = simulate(short, "exact", sample_interval_s=1e-4)
+    interpreted = result_of(short, "exact", sample_interval_s=1e-4)
     assert compiled.solver.switch_modes == interpreted.solver.switch_modes
     np.testing.assert_array_equal(compiled.time_s, interpreted.time_s)
     for column in ("position_m", "velocity_m_per_s", "bottom_m", "rock_force_n", "torsion_angle_rad"):
@@ -272,12 +280,12 @@ def test_divergence_is_reported_at_the_first_bad_sample(monkeypatch: pytest.Monk
     """With a position limit of 0.1 mm the drill "diverges" when a body first moves that far."""
     limit = 1e-4
     short = crushing("carriage", "contact", blows=4)
-    free = simulate(short, "exact")
+    free = result_of(short, "exact")
     first = np.argmax(np.any(np.abs(free.position_m) > limit, axis=1))
     for module in (rpdrill.models.solvers.exact_model, rpdrill.models.evaluation.stability):
         monkeypatch.setattr(module, "POSITION_LIMIT_M", limit)
     with pytest.raises(SimulationFailed, match=f"diverged at t = {free.time_s[first]:.6g} s"):
-        simulate(short, "exact")
+        result_of(short, "exact")
 
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
@@ -298,12 +306,12 @@ def test_every_shipped_scene_runs_exact_and_agrees_with_the_ode(path: Path) -> N
     data["solver"] = {"end_time_s": end_s, "output_interval_s": min(1e-5, duration_s / 20)}
     data["metrics"] = {"transient_blows": 0, "block_blows": 1}
     short = Scene.model_validate(data)
-    exact_run = simulate(short, "exact")
+    exact_run = result_of(short, "exact")
     if prepare(short).dynamic_chain.waves:
         with pytest.raises(ValueError, match=r"drill_string\.bodies\.\w+\.model.* is waves: the ode formulation"):
-            simulate(short, "ode")
+            result_of(short, "ode")
         return
-    ode = simulate(short, "ode", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
+    ode = result_of(short, "ode", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
     pulse_ends_s = np.arange(2) * period_s + duration_s if scene_.impact.piston is None else []  # a piston: strikes only
     switches_s = np.concatenate([np.arange(1, 2) * period_s, pulse_ends_s])
     stored_s = np.append(switches_s[switches_s < end_s - 1e-9], exact_run.time_s[-1])
@@ -337,8 +345,8 @@ def test_piecewise_laws_agree_with_the_ode_to_1e_9_in_the_bottom(make):
     """The exact formulation runs every declared law: the bilinear rock (two states, resets on entering
     loading and free) and compression-only couplings (modes of five links at once)."""
     s = make()
-    exact = simulate(s, "exact")
-    ode = simulate(s, "ode", relative_tolerance=1e-12, absolute_tolerance=1e-15)
+    exact = result_of(s, "exact")
+    ode = result_of(s, "ode", relative_tolerance=1e-12, absolute_tolerance=1e-15)
     assert exact.bottom_m[-1] > 0 and exact.solver.mode_switches == ode.solver.mode_switches
     assert abs(exact.bottom_m[-1] - ode.bottom_m[-1]) <= 1e-9 * exact.bottom_m[-1]
 
@@ -353,14 +361,13 @@ def test_works_from_the_propagators_close_the_energy_balance_at_sparse_samples(m
     agree with the trapezoidal rule on samples 50 and 100 times finer, Richardson-extrapolated
     ((4 T(h / 2) - T(h)) / 3: the trapezoid's h^2 error removed)."""
     scene_ = make()
-    sparse = simulate(scene_, "exact")
+    sparse = result_of(scene_, "exact")
     assert sparse.works_j is not None and sparse.solver.sample_interval_s == scene_.solver.output_interval_s
-    account = energy_account(sparse)
+    account = sparse.energy
     assert account.relative_residual() < 1e-8
     assert account.crushing_work_j[-1] > 0 and account.damping_j[-1] > 0
-    coarse, fine = (energy_account(dataclasses.replace(
-        simulate(scene_, "exact", sample_interval_s=scene_.solver.output_interval_s / finer), works_j=None))
-        for finer in (50, 100))
+    finer = (result_of(scene_, "exact", sample_interval_s=scene_.solver.output_interval_s / n) for n in (50, 100))
+    coarse, fine = (Result(run.scene, dataclasses.replace(run.raw, works_j=None)).energy for run in finer)
     for name in ("impact_work_j", "damping_j"):
         extrapolated = (4 * getattr(fine, name)[-1] - getattr(coarse, name)[-1]) / 3
         assert abs(getattr(account, name)[-1] - extrapolated) < 1e-7 * extrapolated
@@ -373,11 +380,11 @@ def test_a_scan_reuses_the_propagators_and_its_results_are_those_of_a_fresh_buil
     cache = rpdrill.models.solvers.exact_model.OPERATOR_CACHE
     base = crushing_scene(solver__end_time_s=0.2, **SHORT_METRICS).with_solver("exact")
     cache.clear()
-    fresh = simulate(base)
+    fresh = result_of(base)
     keys = len(cache.entries)
     assert keys == fresh.solver.operator_keys > 0
-    again = simulate(base)
-    other = simulate(base.model_copy(update={"impact": base.impact.model_copy(update={"frequency_hz": 47.0})}))
+    again = result_of(base)
+    other = result_of(base.model_copy(update={"impact": base.impact.model_copy(update={"frequency_hz": 47.0})}))
     assert len(cache.entries) == keys and other.solver.operator_keys <= keys
     for name in ("time_s", "position_m", "velocity_m_per_s", "bottom_m", "rock_force_n"):
         assert np.array_equal(getattr(fresh, name), getattr(again, name)), name
@@ -390,13 +397,13 @@ def test_keys_larger_than_the_cache_are_not_kept_and_the_run_is_the_same(monkeyp
     cache = rpdrill.models.solvers.exact_model.OPERATOR_CACHE
     base = crushing_scene(solver__end_time_s=0.2, **SHORT_METRICS).with_solver("exact")
     cache.clear()
-    cached = simulate(base)
+    cached = result_of(base)
     assert len(cache.entries) > 0
     cache.clear()
     monkeypatch.setattr(cache, "max_bytes", 1)
     offered = []
     monkeypatch.setattr(cache, "put", lambda key, arrays: offered.append(key))
-    uncached = simulate(base)
+    uncached = result_of(base)
     assert offered == [] and len(cache.entries) == 0  # not even copied to be offered
     for name in ("time_s", "position_m", "bottom_m", "rock_force_n"):
         assert np.array_equal(getattr(cached, name), getattr(uncached, name)), name

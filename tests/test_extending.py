@@ -1,6 +1,8 @@
 """The examples of docs/extending.md, run exactly as printed there: every Python block from the root of
 the checkout, and the worked example checked: a new connector type (a threaded joint with axial play)
-registered and used from YAML."""
+registered and used from YAML.
+Unit tests of what the worked example extends, models.definition.links and rocklaw.modes, with its runs compared
+by models.evaluation.compare: they import them."""
 
 import re
 from pathlib import Path
@@ -8,14 +10,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 from doc_examples import Ran, run_examples
+from ruamel.yaml import YAML
 from scenes import scene_dict, simulate
 
+import rpdrill
 from rpdrill import Scene
 from rpdrill.models.definition.links import LINK_TYPES, RATE, STRETCH, Link
 from rpdrill.models.evaluation.compare import compare_bottom_at, compare_histories
-from rpdrill.models.evaluation.energy import energy_account
 from rpdrill.rocklaw.modes import check_mode_forces
-from rpdrill.studies.inputs.reading import parse_yaml
+
+# unit tests of: a connector type registered and its mode rows; two runs' histories compared
+UNITS = ("rpdrill.models.definition.links", "rpdrill.models.evaluation.compare", "rpdrill.rocklaw.modes")
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "extending.md"
 SHORT = {"solver.end_time_s": 0.2, "metrics.transient_blows": 3, "metrics.block_blows": 3,
@@ -57,14 +62,20 @@ def joint_type():
 
 
 def _scene(joint_type, **joint) -> Scene:
-    connector = parse_yaml(next(b for b in _blocks("yaml") if b.startswith("collar_bit_joint:")), "docs/extending.md")
+    # YAML 1.2, as rpdrill reads a scene file (studies.inputs.strict_yaml: ruamel.yaml's safe reader)
+    connector = YAML(typ="safe", pure=True).load(next(b for b in _blocks("yaml") if b.startswith("collar_bit_joint:")))
     connector["collar_bit_joint"].update(joint)
     return Scene.model_validate(scene_dict(**SHORT, **{"drill_string.connectors.collar_bit_joint":
                                                        connector["collar_bit_joint"]}))
 
 
+def result_of(s: Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
+    """tests/scenes.py's ``simulate`` as the Result a user holds: its energy account."""
+    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
+
+
 def test_joint_with_play_transmits_nothing_inside_its_play_and_keeps_the_energy_balance(joint_type):
-    run = simulate(_scene(joint_type))
+    run = result_of(_scene(joint_type))
     chain = run.chain
     i = next(k for k, link in enumerate(chain.links) if link.name == "collar_bit_joint")
     link = chain.links[i]
@@ -73,7 +84,7 @@ def test_joint_with_play_transmits_nothing_inside_its_play_and_keeps_the_energy_
     inside = np.abs(stretch) < link.gap_m
     assert inside.any() and (~inside).any()  # the play is crossed
     assert np.all(link.force_n(stretch[inside], 0.0) == 0.0)
-    assert energy_account(run).relative_residual() < 5e-3
+    assert run.energy.relative_residual() < 5e-3
 
 
 def test_exudyn_agrees_with_the_exact_formulation_on_the_new_type(joint_type):

@@ -1,7 +1,9 @@
 """The start and the solver of a drill with items of one's own (models/solvers/exudyn_start.py; issue 47,
 section 3): ``start: preloaded`` is the equilibrium of the assembled system, extension items included, or is
 refused naming the extension; a constraint an explicit solver cannot take is refused before the run naming the
-extension and ``solver.type``; every coordinate is named in Exudyn's order (the solution file's columns)."""
+extension and ``solver.type``; every coordinate is named in Exudyn's order (the solution file's columns).
+Their references, the chain's own static solution (models.drill.chain) and a prepared scene's start and rock law
+(models.solvers.simulation), are units they import."""
 
 from __future__ import annotations
 
@@ -25,6 +27,9 @@ from exudyn.utilities import LoadSolutionFile
 import rpdrill
 from rpdrill.models.drill.chain import axial_chain, static_preload_m
 from rpdrill.models.solvers.simulation import prepare
+
+# unit tests of: the chain's static solution under the feed; a prepared scene's rock law, start and piston
+UNITS = ("rpdrill.models.drill.chain", "rpdrill.models.solvers.simulation")
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = rpdrill.load_scene(ROOT / "studies" / "scenes" / "paper_base.yaml", allow_code=["user_rig"]).with_({

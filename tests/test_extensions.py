@@ -1,6 +1,9 @@
 """An extended drill is a first-class drill: what a multibody engineer adds in Python (items on the built
 model, extensions named by the scene, rock laws by import path) is stepped, solved, accounted, recorded and
-drawn like the rest. Each failure the issue found is a test here (studies: tests/test_extension_studies.py)."""
+drawn like the rest. Each failure the issue found is a test here (studies: tests/test_extension_studies.py).
+Where they check a prepared scene's step, a pickled simulation's run (what a worker does), the drawing's tags and
+a run folder's solution as view_solution loads it, unit tests of models.solvers.simulation, models.runs.scene_run,
+studies.drawings.system_drawing and studies.drawings.drill_animation: they import them."""
 
 from __future__ import annotations
 
@@ -14,11 +17,16 @@ import numpy as np
 import pandas as pd
 import pytest
 import user_rig
+import yaml
 from scenes import crushing_scene
 
 import rpdrill
 from rpdrill.models.runs.scene_run import run as run_simulation
 from rpdrill.models.solvers.simulation import prepare
+
+# unit tests of: a prepared scene's step and its run after pickling; the drawing's tags; a run folder's solution
+UNITS = ("rpdrill.models.runs.scene_run", "rpdrill.models.solvers.simulation", "rpdrill.studies.drawings.drill_animation",
+         "rpdrill.studies.drawings.system_drawing")
 
 ROOT = Path(__file__).resolve().parents[1]
 # the tests' rig (tests/user_rig.py) is code of one's own: allowed for these scenes (a scene runs none unasked)
@@ -30,6 +38,11 @@ SHORT = {"solver.end_time_s": 0.1, "metrics.transient_blows": 1, "metrics.block_
 
 def rate(result) -> float:
     return result.metrics["penetration_rate_m_per_s"]
+
+
+def write(path: Path, scene: rpdrill.Scene) -> None:
+    """The scene as a scene file (as a run folder's scene.resolved.yaml holds it)."""
+    path.write_text(yaml.safe_dump(scene.model_dump(mode="json", by_alias=True, exclude_none=True), sort_keys=False))
 
 
 def clamped(scene=PAPER, **parameters):
@@ -279,11 +292,10 @@ def test_view_solution_replays_an_extended_run_and_refuses_one_it_cannot_rebuild
     from commands import main
 
     from rpdrill.studies.drawings.drill_animation import load_solution
-    from rpdrill.studies.runtime.output_files import write_resolved
 
     scene = PAPER.with_({"extensions": {"clamp": CLAMP}, **SHORT,
                          "extensions.clamp.parameters.stiffness_n_per_m": 1e9})
-    write_resolved(tmp_path / "scene.yaml", scene.model_dump(mode="json", by_alias=True, exclude_none=True))
+    write(tmp_path / "scene.yaml", scene)
     assert main(["simulate", str(tmp_path / "scene.yaml"), "--out", str(tmp_path / "run"), "--animate", "--quiet",
                  "--allow-code", "user_rig"]) == 0
     model, solution = load_solution(tmp_path / "run", allow_code=["user_rig"])
@@ -296,8 +308,7 @@ def test_view_solution_replays_an_extended_run_and_refuses_one_it_cannot_rebuild
     by_hand.run()
     assert load_solution(by_hand)[1]["data"].shape[1] == 1 + by_hand.coordinate_count
     (tmp_path / "plain").mkdir()
-    write_resolved(tmp_path / "plain" / "scene.resolved.yaml",
-                   PAPER.with_(SHORT).model_dump(mode="json", by_alias=True, exclude_none=True))
+    write(tmp_path / "plain" / "scene.resolved.yaml", PAPER.with_(SHORT))
     (tmp_path / "plain" / "solution.txt").write_bytes((tmp_path / "solution.txt").read_bytes())
     with pytest.raises(rpdrill.InputError, match="items added in Python that the scene does not name"):
         load_solution(tmp_path / "plain")

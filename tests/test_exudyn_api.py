@@ -1,4 +1,6 @@
-"""The Exudyn model opened to a user: build it, see its items, add one's own, run it."""
+"""The Exudyn model opened to a user: build it, see its items, add one's own, run it.
+Where it checks the bodies' places and sizes, a unit test of models.drill.shapes (the layout, with the steel of
+models.definition.drill_string): it imports them."""
 
 import math
 from pathlib import Path
@@ -18,6 +20,9 @@ from scenes import crushing_scene, scene
 from rpdrill import build_exudyn, load_scene, simulate
 from rpdrill.models.definition.drill_string import STEEL_DENSITY_KG_PER_M3
 from rpdrill.models.drill.shapes import DEFAULT_DIAMETER_M, layout
+
+# unit tests of: the drill's layout (where each body is drawn, how long, how wide) and the steel it assumes
+UNITS = ("rpdrill.models.definition.drill_string", "rpdrill.models.drill.shapes")
 
 SHORT = {"solver__end_time_s": 0.4, "metrics__transient_blows": 8, "metrics__block_blows": 6}
 FOUR_RODS = Path(__file__).resolve().parents[1] / "studies" / "scenes" / "four_rod_string.yaml"

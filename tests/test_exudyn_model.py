@@ -6,19 +6,21 @@ import numpy as np
 import pytest
 from scenes import PER_BODY, crushing_scene, scene, simulate
 
+import rpdrill
 from rpdrill import build_exudyn
-from rpdrill.models.evaluation.energy import energy_account
-from rpdrill.models.evaluation.metrics import summary_metrics
-from rpdrill.models.solvers import exudyn_model
-from rpdrill.models.solvers.simulation import prepare
 
 SHORT = {"solver__end_time_s": 0.3, "metrics__transient_blows": 4, "metrics__block_blows": 3}
 PER_BODY_KW = {k.replace(".", "__"): v for k, v in PER_BODY.items()}
 
 
+def result_of(s: rpdrill.Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
+    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics, its energy account."""
+    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
+
+
 @pytest.fixture(scope="module")
 def crushing_run():
-    return simulate(crushing_scene(**SHORT))
+    return result_of(crushing_scene(**SHORT))
 
 
 @pytest.mark.parametrize(
@@ -31,7 +33,7 @@ def crushing_run():
     ],
 )
 def test_coordinate_count(overrides, coordinates):
-    assert build_exudyn(prepare(scene(**overrides))).coordinate_count == coordinates
+    assert build_exudyn(scene(**overrides)).coordinate_count == coordinates
 
 
 def test_no_deprecation_warnings():
@@ -63,7 +65,7 @@ def test_rock_force_never_pulls_and_is_capped(crushing_run):
 
 def test_symbolic_and_python_user_functions_agree():
     s = crushing_scene(solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2)
-    symbolic, python = simulate(s), exudyn_model.simulate(s, symbolic=False)
+    symbolic, python = simulate(s), build_exudyn(s, symbolic=False, graphics=False).run().raw
     np.testing.assert_allclose(symbolic.position_m, python.position_m, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(symbolic.bottom_m, python.bottom_m, rtol=1e-12, atol=1e-15)
 
@@ -71,7 +73,7 @@ def test_symbolic_and_python_user_functions_agree():
 def test_energy_balance_within_one_percent_and_shrinking_with_step():
     errors = []
     for step in (2e-5, 1e-5, 5e-6):
-        account = energy_account(simulate(crushing_scene(solver__step_s=step, **SHORT)))
+        account = result_of(crushing_scene(solver__step_s=step, **SHORT)).energy
         assert account.crushing_work_j[-1] > 0.1 * account.impact_work_j[-1]
         errors.append(account.relative_residual())
     assert errors[0] < 0.01
@@ -98,7 +100,7 @@ def test_carriage_carries_the_feed_and_anchored_absorber_takes_it_up():
 
 
 def test_metrics_are_consistent(crushing_run):
-    m = summary_metrics(crushing_run)
+    m = crushing_run.metrics
     period = crushing_run.scene.impact.period_s
     assert m["advance_per_blow_m"] == pytest.approx(m["penetration_rate_m_per_s"] * period)
     assert m["penetration_rate_block_min_m_per_s"] <= m["penetration_rate_m_per_s"] <= \
@@ -118,24 +120,23 @@ def test_resampled_output_grid(crushing_run):
 
 def test_preloaded_start_is_the_static_equilibrium_and_all_formulations_use_it():
     s = crushing_scene(start="preloaded", solver__end_time_s=0.1, metrics__transient_blows=1, metrics__block_blows=2)
-    prepared = prepare(s)
-    chain, q0 = prepared.chain, prepared.initial_positions_m
+    exudyn, exact = result_of(s), result_of(s, "exact")
+    chain, q0 = exudyn.simulation.chain, exudyn.simulation.initial_positions_m  # the prepared scene's
     rock_force = s.rock.stiffness_n_per_m * q0[chain.bit_body]
     assert 0 < rock_force < s.rock.threshold_n
     residual = chain.stiffness_matrix() @ q0 - chain.constant_forces()
     residual[chain.bit_body] += rock_force
     np.testing.assert_allclose(residual, 0.0, atol=1e-6 * s.feed.force_n)  # K q0 + F_rock = F_feed
     assert rock_force == pytest.approx(s.feed.force_n)  # the carriage's feed rests on the rock
-    exudyn, exact = simulate(s), simulate(s, "exact")
     np.testing.assert_allclose(exudyn.position_m[0], q0)
     np.testing.assert_allclose(exact.position_m[0], q0)
     assert exudyn.bottom_m[-1] == pytest.approx(exact.bottom_m[-1], rel=1e-3)
-    assert energy_account(exudyn).relative_residual() < 0.01
+    assert exudyn.energy.relative_residual() < 0.01
 
 
 def test_preload_that_would_crush_is_refused():
     with pytest.raises(ValueError, match="static feed alone crushes the rock"):
-        prepare(scene(start="preloaded", feed__force_n=200e3))
+        rpdrill.simulate(scene(start="preloaded", feed__force_n=200e3))  # refused before it runs
 
 
 MODULE_PROBE = """

@@ -1,28 +1,33 @@
 """The indexing effect (models.drill.indexing): the bit geometry and the angle turned between blows set how
 each blow meets the rock. The geometry's regimes, paper mode untouched to the last bit, an optimum in
 rotation speed that scales with the blow frequency, every formulation running it (Exudyn against the
-ODE, the exact solver or its refusal), rotation speed as a scan axis, bad input."""
+ODE, the exact solver or its refusal), rotation speed as a scan axis, bad input.
+Unit tests of models.drill.indexing (the share of fresh rock a turn leaves, the regimes, the best speed) and of a
+prepared scene's resolved sections (models.solvers.simulation): they import them."""
 
 from __future__ import annotations
 
 import functools
+import inspect
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 import yaml
 from commands import main
-from scenes import CRUSHING, crushing_scene, read_yaml, scene_dict, simulate
+from scenes import CRUSHING, crushing_scene, read_yaml, scene, scene_dict
 
 import rpdrill
 from rpdrill import InputError, Scene, load_study
-from rpdrill.models.definition.scene import Bit
 from rpdrill.models.drill.indexing import CRATER, FRESH, MIN_FRESH_FRACTION, RIDGES, Indexing
-from rpdrill.models.evaluation.metrics import summary_metrics
 from rpdrill.models.solvers.simulation import prepare
-from rpdrill.studies.crosscheck.crosscheck_windows import DEFAULT_STEP_S
-from rpdrill.studies.inputs.reading import prepare_scene
+
+# unit tests of: the indexing geometry (share of fresh rock, regime, best speed); a prepared scene's resolved sections
+UNITS = ("rpdrill.models.drill.indexing", "rpdrill.models.solvers.simulation")
+
+STEP_S = inspect.signature(rpdrill.crosscheck).parameters["step_s"].default  # the cross-check step
 
 BIT = {"diameter_m": 0.216, "gauge_button_diameter_m": 0.019, "gauge_buttons": 12}  # the issue's DTH bit
 DIAMETER, BUTTON = BIT["diameter_m"], BIT["gauge_button_diameter_m"]
@@ -37,8 +42,18 @@ def angle(arc_m: float) -> float:
     return 2.0 * arc_m / DIAMETER
 
 
-def rate(result) -> float:
-    return summary_metrics(result)["penetration_rate_m_per_s"]
+def bit(**changes: float) -> Any:
+    """The issue's DTH bit with ``changes``, as a scene's bit section (what the indexing effect takes)."""
+    return scene(bit=BIT | changes).bit
+
+
+def result_of(s: Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
+    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics."""
+    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
+
+
+def rate(result: rpdrill.Result) -> float:
+    return result.metrics["penetration_rate_m_per_s"]
 
 
 @pytest.mark.parametrize("arc, eta, regime", [
@@ -51,7 +66,7 @@ def rate(result) -> float:
     (PITCH - BUTTON, 1.0, FRESH),  # just past the next button's crater
 ])
 def test_share_of_fresh_rock_from_the_gauge_geometry(arc, eta, regime):
-    indexing = Indexing(Bit(**BIT), None, 36.0)
+    indexing = Indexing(bit(), None, 36.0)
     assert indexing.fresh_fraction(angle(arc)) == pytest.approx(eta, rel=1e-12)
     assert indexing.regime(angle(arc)) == regime
 
@@ -59,12 +74,12 @@ def test_share_of_fresh_rock_from_the_gauge_geometry(arc, eta, regime):
 def test_best_speed_is_a_constant_index_per_blow():
     """n = 60 f w / (pi D): the index per blow is one crater width at every frequency."""
     for frequency in (20.0, 36.0, 80.0):
-        indexing = Indexing(Bit(**BIT), None, frequency)
+        indexing = Indexing(bit(), None, frequency)
         best = indexing.best_speed_rpm()
         assert best / frequency == pytest.approx(60 * BUTTON / (math.pi * DIAMETER))
-        assert Indexing(Bit(**BIT), best, frequency).fresh_fraction(
-            Indexing(Bit(**BIT), best, frequency).prescribed_angle_rad) == pytest.approx(1.0, rel=1e-12)
-    wider = Indexing(Bit(**BIT, crater_width_m=0.025), None, 36.0)
+        assert Indexing(bit(), best, frequency).fresh_fraction(
+            Indexing(bit(), best, frequency).prescribed_angle_rad) == pytest.approx(1.0, rel=1e-12)
+    wider = Indexing(bit(crater_width_m=0.025), None, 36.0)
     assert wider.best_speed_rpm() == pytest.approx(36.0 * 60 * 0.025 / (math.pi * DIAMETER))
 
 
@@ -76,8 +91,8 @@ def test_effect_off_leaves_eq_4_bit_identical(formulation):
     window = {"solver__end_time_s": 5 / 45.0, "metrics__transient_blows": 2, "metrics__block_blows": 2}
     paper = crushing_scene(**window, effects=FULL)
     with_bit = crushing_scene(**window, bit=BIT, rotation={"speed_rpm": 45.0}, effects={**FULL, "indexing": False})
-    assert prepare(paper).rock == prepare(with_bit).rock and prepare(with_bit).blow_starts() is None
-    a, b = simulate(paper, formulation), simulate(with_bit, formulation)
+    a, b = result_of(paper, formulation), result_of(with_bit, formulation)
+    assert a.simulation.rock == b.simulation.rock and b.simulation.blow_starts() is None  # the prepared scenes'
     assert a.bottom_m[-1] > 0 and np.min(a.bit_position_m - a.bottom_m) < 0  # it crushes and lifts off
     for name in ("time_s", "position_m", "velocity_m_per_s", "bottom_m"):
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
@@ -87,10 +102,11 @@ def test_ideal_indexing_is_eq_4():
     """At the best speed every blow meets fresh rock (eta = 1): the indexed law with its threshold state
     gives the paper's penetration."""
     paper = crushing_scene(**SHORT)
-    best = Indexing(Bit(**BIT), None, CRUSHING["impact.frequency_hz"]).best_speed_rpm()
+    best = Indexing(bit(), None, CRUSHING["impact.frequency_hz"]).best_speed_rpm()
     indexed = crushing_scene(**SHORT, bit=BIT, rotation={"speed_rpm": best})
-    assert prepare(indexed).rock.indexed and prepare(indexed).rock.fresh_fraction == pytest.approx(1.0, rel=1e-12)
-    assert rate(simulate(indexed, "exact")) == pytest.approx(rate(simulate(paper, "exact")), rel=1e-9)
+    run = result_of(indexed, "exact")
+    assert run.simulation.rock.indexed and run.simulation.rock.fresh_fraction == pytest.approx(1.0, rel=1e-12)
+    assert rate(run) == pytest.approx(rate(result_of(paper, "exact")), rel=1e-9)
 
 
 def test_penetration_has_an_optimum_in_rpm_that_scales_with_the_frequency():
@@ -98,9 +114,9 @@ def test_penetration_has_an_optimum_in_rpm_that_scales_with_the_frequency():
     below, ridges above, up to the aliasing at half the button pitch, 1.49 n here); at another
     frequency the peak moves with it."""
     for frequency in (40.0, 50.0):
-        best = Indexing(Bit(**BIT), None, frequency).best_speed_rpm()
+        best = Indexing(bit(), None, frequency).best_speed_rpm()
         factors = (0.5, 0.8, 1.0, 1.2, 1.45)
-        rates = [rate(simulate(crushing_scene(**SHORT, impact__frequency_hz=frequency, bit=BIT,
+        rates = [rate(result_of(crushing_scene(**SHORT, impact__frequency_hz=frequency, bit=BIT,
                                               rotation={"speed_rpm": factor * best}), "exact")) for factor in factors]
         assert rates[2] > 0 and int(np.argmax(rates)) == 2, (frequency, rates)
         assert rates[0] < rates[1] < rates[2] > rates[3] > rates[4]
@@ -118,13 +134,13 @@ REFERENCE = {"rpm": "exact", "torsion": "ode"}
 def indexed(name: str):
     """(the reference, Exudyn at the cross-check step) of an ``INDEXED`` scene."""
     s = crushing_scene(**SHORT, **INDEXED[name])
-    reference = simulate(s, "ode", preset="reference") if REFERENCE[name] == "ode" else simulate(s, "exact")
-    return reference, simulate(s, step_s=DEFAULT_STEP_S)
+    reference = result_of(s, "ode", preset="reference") if REFERENCE[name] == "ode" else result_of(s, "exact")
+    return reference, result_of(s, step_s=STEP_S)
 
 
 @functools.cache
 def paper_rate() -> float:
-    return rate(simulate(crushing_scene(**SHORT), "exact"))
+    return rate(result_of(crushing_scene(**SHORT), "exact"))
 
 
 @pytest.mark.slow
@@ -135,7 +151,7 @@ def test_exudyn_agrees_with_the_reference_with_indexing_on(name):
     assert 0 < rate(reference) < 0.9 * paper_rate()  # indexing costs penetration here
     assert rate(exudyn) == pytest.approx(rate(reference), rel=1e-4)
     for result in (reference, exudyn):
-        assert summary_metrics(result)["energy_balance_relative_error"] < 1e-4
+        assert result.metrics["energy_balance_relative_error"] < 1e-4
     etas = np.array(reference.solver.fresh_fractions)
     assert len(etas) == math.ceil(reference.scene.solver.end_time_s * reference.scene.impact.frequency_hz)
     np.testing.assert_allclose(exudyn.solver.fresh_fractions, etas, rtol=1e-3)
@@ -157,7 +173,7 @@ def test_torsion_angle_between_blows_sets_each_share():
 def test_exact_refuses_a_torsion_driven_share_with_the_reason():
     torsion = crushing_scene(**SHORT, **INDEXED["torsion"]).with_solver("exact")
     with pytest.raises(InputError, match="matrices would change at every blow; give rotation.speed_rpm"):
-        prepare_scene(torsion, "scene.yaml")
+        rpdrill.simulate(torsion)  # refused before it runs
 
 
 @pytest.mark.slow
@@ -167,11 +183,11 @@ def test_exact_agrees_with_ode_with_indexing_on():
     the bilinear rock. Over eight blows, the rate of the last four: the torsion-driven share changes at
     each of them (a blow start is where the formulations could part)."""
     window = {"solver__end_time_s": 8 / 45.0, "metrics__transient_blows": 4, "metrics__block_blows": 2}
-    exact = simulate(crushing_scene(**window, **INDEXED["rpm"]), "exact")
-    assert rate(simulate(exact.scene, "ode", preset="reference")) == pytest.approx(rate(exact), rel=1e-6)
+    exact = result_of(crushing_scene(**window, **INDEXED["rpm"]), "exact")
+    assert rate(result_of(exact.scene, "ode", preset="reference")) == pytest.approx(rate(exact), rel=1e-6)
     bilinear = crushing_scene(**window, **SPINNING, bit=BIT, rock={"law": "bilinear", "loading_stiffness_n_per_m": 2e8,
                                                                   "unloading_stiffness_n_per_m": 1e9})
-    exact, reference = simulate(bilinear, "exact"), simulate(bilinear, "ode", preset="reference")
+    exact, reference = result_of(bilinear, "exact"), result_of(bilinear, "ode", preset="reference")
     assert exact.solver.fresh_fractions[3] < 1 and rate(exact) == pytest.approx(rate(reference), rel=1e-6)
 
 
@@ -225,10 +241,11 @@ def test_indexing_alone_builds_the_crushing_it_indexes(tmp_path, capsys):
     both = crushing_scene(**SHORT, bit=BIT, rotation={"speed_rpm": 45.0},
                           effects={"indexing": True, "rock_plasticity": True})
     alone = both.with_({"effects": {"indexing": True}})
-    simulation = prepare(alone)
-    assert simulation.effects.indexing and simulation.effects.rock_plasticity
-    assert "needed by indexing" in simulation.effects.reasons["rock_plasticity"]
-    assert rate(simulate(alone, "exact")) == rate(simulate(both, "exact")) > 0
+    run = result_of(alone, "exact")
+    effects = run.simulation.effects  # the prepared scene's
+    assert effects.indexing and effects.rock_plasticity
+    assert "needed by indexing" in effects.reasons["rock_plasticity"]
+    assert rate(run) == rate(result_of(both, "exact")) > 0
     path = tmp_path / "scene.yaml"
     path.write_text(yaml.safe_dump(alone.model_dump(mode="json", by_alias=True, exclude_none=True)))
     assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet", "--formulation", "exact"]) == 0

@@ -1,5 +1,6 @@
 """models.drill.modal: the rock mode of the in-contact chain on chains with known answers and on a scene.
-Unit tests of models.drill.modal: they import it."""
+Unit tests of models.drill.modal, on chains built of models.drill.chain's bodies and models.definition.links'
+links and on a prepared scene's chain and rock (models.solvers.simulation): they import them."""
 
 import math
 
@@ -12,6 +13,10 @@ from rpdrill.models.drill.chain import AxialChain, ChainBody
 from rpdrill.models.drill.modal import rock_mode_frequency_hz
 from rpdrill.models.solvers.simulation import prepare
 from rpdrill.rocklaw import JenkinsRock
+
+# unit tests of: the rock mode of a chain of bodies and links, and of a prepared scene's chain on its rock
+UNITS = ("rpdrill.models.definition.links", "rpdrill.models.drill.chain", "rpdrill.models.drill.modal",
+         "rpdrill.models.solvers.simulation")
 
 
 def chain(masses_kg: list[float], joint_n_per_m: float | None = None, bit: int | None = None) -> AxialChain:

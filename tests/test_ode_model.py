@@ -11,9 +11,12 @@ import numpy as np
 import pytest
 from scenes import PAPER_BASE, read_yaml, simulate
 
+import rpdrill
+import rpdrill.models.solvers.ode_model
 from rpdrill import Scene, SimulationFailed
-from rpdrill.models.evaluation.energy import energy_account
-from rpdrill.models.solvers import ode_model
+
+# unit tests of: the ODE formulation (its solver's failure injected)
+UNITS = ("rpdrill.models.solvers.ode_model",)
 
 
 def scene_from_base(blows: float = 15, **changes: object) -> Scene:
@@ -34,12 +37,12 @@ CASES = {
 
 
 @functools.cache
-def result(case: str):
+def result(case: str) -> rpdrill.Result:
     """Eight blows of a case at the reference preset: the crushing cases switch into crushing ten times and
     lift off, the other lifts off in every blow, the torsion line's overshoot peaks at 14 ms (what the
     tests below check holds from the first blows on; fifteen blows cost twice as much)."""
-    return simulate(scene_from_base(blows=8, **{"metrics.transient_blows": 4, "metrics.block_blows": 2}, **CASES[case]),
-                    "ode", preset="reference")
+    s = scene_from_base(blows=8, **{"metrics.transient_blows": 4, "metrics.block_blows": 2}, **CASES[case])
+    return rpdrill.simulate(s.with_solver("ode", preset="reference"), budget=None)  # tests/scenes.py's simulate
 
 
 def test_does_not_import_exudyn() -> None:
@@ -49,7 +52,7 @@ def test_does_not_import_exudyn() -> None:
 
 @pytest.mark.parametrize("case", list(CASES))
 def test_energy_balances(case: str) -> None:
-    assert energy_account(result(case)).relative_residual() < 1e-4
+    assert result(case).energy.relative_residual() < 1e-4
 
 
 @pytest.mark.parametrize("case", list(CASES))
@@ -120,6 +123,7 @@ def test_unknown_method_is_rejected() -> None:
 
 
 def test_solver_failure_raises_simulation_failed(monkeypatch: pytest.MonkeyPatch) -> None:
+    ode_model = rpdrill.models.solvers.ode_model
     real = ode_model.solve_ivp
 
     def failing(*args, **kwargs):

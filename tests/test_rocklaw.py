@@ -1,6 +1,6 @@
 """The rock laws alone, through the interface (rocklaw.base.RockLaw): pure functions, the ODE mode
 tables against the return maps, and the symbolic recording for Exudyn.
-Unit tests of rocklaw.base: they import it."""
+Unit tests of rocklaw.base, rocklaw.modes and rocklaw.exudyn_element: they import them."""
 
 import dataclasses
 import math
@@ -11,6 +11,9 @@ import pytest
 from rpdrill.rocklaw import LAWS, TABLE_1, BilinearRock, JenkinsRock, RockLaw, force_and_state
 from rpdrill.rocklaw.base import local_values
 from rpdrill.rocklaw.modes import check_mode_forces, evaluate
+
+# unit tests of: a law's local values, its mode tables evaluated and checked, its Exudyn element's compiled force
+UNITS = ("rpdrill.rocklaw.base", "rpdrill.rocklaw.exudyn_element", "rpdrill.rocklaw.modes")
 
 ROCK = JenkinsRock(stiffness_n_per_m=5e8, damping_n_s_per_m=0.0, threshold_n=138e3)
 CRUSH = ROCK.crushing_penetration_m  # 276 um
