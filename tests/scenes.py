@@ -50,7 +50,12 @@ def crushing_scene(**overrides: Any) -> Scene:
     return scene(**({k.replace(".", "__"): v for k, v in CRUSHING.items()} | overrides))
 
 
-def simulate(scene: Scene, formulation: str | None = None, **options: Any) -> Any:
+def result_of(scene: Scene, formulation: str | None = None, **options: Any) -> rpdrill.Result:
     """Run ``scene`` with ``formulation`` (default: the scene's) and solver ``options``: ``rpdrill.simulate``,
-    unbudgeted (tests run scenes of many steps on purpose), its formulation's result (``Result.raw``)."""
-    return rpdrill.simulate(scene.with_solver(formulation, **options), budget=None).raw
+    unbudgeted (tests run scenes of many steps on purpose); the Result a user holds (metrics, energy account)."""
+    return rpdrill.simulate(scene.with_solver(formulation, **options), budget=None)
+
+
+def simulate(scene: Scene, formulation: str | None = None, **options: Any) -> Any:
+    """:func:`result_of`'s formulation's result (``Result.raw``: every sample, the chain)."""
+    return result_of(scene, formulation, **options).raw

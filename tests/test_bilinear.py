@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 import yaml
 from commands import main
-from scenes import scene, scene_dict
+from scenes import result_of, scene, scene_dict
 
 import rpdrill
 from rpdrill.models.evaluation.compare import compare_runs, verdict
@@ -28,11 +28,6 @@ K_LOAD, K_UNLOAD = 2e8, 1e9
 LAW = BilinearRock(K_LOAD, K_UNLOAD)
 ROCK = {"law": "bilinear", "loading_stiffness_n_per_m": K_LOAD, "unloading_stiffness_n_per_m": K_UNLOAD}
 BLOWS = 15  # the shortest window the default metrics accept
-
-
-def result_of(s: rpdrill.Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
-    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics, its energy account."""
-    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 def walk(path_m: np.ndarray, law: BilinearRock = LAW, state: tuple[float, ...] | None = None

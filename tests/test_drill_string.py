@@ -14,9 +14,8 @@ import numpy as np
 import pytest
 from commands import main
 from pydantic import ValidationError
-from scenes import read_yaml, scene, scene_dict, simulate
+from scenes import read_yaml, result_of, scene, scene_dict, simulate
 
-import rpdrill
 from rpdrill import Scene, load_scene
 from rpdrill.models.definition.links import RATE, STRETCH, Coupling, Link
 from rpdrill.models.drill.chain import axial_chain, link_load_n
@@ -31,11 +30,6 @@ UNITS = ("rpdrill.models.definition.links", "rpdrill.models.drill.chain", "rpdri
 
 SCENES = Path(__file__).resolve().parents[1] / "studies" / "scenes"
 ROD = {"length_m": 3.66, "diameter_m": 0.045, "bore_diameter_m": 0.012}
-
-
-def result_of(s: Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
-    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics, its energy account."""
-    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 def rod_string(**rod_overrides) -> Scene:

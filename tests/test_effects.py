@@ -6,9 +6,8 @@ import numpy as np
 import pytest
 import yaml
 from commands import main
-from scenes import CRUSHING, scene, scene_dict, simulate
+from scenes import CRUSHING, result_of, scene, scene_dict, simulate
 
-import rpdrill
 from rpdrill import build_exudyn
 from rpdrill.models.solvers.simulation import prepare
 
@@ -20,11 +19,6 @@ CRUSH = {k.replace(".", "__"): v for k, v in CRUSHING.items()}
 # what a penetration-rate scan needs: the same physics, no torsion, no forces, no energy
 RATE_ONLY = {"effects": {"rock_damping": True, "joint_damping": True},
              "outputs": {"metrics": ["penetration_rate_m_per_s"]}}
-
-
-def result_of(s: rpdrill.Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
-    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics."""
-    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 def test_full_model_when_no_effects_section():

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scenes import PAPER_BASE, PER_BODY, crushing_scene, read_yaml, scene
+from scenes import PAPER_BASE, PER_BODY, crushing_scene, read_yaml, result_of, scene
 
 import rpdrill
 import rpdrill.models.evaluation.stability
@@ -56,11 +56,6 @@ UNDAMPED = {
 ODE_RTOL, ODE_ATOL = 1e-12, 1e-15
 ODE_BLOWS = 6  # the tight ODE's window against the exact solution: its cost grows with every blow
 AGREEMENT = 1e-9
-
-
-def result_of(s: Scene, formulation: str | None = None, **options: object) -> Result:
-    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics, its energy account."""
-    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 def crushing(feed: str, damping_mode: str, blows: int = BLOWS, **changes: object) -> Scene:

@@ -11,9 +11,8 @@ import numpy as np
 import pytest
 from doc_examples import Ran, run_examples
 from ruamel.yaml import YAML
-from scenes import scene_dict, simulate
+from scenes import result_of, scene_dict, simulate
 
-import rpdrill
 from rpdrill import Scene
 from rpdrill.models.definition.links import LINK_TYPES, RATE, STRETCH, Link
 from rpdrill.models.evaluation.compare import compare_bottom_at, compare_histories
@@ -67,11 +66,6 @@ def _scene(joint_type, **joint) -> Scene:
     connector["collar_bit_joint"].update(joint)
     return Scene.model_validate(scene_dict(**SHORT, **{"drill_string.connectors.collar_bit_joint":
                                                        connector["collar_bit_joint"]}))
-
-
-def result_of(s: Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
-    """tests/scenes.py's ``simulate`` as the Result a user holds: its energy account."""
-    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 def test_joint_with_play_transmits_nothing_inside_its_play_and_keeps_the_energy_balance(joint_type):

@@ -4,18 +4,13 @@ import warnings
 
 import numpy as np
 import pytest
-from scenes import PER_BODY, crushing_scene, scene, simulate
+from scenes import PER_BODY, crushing_scene, result_of, scene, simulate
 
 import rpdrill
 from rpdrill import build_exudyn
 
 SHORT = {"solver__end_time_s": 0.3, "metrics__transient_blows": 4, "metrics__block_blows": 3}
 PER_BODY_KW = {k.replace(".", "__"): v for k, v in PER_BODY.items()}
-
-
-def result_of(s: rpdrill.Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
-    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics, its energy account."""
-    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 @pytest.fixture(scope="module")

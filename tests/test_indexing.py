@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import yaml
 from commands import main
-from scenes import CRUSHING, crushing_scene, read_yaml, scene, scene_dict
+from scenes import CRUSHING, crushing_scene, read_yaml, result_of, scene, scene_dict
 
 import rpdrill
 from rpdrill import InputError, Scene, load_study
@@ -45,11 +45,6 @@ def angle(arc_m: float) -> float:
 def bit(**changes: float) -> Any:
     """The issue's DTH bit with ``changes``, as a scene's bit section (what the indexing effect takes)."""
     return scene(bit=BIT | changes).bit
-
-
-def result_of(s: Scene, formulation: str | None = None, **options: object) -> rpdrill.Result:
-    """tests/scenes.py's ``simulate`` as the Result a user holds: its metrics."""
-    return rpdrill.simulate(s.with_solver(formulation, **options), budget=None)
 
 
 def rate(result: rpdrill.Result) -> float:
