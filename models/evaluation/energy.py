@@ -90,8 +90,8 @@ class EnergyAccount:
         return residual
 
     def relative_residual(self) -> float:
-        """Largest |residual| over the run divided by the total impact work; not a number when an item of
-        one's own is not accounted for (the result's info names it)."""
+        """max_t abs(``residual_j``) over the run divided by the total impact work; not a number when an item
+        of one's own is not accounted for (``Result.raw.user_energy.unaccounted`` names it)."""
         if not self.complete:
             return float("nan")
         return float(np.max(np.abs(self.residual_j)) / max(self.impact_work_j[-1], 1e-300))
