@@ -19,6 +19,15 @@ OK, NO_EXIT = 0, 1  # kernel status: NO_EXIT where a switch's modes have no exit
 
 
 @njit(cache=True)
+def _copy(source: np.ndarray, target: np.ndarray) -> None:
+    """target = source, element by element (a slice assignment compiles numba's shape-mismatch message: 3 to 4 of the
+    kernel's 6.5 s of compilation, for a check these equal shapes never fail)."""
+    for r in range(source.shape[0]):
+        for c in range(source.shape[1]):
+            target[r, c] = source[r, c]
+
+
+@njit(cache=True)
 def _left_multiply(matrix: np.ndarray, transposed: bool, product: np.ndarray, out: np.ndarray) -> None:
     """out = M product (``transposed``: ``matrix`` holds M^T); the innermost loop runs along product's rows."""
     size, columns = product.shape
@@ -58,17 +67,17 @@ def _propagate(key: int, length_s: float, taylor: np.ndarray, anchors: np.ndarra
         while whole:
             if whole & 1:
                 _left_multiply(block, False, product, scratch)
-                product[:] = scratch
+                _copy(scratch, product)
             whole >>= 1
             if whole:
                 _left_multiply(block, False, block, squared)
-                block[:] = squared
+                _copy(squared, block)
     if power:
         _left_multiply(readout[key, :, power * width:power * width + size], True, product, scratch)
-        product[:] = scratch
+        _copy(scratch, product)
     if anchor:
         _left_multiply(anchors[key, :, anchor * size:(anchor + 1) * size], True, product, scratch)
-        product[:] = scratch
+        _copy(scratch, product)
     order = taylor.shape[2] // width - 1
     series = np.zeros((size, size))  # sum_k s^k A^k / k! (stored transposed, as the Taylor matrices)
     power_of_rest = 1.0
@@ -78,7 +87,7 @@ def _propagate(key: int, length_s: float, taylor: np.ndarray, anchors: np.ndarra
                 series[j, r] += power_of_rest * taylor[key, j, k * width + r]
         power_of_rest *= rest
     _left_multiply(series, True, product, scratch)
-    product[:] = scratch
+    _copy(scratch, product)
 
 
 @njit(cache=True)
@@ -89,7 +98,7 @@ def monodromy(columns: np.ndarray, time_s: np.ndarray, rows: np.ndarray, keys: n
     """product = dw/dw0 columns over the run (module doc); OK, or NO_EXIT."""
     size = columns.shape[0]
     width = readout.shape[2] // per_anchor
-    product[:] = columns
+    _copy(columns, product)
     scratch = np.empty_like(product)
     before, after, jump, c_product = np.empty(size), np.empty(size), np.empty(size), np.empty(product.shape[1])
     last = time_s.shape[0] - 1
@@ -118,7 +127,8 @@ def monodromy(columns: np.ndarray, time_s: np.ndarray, rows: np.ndarray, keys: n
                     total_after += taylor[new, k, width + r] * w_after[k]
                 before[r], after[r] = total_before, total_after
             # M f-: the reset rows replace their targets (the bottom's kept where the reset would lower it)
-            jump[:] = after - before
+            for r in range(size):
+                jump[r] = after[r] - before[r]
             c_before = 0.0
             for k in range(size):
                 c_before += readout[old, k, size + 2 + e] * before[k]
@@ -127,7 +137,7 @@ def monodromy(columns: np.ndarray, time_s: np.ndarray, rows: np.ndarray, keys: n
                 for k in range(size):
                     total += readout[old, k, size + 2 + e] * product[k, c]
                 c_product[c] = total
-            scratch[:] = product
+            _copy(product, scratch)
             for j in range(reset_counts[old, e]):
                 target = reset_targets[old, e, j]
                 row = reset_rows[old, e, j]
