@@ -2,8 +2,9 @@
 processes, each compile the kernels they call before the cache holds them.
 
 Usage: python benchmarks/bench_compile.py [--base REV]
-Three first calls, each in a fresh process with an empty numba cache (``NUMBA_CACHE_DIR``): an exact run of
-paper_base, its periodic orbit (the monodromy kernel), an exact run of the shipped top-hammer wave scene. Prints
+Three first calls, each alone in a fresh process with an empty numba cache (``NUMBA_CACHE_DIR``): an exact run of
+paper_base, its periodic orbit (its time run's kernels and the monodromy kernel), an exact run of the shipped
+top-hammer wave scene. Prints
 each call's process CPU and every kernel's compile time over 0.1 s (numba's ``numba:compile`` events; a kernel's
 time includes what it compiles inside it). ``--base REV``: the same at that git revision too, for a change's before.
 """
@@ -27,7 +28,7 @@ CALLS = {
                 '**short}), formulation="exact", budget=None)',
 }
 
-# In the fresh process: the calls before this one warm (their kernels compiled and cached), then this one timed.
+# In the fresh process: one call, timed.
 FIRST_CALL = """
 import sys, time
 from numba.core import event
@@ -42,7 +43,6 @@ class Timer(event.Listener):
                          e.data["dispatcher"].py_func.__qualname__))
 short = {{"metrics.transient_blows": 1, "metrics.block_blows": 1}}
 paper = rpdrill.load_scene("paper_base").with_({{"solver.end_time_s": 0.05, **short}})
-{before}
 event.register("numba:compile", Timer())
 start = time.process_time()
 {call}
@@ -55,12 +55,10 @@ for seconds, name in compiled:
 
 
 def first_calls(tree: Path, cwd: Path) -> None:
-    """Each call of CALLS timed in a fresh process (the calls before it run first in it) on one empty cache per
-    process, rpdrill imported from ``tree``."""
-    names = list(CALLS)
-    for i, name in enumerate(names):
+    """Each call of CALLS timed alone in a fresh process on an empty cache, rpdrill imported from ``tree``."""
+    for name, call in CALLS.items():
         with tempfile.TemporaryDirectory() as cache:
-            code = FIRST_CALL.format(before="\n".join(CALLS[n] for n in names[:i]), call=CALLS[name])
+            code = FIRST_CALL.format(call=call)
             env = {**os.environ, "PYTHONPATH": str(tree), "NUMBA_CACHE_DIR": cache}
             out = subprocess.run([sys.executable, "-c", code], env=env, cwd=cwd, check=True, capture_output=True,
                                  text=True).stdout.splitlines()
