@@ -409,3 +409,4 @@ def test_a_study_on_a_dask_local_cluster_stops_within_2_s_without_worker_traceba
     assert_stopped_cleanly(stopped, 130, len(kept))
     assert len(stopped.err.splitlines()) == 2, stopped.err  # what it runs, and the one line of the stop
     assert json.loads((out / "study.json").read_text())["sessions"][-1]["interrupted"] is True
+

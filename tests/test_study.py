@@ -7,6 +7,7 @@ import contextlib
 import csv
 import hashlib
 import json
+import logging
 import os
 import signal
 import subprocess
@@ -23,7 +24,13 @@ from scenes import PAPER_BASE, scene_dict
 
 import rpdrill
 from rpdrill.models.definition.outputs import METRICS
-from rpdrill.studies.runtime.pools import BATCHES_PER_WORKER, ONE_THREAD, batches, process_pool
+from rpdrill.studies.runtime.pools import (
+    BATCHES_PER_WORKER,
+    ONE_THREAD,
+    _dask_logs_quiet,
+    batches,
+    process_pool,
+)
 
 # the metrics' registry, and the process pools' batches and threads
 UNITS = ("rpdrill.models.definition.outputs", "rpdrill.studies.runtime.pools")
@@ -376,3 +383,24 @@ def test_exact_formulation_as_the_fast_path_agrees_with_exudyn(tmp_path):
         rates[formulation] = [float(r["penetration_rate_m_per_s"]) for r in sorted(rows(out), key=lambda r: r["point"])]
     assert min(rates["exact"]) > 0
     assert rates["exudyn"] == pytest.approx(rates["exact"], rel=3e-3)
+
+
+def test_a_stop_while_a_result_is_fetched_from_dask_logs_nothing_but_a_lost_key_is_logged():
+    """A stop during the fetch of a finished batch cancels it, and Dask's scheduler then logged
+    "Couldn't gather keys: {...: 'forgotten'}" at ERROR (in 1 stop of 6 of tests/test_interrupts.py::
+    test_a_study_on_a_dask_local_cluster_stops_within_2_s_without_worker_tracebacks); a key still known
+    when a fetch fails (a worker lost) stays logged."""
+    scheduler = logging.getLogger("distributed.scheduler")
+    records: list[logging.LogRecord] = []
+    handler = logging.Handler()
+    handler.emit = records.append  # type: ignore[method-assign]
+    scheduler.addHandler(handler)
+    try:
+        with _dask_logs_quiet():
+            scheduler.error("Couldn't gather keys: %s", {"run_batch-0": "forgotten"})
+            scheduler.error("Couldn't gather keys: %s", {"run_batch-1": "memory"})
+        scheduler.error("Couldn't gather keys: %s", {"run_batch-2": "forgotten"})
+    finally:
+        scheduler.removeHandler(handler)
+    assert [record.getMessage() for record in records] == [
+        "Couldn't gather keys: {'run_batch-1': 'memory'}", "Couldn't gather keys: {'run_batch-2': 'forgotten'}"]
