@@ -1,10 +1,11 @@
 """Where the test suite's CPU goes: every test's CPU seconds, its own and its subprocesses'.
 
-Usage: python benchmarks/bench_tests.py [PYTEST ARGS ...]   (default: the whole suite, as the README runs it)
+Usage: python benchmarks/bench_tests.py [--save CSV] [PYTEST ARGS ...]   (default: the whole suite, as the README runs it)
 Runs ``python -m pytest -q -p bench_tests PYTEST ARGS`` from the checkout with this file as a pytest plugin
 (loaded by every xdist worker too): each test's ``time.process_time()`` of the process that ran it plus
 ``resource.getrusage(RUSAGE_CHILDREN)`` (the subprocesses and pool workers it waited for), setup and
-teardown included. Prints the 40 costliest tests, the CPU per test file and the total.
+teardown included. Prints the 40 costliest tests, the CPU per test file and the total; ``--save CSV`` writes every
+test's row (cpu_s, own_s, children_s, wall_s, test).
 """
 
 from __future__ import annotations
@@ -43,19 +44,25 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
 
 
 def main(arguments: list[str]) -> int:
+    save = None
+    if arguments[:1] == ["--save"]:
+        save, arguments = Path(arguments[1]), arguments[2:]
     with tempfile.TemporaryDirectory() as folder:
         env = {**os.environ, RECORDS: folder,
                "PYTHONPATH": os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")]))}
         status = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "bench_tests", *arguments], cwd=ROOT,
                                 env=env, check=False).returncode
         rows = [line.split(" ", 3) for path in Path(folder).glob("*.txt") for line in path.read_text().splitlines()]
-    tests = sorted(((float(own) + float(children), float(own), float(children), node.split("@")[0])
-                    for own, children, _, node in rows), reverse=True)
+    tests = sorted(((float(own) + float(children), float(own), float(children), node.split("@")[0], float(wall))
+                    for own, children, wall, node in rows), reverse=True)
+    if save is not None:
+        save.write_text("cpu_s,own_s,children_s,wall_s,test\n" + "".join(
+            f"{total:.3f},{own:.3f},{children:.3f},{wall:.3f},{node}\n" for total, own, children, node, wall in tests))
     print(f"\n{'CPU s':>8} {'own':>8} {'children':>8}  test")
-    for total, own, children, node in tests[:40]:
+    for total, own, children, node, _ in tests[:40]:
         print(f"{total:8.2f} {own:8.2f} {children:8.2f}  {node}")
     files: dict[str, float] = defaultdict(float)
-    for total, _, _, node in tests:
+    for total, _, _, node, _ in tests:
         files[node.split("::")[0]] += total
     print(f"\n{'CPU s':>8}  file")
     for name, total in sorted(files.items(), key=lambda item: -item[1]):
