@@ -8,6 +8,7 @@ import pytest
 import yaml
 from commands import main
 from matplotlib.figure import Figure
+from pictures import inked_at_the_edges
 from PIL import Image
 from scenes import crushing_scene, scene_dict, simulate
 
@@ -95,6 +96,9 @@ def test_simulate_draws_the_drill_and_with_animate_writes_what_exudyns_viewer_op
     assert {"drill.png", "drill.gif"} <= {p.name for p in exact.iterdir()}
     assert not (exact / "solution.txt").exists()  # only an Exudyn run writes Exudyn's solution file
     assert json.loads((exact / "summary.json").read_text())["formulation"] == "exact"
+    for movie in (out / "drill.gif", exact / "drill.gif"):  # Exudyn's: the model's graphics; exact: the drawing
+        assert inked_at_the_edges(movie) == 0, movie
+
 
 
 def test_a_drawing_into_a_folder_that_is_not_there_is_refused_before_anything_is_drawn(tmp_path):

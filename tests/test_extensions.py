@@ -290,6 +290,7 @@ def test_draw_an_extended_model_from_its_exudyn_graphics(tmp_path):
 def test_view_solution_replays_an_extended_run_and_refuses_one_it_cannot_rebuild(tmp_path):
     """Why 6: view_solution of an extended run failed (SetODE2Coords: incompatible size of vectors)."""
     from commands import main
+    from pictures import inked_at_the_edges
 
     from rpdrill.studies.drawings.drill_animation import load_solution
 
@@ -302,6 +303,7 @@ def test_view_solution_replays_an_extended_run_and_refuses_one_it_cannot_rebuild
     assert solution["data"].shape[1] == 1 + model.coordinate_count and "clamp" in {
         model.mbs.GetObject(i)["name"] for i in range(model.mbs.systemData.NumberOfObjects())}
     assert (tmp_path / "run" / "drill.gif").stat().st_size > 10_000  # the model drawn from its graphics, every frame
+    assert inked_at_the_edges(tmp_path / "run" / "drill.gif") == 0  # laid out: its labels inside the frame
     assert (tmp_path / "run" / "drill.png").stat().st_size > 10_000
     by_hand = clamped(PAPER.with_(SHORT), stiffness_n_per_m=1e9)
     by_hand.write_solution(tmp_path / "solution.txt")

@@ -32,7 +32,7 @@ from matplotlib.figure import Figure
 
 from ...models.evaluation.results import SimulationResult
 from ...models.evaluation.run_result import Result
-from ..figures.figure_style import figure
+from ..figures.figure_style import figure, keep_layout
 from ..inputs.arguments import (
     built_model_problem,
     check,
@@ -158,6 +158,9 @@ def write_animation(result: SimulationResult | Result | ExudynModel, path: str |
                      f"{1e3 * (positions[k, result.chain.bit_body] - positions[0, result.chain.bit_body]):+.3f} mm, "
                      f"borehole bottom {1e3 * (bottom[k] - bottom[0]):+.3f} mm since the window's start", fontsize=9)
 
+    frame(0)
+    fig.draw_without_rendering()
+    keep_layout(fig)  # laid out once: each frame's drawing, its title and labels keep the first frame's margins
     save_frames(fig, frame, len(times), path, writer)
     return factor
 
@@ -274,7 +277,7 @@ def model_animation(model: ExudynModel, path: str | Path, blows: int = 3, magnif
                      f"(blow {data[rows[k], 0] / period:.2f}); items of one's own in this colour", fontsize=9)
 
     frame(0)
-    fig.canvas.draw()
-    fig.set_layout_engine("none")  # laid out once: every frame is drawn as the first (a layout per frame costs)
+    fig.draw_without_rendering()
+    keep_layout(fig)  # laid out once: every frame is drawn as the first (a layout per frame costs)
     save_frames(fig, frame, len(rows), path, writer)
     return factor

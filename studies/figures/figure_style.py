@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import matplotlib
 from matplotlib.figure import Figure
 from matplotlib.layout_engine import ConstrainedLayoutEngine
 
@@ -63,5 +64,14 @@ def save(fig: Figure, path: Path, dpi: int = 120) -> list[Path]:
         options = {"pil_kwargs": {"compress_level": 1}} if target.suffix == ".png" else {}
         fig.savefig(target, dpi=dpi, bbox_inches=None if constrained else "tight", **options)
         if constrained:
-            fig.set_layout_engine("none")  # laid out: the next file is drawn as this one was
+            keep_layout(fig)  # laid out: the next file is drawn as this one was
     return paths
+
+
+def keep_layout(fig: Figure) -> None:
+    """Keep ``fig``'s layout as it was last solved: no layout engine at all. (``set_layout_engine("none")``
+    leaves a placeholder engine, for which every ``savefig``, and so every animation frame grabbed, first
+    draws the whole figure once more: the timeseries figure's two files took 4 draws, the animation's 60
+    frames 120.) The rc settings that would choose an engine for None are set aside for the call."""
+    with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+        fig.set_layout_engine(None)
