@@ -24,7 +24,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -61,7 +61,6 @@ from ..evaluation.results import SimulationResult
 from ..evaluation.run_record import ExudynSolverRecord
 from ..evaluation.run_result import Result
 from ..evaluation.stability import StepLimitWarning, check_result, step_warning
-from ..waves.exudyn_waves import WaveExudyn
 from .exudyn_graphics import DrillGraphics, body_graphics, chain_cylinders, torsion_graphics
 from .exudyn_messages import (
     SOLVER_TYPES,
@@ -94,6 +93,8 @@ from .exudyn_user_items import (
 )
 from .simulation import Simulation, exudyn_simulation, solver_settings
 
+if TYPE_CHECKING:
+    from ..waves.exudyn_waves import WaveExudyn
 COORDINATE = exu.OutputVariableType.Coordinates
 RATE = exu.OutputVariableType.Coordinates_t
 AXIS_X_FROM_Z = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]  # a rotational node's local z onto the drilling axis
@@ -287,8 +288,7 @@ class ExudynModel:
         if progress is not None:
             self._watch.append(progress_reporter(self.simulation.settings.end_time_s, progress))
         self._install()
-        warning = step_warning(self.simulation) if self.waves is None else None
-        if warning:
+        if self.waves is None and (warning := step_warning(self.simulation)):
             warnings.warn(warning, StepLimitWarning, stacklevel=3)
         blas = self.waves.single_threaded() if self.waves is not None else contextlib.nullcontext()
         with no_cyclic_gc(), exudyn_messages_as_warnings(self.simulation.name), blas, solver_errors(self):
@@ -351,6 +351,7 @@ def build_exudyn(run: Scene | Simulation, symbolic: bool = True, graphics: bool 
                          "prepared simulation")
     simulation, named = exudyn_simulation(run)
     if simulation.dynamic_chain.waves:  # the string's bodies with mass, the rods an element (models.waves)
+        from ..waves.exudyn_waves import WaveExudyn  # here: without wave rods, neither they nor numba load
         model = WaveExudyn(simulation, symbolic).model(ExudynModel, ExudynBody, ExudynConnector,
                                                        simulation_settings(simulation), named)
         apply_extensions(model)
@@ -475,9 +476,8 @@ def _read_result(model: ExudynModel, ok: bool, cpu: float) -> SimulationResult:
     reached_s = mbs.systemData.GetTime()
     data = {name: mbs.GetSensorStoredData(sensor) for name, sensor in model.sensors.items()}
     time_s = data["x0"][:, 0]
-    n = model.chain.size
-    position = np.column_stack([data[f"x{i}"][:, 1] for i in range(n)])
-    velocity = np.column_stack([data[f"v{i}"][:, 1] for i in range(n)])
+    position = np.column_stack([data[f"x{i}"][:, 1] for i in range(model.chain.size)])
+    velocity = np.column_stack([data[f"v{i}"][:, 1] for i in range(model.chain.size)])
     history = np.array(model.rock.bottom_history)
     piston = None if model.piston is None else model.piston.history(time_s, position, velocity)
     position, velocity = position[:, :simulation.chain.size], velocity[:, :simulation.chain.size]
