@@ -46,6 +46,13 @@ def short_scene(**overrides) -> rpdrill.Scene:
     return scene(**SHORT, **overrides)
 
 
+def coarse(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The advice's curves at 5 points and its map at 3 x 3, not 15 and 12 x 12 (most of an advice's runs):
+    for the tests that check something else; test_advise_finds_the_best_of_a_fine_grid checks them as shipped."""
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.MAP_POINTS", 3)
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.SLICE_POINTS", 5)
+
+
 @pytest.mark.slow
 def test_advise_finds_the_best_of_a_fine_grid():
     """Differential evolution against every point of a 1 Hz x 1 kN grid over the same bounds."""
@@ -153,10 +160,11 @@ def test_advise_command_writes_the_advice(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_an_interrupted_advice_continues_where_it_stopped(tmp_path, capsys):
+def test_an_interrupted_advice_continues_where_it_stopped(tmp_path, capsys, monkeypatch):
     """The points of a cut run (its checkpoint cut mid-line, as a kill leaves it) are replayed, the rest
     run: the same advice as an uncut run; a finished advice run again replays every point; another
     advice into the folder is refused before it runs."""
+    coarse(monkeypatch)
     scene = write_scene(tmp_path)
     command = ["advise", scene, "--frequency-hz", "45", "70", "--feed-kn", "35", "60", "--popsize", "3",
                "--generations", "2", "--workers", "1", "--quiet"]
@@ -193,9 +201,10 @@ def test_advise_bad_bounds_exit_2(tmp_path, capsys, arguments, expected):
 
 
 @pytest.mark.slow
-def test_the_library_call_gives_the_commands_advice(tmp_path):
+def test_the_library_call_gives_the_commands_advice(tmp_path, monkeypatch):
     """rpdrill.advise with the bounds in SI units: the advice and the files the command writes for the same
     inputs (``out``; a rerun there replays every point); a bound the search does not take is an InputError naming it and what is allowed."""
+    coarse(monkeypatch)
     scene = write_scene(tmp_path)
     out = tmp_path / "out"
     assert main(["advise", scene, "--frequency-hz", "45", "70", "--feed-kn", "35", "60", "--popsize", "3",

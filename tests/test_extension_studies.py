@@ -18,7 +18,7 @@ import rpdrill
 from rpdrill.studies.sensitivity.sensitivity_study import scene_values
 
 # the numbers of a scene a sensitivity study may vary
-UNITS = ("rpdrill.studies.sensitivity.sensitivity_study",)
+UNITS = ("rpdrill.studies.sensitivity.sensitivity_study", "rpdrill.studies.advice.advice_search")
 
 MASS = "extensions.clamp.parameters.mass_kg"
 ALLOW = ["user_rig"]  # the tests' rig (tests/user_rig.py): code of one's own, allowed by who reads the scenes
@@ -105,7 +105,11 @@ def test_an_extension_parameter_is_a_sensitivity_parameter(tmp_path):
 
 
 @pytest.mark.slow
-def test_an_extension_parameter_is_an_advice_axis():
+def test_an_extension_parameter_is_an_advice_axis(monkeypatch):
+    """The curves and the map coarse (3 points a curve, 2 x 2: 25 runs, not 192): what is checked is that the
+    search takes the extension's parameter as an axis, not those grids (tests/test_advice.py checks them)."""
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.MAP_POINTS", 2)
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.SLICE_POINTS", 3)
     scene = rpdrill.load_scene(PAPER_BASE, allow_code=ALLOW).with_({**SHORT, "extensions": CLAMP, "solver.end_time_s": 0.07,
                                                   "metrics.transient_blows": 1, "metrics.block_blows": 2})
     (advice,) = rpdrill.advise(scene, {"impact.frequency_hz": (45.0, 60.0), "feed.force_n": (20e3, 30e3),

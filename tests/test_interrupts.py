@@ -24,6 +24,9 @@ from scenes import PAPER_BASE
 
 import rpdrill
 
+# the advice's grids made coarse for an advice's reruns
+UNITS = ("rpdrill.studies.advice.advice_search",)
+
 ROOT = Path(__file__).resolve().parents[1]
 EXIT_WITHIN_S = 2.0
 LEFT_WITHIN_S = 2.0  # no process of a stopped run's session may be left this long after the command exited
@@ -302,9 +305,12 @@ def test_a_calibration_stops_within_2_s_and_resumes_to_the_same_evaluations(tmp_
 
 
 @pytest.mark.slow
-def test_an_advice_stops_within_2_s_and_resumes_to_the_same_advice(tmp_path):
+def test_an_advice_stops_within_2_s_and_resumes_to_the_same_advice(tmp_path, monkeypatch):
     """rpdrill advise keeps every point run before the signal (evaluations.jsonl) and, run again,
-    replays them and gives the advice of an uninterrupted run."""
+    replays them and gives the advice of an uninterrupted run. The reruns here draw the curves and the map
+    coarse (what is checked is the search's replay; the stop comes within its first 32 points, before them)."""
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.MAP_POINTS", 3)
+    monkeypatch.setattr("rpdrill.studies.advice.advice_search.SLICE_POINTS", 5)
     # 1 s of the drill (45 blows at the lowest frequency; 3 s before): ~2 CPU s less a command, and the
     # command still runs for seconds after its 10th point
     scene = write(tmp_path / "drill.yaml", {**yaml.safe_load(PAPER_BASE.read_text()), "solver": {"end_time_s": 1.0}})
