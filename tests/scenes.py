@@ -4,6 +4,8 @@ it; rpdrill's own reader adds refusals of bad input, which the tests' files are 
 
 from __future__ import annotations
 
+import copy
+import functools
 from pathlib import Path
 from typing import Any
 
@@ -22,8 +24,13 @@ PER_BODY = {"drill_string.bodies.carriage": None, "drill_string.connectors.shock
 
 
 def read_yaml(path: str | Path) -> dict[str, Any]:
-    """The mapping in a YAML file."""
-    return YAML(typ="safe", pure=True).load(Path(path).read_text(encoding="utf-8"))
+    """The mapping in a YAML file (a copy of the text's parse, kept: the tests read the shipped scenes often)."""
+    return copy.deepcopy(_parsed(Path(path).read_text(encoding="utf-8")))
+
+
+@functools.lru_cache(maxsize=32)
+def _parsed(text: str) -> Any:
+    return YAML(typ="safe", pure=True).load(text)
 
 
 def scene_dict(path: Path = PAPER_BASE, **overrides: Any) -> dict:

@@ -116,3 +116,15 @@ def test_what_rpdrill_writes_reads_back(tmp_path):
     data = {"name": "x", "texts": ["02500", "1:00", "yes", "on", "2024-01-01", "1e5"], "numbers": [1e-5, 2500, 1e300]}
     write_resolved(tmp_path / "r.yaml", data)
     assert read_yaml(tmp_path / "r.yaml") == data
+
+
+def test_a_text_read_twice_gives_two_independent_mappings():
+    """The parse of a text is kept for its next read (studies.inputs.strict_yaml): each read gets its own copy,
+    and a refused text is refused again."""
+    text = "a: {b: [1.0, 2.0]}\n"
+    first = parse_yaml(text, "x.yaml")
+    first["a"]["b"].append(3.0)
+    assert parse_yaml(text, "x.yaml") == {"a": {"b": [1.0, 2.0]}}
+    for _ in range(2):
+        with pytest.raises(InputError, match="a.b.c"):
+            parse_yaml("a: {b: {c: 1, c: 2}}\n", "x.yaml")
