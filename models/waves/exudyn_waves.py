@@ -206,9 +206,10 @@ class WaveExudyn:
                                 stepper.step_s)
             def end() -> Snapshot:  # Exudyn's state at the step's end: exact (taken only for a peak there)
                 return stepper._snapshot(k * stepper.step_s, w, stepper.key(), after=False)
-            stepper.close_ports(k - 1, self.body_ports, body_segments(stepper.last_segments, motion), again=True,
-                                ends=(self.step_start, end))
-            stepper.works[1] += port_work_j(stepper.last_segments, motion, self.body_ports, stepper.port_impedances)
+            moved = body_segments(stepper.last_segments, motion)
+            stepper.close_ports(k - 1, self.body_ports, moved, again=True, ends=(self.step_start, end))
+            stepper.works[1] += port_work_j(stepper.last_segments, moved, motion, self.body_ports,
+                                            stepper.port_impedances)
             self.closed = k
         if k >= self.closed:
             self.previous, self.previous_velocity = w[:stepper.layout.n].copy(), velocity

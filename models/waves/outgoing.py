@@ -211,11 +211,12 @@ def _moved(s: Segment, position, velocity, acceleration) -> Segment:
 GAUSS_POINTS, GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(3)
 
 
-def port_work_j(segments: list[Segment], motion: BodyMotion, ports: np.ndarray, impedances: np.ndarray) -> float:
-    """int Z (v - 2 w_in) v dt into the rods at ``ports`` over the step, v the bodies' motion (:func:`body_segments`)
-    and w_in each segment's arriving line: Gauss-Legendre on 3 points per segment."""
+def port_work_j(segments: list[Segment], moved: list[Segment], motion: BodyMotion, ports: np.ndarray,
+                impedances: np.ndarray) -> float:
+    """int Z (v - 2 w_in) v dt into the rods at ``ports`` over the step, v the bodies' motion (``moved``:
+    :func:`body_segments` of ``segments`` and ``motion``) and w_in each segment's arriving line: Gauss-Legendre on
+    3 points per segment."""
     total = 0.0
-    moved = body_segments(segments, motion)
     for s, m in zip(segments, moved, strict=True):
         length = s.end - s.begin
         for point, weight in zip(GAUSS_POINTS, GAUSS_WEIGHTS, strict=True):
