@@ -74,16 +74,10 @@ def main() -> None:
     args = parser.parse_args()
     print("| first call (empty cache) | CPU s | kernels compiled (over 0.1 s) |")
     print("|---|---|---|")
-    if args.base:
-        sys.path.insert(0, str(Path(__file__).parent))
-        from bench_same_results import export
+    sys.path.insert(0, str(Path(__file__).parent))
+    from bench_same_results import at_base_and_here
 
-        with tempfile.TemporaryDirectory() as folder:
-            tree = export(args.base, Path(folder))
-            print(f"| at {args.base} | | |")
-            first_calls(tree, tree / "rpdrill")
-        print("| this checkout | | |")
-    first_calls(ROOT, ROOT)
+    at_base_and_here(args.base, lambda tree: first_calls(tree, tree / "rpdrill" if tree != ROOT else ROOT), 3)
 
 
 if __name__ == "__main__":

@@ -13,7 +13,6 @@ import argparse
 import os
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -77,16 +76,10 @@ def main() -> None:
     args = parser.parse_args()
     print("| figure | CPU s (median) | figure draws |")
     print("|---|---|---|")
-    if args.base:
-        sys.path.insert(0, str(Path(__file__).parent))
-        from bench_same_results import export
+    sys.path.insert(0, str(Path(__file__).parent))
+    from bench_same_results import at_base_and_here
 
-        with tempfile.TemporaryDirectory() as folder:
-            tree = export(args.base, Path(folder))
-            print(f"| at {args.base} | | |")
-            figures(tree, args.repeats)
-        print("| this checkout | | |")
-    figures(ROOT, args.repeats)
+    at_base_and_here(args.base, lambda tree: figures(tree, args.repeats), 3)
 
 
 if __name__ == "__main__":

@@ -32,6 +32,7 @@ import sys
 import tarfile
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -64,6 +65,18 @@ def export(revision: str, folder: Path) -> Path:
     with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
         tar.extractall(package, filter="data")
     return folder
+
+
+def at_base_and_here(base: str | None, rows: Callable[[Path], None], columns: int) -> None:
+    """``rows(tree)`` of a markdown table at git revision ``base`` (when given) and then at this checkout, each
+    part under a row naming it (``columns`` the table's)."""
+    blanks = " |" * (columns - 1)
+    if base:
+        with tempfile.TemporaryDirectory() as folder:
+            print(f"| at {base} |{blanks}")
+            rows(export(base, Path(folder)))
+        print(f"| this checkout |{blanks}")
+    rows(ROOT)
 
 
 def run_command(path_entry: Path, words: list[str], out: Path, workers: int) -> float:
