@@ -128,7 +128,8 @@ class WaveExudyn:
         self.pulse_on_body = self.stepper.pulse_outside = chain.impact_body in self.bodies and impact.piston is None
         self.last_powers: np.ndarray | None = None
         self.indices = np.array([mbs.GetNodeODE2Index(self.bodies[i][0]) for i in kinematic], dtype=int)
-        self.velocity_index = [self.stepper.layout.velocity[i] for i in kinematic]
+        self.body_nodes = np.array(sorted(self.bodies), dtype=int)  # the bodies' places in the element's state
+        self.velocity_index = np.array([self.stepper.layout.velocity[i] for i in kinematic], dtype=int)
         self.closed, self.previous = 0, self.stepper.w[:self.stepper.layout.n].copy()
         self.previous_velocity = np.zeros(self.stepper.layout.n)
         self.last_velocity: np.ndarray | None = None  # the bodies' velocities at the last step's start
@@ -194,7 +195,7 @@ class WaveExudyn:
             return
         w = stepper.w
         before = w[:stepper.layout.n].copy()
-        w[sorted(self.bodies)] = np.asarray(data.GetODE2Coordinates())[self.indices]
+        w[self.body_nodes] = np.asarray(data.GetODE2Coordinates())[self.indices]
         w[self.velocity_index] = np.asarray(data.GetODE2Coordinates_t())[self.indices]
         for face, body in self.attached.items():
             w[face] = w[body]
@@ -223,11 +224,11 @@ class WaveExudyn:
         if k >= stepper.steps:
             return True
         self._sync()
-        if not np.all(np.isfinite(stepper.w)):
+        if not np.isfinite(stepper.w).all():
             self.failed_at_s = k * stepper.step_s
             return False
-        velocity = stepper.w[self.velocity_index].copy()
-        positions = stepper.w[sorted(self.bodies)].copy()
+        velocity = stepper.w[self.velocity_index]
+        positions = stepper.w[self.body_nodes]
         if self.last_velocity is not None:  # Exudyn's forces over the last step: the bodies' motion predicted
             h = stepper.step_s
             applied = self.load_values[:, 0] + 0.5 * h * self.load_values[:, 1] \
@@ -267,8 +268,8 @@ class WaveExudyn:
             internal += float(link.force_n(link.stretch(w), rate)) * rate
         rock = 0.0
         if self.rock is not None:
-            rock = float(self.rock.rock.force(w[chain.bit_body], velocity[chain.bit_body], self.rock.state)) \
-                * velocity[chain.bit_body]
+            bit_velocity = float(velocity[chain.bit_body])  # plain floats: the law as fast as it evaluates in Python
+            rock = self.rock.rock.force(float(w[chain.bit_body]), bit_velocity, self.rock.state, SCALAR) * bit_velocity
         return np.array([impact, internal + rock, rock])
 
     def _add_works(self, t: float) -> None:

@@ -37,23 +37,36 @@ def key_arrays(stepper, key: Key) -> tuple[np.ndarray, ...]:
     return key.cache["kernel"]
 
 
+def run_constants(stepper) -> tuple[np.ndarray, np.ndarray, float, float, float]:
+    """(the stepper's own ports as a mask over its ports, a wave piston's two ports, its impedance, the momentum
+    and force tolerances of its rest), fixed for a run once the ports are shared out (cached on the stepper)."""
+    cached = stepper.run_constants
+    if cached is not None and cached[0] is stepper.own_ports:
+        return cached[1]
+    own = np.zeros(len(stepper.ports), dtype=np.bool_)
+    own[stepper.own_ports] = True
+    pistons, impedance = np.zeros(2, dtype=np.int64), 0.0
+    if stepper.piston_rod is not None:
+        pistons[:] = (2 * stepper.piston_rod, 2 * stepper.piston_rod + 1)
+        impedance = stepper.chain.waves[stepper.piston_rod].impedance_n_s_per_m
+    setup = stepper.setup
+    momentum_tolerance = 1e-9 * setup.momentum_n_s if setup is not None else 0.0
+    force_tolerance = 1e-9 * impedance * (setup.strike_velocity_m_per_s if setup is not None else 0.0)
+    constants = (own, pistons, impedance, momentum_tolerance, force_tolerance)
+    stepper.run_constants = (stepper.own_ports, constants)
+    return constants
+
+
 def run_fast(stepper, stop: int) -> tuple[int, int]:
     """Whole steps from the stepper's step index up to ``stop`` (exclusive) in the kernel; (status, the
     step reached). The caller makes sure no blow start, phase change or sample falls before ``stop``."""
     key, lines, stats = stepper.key(), stepper.lines, stepper.statistics
     propagator, grams, rows, slopes, velocity, integral, forces, impact, columns, counts = key_arrays(stepper, key)
-    own = np.zeros(len(stepper.ports), dtype=np.bool_)
-    own[stepper.own_ports] = True
-    mode, pistons, impedance = PISTON_NONE, np.zeros(2, dtype=np.int64), 0.0
+    own, pistons, impedance, momentum_tolerance, force_tolerance = run_constants(stepper)
+    mode = PISTON_NONE
     if stepper.piston_rod is not None:
         contact = stepper.modes[stepper.contact]
         mode = PISTON_OPEN if contact == OPEN else PISTON_CLOSED if contact == CLOSED else PISTON_NONE
-        pistons[:] = (2 * stepper.piston_rod, 2 * stepper.piston_rod + 1)
-        rod = stepper.chain.waves[stepper.piston_rod]
-        impedance = rod.impedance_n_s_per_m
-    setup = stepper.setup
-    momentum_tolerance = 1e-9 * setup.momentum_n_s if setup is not None else 0.0
-    force_tolerance = 1e-9 * impedance * (setup.strike_velocity_m_per_s if setup is not None else 0.0)
     rock = np.zeros(1)
     loads = np.zeros((2, len(forces)))
     status, reached = run_steps(
@@ -87,4 +100,4 @@ def run_fast(stepper, stop: int) -> tuple[int, int]:
     return status, reached
 
 
-__all__ = ["SWITCH", "key_arrays", "run_fast"]
+__all__ = ["SWITCH", "key_arrays", "run_constants", "run_fast"]

@@ -145,8 +145,10 @@ def readings(segments: list[Segment], waves: StepWaves, step_s: float, ports: np
     v = np.array([s.v0[ports] for s in kept] + [s.v1[ports] for s in kept])
     a = np.array([s.a0[ports] for s in kept] + [s.a1[ports] for s in kept])
     values = signs[ports] * (v - 2.0 * a)
-    arriving = sum((s.end - s.begin) * (s.a0[ports] ** 2 + s.a0[ports] * s.a1[ports] + s.a1[ports] ** 2) / 3.0
-                   for s in segments)
+    arriving = 0.0
+    for s in segments:
+        a0, a1 = s.a0[ports], s.a1[ports]
+        arriving = arriving + (s.end - s.begin) * (a0**2 + a0 * a1 + a1**2) / 3.0
     energy = down[ports] * impedances[ports] * step_s * (waves.leaving_square() - arriving)
     count = len(kept)
 
@@ -192,7 +194,7 @@ def body_segments(segments: list[Segment], motion: BodyMotion) -> list[Segment]:
     (``solved``), its predicted motion (which has the bodies' response to a front within the step) corrected
     by the quadratic that meets Exudyn's end states; else ``motion``'s quadratic."""
     if not all(s.solved for s in segments):
-        return [_moved(s, motion.position, motion.velocity, motion.acceleration) for s in segments]
+        return [_moved(s, motion) for s in segments]
     first, last = segments[0], segments[-1]
     correction = BodyMotion(np.zeros_like(motion.x0), (motion.x1 - motion.x0) - (last.x1 - first.x0),
                             motion.v0 - first.v0, motion.v1 - last.v1, motion.step_s)
@@ -202,39 +204,43 @@ def body_segments(segments: list[Segment], motion: BodyMotion) -> list[Segment]:
             for s in segments]
 
 
-def _moved(s: Segment, position, velocity, acceleration) -> Segment:
+def _moved(s: Segment, motion: BodyMotion) -> Segment:
+    """``s`` with the ports' nodes moving as ``motion``'s quadratic (rows: its start and its end)."""
     arriving = (s.a1 - s.a0) / max(s.end - s.begin, TINY)
-    return Segment(s.begin, s.end, position(s.begin), position(s.end), velocity(s.begin), velocity(s.end), s.a0, s.a1,
-                   acceleration(s.begin) - arriving, acceleration(s.end) - arriving)
+    ends = np.array([[s.begin], [s.end]])
+    x, v, d = motion.position(ends), motion.velocity(ends), motion.acceleration(ends) - arriving
+    return Segment(s.begin, s.end, x[0], x[1], v[0], v[1], s.a0, s.a1, d[0], d[1])
 
 
 GAUSS_POINTS, GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(3)
+GAUSS_FRACTIONS = np.array([0.5 * (1.0 + point) for point in GAUSS_POINTS])[:, None]  # u of each point, a column
+# the cubic through p0, p1 with slopes m0, m1 (per unit of u) at u = 0, 1 at each point u: the weights of
+# (p0, m0, p1, m1), (2 u^3 - 3 u^2 + 1, u^3 - 2 u^2 + u, -2 u^3 + 3 u^2, u^3 - u^2), each a column
+HERMITE = tuple(np.array(column)[:, None] for column in zip(*[
+    (2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u, -2 * u**3 + 3 * u**2, u**3 - u**2)
+    for u in (0.5 * (1.0 + point) for point in GAUSS_POINTS)], strict=True))
 
 
 def port_work_j(segments: list[Segment], moved: list[Segment], motion: BodyMotion, ports: np.ndarray,
                 impedances: np.ndarray) -> float:
     """int Z (v - 2 w_in) v dt into the rods at ``ports`` over the step, v the bodies' motion (``moved``:
     :func:`body_segments` of ``segments`` and ``motion``) and w_in each segment's arriving line: Gauss-Legendre on
-    3 points per segment."""
+    3 points per segment (rows: the points)."""
+    impedance = impedances[ports]
     total = 0.0
     for s, m in zip(segments, moved, strict=True):
         length = s.end - s.begin
-        for point, weight in zip(GAUSS_POINTS, GAUSS_WEIGHTS, strict=True):
-            u = 0.5 * (1.0 + point)
-            if s.solved:  # between the segment's ends: its velocities (and slopes) as a cubic
-                h = length * motion.step_s
-                v = _hermite(u, m.v0[ports], m.v1[ports], h * (m.d0[ports] + (s.a1 - s.a0)[ports] / h),
-                             h * (m.d1[ports] + (s.a1 - s.a0)[ports] / h))
-            else:
-                v = motion.velocity(s.begin + u * length)[ports]
-            arriving = s.a0[ports] + u * (s.a1[ports] - s.a0[ports])
-            total += 0.5 * weight * length * float(np.sum(impedances[ports] * (v - 2.0 * arriving) * v))
+        a0, a1 = s.a0[ports], s.a1[ports]
+        if s.solved:  # between the segment's ends: its velocities (and slopes) as a cubic
+            h = length * motion.step_s
+            v = HERMITE[0] * m.v0[ports] + HERMITE[1] * (h * (m.d0[ports] + (a1 - a0) / h)) \
+                + HERMITE[2] * m.v1[ports] + HERMITE[3] * (h * (m.d1[ports] + (a1 - a0) / h))
+        else:
+            v = motion.velocity(s.begin + GAUSS_FRACTIONS * length)[:, ports]
+        arriving = a0 + GAUSS_FRACTIONS * (a1 - a0)
+        for weight, power in zip(GAUSS_WEIGHTS, np.sum(impedance * (v - 2.0 * arriving) * v, axis=1), strict=True):
+            total += 0.5 * weight * length * float(power)
     return total * motion.step_s
-
-
-def _hermite(u: float, p0: np.ndarray, p1: np.ndarray, m0: np.ndarray, m1: np.ndarray) -> np.ndarray:
-    """The cubic through p0, p1 with slopes m0, m1 (per unit of u) at u = 0, 1."""
-    return (2 * u**3 - 3 * u**2 + 1) * p0 + (u**3 - 2 * u**2 + u) * m0 + (-2 * u**3 + 3 * u**2) * p1 + (u**3 - u**2) * m1
 
 
 __all__ = ["BodyMotion", "Segment", "StepWaves", "body_segments", "outgoing", "port_work_j", "readings"]

@@ -112,6 +112,7 @@ class Stepper(Recorder):
         self.port_signs = np.array([SIGMA[port.end] for port in self.ports]) * self.port_impedances
         self.port_down = np.array([1.0 if port.end == TOP else -1.0 for port in self.ports])  # flux along +x
         self.own_ports = np.arange(len(self.ports))  # the Exudyn model closes the others (its bodies' ports)
+        self.run_constants = None  # the compiled kernel's fixed arguments (models.waves.fast_path.run_constants)
         self.pulse_outside = False  # the Exudyn model integrates the pulse on a body with mass, and counts its work
         self.string_ports = [p for p, port in enumerate(self.ports) if port.node < self.string_size]
         self.rigid_names = [link.name for link in self.system.rigid_links]
@@ -363,7 +364,7 @@ class Stepper(Recorder):
             read = readings(segments, mine, self.step_s, ports, self.port_signs, self.port_impedances, self.port_down)
         stats = self.statistics
         raised = (read.compression_n > stats.compression_n[-1][ports], read.tension_n > stats.tension_n[-1][ports])
-        if raised[0].any() or raised[1].any():
+        if np.logical_or(*raised).any():
             if ends is None:  # the step just done by the stepper: its start, and its end now
                 ends = (self.step_start, self._snapshot((k + 1) * self.step_s, self.w, self.key(), after=False))
             self.offer_peaks(read, raised, ports, ends)
