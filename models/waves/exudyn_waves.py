@@ -134,7 +134,7 @@ class WaveExudyn:
         self.previous_velocity = np.zeros(self.stepper.layout.n)
         self.last_velocity: np.ndarray | None = None  # the bodies' velocities at the last step's start
         self.last_positions = np.zeros(len(self.bodies))
-        self.step_start = None  # the snapshot of the step in progress at its start (models.waves.recording)
+        self.step_start = None  # the snapshot of the step in progress at its start, made if a peak wants it
         self.masses = np.array([chain.bodies[i].mass_kg for i in sorted(self.bodies)])
         self.failed_at_s: float | None = None
 
@@ -242,7 +242,7 @@ class WaveExudyn:
                             kept=stepper.caught_at_end)
         if len(self.body_ports):  # the step's start after its arriving jumps: a body port's peak may be there
             stepper._set_inputs(k)
-            self.step_start = stepper._snapshot(k * stepper.step_s, stepper.w, stepper.key(), after=True)
+            self.step_start = stepper.snapshot_if_wanted(k * stepper.step_s, stepper.w, stepper.key(), after=True)
         stepper.advance()
         # the dashpots are Exudyn's: their force at the predicted velocity, a straight line, taken out
         start = stepper.body_loads[0] + self.dashpots * velocity

@@ -188,9 +188,10 @@ class WaveLines:
         return float(self.rods[rod].impedance_n_s_per_m * self.step_s * (self.square_sum[2 * rod]
                                                                          + self.square_sum[2 * rod + 1]))
 
-    def energies_j(self) -> np.ndarray:
-        """:meth:`energy_j` of every rod."""
-        return self.impedances * self.step_s * (self.square_sum[::2] + self.square_sum[1::2])
+    def energies_j(self, square_sum: np.ndarray | None = None) -> np.ndarray:
+        """:meth:`energy_j` of every rod (from ``square_sum``, the running sums as they were, if given)."""
+        square_sum = self.square_sum if square_sum is None else square_sum
+        return self.impedances * self.step_s * (square_sum[::2] + square_sum[1::2])
 
     def momentum_n_s(self, rod: int) -> float:
         """Z int (d + u) over the waves in flight: the rod's momentum mu int v dx."""

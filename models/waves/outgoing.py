@@ -133,8 +133,13 @@ class PortReadings:
     tension_n: np.ndarray
     energy_j: np.ndarray
     arriving_j: np.ndarray  # the energy the arriving wave brings, Z int w_in^2 dt
-    compression_at: list[tuple[Segment, int]]  # per port, the segment and its end (0 start, 1 end) of the value
-    tension_at: list[tuple[Segment, int]]
+    kept: list[Segment]  # the segments whose ends the values are read at
+    compression_index: np.ndarray  # per port, where its compression is: index into the kept segments' ends
+    tension_index: np.ndarray  # (their starts, then their ends)
+
+    def at(self, index: np.ndarray, port: int) -> tuple[Segment, int]:
+        """The segment and its end (0 start, 1 end) of a port's value at ``index`` (compression or tension)."""
+        return self.kept[index[port] % len(self.kept)], int(index[port] // len(self.kept))
 
 
 def readings(segments: list[Segment], waves: StepWaves, step_s: float, ports: np.ndarray,
@@ -150,12 +155,8 @@ def readings(segments: list[Segment], waves: StepWaves, step_s: float, ports: np
         a0, a1 = s.a0[ports], s.a1[ports]
         arriving = arriving + (s.end - s.begin) * (a0**2 + a0 * a1 + a1**2) / 3.0
     energy = down[ports] * impedances[ports] * step_s * (waves.leaving_square() - arriving)
-    count = len(kept)
-
-    def where(index: np.ndarray) -> list[tuple[Segment, int]]:
-        return [(kept[i % count], i // count) for i in index]
     return PortReadings(values.max(axis=0), np.maximum(-values.min(axis=0), 0.0), energy,
-                        impedances[ports] * step_s * arriving, where(values.argmax(axis=0)), where(values.argmin(axis=0)))
+                        impedances[ports] * step_s * arriving, kept, values.argmax(axis=0), values.argmin(axis=0))
 
 
 @dataclass(frozen=True)

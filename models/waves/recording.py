@@ -10,7 +10,9 @@ rod end's stress is the blow's peak and a front shows both its sides: models.eva
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cache
 
 import numpy as np
 
@@ -105,10 +107,24 @@ class Recorder:
 
     def _snapshot(self, t: float, w: np.ndarray, key: Key, after: bool) -> Snapshot:
         """The state now with the works and the waves' energy a sample of it has."""
-        energies = self.lines.energies_j()
+        return self._snapshot_of(t, w.copy(), key, after, self.works + np.array([0.0, self._step_flux[2]]),
+                                 self.lines.square_sum, self._step_flux)
+
+    def snapshot_if_wanted(self, t: float, w: np.ndarray, key: Key, after: bool) -> Callable[[], Snapshot]:
+        """:meth:`_snapshot` of now, made when called (a peak there is rare): what it reads is copied now."""
+        state, works = w.copy(), self.works + np.array([0.0, self._step_flux[2]])
+        square_sum, flux = self.lines.square_sum.copy(), self._step_flux.copy()
+
+        @cache  # one snapshot, however many peaks want it
+        def made() -> Snapshot:
+            return self._snapshot_of(t, state, key, after, works, square_sum, flux)
+        return made
+
+    def _snapshot_of(self, t: float, state: np.ndarray, key: Key, after: bool, works: np.ndarray,
+                     square_sum: np.ndarray, flux: np.ndarray) -> Snapshot:
+        energies = self.lines.energies_j(square_sum)
         piston = 0.0 if self.piston_rod is None else energies[self.piston_rod]
-        return Snapshot(t, w.copy(), key, after, self.works + np.array([0.0, self._step_flux[2]]),
-                        float(np.sum(energies)) - piston + self._step_flux[0], piston + self._step_flux[1])
+        return Snapshot(t, state, key, after, works, float(np.sum(energies)) - piston + flux[0], piston + flux[1])
 
     def record_peaks(self) -> None:
         """The samples of the blow's peaks (models.waves.recording): kept, or recorded from their snapshots."""
@@ -119,12 +135,12 @@ class Recorder:
                 self.samples.kept[where] = True
 
     def offer_peaks(self, read, raised: tuple[np.ndarray, np.ndarray], ports: np.ndarray,
-                    ends: tuple[Snapshot | None, Snapshot | None]) -> None:
+                    ends: tuple[Snapshot | Callable[[], Snapshot] | None, ...]) -> None:
         """Where a port's blow peak was raised in a step (``raised``: compression, tension masks over ``ports``):
         the sample at that segment's end, or the step's start or end ``ends``."""
-        for kind, at, mask in ((COMPRESSION, read.compression_at, raised[0]), (TENSION, read.tension_at, raised[1])):
+        for kind, at, mask in ((COMPRESSION, read.compression_index, raised[0]), (TENSION, read.tension_index, raised[1])):
             for j in np.flatnonzero(mask):
-                segment, end = at[j]
+                segment, end = read.at(at, j)
                 index = segment.samples[end]
                 if index < 0:
                     index = ends[end] if (segment.begin <= TINY_FRACTION if end == 0 else segment.end >= 1 - TINY_FRACTION) \

@@ -21,6 +21,7 @@ negative at a step's end: at most a step late, its energy kept (models.drill.pis
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -121,7 +122,7 @@ class Stepper(Recorder):
         self.modes = self.system.initial_modes(self.w)
         self.phase_index = 0
         self.samples, self.statistics, self.peaks = Samples(), BlowStatistics(), BlowPeaks()
-        self.step_start: Snapshot | None = None  # the state at the start of the step in progress (a peak's sample)
+        self.step_start: Callable[[], Snapshot] | None = None  # the state at the start of the step in progress (a peak's sample)
         weights = np.zeros((2, len(self.ports)))  # the string's and a wave piston's waves' energy: Z h square sums
         for p, port in enumerate(self.ports):
             weights[int(port.rod == self.piston_rod), p] = port.impedance_n_s_per_m * step_s
@@ -212,7 +213,7 @@ class Stepper(Recorder):
         self._step_impulse = np.zeros(len(self.kinematic))
         segments: list[Segment] = []
         begin = (t0, w.copy(), self.key(), -1)
-        self.step_start = self._snapshot(t0, w, self.key(), after=True)  # a peak there: after the step's jumps
+        self.step_start = self.snapshot_if_wanted(t0, w, self.key(), after=True)  # a peak there: after the step's jumps
         while t < t1 - 1e-12 * h:
             later = np.flatnonzero(self.phase_changes > t + 1e-12 * h)
             phase = self.phase_changes[later[0]] if len(later) else np.inf
@@ -343,7 +344,7 @@ class Stepper(Recorder):
         return False
 
     def close_ports(self, k: int, ports: np.ndarray, segments: list[Segment], again: bool = False,
-                    provisional: bool = False, ends: tuple[Snapshot | None, Snapshot | None] | None = None) -> None:
+                    provisional: bool = False, ends: tuple[Snapshot | Callable[[], Snapshot] | None, ...] | None = None) -> None:
         """Store the outgoing waves over step k from its segments (models.waves.outgoing) and add the step to
         the blow's section figures of ``ports``; ``provisional``: store every port (the others are stored
         ``again`` later, from the Exudyn bodies)."""
