@@ -20,8 +20,9 @@ the scenes at these segments per rod in the exact formulation (the convergence o
 the waves).
 ``--lumped-lundberg``: Lundberg's check on lumped rods of 64 to 512 segments (Exudyn, reference preset),
 the dispersion the wave element removes.
-``--cost --base REV [--repeat N]``: the same in the exact formulation at git revision REV and at this checkout, in
-turns, each a process of its own (N rounds; each round's ratio and their median).
+``--cost --base REV [--repeat N] [--formulation exact|exudyn] [--blows B]``: the same in one formulation (default
+exact; the scene's first B blows if given) at git revision REV and at this checkout, in turns, each a process of its
+own (N rounds; each round's ratio and their median), and whether both gave the same run to the bit.
 ``--cost [--repeat N]``: the CPU per blow of studies/scenes/top_hammer_waves.yaml as shipped (20 blows) in each
 formulation, the median of N runs (default 3) after a warm-up, the process's CPU.
 ``--fronts``: tests/test_wave_fronts.py's cases against its independent characteristics solution
@@ -230,46 +231,58 @@ def cost(repeat: int = 3) -> None:
 # One formulation's CPU per blow of the shipped top-hammer wave scene, in a process of its own (rpdrill imported
 # from PYTHONPATH: this checkout, or a revision exported by --base), after a warm-up run; through the public API.
 PER_BLOW = """
-import statistics, sys, time, warnings
+import hashlib, statistics, sys, time, warnings
 warnings.simplefilter("ignore")
+import numpy as np
 import rpdrill
-formulation, repeat = sys.argv[1], int(sys.argv[2])
+formulation, repeat, blows = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 scene = rpdrill.load_scene("studies/scenes/top_hammer_waves.yaml").with_({"solver.formulation": formulation})
+if blows:
+    scene = scene.with_({"solver.end_time_s": blows / scene.impact.frequency_hz, "metrics.transient_blows": blows - 1,
+                         "metrics.block_blows": 1})
 blows = round(scene.solver.end_time_s * scene.impact.frequency_hz)
 rpdrill.simulate(scene)
 times = []
 for _ in range(repeat):
     start = time.process_time()
-    rpdrill.simulate(scene)
+    result = rpdrill.simulate(scene)
     times.append(time.process_time() - start)
-print(rpdrill.__file__, statistics.median(times) / blows)
+digest = hashlib.sha256()  # every column of the time series, every figure but the run's CPU time, to the bit
+for name, column in sorted(result.columns().items()):
+    digest.update(name.encode() + np.ascontiguousarray(column, dtype=float).tobytes())
+for name, value in sorted(result.metrics.items()):
+    if name != "cpu_time_s":
+        digest.update(f"{name}={value!r}".encode())
+print(rpdrill.__file__, statistics.median(times) / blows, digest.hexdigest()[:16])
 """
 
 
-def cost_against(base: str, rounds: int, formulation: str = "exact") -> None:
-    """CPU per blow of the shipped top-hammer wave scene at revision ``base`` and at this checkout, in turns (base,
-    then here, ``rounds`` times; each a process of 3 runs after a warm-up, its median): each round's ratio and
-    the median of the rounds'."""
+def cost_against(base: str, rounds: int, formulation: str = "exact", blows: int = 0) -> None:
+    """CPU per blow of the shipped top-hammer wave scene (its first ``blows`` blows, if given) at revision ``base``
+    and at this checkout, in turns (base, then here, ``rounds`` times; each a process of 3 runs after a warm-up,
+    its median): each round's ratio and the median of the rounds', and whether both gave the same run to the bit
+    (a digest of every time-series column and every figure but the CPU time)."""
     sys.path.insert(0, str(Path(__file__).parent))
     from bench_same_results import ROOT, export
 
     with tempfile.TemporaryDirectory() as folder:
         trees = {"base": export(base, Path(folder)), "here": ROOT}
-        print(f"| round | {base} CPU s per blow | this checkout | ratio |")
-        print("|---|---|---|---|")
+        print(f"| round | {base} CPU s per blow | this checkout | ratio | the same run to the bit |")
+        print("|---|---|---|---|---|")
         ratios = []
         for n in range(rounds):
-            per_blow = {}
+            per_blow, digests = {}, {}
             for name, tree in trees.items():
                 env = {**os.environ, "PYTHONPATH": str(tree)}
                 cwd = tree / "rpdrill" if name == "base" else tree
-                out = subprocess.run([sys.executable, "-c", PER_BLOW, formulation, "3"], env=env, cwd=cwd, check=True,
-                                     capture_output=True, text=True).stdout.split()
+                out = subprocess.run([sys.executable, "-c", PER_BLOW, formulation, "3", str(blows)], env=env, cwd=cwd,
+                                     check=True, capture_output=True, text=True).stdout.split()
                 if not out[0].startswith(str(tree)):
                     raise SystemExit(f"rpdrill imported from {out[0]}, not from {tree}")
-                per_blow[name] = float(out[1])
+                per_blow[name], digests[name] = float(out[1]), out[2]
             ratios.append(per_blow["here"] / per_blow["base"])
-            print(f"| {n + 1} | {per_blow['base']:.4f} | {per_blow['here']:.4f} | {ratios[-1]:.3f} |", flush=True)
+            same = "yes" if digests["here"] == digests["base"] else f"no ({digests['base']} against {digests['here']})"
+            print(f"| {n + 1} | {per_blow['base']:.4f} | {per_blow['here']:.4f} | {ratios[-1]:.3f} | {same} |", flush=True)
         print(f"median ratio {statistics.median(ratios):.3f} ({formulation})")
 
 
@@ -315,6 +328,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--cost", action="store_true", help="CPU per blow of the shipped top-hammer wave scene")
     parser.add_argument("--repeat", type=int, default=3, help="--cost: runs per formulation (the median)")
     parser.add_argument("--base", help="--cost: against this git revision instead, in turns (--repeat rounds)")
+    parser.add_argument("--formulation", choices=("exact", "exudyn"), default="exact", help="--cost --base: this one")
+    parser.add_argument("--blows", type=int, default=0, help="--cost --base: the scene's first N blows (N >= 2)")
     parser.add_argument("--fronts", action="store_true", help="the model against the tests' characteristics solution")
     parser.add_argument("--fine", action="store_true", help="--strings: lumped rods refined (--segments), exact")
     parser.add_argument("--segments", type=lambda text: tuple(int(n) for n in text.split(",")), default=(16, 32, 64),
@@ -328,7 +343,7 @@ def main(argv: list[str] | None = None) -> None:
     if args.fronts:
         fronts()
     if args.cost and args.base:
-        cost_against(args.base, args.repeat)
+        cost_against(args.base, args.repeat, args.formulation, args.blows)
     elif args.cost:
         cost(args.repeat)
     if args.strings:
