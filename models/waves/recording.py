@@ -12,7 +12,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import cache
 
 import numpy as np
 
@@ -114,11 +113,7 @@ class Recorder:
         """:meth:`_snapshot` of now, made when called (a peak there is rare): what it reads is copied now."""
         state, works = w.copy(), self.works + np.array([0.0, self._step_flux[2]])
         square_sum, flux = self.lines.square_sum.copy(), self._step_flux.copy()
-
-        @cache  # one snapshot, however many peaks want it
-        def made() -> Snapshot:
-            return self._snapshot_of(t, state, key, after, works, square_sum, flux)
-        return made
+        return lambda: self._snapshot_of(t, state, key, after, works, square_sum, flux)
 
     def _snapshot_of(self, t: float, state: np.ndarray, key: Key, after: bool, works: np.ndarray,
                      square_sum: np.ndarray, flux: np.ndarray) -> Snapshot:

@@ -264,7 +264,7 @@ class Stepper(Recorder):
         if t1 - begin[0] > 1e-12 * h or not segments:
             segments.append(self._segment(begin, t1, w, key))
         self.w = w
-        if not np.all(np.isfinite(w)) or np.max(np.abs(w[:layout.n])) > POSITION_LIMIT_M:
+        if not np.isfinite(w).all() or np.abs(w[:layout.n]).max() > POSITION_LIMIT_M:
             raise SimulationFailed(f"scene '{self.simulation.name}': the wave solution diverged at t = {t1:.6g} s")
         caught = self._close_step(k, segments, key)
         if self.kinematic:  # the loads on the Exudyn bodies over the step: its end value and its mean
@@ -359,7 +359,7 @@ class Stepper(Recorder):
         if not provisional:
             read = readings(segments, waves, self.step_s, ports, self.port_signs, self.port_impedances, self.port_down)
         else:  # every port stored (``stored`` is every index): the readings of ``ports``
-            position = {int(port): i for i, port in enumerate(ports)}
+            position = {int(port): i for i, port in enumerate(ports)} if waves.pieces else {}
             mine = StepWaves(waves.left[ports], waves.right[ports], waves.start[ports],
                              {position[j]: rows for j, rows in waves.pieces.items() if j in position})
             read = readings(segments, mine, self.step_s, ports, self.port_signs, self.port_impedances, self.port_down)
@@ -426,7 +426,7 @@ class Stepper(Recorder):
         candidates = (end > 0.0) | returning
         if ignored is not None:
             candidates[ignored] = False
-        if not np.any(candidates):
+        if not candidates.any():
             return None
         return key_levels(self, key).first_switch(rows, slopes, w0, span_s, candidates)
 
