@@ -40,7 +40,7 @@ def key_arrays(stepper, key: Key) -> tuple[np.ndarray, ...]:
 def run_constants(stepper) -> tuple[np.ndarray, np.ndarray, float, float, float]:
     """(the stepper's own ports as a mask over its ports, a wave piston's two ports, its impedance, the momentum
     and force tolerances of its rest), fixed for a run once the ports are shared out (cached on the stepper)."""
-    cached = stepper.run_constants
+    cached = stepper.kernel_constants
     if cached is not None and cached[0] is stepper.own_ports:
         return cached[1]
     own = np.zeros(len(stepper.ports), dtype=np.bool_)
@@ -53,7 +53,7 @@ def run_constants(stepper) -> tuple[np.ndarray, np.ndarray, float, float, float]
     momentum_tolerance = 1e-9 * setup.momentum_n_s if setup is not None else 0.0
     force_tolerance = 1e-9 * impedance * (setup.strike_velocity_m_per_s if setup is not None else 0.0)
     constants = (own, pistons, impedance, momentum_tolerance, force_tolerance)
-    stepper.run_constants = (stepper.own_ports, constants)
+    stepper.kernel_constants = (stepper.own_ports, constants)  # kept while the ports' shares stay
     return constants
 
 

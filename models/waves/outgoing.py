@@ -214,12 +214,10 @@ def _moved(s: Segment, motion: BodyMotion) -> Segment:
 
 
 GAUSS_POINTS, GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(3)
-GAUSS_FRACTIONS = np.array([0.5 * (1.0 + point) for point in GAUSS_POINTS])[:, None]  # u of each point, a column
-# the cubic through p0, p1 with slopes m0, m1 (per unit of u) at u = 0, 1 at each point u: the weights of
-# (p0, m0, p1, m1), (2 u^3 - 3 u^2 + 1, u^3 - 2 u^2 + u, -2 u^3 + 3 u^2, u^3 - u^2), each a column
-HERMITE = tuple(np.array(column)[:, None] for column in zip(*[
-    (2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u, -2 * u**3 + 3 * u**2, u**3 - u**2)
-    for u in (0.5 * (1.0 + point) for point in GAUSS_POINTS)], strict=True))
+GAUSS_FRACTIONS = (0.5 * (1.0 + GAUSS_POINTS))[:, None]  # u of each point, a column
+# the cubic through p0, p1 with slopes m0, m1 (per unit of u) at u = 0, 1, at each point u: the weights of p0, m0, p1, m1
+_U = GAUSS_FRACTIONS
+HERMITE = (2 * _U**3 - 3 * _U**2 + 1, _U**3 - 2 * _U**2 + _U, -2 * _U**3 + 3 * _U**2, _U**3 - _U**2)
 
 
 def port_work_j(segments: list[Segment], moved: list[Segment], motion: BodyMotion, ports: np.ndarray,

@@ -133,9 +133,10 @@ class Recorder:
                     ends: tuple[Snapshot | Callable[[], Snapshot] | None, ...]) -> None:
         """Where a port's blow peak was raised in a step (``raised``: compression, tension masks over ``ports``):
         the sample at that segment's end, or the step's start or end ``ends``."""
-        for kind, at, mask in ((COMPRESSION, read.compression_index, raised[0]), (TENSION, read.tension_index, raised[1])):
+        for kind, places, mask in ((COMPRESSION, read.compression_index, raised[0]),
+                                   (TENSION, read.tension_index, raised[1])):
             for j in np.flatnonzero(mask):
-                segment, end = read.at(at, j)
+                segment, end = read.at(places, j)
                 index = segment.samples[end]
                 if index < 0:
                     index = ends[end] if (segment.begin <= TINY_FRACTION if end == 0 else segment.end >= 1 - TINY_FRACTION) \

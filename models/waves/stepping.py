@@ -113,7 +113,7 @@ class Stepper(Recorder):
         self.port_signs = np.array([SIGMA[port.end] for port in self.ports]) * self.port_impedances
         self.port_down = np.array([1.0 if port.end == TOP else -1.0 for port in self.ports])  # flux along +x
         self.own_ports = np.arange(len(self.ports))  # the Exudyn model closes the others (its bodies' ports)
-        self.run_constants = None  # the compiled kernel's fixed arguments (models.waves.fast_path.run_constants)
+        self.kernel_constants = None  # the compiled kernel's fixed arguments (models.waves.fast_path.run_constants)
         self.pulse_outside = False  # the Exudyn model integrates the pulse on a body with mass, and counts its work
         self.string_ports = [p for p, port in enumerate(self.ports) if port.node < self.string_size]
         self.rigid_names = [link.name for link in self.system.rigid_links]
