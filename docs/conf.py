@@ -5,8 +5,10 @@
 
 Pages: the Markdown files of docs/ (MyST), the gallery of examples/ (sphinx-gallery, every example run at
 the build), the API reference from the docstrings of ``rpdrill.__all__`` and ``rpdrill.rocklaw.__all__``
-(autodoc, autosummary and numpydoc; its pages are written at the build into docs/reference/generated/).
-Warnings are errors: a broken link, a page no toctree reaches, a docstring numpydoc cannot read.
+(autodoc, autosummary and numpydoc; its pages are written at the build into docs/reference/generated/), the
+Python blocks of the pages of ``page_examples`` run as printed (docs/page_examples.py).
+Warnings are errors: a broken link, a page no toctree reaches, a docstring numpydoc cannot read, a page's Python
+block that fails.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from importlib.metadata import version as _version
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
-sys.path.insert(0, str(DOCS))  # gallery_arguments
+sys.path.insert(0, str(DOCS))  # gallery_arguments, page_examples
 
 project = "rpdrill"
 author = "the rpdrill authors"
@@ -32,7 +34,13 @@ extensions = [
     "sphinxcontrib.mermaid",
     "numpydoc",
     "sphinx_gallery.gen_gallery",
+    "page_examples",
 ]
+
+# the pages whose Python blocks run at the build, one process per page from the root of the checkout, and the
+# text that marks a block not run alone (extending.md's worked connector type: tests/test_extending.py runs it);
+# getting_started.md's blocks are run, and their output compared, by tests/test_docs_site.py
+page_examples = {"api": (), "extending": ("class JointWithPlay",)}
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"

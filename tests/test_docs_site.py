@@ -1,9 +1,11 @@
 """The README is a front page and the documentation site holds the rest: every page of docs/ is reachable from
 its landing page, the README's links lead to pages that exist, its commands are the ones CI runs, and the
-Getting started page's Python runs as printed. (The site itself is built strictly by .ci/run:
-sphinx-build -W fails on a broken link or a page no toctree reaches.)"""
+Getting started page's Python runs as printed, and the build runs the other pages' Python blocks. (The site
+itself is built strictly by .ci/run: sphinx-build -W fails on a broken link, a page no toctree reaches, a
+page's Python block that does not run.)"""
 
 import re
+import runpy
 import subprocess
 import sys
 from pathlib import Path
@@ -85,3 +87,30 @@ def test_the_getting_started_python_runs_as_printed(tmp_path):
         assert done.returncode == 0, done.stderr
         printed.append(done.stdout)
     assert printed[0] == "15.6 mm/s\n"  # the rate the page shows for the changed scene
+
+
+def test_the_sites_build_runs_every_page_with_python_blocks():
+    """Every page with Python blocks is run by the build (docs/conf.py's ``page_examples``) but Getting started,
+    whose output the test above compares."""
+    configured = runpy.run_path(str(DOCS / "conf.py"))["page_examples"]
+    with_blocks = {path.stem for path in DOCS.glob("*.md") if "```python\n" in path.read_text(encoding="utf-8")}
+    assert set(configured) | {"getting_started"} == with_blocks
+
+
+def test_the_build_fails_at_the_line_of_a_python_block_that_does_not_run_alone(tmp_path):
+    """docs/page_examples.py in a site of one page: each block runs in a namespace of its own (the second uses a
+    name of the first: a NameError, reported at its line, and the strict build fails); a block marked not to run
+    alone is not run."""
+    source = tmp_path / "source"
+    source.mkdir()
+    (source / "conf.py").write_text(
+        f"import sys\nsys.path.insert(0, {str(DOCS)!r})\nextensions = ['myst_parser', 'page_examples']\n"
+        "root_doc = 'page'\npage_examples = {'page': ('NOT ALONE',)}\n", encoding="utf-8")
+    (source / "page.md").write_text("# Page\n\n```python\nx = 1\n```\n\nText.\n\n```python\nprint(x)\n```\n\n"
+                                    "```python\nraise SystemExit('NOT ALONE')\n```\n", encoding="utf-8")
+    done = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "dummy", str(source),
+                           str(tmp_path / "out")], capture_output=True, text=True, check=False, timeout=300)
+    assert done.returncode != 0
+    warnings = [line for line in done.stderr.splitlines() if "WARNING" in line]
+    assert len(warnings) == 1 and "page.md:10" in warnings[0], done.stderr
+    assert "NameError: name 'x' is not defined" in done.stderr and "NOT ALONE" not in done.stderr

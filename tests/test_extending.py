@@ -1,6 +1,6 @@
-"""The examples of docs/extending.md, run exactly as printed there: every Python block from the root of
-the checkout, and the worked example checked: a new connector type (a threaded joint with axial play)
-registered and used from YAML.
+"""The examples of docs/extending.md (every Python block runs as printed when the site is built:
+docs/page_examples.py), and the worked example checked: a new connector type (a threaded joint with axial
+play) registered and used from YAML.
 Unit tests of what the worked example extends, models.definition.links and rocklaw.modes, with its runs compared
 by models.evaluation.compare: they import them."""
 
@@ -9,7 +9,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from doc_examples import Ran, run_examples
 from ruamel.yaml import YAML
 from scenes import result_of, scene_dict, simulate
 
@@ -38,18 +37,6 @@ def test_the_page_shows_each_way_with_an_example():
     for way in ("drill_string.bodies.clamp", '"extensions"', "rate_dependent_rock:RateDependentRock",
                 "add_energy_term", "exu.SolveDynamic", "rpdrill.draw(model"):
         assert any(way in block for block in _blocks("python")) or way in DOC.read_text(), way
-
-
-@pytest.fixture(scope="module")
-def ran() -> list[Ran]:
-    """Every runnable block run in order in one fresh process (tests/doc_examples.py)."""
-    return run_examples(RUNNABLE, DOC.parents[1])
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("index", range(len(RUNNABLE)), ids=[f"example{i}" for i in range(len(RUNNABLE))])
-def test_every_python_block_runs_from_the_root_of_the_checkout(ran, index):
-    assert not ran[index].failed and "Traceback" not in ran[index].err, ran[index].err
 
 
 @pytest.fixture(scope="module")
