@@ -54,7 +54,12 @@ UNDAMPED = {
     "torsion__damping_n_m_s_per_rad": 0.0,
 }
 ODE_RTOL, ODE_ATOL = 1e-12, 1e-15
-ODE_BLOWS = 6  # the tight ODE's window against the exact solution: its cost grows with every blow
+# the tight ODE's window against the exact solution: its cost grows with every blow. Four blows hold every event
+# of the per-body drill (its last switch is in its fourth: six blows had the same switches and bottom) and
+# four crushing blows of the carriage drill, each with its contact, lift-off and re-strike; the differences
+# do not grow with the blows (bottom 7.4e-13 at four blows, 8.8e-13 at six). Over four blows the ODE at
+# relative_tolerance 1e-8, or with the rock threshold 1e-7 higher, fails the 1e-9 agreement in every case below
+ODE_BLOWS = 4
 AGREEMENT = 1e-9
 
 
@@ -107,11 +112,11 @@ def test_checking_and_estimating_a_run_does_not_load_the_kernels() -> None:
 @pytest.mark.parametrize("feed", list(FEEDS))
 def test_agrees_with_tight_ode(feed: str, damping_mode: str) -> None:
     """At every pulse switch of ODE_BLOWS blows: the carriage drill crushes in each; the per-body drill,
-    held on the rock by the feed on every body, makes its last switch in its fourth blow."""
+    held on the rock by the feed on every body, makes its last switch in its fourth blow (the last one)."""
     reference = result_of(crushing(feed, damping_mode, blows=ODE_BLOWS), "exact")
     ode = result_of(reference.scene, "ode", method="DOP853", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
     assert reference.solver.switches_into.get("crushing", 0) >= 2
-    assert reference.bottom_m[-1] > 5e-4  # the bottom advanced by crushing
+    assert reference.bottom_m[-1] > 2.5e-4  # the bottom advanced by crushing (2.8e-4 m: the carriage drill's four blows)
     assert relative_error(ode, reference, "bottom_m") < AGREEMENT
     assert relative_error(ode, reference, "bit_position_m") < AGREEMENT
     end = (ode.torsion_angle_rad[-1], reference.torsion_angle_rad[-1])
@@ -121,8 +126,9 @@ def test_agrees_with_tight_ode(feed: str, damping_mode: str) -> None:
 @pytest.mark.slow
 @pytest.mark.parametrize("shape", ["rectangular", "triangular"])
 def test_other_pulse_shapes_agree_with_tight_ode(shape: str) -> None:
-    """The rectangular pulse (constant state) and the triangular one (ramp state, two phases)."""
-    reference = result_of(crushing("carriage", "contact", blows=6, impact__shape=shape), "exact")
+    """The rectangular pulse (constant state) and the triangular one (ramp state, two phases), over
+    ODE_BLOWS blows (the triangular pulse crushes in each of them)."""
+    reference = result_of(crushing("carriage", "contact", blows=ODE_BLOWS, impact__shape=shape), "exact")
     ode = result_of(reference.scene, "ode", method="DOP853", relative_tolerance=ODE_RTOL, absolute_tolerance=ODE_ATOL)
     assert reference.solver.switches_into.get("crushing", 0) >= 4
     assert relative_error(ode, reference, "bottom_m") < AGREEMENT
@@ -319,13 +325,15 @@ def test_every_shipped_scene_runs_exact_and_agrees_with_the_ode(path: Path) -> N
 
 def four_rods_with_couplings() -> Scene:
     """The four-rod string with compression-only couplings on soft limestone, 400 kN blows: it crushes
-    in its first blow; one blow (the rattle of loose couplings is chaotic over many blows)."""
+    in its first blow; one blow (the rattle of loose couplings is chaotic over many blows), its first
+    10 ms (at 100 Hz: the crushing ends at 3.7 ms, 73 switches of the couplings follow; the 20 ms of the
+    scene's 50 Hz, 180 switches, ended with the same bottom to 1e-12 and cost 2.5 times as much)."""
     data = read_yaml(FOUR_ROD)
     for name in ("shank_coupling", "coupling1", "coupling2", "coupling3", "bit_coupling"):
         data["drill_string"]["connectors"][name]["type"] = "coupling"
-    data["rock"], data["impact"]["amplitude_n"] = {"name": "soft_limestone"}, 400e3
+    data["rock"], data["impact"]["amplitude_n"], data["impact"]["frequency_hz"] = {"name": "soft_limestone"}, 400e3, 100.0
     data["metrics"] = {"transient_blows": 0, "block_blows": 1}
-    data["solver"] = {"end_time_s": 0.02, "output_interval_s": 1e-5}
+    data["solver"] = {"end_time_s": 0.01, "output_interval_s": 1e-5}
     return Scene.model_validate(data)
 
 
