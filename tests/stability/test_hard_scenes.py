@@ -107,7 +107,12 @@ def test_crushing_scenes_do_crush(name):
 
 @pytest.mark.slow
 def test_long_run_650_blows():
-    reference = summary_metrics(simulate(hard_scene(LONG_RUN, {"formulation": "exact"})))
+    """650 blows, each crushing and lifting off, on the fast and standard presets: physical, and within their
+    stated energy and rate errors of the exact formulation (measured: rate 4.7e-5 and 1.6e-5 of the exact
+    4.76 mm/s, against the stated 1e-3 and 1e-4)."""
+    exact = simulate(hard_scene(LONG_RUN, {"formulation": "exact"}))
+    assert exact.solver.switches_into["crushing"] >= 650 and exact.solver.switches_into["free"] >= 650
+    reference = summary_metrics(exact)
     for preset in ("fast", "standard"):
         result = simulate(hard_scene(LONG_RUN, {"preset": preset}))
         assert_physical(result)
