@@ -287,13 +287,17 @@ def test_draw_an_extended_model_from_its_exudyn_graphics(tmp_path):
 
 
 @pytest.mark.slow
-def test_view_solution_replays_an_extended_run_and_refuses_one_it_cannot_rebuild(tmp_path):
-    """Why 6: view_solution of an extended run failed (SetODE2Coords: incompatible size of vectors)."""
+def test_view_solution_replays_an_extended_run_and_refuses_one_it_cannot_rebuild(tmp_path, monkeypatch):
+    """Why 6: view_solution of an extended run failed (SetODE2Coords: incompatible size of vectors). The
+    animation at 4 frames a blow, not 20 (as tests/test_drill_drawing.py's command test: each frame is drawn
+    alike, the first is the one read; three quarters of this test's CPU went into drawing 60 frames, measured)."""
     from commands import main
     from pictures import inked_at_the_edges
 
+    from rpdrill.studies.drawings import drill_animation
     from rpdrill.studies.drawings.drill_animation import load_solution
 
+    monkeypatch.setattr(drill_animation, "FRAMES_PER_BLOW", 4)
     scene = PAPER.with_({"extensions": {"clamp": CLAMP}, **SHORT,
                          "extensions.clamp.parameters.stiffness_n_per_m": 1e9})
     write(tmp_path / "scene.yaml", scene)

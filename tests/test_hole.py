@@ -18,7 +18,10 @@ import rpdrill
 UNITS = ("rpdrill.studies.hole.hole_run", "rpdrill.studies.hole.hole_figures")
 
 RIG = Path(rpdrill.__file__).parent / "studies" / "scenes" / "top_hammer_waves.yaml"
-RIG_OVERRIDES = {"solver.formulation": "exact", "solver.end_time_s": 2.0, "solver.output_interval_s": 1e-4}
+# samples every 1 ms, not 0.1 ms: a hole's figures are the settling stepper's own at the blow starts
+# (models.steady.wave_settling) and the rods' stress envelopes the stepper's, not read from the samples; every
+# record of this file's holes measured the same at both to round-off (1e-16), the runs 16-30 % cheaper
+RIG_OVERRIDES = {"solver.formulation": "exact", "solver.end_time_s": 2.0, "solver.output_interval_s": 1e-3}
 ROD = {"length_m": 1.5, "diameter_m": 0.045, "bore_diameter_m": 0.012, "model": "waves"}
 
 
@@ -147,9 +150,10 @@ def test_an_advised_hole_runs_each_depth_at_the_advisors_point_and_says_the_time
     """``operating: advise`` (a small search at a fixed power): the depth's run is at the point found, inside the
     bounds, its scene written beside the rig's; the time gained is the fixed setting's time less the hole's."""
     advise = {"bounds": {"impact.frequency_hz": [40.0, 60.0], "feed.force_n": [8000.0, 16000.0]}, "power_kw": 15.0,
-              "popsize": 2, "max_generations": 1, "search_end_time_s": 0.1}
-    rig = {**RIG_OVERRIDES, "metrics.transient_blows": 2, "metrics.block_blows": 2}  # search runs of 4 blows:
-    # the test checks where the hole runs and its time gained, not the search's best (tests/test_advice.py does)
+              "popsize": 2, "max_generations": 1, "search_end_time_s": 0.05}
+    rig = {**RIG_OVERRIDES, "metrics.transient_blows": 1, "metrics.block_blows": 1}  # search runs of 2 blows at
+    # 40 Hz: the test checks where the hole runs and its time gained, not the search's best (tests/test_advice.py
+    # does); the settled runs read their own blows (the same 28 and rates as with search runs of 4 blows, measured)
     path = hole_file(tmp_path, "advised", depth_m=1.5, layers=[{"to_m": 1.5, "rock": {"name": "sandstone"}}],
                      operating={"advise": advise}, rig_overrides=rig)
     drilled = rpdrill.drill_hole(path, out=tmp_path / "out", workers=1)

@@ -147,14 +147,17 @@ def test_the_shipped_scene_reproduces_the_headlines_but_fig_6_and_says_so(tmp_pa
     within the reproduction file's tolerance and every rising trend, but Fig. 6's (docs/fig6.md: a global
     search found none together with the rest); the command exits 1 and says how many it reached, and
     the page gives the reason for Fig. 6's missing optima. The file's variants (other upper strings,
-    three quarters of its runs) are left out of this copy of it: they state no claim of the paper."""
+    three quarters of its runs) and its figures (the paper's Figs. 2-6 drawn from the same runs, a quarter of
+    what was left; test_reproduce_writes_generated_pages_... draws one) are left out of this copy of it: they
+    state no claim of the paper."""
     shipped = ROOT / "studies" / "paper" / "reproduction.yaml"
     data = yaml.safe_load(shipped.read_text(encoding="utf-8"))
-    assert data.pop("variants")
+    assert data.pop("variants") and data.pop("figures")
     data["base_scene"] = str(shipped.parent / data["base_scene"])
     data["calibration"] = str(shipped.parent / data["calibration"])
     out = tmp_path / "out"
-    assert main(["reproduce", str(write(tmp_path / "reproduction.yaml", data)), "--out", str(out), "--quiet"]) == 1
+    assert main(["reproduce", str(write(tmp_path / "reproduction.yaml", data)), "--out", str(out), "--workers", "1",
+                 "--quiet"]) == 1
     assert "6 of 8 optima the paper states reached" in capsys.readouterr().err
     record = json.loads((out / "reproduction.json").read_text())["variants"]
     assert list(record) == ["None"]
@@ -177,15 +180,16 @@ def test_the_shipped_scene_reproduces_the_headlines_but_fig_6_and_says_so(tmp_pa
 
 
 @pytest.mark.slow
-def test_the_fig6_searchs_best_drill_has_spikes_not_maxima(tmp_path, capsys):
+def test_the_fig6_searchs_best_drill_has_spikes_not_maxima():
     """docs/fig6.md: the best drill of the Fig. 6 search, scanned every 1 Hz, reaches six of the eight
     stated optima with every trend rising, but its Fig. 6 "optima" are single-frequency spikes (80 %
-    bands at most 2 Hz wide) and the softest rock's lies far below 80 Hz."""
-    source = ROOT / "docs" / "fig6" / "best_drill_reproduction.yaml"
-    out = tmp_path / "out"
-    assert main(["reproduce", str(source), "--out", str(out), "--quiet"]) == 1
-    assert "3 of 3 trends hold; 6 of 8 optima the paper states reached" in capsys.readouterr().err
-    optima = {o["label"]: o for o in json.loads((out / "reproduction.json").read_text())["variants"]["None"]["optima"]}
+    bands at most 2 Hz wide) and the softest rock's lies far below 80 Hz. As the library call in this
+    process, without ``out``: the same scans and optima as the command (test_reproduce_as_a_library_call_...),
+    without drawing its five figures or starting a pool (a quarter of the command's CPU, measured)."""
+    result = rpdrill.reproduce(ROOT / "docs" / "fig6" / "best_drill_reproduction.yaml", workers=1)
+    assert [t["rises"] for t in result.trends] == [True, True, True]
+    assert (len(result.reached), len(result.stated)) == (6, 8) and not result.passed
+    optima = {r.case.label: r.optimum.record for r in result.results}
     for label in FIG6:
         low, high = optima[label]["band_80"]
         assert optima[label]["optimum_value"] > 0 and high - low <= 2.0, label
