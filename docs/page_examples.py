@@ -98,19 +98,26 @@ def run_examples(examples: list[str], cwd: Path, timeout_s: float = 1800) -> lis
         return ran
 
 
+def page_problems(source: Path, pages: dict[str, tuple[str, ...]]) -> list[tuple[str, int, str]]:
+    """(page, line, problem) of every block of ``pages`` (a page's name without ``.md`` in the folder ``source``
+    -> the texts that mark a block not run alone) that does not run as printed from ``source``'s parent."""
+    problems = []
+    for page, skip in pages.items():
+        blocks = page_blocks((source / f"{page}.md").read_text(encoding="utf-8"), tuple(skip))
+        ran = run_examples([block.code for block in blocks], source.parent)
+        problems += [(page, block.line, done.problem) for block, done in zip(blocks, ran, strict=True) if done.problem]
+    return problems
+
+
 def _run_pages(app) -> None:
     """Sphinx ``builder-inited``: every page of ``page_examples`` run; a block that fails, a warning at its line."""
     from sphinx.util import logging
 
     logger = logging.getLogger(__name__)
-    source, root = Path(app.srcdir), Path(app.srcdir).parent
-    for page, skip in app.config.page_examples.items():
-        blocks = page_blocks((source / f"{page}.md").read_text(encoding="utf-8"), tuple(skip))
-        logger.info(f"page_examples: running the {len(blocks)} Python blocks of {page}.md")
-        for block, ran in zip(blocks, run_examples([b.code for b in blocks], root), strict=True):
-            if ran.problem:
-                logger.warning(f"this Python block does not run as printed (from the root of the checkout):\n"
-                               f"{ran.problem}", location=(page, block.line))
+    logger.info(f"page_examples: running the Python blocks of {', '.join(app.config.page_examples)}")
+    for page, line, problem in page_problems(Path(app.srcdir), app.config.page_examples):
+        logger.warning(f"this Python block does not run as printed (from the root of the checkout):\n{problem}",
+                       location=(page, line))
 
 
 def setup(app) -> dict[str, bool]:
