@@ -78,7 +78,6 @@ from ..drill.pulse import (
 from ..evaluation.results import SimulationResult
 from ..evaluation.run_record import ExactSolverRecord
 from ..evaluation.stability import POSITION_LIMIT_M, SimulationFailed, diverged_index
-from ..waves import exact_waves
 from .exact_kernels import (
     BLOW_START,
     DIVERGED,
@@ -431,6 +430,8 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     if why:
         raise SceneError(("solver", "formulation"), "exact", why)
     if simulation.dynamic_chain.waves:  # rods carried as waves: the characteristics (models.waves)
+        from ..waves import exact_waves  # its kernels: 0.24 s to import, only where a scene has wave rods
+
         return exact_waves.simulate(simulation, progress)
     start = time.process_time()
     with BLAS.limit(limits=1, user_api="blas"):
