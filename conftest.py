@@ -2,6 +2,8 @@
 package of tests: pytest collects its folder as a plain directory, so that the tests run in a checkout
 of any folder name (``rpdrill-main``, ``rpdrill-1.0``), not only in one whose name is a Python name."""
 
+import subprocess
+import sys
 import warnings
 from pathlib import Path
 
@@ -24,6 +26,38 @@ def _module_fixtures(item: pytest.Item) -> bool:
     """Whether ``item`` uses a module-scoped fixture (a result computed once and asserted on many times)."""
     definitions = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
     return any(defs and defs[-1].scope == "module" for defs in definitions.values())
+
+
+# numba's kernels (compiled at their first call, then cached on disk beside their modules: ``cache=True``) and a run
+# that compiles each set: the exact formulation with its periodic orbit's monodromy, and the wave rods
+KERNEL_MODULES = ("models/solvers/exact_kernels", "models/solvers/exact_power_kernels", "models/waves/kernels",
+                  "models/steady/monodromy_kernel")
+KERNEL_RUNS = (
+    ('import rpdrill; rpdrill.simulate(rpdrill.load_scene("paper_base").with_({"solver.end_time_s": 0.25, '
+    '"solver.steady_state": "periodic"}), formulation="exact")'),
+    ('import rpdrill; rpdrill.simulate(rpdrill.load_scene("top_hammer_waves").with_({"solver.end_time_s": 0.02, '
+    '"metrics.transient_blows": 0, "metrics.block_blows": 1}), formulation="exact")'),
+)
+
+
+def _kernels_cached() -> bool:
+    return all(any((ROOT / module).parent.glob(f"__pycache__/{Path(module).name}.*.nbi")) for module in KERNEL_MODULES)
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """On the controller of pytest-xdist workers, before they start (its own session start runs last): a checkout
+    whose numba kernels are not compiled yet (a fresh clone) compiles them once, the two sets side by side in
+    processes of their own, instead of once in each worker that first needs them (both did, in the suite's first
+    tests: 436.0 CPU s and 235.57 s for the suite against 395.5 and 214.91 with the kernels cached, `python
+    benchmarks/bench_tests.py`; docs/performance.md, "Test suite")."""
+    if hasattr(session.config, "workerinput") or not getattr(session.config.option, "numprocesses", 0):
+        return
+    if _kernels_cached():
+        return
+    runs = [subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            for code in KERNEL_RUNS]
+    for run in runs:  # a run that fails leaves its kernels to the tests, whose failures say why
+        run.wait(timeout=600)
 
 
 @pytest.hookimpl(tryfirst=True)
