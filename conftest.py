@@ -56,8 +56,11 @@ def pytest_sessionstart(session: pytest.Session) -> None:
         return
     runs = [subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             for code in KERNEL_RUNS]
-    for run in runs:  # a run that fails leaves its kernels to the tests, whose failures say why
-        run.wait(timeout=600)
+    for run in runs:  # a run that fails, or hangs, leaves its kernels to the tests, whose failures say why
+        try:
+            run.wait(timeout=600)
+        except subprocess.TimeoutExpired:
+            run.kill()
 
 
 @pytest.hookimpl(tryfirst=True)
