@@ -1,10 +1,10 @@
 """The Python examples of the site's pages, run when the site is built (a Sphinx extension of docs/conf.py).
 
 Every ```` ```python ```` block of a page named in ``page_examples`` (conf.py: a page's name without its
-``.md`` -> the texts that mark a block not run alone, such as a class the page's test defines) runs as printed from the root of the checkout,
-the page's blocks one after the other in one new Python process: each as ``python -c`` would run it (its own
-``__main__`` namespace: a name a block does not import or define is a NameError), each one's output and failure
-kept apart. One interpreter start and one import of the libraries per page, not one per block (docs/api.md:
+``.md`` -> the texts that mark a block not run alone, such as a class the page's test defines) runs as printed
+from the root of the checkout, the page's blocks one after the other in one new Python process: each as
+``python -c`` would run it (its own ``__main__`` namespace: a name a block does not import or define is a
+NameError), each one's output and failure kept apart. One interpreter start and one import of the libraries per page, not one per block (docs/api.md:
 55 CPU s in 18 processes, 31 in one). Running them in sequence in one process also checks what docs/api.md
 promises: a call leaves the caller's process as it was, so the next block runs as it would alone.
 

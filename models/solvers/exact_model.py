@@ -430,7 +430,8 @@ def simulate(run: Scene | Simulation, progress: Callable[[float], None] | None =
     if why:
         raise SceneError(("solver", "formulation"), "exact", why)
     if simulation.dynamic_chain.waves:  # rods carried as waves: the characteristics (models.waves)
-        from ..waves import exact_waves  # its kernels: 0.24 s to import, only where a scene has wave rods
+        # its kernels: about 45 ms of imports, only where a scene has wave rods
+        from ..waves import exact_waves
 
         return exact_waves.simulate(simulation, progress)
     start = time.process_time()
